@@ -1,0 +1,156 @@
+//! The error type of `polis-geom`.
+
+use glam::DVec2;
+
+/// Which ring of a [`PolygonWithHoles`](crate::PolygonWithHoles) an error is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Ring {
+    /// The outer boundary.
+    Outer,
+    /// The hole with this index in [`PolygonWithHoles::holes`](crate::PolygonWithHoles::holes).
+    Hole(usize),
+}
+
+impl std::fmt::Display for Ring {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Ring::Outer => f.write_str("outer ring"),
+            Ring::Hole(i) => write!(f, "hole {i}"),
+        }
+    }
+}
+
+/// What is wrong with a piece of geometry handed to `polis-geom`.
+///
+/// Every variant names the offending vertices, edges or ids so the caller can find them.
+/// Edge `i` of a ring runs from vertex `i` to vertex `(i + 1) % len`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GeomError {
+    /// A coordinate is NaN or infinite.
+    #[error(
+        "vertex {index} has a non-finite coordinate ({point}); coordinates must be finite numbers"
+    )]
+    NonFinite {
+        /// Index of the vertex.
+        index: usize,
+        /// The offending point.
+        point: DVec2,
+    },
+    /// A coordinate is finite but too large to be handled exactly (see [`MAX_COORDINATE`](crate::MAX_COORDINATE)).
+    #[error(
+        "vertex {index} at {point} lies outside ±{limit} m; move the geometry closer to the origin"
+    )]
+    OutOfRange {
+        /// Index of the vertex.
+        index: usize,
+        /// The offending point.
+        point: DVec2,
+        /// The limit that was exceeded, in metres.
+        limit: f64,
+    },
+    /// Fewer than three distinct points.
+    #[error("the ring has {distinct} distinct vertices; a polygon needs at least 3")]
+    TooFewVertices {
+        /// How many distinct vertices there are.
+        distinct: usize,
+    },
+    /// Two vertices coincide.
+    #[error("vertices {first} and {second} are the same point {point}; remove the repeat")]
+    RepeatedVertex {
+        /// The first index.
+        first: usize,
+        /// The second index.
+        second: usize,
+        /// The shared position.
+        point: DVec2,
+    },
+    /// All vertices are collinear: the ring encloses no area.
+    #[error("the ring encloses zero area (all vertices are collinear)")]
+    ZeroArea,
+    /// Two edges of a ring (or of two rings) intersect where they must not.
+    #[error(
+        "edge {first_edge} of the {first_ring} and edge {second_edge} of the {second_ring} intersect near {point}; rings must be simple and disjoint"
+    )]
+    SelfIntersection {
+        /// Ring of the first edge.
+        first_ring: Ring,
+        /// Index of the first edge in its ring.
+        first_edge: usize,
+        /// Ring of the second edge.
+        second_ring: Ring,
+        /// Index of the second edge in its ring.
+        second_edge: usize,
+        /// A point where they meet.
+        point: DVec2,
+    },
+    /// A hole lies (partly) outside the outer ring.
+    #[error("hole {hole} is not inside the outer ring")]
+    HoleOutside {
+        /// Index of the hole.
+        hole: usize,
+    },
+    /// A hole lies inside another hole.
+    #[error("hole {inner} lies inside hole {outer}; holes must be disjoint")]
+    NestedHoles {
+        /// The hole that is inside.
+        inner: usize,
+        /// The hole that contains it.
+        outer: usize,
+    },
+    /// An error in one ring of a polygon with holes.
+    #[error("{ring}: {source}")]
+    InRing {
+        /// Which ring.
+        ring: Ring,
+        /// What is wrong with it.
+        source: Box<GeomError>,
+    },
+    /// A graph id does not name a live node or edge.
+    #[error("{what} id {index} does not name a live {what} of this graph")]
+    InvalidId {
+        /// "node" or "edge".
+        what: &'static str,
+        /// The raw index.
+        index: u32,
+    },
+    /// An edge would have zero length (its two ends coincide, possibly after snapping).
+    #[error(
+        "the edge from {a} to {b} has zero length (after snapping); edges must join distinct points"
+    )]
+    ZeroLengthEdge {
+        /// First end.
+        a: DVec2,
+        /// Second end.
+        b: DVec2,
+    },
+    /// A parameter is outside its allowed range.
+    #[error("invalid parameter `{name}`: {reason}")]
+    InvalidParameter {
+        /// The parameter's name.
+        name: &'static str,
+        /// Why it is invalid.
+        reason: String,
+    },
+    /// An image could not be read as a grey-scale raster.
+    #[error("could not read raster image: {0}")]
+    Image(String),
+}
+
+/// Checks that a point is finite and within [`MAX_COORDINATE`](crate::MAX_COORDINATE).
+///
+/// `index` is only used to name the point in the error.
+pub fn validate_point(index: usize, point: DVec2) -> Result<(), GeomError> {
+    if !point.is_finite() {
+        return Err(GeomError::NonFinite { index, point });
+    }
+    let limit = crate::MAX_COORDINATE;
+    if point.x.abs() > limit || point.y.abs() > limit {
+        return Err(GeomError::OutOfRange {
+            index,
+            point,
+            limit,
+        });
+    }
+    Ok(())
+}

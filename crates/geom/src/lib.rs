@@ -1,0 +1,61 @@
+//! # polis-geom
+//!
+//! The shared geometric vocabulary of [polis](https://example.invalid/polis): every stage
+//! (roads, cells, lots, buildings, facades, export) speaks these types, so a stage can be
+//! replaced by anyone who can build them by hand.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`predicates`] | exact orientation and segment–segment classification |
+//! | [`polygon`] | [`Polygon`], [`PolygonWithHoles`]: area, centroid, point location, validation |
+//! | [`bbox`] | [`Aabb2`] |
+//! | [`graph`] | `PlanarGraph<N, E>`: a planar embedded graph with stable ids |
+//! | [`spatial`] | a spatial index over points and segments |
+//! | [`field`] | `Field`: input maps (population, water, elevation …) |
+//! | [`mesh`], [`scene`] | `Mesh` and `Scene`: the contract between generators and exporters |
+//!
+//! ## Numeric policy
+//!
+//! * Metres, `f64` ([`DVec2`], [`DVec3`]) everywhere inside; `f32` only in [`mesh`] data.
+//! * Every left/right/on/crossing decision uses exact predicates ([`predicates`]); derived
+//!   points are computed in floating point only after the topology is decided.
+//! * Coordinates must be finite and within [`MAX_COORDINATE`] metres of the origin;
+//!   validation reports anything else as a [`GeomError`].
+//! * Polygons: simple rings, no repeated closing vertex, counter-clockwise outer rings,
+//!   clockwise holes.
+//!
+//! ## Example
+//!
+//! ```
+//! use polis_geom::{DVec2, Polygon, PointLocation};
+//!
+//! let lot = Polygon::rect(DVec2::new(0.0, 0.0), DVec2::new(20.0, 30.0));
+//! lot.validate()?;
+//! assert_eq!(lot.area(), 600.0);
+//! assert_eq!(lot.locate(DVec2::new(5.0, 5.0)), PointLocation::Inside);
+//! # Ok::<(), polis_geom::GeomError>(())
+//! ```
+
+pub use glam;
+pub use glam::{DVec2, DVec3};
+
+pub mod bbox;
+pub mod error;
+pub mod field;
+pub mod graph;
+pub mod mesh;
+pub mod polygon;
+pub mod predicates;
+pub mod scene;
+pub mod spatial;
+
+pub use bbox::Aabb2;
+pub use error::{GeomError, Ring};
+pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
+pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};
+
+/// The largest coordinate magnitude, in metres, that validation accepts (100,000 km).
+///
+/// Far beyond any city, and small enough that squared lengths and areas stay well inside
+/// `f64`'s exact-integer and overflow ranges.
+pub const MAX_COORDINATE: f64 = 1.0e8;
