@@ -135,6 +135,47 @@ pub enum GeomError {
     /// An image could not be read as a grey-scale raster.
     #[error("could not read raster image: {0}")]
     Image(String),
+    /// Two nodes of a graph are already joined by an edge.
+    #[error(
+        "nodes {a} and {b} are already joined by edge {existing}; a planar graph has no duplicate edges"
+    )]
+    DuplicateEdge {
+        /// First node id.
+        a: u32,
+        /// Second node id.
+        b: u32,
+        /// The edge that joins them.
+        existing: u32,
+    },
+    /// Two edges of a planar graph cross or overlap (share more than a common end).
+    #[error(
+        "edges {first} and {second} meet at {point} away from a common end; insert edges with `insert_segment` to keep the graph planar"
+    )]
+    EdgesIntersect {
+        /// The edge with the smaller id.
+        first: u32,
+        /// The other edge.
+        second: u32,
+        /// A point they share.
+        point: DVec2,
+    },
+    /// A node lies on another node or inside an edge it is not an end of.
+    #[error(
+        "node {node} at {point} lies on {what} {other}; snap it (e.g. `insert_point`) instead of adding it raw"
+    )]
+    NodeOnGeometry {
+        /// The node.
+        node: u32,
+        /// Its position.
+        point: DVec2,
+        /// `"node"` or `"edge"`.
+        what: &'static str,
+        /// The node or edge it lies on.
+        other: u32,
+    },
+    /// The internal bookkeeping of a graph is inconsistent (a bug, or a hand-edited file).
+    #[error("graph is inconsistent: {0}")]
+    GraphCorrupt(String),
 }
 
 /// Checks that a point is finite and within [`MAX_COORDINATE`](crate::MAX_COORDINATE).

@@ -51,6 +51,7 @@ pub mod spatial;
 
 pub use bbox::Aabb2;
 pub use error::{GeomError, Ring};
+pub use graph::{EdgeId, NodeId, PlanarGraph};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
 pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};
 
