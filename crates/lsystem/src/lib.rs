@@ -1,4 +1,26 @@
-//! polis-lsystem: a parametric L-system engine (modules, productions, context, stochastic choice, query and communication modules, text grammar, 3-D turtle).
+//! # polis-lsystem
 //!
-//! **Status: not yet implemented.** This crate is a placeholder in the workspace; the
-//! issue tracker names what it will own. Nothing here pretends to work yet.
+//! A parametric, context-sensitive, stochastic, open L-system engine with a text grammar
+//! and a 3-D turtle (Prusinkiewicz & Lindenmayer, *The Algorithmic Beauty of Plants*,
+//! 1990, ch. 1; Parish & Müller 2001 §3.1).
+
+pub use glam;
+pub use rand;
+pub use rand_pcg;
+
+pub mod command;
+pub mod context;
+pub mod derivation;
+pub mod error;
+mod random;
+pub mod string;
+pub mod turtle;
+pub mod typed;
+
+pub use command::{Command, ModuleKind, QueryKind};
+pub use context::{BranchIndex, ContextItem};
+pub use derivation::{Derivation, DeriveOptions, Environment, Rules, StepReport};
+pub use error::{LsystemError, Result};
+pub use string::{ModuleString, ParamString};
+pub use turtle::{Geometry, Segment, Turtle, TurtleOptions, TurtleSink, TurtleState};
+pub use typed::{Match, Module, Production, Successor, TypedRules};
