@@ -10,7 +10,6 @@ pub fn unit_f64<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 }
 
 /// A standard normal variate (Box–Muller, two uniform draws).
-#[allow(dead_code)] // used by the grammar front end
 pub fn normal_f64<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     let u1 = 1.0 - unit_f64(rng); // (0, 1]
     let u2 = unit_f64(rng);

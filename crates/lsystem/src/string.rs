@@ -154,14 +154,12 @@ impl ParamString {
 
     /// Appends a parameter to the last module.
     #[inline]
-    #[allow(dead_code)]
     pub(crate) fn push_param(&mut self, v: f64) {
         self.params.push(v);
     }
 
     /// `true` once the arena has outgrown its 32-bit offsets.
     #[inline]
-    #[allow(dead_code)]
     pub(crate) fn arena_overflowed(&self) -> bool {
         self.params.len() > MAX_PARAMS
     }

@@ -1,0 +1,855 @@
+//! Compiling a grammar syntax tree into the runtime [`Grammar`]: interned symbols,
+//! production tables by predecessor symbol, bytecode for conditions and arguments, and
+//! the [`Rules`] implementation the derivation engine runs.
+
+use rand_pcg::Pcg64Mcg;
+
+use super::ast::{GrammarAst, ModuleCall, PatternItem, ProductionAst, Section};
+use super::expr::{self, Expr, Op};
+use super::parse;
+use crate::command::{Command, ModuleKind, QueryKind};
+use crate::context::{BranchIndex, ContextItem, ContextView, match_left, match_right};
+use crate::derivation::{Derivation, DeriveOptions, Rules};
+use crate::error::{LsystemError, Result};
+use crate::random::unit_f64;
+use crate::string::ParamString;
+use crate::turtle::TurtleState;
+
+/// Symbols with a fixed id and meaning in every grammar, in id order.
+pub const BUILTIN_SYMBOLS: &[(&str, Command)] = &[
+    ("[", Command::Push),
+    ("]", Command::Pop),
+    ("%", Command::Cut),
+    ("F", Command::Forward(None)),
+    ("f", Command::Move(None)),
+    ("G", Command::Forward(None)),
+    ("g", Command::Move(None)),
+    ("+", Command::TurnLeft(None)),
+    ("-", Command::TurnRight(None)),
+    ("&", Command::PitchDown(None)),
+    ("^", Command::PitchUp(None)),
+    ("\\", Command::RollLeft(None)),
+    ("/", Command::RollRight(None)),
+    ("|", Command::TurnAround),
+    ("$", Command::RollToVertical),
+    ("!", Command::Width(None)),
+    ("'", Command::Colour(None)),
+    ("{", Command::PolygonStart),
+    (".", Command::PolygonVertex),
+    ("}", Command::PolygonEnd),
+    ("@o", Command::Dot(None)),
+    ("?P", Command::Query(QueryKind::Position)),
+    ("?H", Command::Query(QueryKind::Heading)),
+    ("?U", Command::Query(QueryKind::Up)),
+    ("?L", Command::Query(QueryKind::Left)),
+    ("?E", Command::Communicate),
+];
+
+#[inline]
+fn with_arg(c: Command, a: Option<f64>) -> Command {
+    match c {
+        Command::Forward(_) => Command::Forward(a),
+        Command::Move(_) => Command::Move(a),
+        Command::TurnLeft(_) => Command::TurnLeft(a),
+        Command::TurnRight(_) => Command::TurnRight(a),
+        Command::PitchDown(_) => Command::PitchDown(a),
+        Command::PitchUp(_) => Command::PitchUp(a),
+        Command::RollLeft(_) => Command::RollLeft(a),
+        Command::RollRight(_) => Command::RollRight(a),
+        Command::Width(_) => Command::Width(a),
+        Command::Colour(_) => Command::Colour(a),
+        Command::Dot(_) => Command::Dot(a),
+        other => other,
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Arg {
+    Const(f64),
+    Var(u32),
+    Code(u32, u32),
+}
+
+#[derive(Debug, Clone)]
+struct SuccModule {
+    symbol: u32,
+    args: Vec<Arg>,
+}
+
+/// A context pattern module: symbol id and parameter count.
+type Pat = ContextItem<(u32, u32)>;
+
+#[derive(Debug, Clone)]
+struct CProduction {
+    arity: u32,
+    left: Vec<Pat>,
+    right: Vec<Pat>,
+    condition: Option<(u32, u32)>,
+    successor: Vec<SuccModule>,
+    probability: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Table {
+    productions: Vec<CProduction>,
+    by_symbol: Vec<Vec<u32>>,
+}
+
+/// Reusable buffers of a [`Grammar`] derivation.
+#[derive(Debug, Default)]
+pub struct GrammarScratch {
+    vars: Vec<f64>,
+    stack: Vec<f64>,
+    left: Vec<u32>,
+    right: Vec<u32>,
+    candidates: Vec<(u32, f64)>,
+}
+
+/// A compiled text grammar: the rules of a numeric-parameter L-system.
+///
+/// Build it with [`Grammar::parse`]; derive with [`Grammar::derivation`]. It implements
+/// [`Rules`] with [`ParamString`] strings. See the [crate docs](crate) for the language.
+#[derive(Debug, Clone)]
+pub struct Grammar {
+    ast: GrammarAst,
+    names: Vec<String>,
+    commands: Vec<Command>,
+    kinds: Vec<ModuleKind>,
+    ignore: Vec<bool>,
+    productions: Table,
+    decompositions: Table,
+    interpretations: Table,
+    code: Vec<Op>,
+    axiom: ParamString,
+    defines: Vec<(String, f64)>,
+    context_sensitive: bool,
+    needs_pass: bool,
+}
+
+/// Where a statement of a parsed text starts, for compile errors.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Location {
+    pub line: usize,
+    pub column: usize,
+    pub text: String,
+}
+
+fn compile_err(
+    what: &str,
+    label: Option<&str>,
+    index: usize,
+    loc: Option<&Location>,
+    message: impl std::fmt::Display,
+) -> LsystemError {
+    match loc {
+        Some(l) => LsystemError::Parse {
+            line: l.line,
+            column: l.column,
+            message: format!("{message}"),
+            snippet: l.text.clone(),
+        },
+        None => LsystemError::Parse {
+            line: 0,
+            column: 0,
+            message: format!("{message}"),
+            snippet: match label {
+                Some(l) => format!("{what} {l}"),
+                None => format!("{what} #{}", index + 1),
+            },
+        },
+    }
+}
+
+fn substitute(e: &Expr, defines: &[(String, f64)], formals: &[String]) -> Expr {
+    match e {
+        Expr::Var(n) if !formals.contains(n) => match defines.iter().rev().find(|(d, _)| d == n) {
+            Some((_, v)) => Expr::Num(*v),
+            None => e.clone(),
+        },
+        Expr::Num(_) | Expr::Var(_) => e.clone(),
+        Expr::Unary(o, a) => Expr::Unary(*o, Box::new(substitute(a, defines, formals))),
+        Expr::Binary(o, a, b) => Expr::Binary(
+            *o,
+            Box::new(substitute(a, defines, formals)),
+            Box::new(substitute(b, defines, formals)),
+        ),
+        Expr::Cond(c, a, b) => Expr::Cond(
+            Box::new(substitute(c, defines, formals)),
+            Box::new(substitute(a, defines, formals)),
+            Box::new(substitute(b, defines, formals)),
+        ),
+        Expr::Call(f, args) => Expr::Call(
+            *f,
+            args.iter()
+                .map(|a| substitute(a, defines, formals))
+                .collect(),
+        ),
+    }
+}
+
+fn has_vars(e: &Expr) -> bool {
+    match e {
+        Expr::Num(_) => false,
+        Expr::Var(_) => true,
+        Expr::Unary(_, a) => has_vars(a),
+        Expr::Binary(_, a, b) => has_vars(a) || has_vars(b),
+        Expr::Cond(c, a, b) => has_vars(c) || has_vars(a) || has_vars(b),
+        Expr::Call(_, args) => args.iter().any(has_vars),
+    }
+}
+
+impl Grammar {
+    /// Parses and compiles a grammar text.
+    ///
+    /// Errors carry the line, column and text of the problem; arbitrary input never panics.
+    pub fn parse(text: &str) -> Result<Self> {
+        let (ast, locations) = parse::parse(text)?;
+        Self::compile(ast, &locations)
+    }
+
+    /// Compiles a syntax tree (e.g. one built or edited in code). Compile errors then
+    /// name the production by label or number instead of a line.
+    pub fn from_ast(ast: GrammarAst) -> Result<Self> {
+        Self::compile(ast, &[])
+    }
+
+    fn compile(ast: GrammarAst, locations: &[Location]) -> Result<Self> {
+        let mut g = Grammar {
+            names: Vec::new(),
+            commands: Vec::new(),
+            kinds: Vec::new(),
+            ignore: Vec::new(),
+            productions: Table::default(),
+            decompositions: Table::default(),
+            interpretations: Table::default(),
+            code: Vec::new(),
+            axiom: ParamString::new(),
+            defines: Vec::new(),
+            context_sensitive: false,
+            needs_pass: false,
+            ast: GrammarAst::default(),
+        };
+        for (name, c) in BUILTIN_SYMBOLS {
+            g.intern(name);
+            if let Some(slot) = g.commands.last_mut() {
+                *slot = *c;
+            }
+            if let Some(k) = g.kinds.last_mut() {
+                *k = c.kind();
+            }
+        }
+        for (k, d) in ast.defines.iter().enumerate() {
+            let defines = g.defines.clone();
+            let v = expr::eval_const(&d.value, &|n| {
+                defines.iter().rev().find(|(m, _)| m == n).map(|(_, v)| *v)
+            })
+            .map_err(|m| compile_err("#define", Some(&d.name), k, None, m))?;
+            g.defines.push((d.name.clone(), v));
+        }
+        for s in &ast.ignore {
+            let id = g.intern(s) as usize;
+            if let Some(f) = g.ignore.get_mut(id) {
+                *f = true;
+            }
+        }
+        for s in &ast.communication {
+            let id = g.intern(s) as usize;
+            let kind = g.kinds.get(id).copied().unwrap_or(ModuleKind::Plain);
+            if kind != ModuleKind::Plain {
+                return Err(compile_err(
+                    "#communication",
+                    Some(s),
+                    0,
+                    None,
+                    "brackets and `%` cannot be communication modules",
+                ));
+            }
+            if let Some(c) = g.commands.get_mut(id) {
+                *c = Command::Communicate;
+            }
+        }
+        g.axiom = g.constant_string(&ast.axiom)?;
+        for (k, p) in ast.productions.iter().enumerate() {
+            g.add_production(p, k, locations.get(k))?;
+        }
+        let uses_pass = |id: u32| {
+            matches!(
+                g.commands.get(id as usize),
+                Some(Command::Query(_) | Command::Communicate)
+            )
+        };
+        g.needs_pass = g.axiom.iter().any(|(s, _)| uses_pass(s))
+            || [&g.productions, &g.decompositions].iter().any(|t| {
+                t.productions
+                    .iter()
+                    .any(|p| p.successor.iter().any(|m| uses_pass(m.symbol)))
+            });
+        g.ast = ast;
+        Ok(g)
+    }
+
+    fn intern(&mut self, name: &str) -> u32 {
+        if let Some(i) = self.names.iter().position(|n| n == name) {
+            return i as u32;
+        }
+        self.names.push(name.to_string());
+        self.commands.push(Command::None);
+        self.kinds.push(ModuleKind::Plain);
+        self.ignore.push(false);
+        (self.names.len() - 1) as u32
+    }
+
+    fn constant_string(&mut self, calls: &[ModuleCall]) -> Result<ParamString> {
+        let mut s = ParamString::new();
+        for (k, m) in calls.iter().enumerate() {
+            let id = self.intern(&m.symbol);
+            let mut params = Vec::with_capacity(m.args.len());
+            for a in &m.args {
+                let e = substitute(a, &self.defines, &[]);
+                params.push(
+                    expr::eval_const(&e, &|_| None)
+                        .map_err(|msg| compile_err("axiom module", None, k, None, msg))?,
+                );
+            }
+            s.push(id, &params)?;
+        }
+        Ok(s)
+    }
+
+    fn pattern(&mut self, items: &[PatternItem]) -> Vec<Pat> {
+        items
+            .iter()
+            .map(|i| match i {
+                PatternItem::Module(m) => {
+                    ContextItem::Module((self.intern(&m.symbol), m.params.len() as u32))
+                }
+                PatternItem::Open => ContextItem::Open,
+                PatternItem::Close => ContextItem::Close,
+            })
+            .collect()
+    }
+
+    fn add_production(
+        &mut self,
+        p: &ProductionAst,
+        index: usize,
+        loc: Option<&Location>,
+    ) -> Result<()> {
+        let err = |m: String| compile_err("production", p.label.as_deref(), index, loc, m);
+        if p.left.iter().any(|i| !matches!(i, PatternItem::Module(_))) {
+            return Err(err("brackets are not allowed in a left context".into()));
+        }
+        if p.section != Section::Productions && (!p.left.is_empty() || !p.right.is_empty()) {
+            return Err(err(
+                "decomposition and interpretation rules are context-free: remove the context"
+                    .into(),
+            ));
+        }
+        let mut formals: Vec<String> = Vec::new();
+        let modules = p
+            .left
+            .iter()
+            .filter_map(|i| match i {
+                PatternItem::Module(m) => Some(m),
+                _ => None,
+            })
+            .chain(std::iter::once(&p.predecessor))
+            .chain(p.right.iter().filter_map(|i| match i {
+                PatternItem::Module(m) => Some(m),
+                _ => None,
+            }));
+        for m in modules {
+            for n in &m.params {
+                if formals.contains(n) {
+                    return Err(err(format!("parameter `{n}` is bound twice")));
+                }
+                formals.push(n.clone());
+            }
+        }
+        let pred = self.intern(&p.predecessor.symbol);
+        if matches!(
+            self.kinds.get(pred as usize),
+            Some(ModuleKind::BranchOpen | ModuleKind::BranchClose | ModuleKind::Cut)
+        ) {
+            return Err(err(format!(
+                "`{}` cannot be a predecessor",
+                p.predecessor.symbol
+            )));
+        }
+        let left = self.pattern(&p.left);
+        let right = self.pattern(&p.right);
+        let slot = |n: &str| formals.iter().position(|f| f == n).map(|k| k as u32);
+        let condition = match &p.condition {
+            None => None,
+            Some(c) => {
+                let e = substitute(c, &self.defines, &formals);
+                let start = self.code.len() as u32;
+                expr::compile(&e, &slot, &mut self.code).map_err(err)?;
+                Some((start, self.code.len() as u32))
+            }
+        };
+        let mut successor = Vec::with_capacity(p.successor.len());
+        for m in &p.successor {
+            let symbol = self.intern(&m.symbol);
+            let mut args = Vec::with_capacity(m.args.len());
+            for a in &m.args {
+                let e = substitute(a, &self.defines, &formals);
+                let arg = match &e {
+                    Expr::Var(n) => {
+                        Arg::Var(slot(n).ok_or_else(|| err(format!("unknown name `{n}`")))?)
+                    }
+                    _ if !has_vars(&e) && !e.is_random() => {
+                        Arg::Const(expr::eval_const(&e, &|_| None).map_err(err)?)
+                    }
+                    _ => {
+                        let start = self.code.len() as u32;
+                        expr::compile(&e, &slot, &mut self.code).map_err(err)?;
+                        Arg::Code(start, self.code.len() as u32)
+                    }
+                };
+                args.push(arg);
+            }
+            successor.push(SuccModule { symbol, args });
+        }
+        let probability = match &p.probability {
+            None => None,
+            Some(w) => {
+                let v =
+                    expr::eval_const(&substitute(w, &self.defines, &[]), &|_| None).map_err(err)?;
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(err(format!(
+                        "probability {v} is not a finite non-negative number"
+                    )));
+                }
+                Some(v)
+            }
+        };
+        if !left.is_empty() || !right.is_empty() {
+            self.context_sensitive = true;
+        }
+        let table = match p.section {
+            Section::Productions => &mut self.productions,
+            Section::Decomposition => &mut self.decompositions,
+            Section::Interpretation => &mut self.interpretations,
+        };
+        let id = table.productions.len() as u32;
+        table.productions.push(CProduction {
+            arity: p.predecessor.params.len() as u32,
+            left,
+            right,
+            condition,
+            successor,
+            probability,
+        });
+        let sym = pred as usize;
+        if table.by_symbol.len() <= sym {
+            table.by_symbol.resize_with(sym + 1, Vec::new);
+        }
+        if let Some(l) = table.by_symbol.get_mut(sym) {
+            l.push(id);
+        }
+        Ok(())
+    }
+
+    /// The syntax tree this grammar was compiled from.
+    pub fn ast(&self) -> &GrammarAst {
+        &self.ast
+    }
+
+    /// The grammar as text (pretty-printed; parses back to the same syntax tree).
+    pub fn to_text(&self) -> String {
+        self.ast.to_string()
+    }
+
+    /// The axiom.
+    pub fn axiom(&self) -> &ParamString {
+        &self.axiom
+    }
+
+    /// The value of a `#define` constant.
+    pub fn constant(&self, name: &str) -> Option<f64> {
+        self.defines
+            .iter()
+            .rev()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+    }
+
+    /// The id of a symbol used by the grammar (or built in).
+    pub fn symbol_id(&self, name: &str) -> Option<u32> {
+        self.names.iter().position(|n| n == name).map(|i| i as u32)
+    }
+
+    /// The name of a symbol id.
+    pub fn symbol_name(&self, id: u32) -> Option<&str> {
+        self.names.get(id as usize).map(String::as_str)
+    }
+
+    /// Parses a module string with constant arguments (names: `#define` constants) over
+    /// this grammar's symbols, e.g. to start from another axiom.
+    pub fn parse_string(&self, text: &str) -> Result<ParamString> {
+        let names: Vec<String> = self.defines.iter().map(|(n, _)| n.clone()).collect();
+        let calls = parse::parse_modules(text, &names)?;
+        let mut s = ParamString::new();
+        for m in &calls {
+            let Some(id) = self.symbol_id(&m.symbol) else {
+                return Err(LsystemError::Parse {
+                    line: 1,
+                    column: 1,
+                    message: format!("symbol `{}` does not occur in the grammar", m.symbol),
+                    snippet: text.chars().take(40).collect(),
+                });
+            };
+            let mut params = Vec::with_capacity(m.args.len());
+            for a in &m.args {
+                let e = substitute(a, &self.defines, &[]);
+                params.push(expr::eval_const(&e, &|_| None).map_err(|msg| {
+                    LsystemError::Parse {
+                        line: 1,
+                        column: 1,
+                        message: msg,
+                        snippet: text.chars().take(40).collect(),
+                    }
+                })?);
+            }
+            s.push(id, &params)?;
+        }
+        Ok(s)
+    }
+
+    /// Formats a string of this grammar, e.g. `F(1)+F(0.5)[A]`.
+    pub fn format_string(&self, s: &ParamString) -> String {
+        let mut out = String::new();
+        for (sym, params) in s.iter() {
+            out.push_str(self.symbol_name(sym).unwrap_or("�"));
+            if !params.is_empty() {
+                out.push('(');
+                for (k, p) in params.iter().enumerate() {
+                    if k > 0 {
+                        out.push(',');
+                    }
+                    out.push_str(&p.to_string());
+                }
+                out.push(')');
+            }
+        }
+        out
+    }
+
+    /// A derivation from the axiom that borrows this grammar.
+    pub fn derivation(&self, options: DeriveOptions) -> Derivation<&Grammar> {
+        Derivation::new(self, self.axiom.clone(), options)
+    }
+
+    /// A derivation from the axiom that owns this grammar.
+    pub fn into_derivation(self, options: DeriveOptions) -> Derivation<Grammar> {
+        let axiom = self.axiom.clone();
+        Derivation::new(self, axiom, options)
+    }
+
+    #[inline]
+    fn kind_of(&self, s: &ParamString, i: usize) -> ModuleKind {
+        self.kinds
+            .get(s.symbol(i) as usize)
+            .copied()
+            .unwrap_or(ModuleKind::Plain)
+    }
+
+    #[inline]
+    fn eval(&self, range: (u32, u32), scratch: &mut GrammarScratch, rng: &mut Pcg64Mcg) -> f64 {
+        let code = self
+            .code
+            .get(range.0 as usize..range.1 as usize)
+            .unwrap_or(&[]);
+        expr::run(code, &scratch.vars, &mut scratch.stack, Some(rng))
+    }
+
+    /// Matches contexts, binds parameters and checks the condition of `p` at module `i`.
+    #[inline]
+    fn matches(
+        &self,
+        p: &CProduction,
+        view: &TextView<'_>,
+        branches: &BranchIndex,
+        i: usize,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+    ) -> bool {
+        let s = view.s;
+        let eq = |&(sym, arity): &(u32, u32), pos: usize| {
+            s.symbol(pos) == sym && s.params(pos).len() == arity as usize
+        };
+        if p.left.is_empty() {
+            scratch.left.clear();
+        } else if !match_left(view, branches, i, &p.left, eq, &mut scratch.left) {
+            return false;
+        }
+        if p.right.is_empty() {
+            scratch.right.clear();
+        } else if !match_right(view, branches, i, &p.right, eq, &mut scratch.right) {
+            return false;
+        }
+        scratch.vars.clear();
+        for &k in &scratch.left {
+            scratch.vars.extend_from_slice(s.params(k as usize));
+        }
+        scratch.vars.extend_from_slice(s.params(i));
+        for &k in &scratch.right {
+            scratch.vars.extend_from_slice(s.params(k as usize));
+        }
+        match p.condition {
+            None => true,
+            Some(c) => expr::truth(self.eval(c, scratch, rng)),
+        }
+    }
+
+    #[inline]
+    fn produce(
+        &self,
+        p: &CProduction,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+        dst: &mut ParamString,
+    ) {
+        for m in &p.successor {
+            dst.begin(m.symbol);
+            for a in &m.args {
+                let v = match *a {
+                    Arg::Const(v) => v,
+                    Arg::Var(k) => scratch.vars.get(k as usize).copied().unwrap_or(f64::NAN),
+                    Arg::Code(s, e) => self.eval((s, e), scratch, rng),
+                };
+                dst.push_param(v);
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn apply(
+        &self,
+        table: &Table,
+        s: &ParamString,
+        i: usize,
+        branches: &BranchIndex,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+        dst: &mut ParamString,
+    ) -> bool {
+        let Some(list) = table.by_symbol.get(s.symbol(i) as usize) else {
+            return false;
+        };
+        let arity = s.params(i).len() as u32;
+        let view = TextView { g: self, s };
+        for (k, &pi) in list.iter().enumerate() {
+            let Some(p) = table.productions.get(pi as usize) else {
+                continue;
+            };
+            if p.arity != arity || !self.matches(p, &view, branches, i, rng, scratch) {
+                continue;
+            }
+            let Some(w) = p.probability else {
+                self.produce(p, rng, scratch, dst);
+                return true;
+            };
+            scratch.candidates.clear();
+            scratch.candidates.push((pi, w));
+            let mut total = w;
+            for &qi in list.get(k + 1..).unwrap_or(&[]) {
+                let Some(q) = table.productions.get(qi as usize) else {
+                    continue;
+                };
+                if let Some(wq) = q.probability
+                    && q.arity == arity
+                    && self.matches(q, &view, branches, i, rng, scratch)
+                {
+                    scratch.candidates.push((qi, wq));
+                    total += wq;
+                }
+            }
+            if total <= 0.0 {
+                return false;
+            }
+            let target = unit_f64(rng) * total;
+            let mut acc = 0.0;
+            let mut chosen = pi;
+            for &(ci, cw) in &scratch.candidates {
+                chosen = ci;
+                acc += cw;
+                if target < acc {
+                    break;
+                }
+            }
+            let Some(c) = table.productions.get(chosen as usize) else {
+                return false;
+            };
+            // Re-bind the chosen production's parameters (its condition held above).
+            self.rebind(c, &view, branches, i, scratch);
+            self.produce(c, rng, scratch, dst);
+            return true;
+        }
+        false
+    }
+
+    /// Binds the parameters of `p` at `i` without evaluating its condition.
+    fn rebind(
+        &self,
+        p: &CProduction,
+        view: &TextView<'_>,
+        branches: &BranchIndex,
+        i: usize,
+        scratch: &mut GrammarScratch,
+    ) {
+        let s = view.s;
+        let eq = |&(sym, arity): &(u32, u32), pos: usize| {
+            s.symbol(pos) == sym && s.params(pos).len() == arity as usize
+        };
+        scratch.left.clear();
+        scratch.right.clear();
+        if !p.left.is_empty() {
+            match_left(view, branches, i, &p.left, eq, &mut scratch.left);
+        }
+        if !p.right.is_empty() {
+            match_right(view, branches, i, &p.right, eq, &mut scratch.right);
+        }
+        scratch.vars.clear();
+        for &k in &scratch.left {
+            scratch.vars.extend_from_slice(s.params(k as usize));
+        }
+        scratch.vars.extend_from_slice(s.params(i));
+        for &k in &scratch.right {
+            scratch.vars.extend_from_slice(s.params(k as usize));
+        }
+    }
+}
+
+struct TextView<'a> {
+    g: &'a Grammar,
+    s: &'a ParamString,
+}
+
+impl ContextView for TextView<'_> {
+    #[inline]
+    fn len(&self) -> usize {
+        self.s.len()
+    }
+    #[inline]
+    fn kind(&self, i: usize) -> ModuleKind {
+        self.g.kind_of(self.s, i)
+    }
+    #[inline]
+    fn ignored(&self, i: usize) -> bool {
+        self.g
+            .ignore
+            .get(self.s.symbol(i) as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+}
+
+static EMPTY_BRANCHES: std::sync::LazyLock<BranchIndex> =
+    std::sync::LazyLock::new(BranchIndex::default);
+
+impl Rules for Grammar {
+    type String = ParamString;
+    type Scratch = GrammarScratch;
+
+    #[inline]
+    fn kind(&self, s: &ParamString, i: usize) -> ModuleKind {
+        self.kind_of(s, i)
+    }
+    #[inline]
+    fn command(&self, s: &ParamString, i: usize) -> Command {
+        let c = self
+            .commands
+            .get(s.symbol(i) as usize)
+            .copied()
+            .unwrap_or(Command::None);
+        with_arg(c, s.params(i).first().copied())
+    }
+    #[inline]
+    fn is_ignored(&self, s: &ParamString, i: usize) -> bool {
+        self.ignore
+            .get(s.symbol(i) as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+    fn is_context_sensitive(&self) -> bool {
+        self.context_sensitive
+    }
+    #[inline]
+    fn rewrite(
+        &self,
+        src: &ParamString,
+        i: usize,
+        branches: &BranchIndex,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+        dst: &mut ParamString,
+    ) -> Result<bool> {
+        Ok(self.apply(&self.productions, src, i, branches, rng, scratch, dst))
+    }
+    fn has_decomposition(&self) -> bool {
+        !self.decompositions.productions.is_empty()
+    }
+    fn decompose(
+        &self,
+        src: &ParamString,
+        i: usize,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+        dst: &mut ParamString,
+    ) -> Result<bool> {
+        Ok(self.apply(
+            &self.decompositions,
+            src,
+            i,
+            &EMPTY_BRANCHES,
+            rng,
+            scratch,
+            dst,
+        ))
+    }
+    fn has_interpretation(&self) -> bool {
+        !self.interpretations.productions.is_empty()
+    }
+    fn interpret(
+        &self,
+        src: &ParamString,
+        i: usize,
+        rng: &mut Pcg64Mcg,
+        scratch: &mut GrammarScratch,
+        dst: &mut ParamString,
+    ) -> Result<bool> {
+        Ok(self.apply(
+            &self.interpretations,
+            src,
+            i,
+            &EMPTY_BRANCHES,
+            rng,
+            scratch,
+            dst,
+        ))
+    }
+    fn fill_query(&self, s: &mut ParamString, i: usize, kind: QueryKind, state: &TurtleState) {
+        let v = match kind {
+            QueryKind::Position => state.position,
+            QueryKind::Heading => state.heading,
+            QueryKind::Up => state.up,
+            QueryKind::Left => state.left,
+        };
+        for (p, c) in s.params_mut(i).iter_mut().zip([v.x, v.y, v.z]) {
+            *p = c;
+        }
+    }
+    fn needs_pass(&self, _s: &ParamString) -> bool {
+        self.needs_pass
+    }
+    fn check_storage(&self, s: &ParamString) -> Result<()> {
+        if s.arena_overflowed() {
+            return Err(LsystemError::TooManyParameters {
+                max: crate::string::MAX_PARAMS,
+            });
+        }
+        Ok(())
+    }
+}
