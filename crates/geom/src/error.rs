@@ -176,6 +176,119 @@ pub enum GeomError {
     /// The internal bookkeeping of a graph is inconsistent (a bug, or a hand-edited file).
     #[error("graph is inconsistent: {0}")]
     GraphCorrupt(String),
+    /// The constrained Delaunay triangulation failed on input that passed validation.
+    #[error("triangulation failed: {0}; please report this polygon as a bug")]
+    Triangulation(String),
+    /// A mesh attribute array has the wrong length.
+    #[error(
+        "mesh attribute `{attribute}` has {len} entries but the mesh has {expected} vertices; give every vertex one entry"
+    )]
+    MeshAttributeLength {
+        /// `"normals"` or `"uvs"`.
+        attribute: &'static str,
+        /// Its length.
+        len: usize,
+        /// The number of positions.
+        expected: usize,
+    },
+    /// The index list does not describe whole triangles.
+    #[error(
+        "the mesh has {len} indices, which is not a multiple of 3; indices list whole triangles"
+    )]
+    MeshIndexCount {
+        /// Number of indices.
+        len: usize,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    #[error(
+        "triangle {triangle} refers to vertex {index} but the mesh has {vertex_count} vertices"
+    )]
+    MeshIndexOutOfRange {
+        /// The triangle.
+        triangle: usize,
+        /// The bad index.
+        index: u32,
+        /// Number of vertices.
+        vertex_count: usize,
+    },
+    /// A vertex attribute is NaN or infinite (or a normal is not of unit length).
+    #[error(
+        "vertex {vertex} has an invalid {attribute}: {reason}; positions, normals and uvs must be finite and normals of unit length"
+    )]
+    MeshInvalidVertex {
+        /// `"position"`, `"normal"` or `"uv"`.
+        attribute: &'static str,
+        /// The vertex.
+        vertex: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// A triangle has zero area (repeated or collinear corners, after rounding to `f32`).
+    #[error(
+        "triangle {triangle} has zero area (repeated or collinear corners); drop it or move its vertices apart"
+    )]
+    DegenerateTriangle {
+        /// The triangle.
+        triangle: usize,
+    },
+    /// A mesh meant to be a closed solid has an edge not shared by exactly two triangles.
+    #[error(
+        "the edge from {a} to {b} is used by {uses} triangles; a closed mesh uses every edge exactly twice"
+    )]
+    OpenEdge {
+        /// One end (position).
+        a: glam::Vec3,
+        /// The other end (position).
+        b: glam::Vec3,
+        /// How many triangles use it.
+        uses: usize,
+    },
+    /// Two triangles sharing an edge run it in the same direction: their windings disagree.
+    #[error(
+        "the two triangles on the edge from {a} to {b} are wound the same way; flip one so the surface is consistently oriented"
+    )]
+    InconsistentWinding {
+        /// One end (position).
+        a: glam::Vec3,
+        /// The other end (position).
+        b: glam::Vec3,
+    },
+    /// A scene object refers to another object that does not exist.
+    #[error("{referrer} refers to {what} {index} but the scene has {len}; add it first")]
+    SceneIndexOutOfRange {
+        /// Who holds the reference, e.g. `"node 3"`.
+        referrer: String,
+        /// The kind of object referred to, e.g. `"mesh"`.
+        what: &'static str,
+        /// The bad index.
+        index: usize,
+        /// How many objects of that kind exist.
+        len: usize,
+    },
+    /// The node graph is not a tree.
+    #[error("node {node} {problem}; scene nodes must form a tree under the roots")]
+    SceneNotATree {
+        /// The offending node.
+        node: usize,
+        /// What is wrong: on a cycle, two parents, unreachable.
+        problem: String,
+    },
+    /// A scene value (transform, material factor, image, metadata) is invalid.
+    #[error("{what} is invalid: {reason}")]
+    SceneInvalidValue {
+        /// Which value, e.g. `"node 2 transform"`.
+        what: String,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
+    /// One mesh of a scene is invalid.
+    #[error("mesh {mesh}: {source}")]
+    InMesh {
+        /// The mesh index.
+        mesh: usize,
+        /// What is wrong with it.
+        source: Box<GeomError>,
+    },
 }
 
 /// Checks that a point is finite and within [`MAX_COORDINATE`](crate::MAX_COORDINATE).

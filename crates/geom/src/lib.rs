@@ -52,8 +52,10 @@ pub mod spatial;
 pub use bbox::Aabb2;
 pub use error::{GeomError, Ring};
 pub use graph::{EdgeId, NodeId, PlanarGraph};
+pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
 pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};
+pub use scene::{Material, MaterialId, MeshId, MetaValue, Scene, Transform};
 
 /// The largest coordinate magnitude, in metres, that validation accepts (100,000 km).
 ///

@@ -1,0 +1,92 @@
+//! Constrained Delaunay triangulation and prism extrusion throughput.
+//!
+//! Run with `cargo bench -p polis-geom --bench triangulate`.
+
+use divan::counter::ItemsCount;
+use divan::{Bencher, black_box};
+use polis_geom::mesh::prism;
+use polis_geom::{DVec2, Polygon, PolygonWithHoles, triangulate};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+fn main() {
+    divan::main();
+}
+
+/// A random star-shaped polygon around the origin: one vertex per angular sector, random
+/// angle within it, random radius in [50, 100] m.
+fn star(n: usize, seed: u64) -> Polygon {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    Polygon::new(
+        (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * (i as f64 + 0.9 * rng.random::<f64>()) / n as f64;
+                let r = rng.random_range(50.0..100.0);
+                DVec2::new(r * a.cos(), r * a.sin())
+            })
+            .collect(),
+    )
+}
+
+/// A comb of `teeth` 1 m teeth, 50 m deep: `4·teeth + 2` vertices, long reflex pockets.
+fn comb(teeth: usize) -> Polygon {
+    let mut pts = Vec::with_capacity(4 * teeth + 2);
+    for i in 0..teeth {
+        let x = 2.0 * i as f64;
+        pts.extend([
+            DVec2::new(x, 0.0),
+            DVec2::new(x + 1.0, 0.0),
+            DVec2::new(x + 1.0, 50.0),
+            DVec2::new(x + 2.0, 50.0),
+        ]);
+    }
+    pts.push(DVec2::new(2.0 * teeth as f64, -10.0));
+    pts.push(DVec2::new(0.0, -10.0));
+    Polygon::new(pts)
+}
+
+fn bench_triangulate(bencher: Bencher<'_, '_>, p: PolygonWithHoles) {
+    let n: usize = p.rings().map(|(_, r)| r.len()).sum();
+    bencher
+        .counter(ItemsCount::new(n))
+        .bench(|| triangulate(black_box(&p)));
+}
+
+/// 10,000-vertex random star (counter: vertices/s, including validation).
+#[divan::bench]
+fn triangulate_star_10k(bencher: Bencher<'_, '_>) {
+    bench_triangulate(bencher, star(10_000, 1).into());
+}
+
+/// 10,002-vertex comb (counter: vertices/s, including validation).
+#[divan::bench]
+fn triangulate_comb_10k(bencher: Bencher<'_, '_>) {
+    bench_triangulate(bencher, comb(2_500).into());
+}
+
+/// Validation alone on the 10,000-vertex star, to separate its share.
+#[divan::bench]
+fn validate_star_10k(bencher: Bencher<'_, '_>) {
+    let p: PolygonWithHoles = star(10_000, 1).into();
+    bencher
+        .counter(ItemsCount::new(10_000usize))
+        .bench(|| black_box(&p).validate());
+}
+
+/// A closed prism from a 10 × 20 m box footprint: the LOD-0 building (counter: prisms/s).
+#[divan::bench]
+fn prism_box(bencher: Bencher<'_, '_>) {
+    let p: PolygonWithHoles = Polygon::rect(DVec2::ZERO, DVec2::new(10.0, 20.0)).into();
+    bencher
+        .counter(ItemsCount::new(1usize))
+        .bench(|| prism(black_box(&p), 0.0, 12.0, None));
+}
+
+/// A closed prism from the 10,000-vertex star (counter: footprint vertices/s).
+#[divan::bench]
+fn prism_star_10k(bencher: Bencher<'_, '_>) {
+    let p: PolygonWithHoles = star(10_000, 1).into();
+    bencher
+        .counter(ItemsCount::new(10_000usize))
+        .bench(|| prism(black_box(&p), 0.0, 12.0, None));
+}
