@@ -1,0 +1,672 @@
+//! The event loop: edge events, split events and every simultaneous or degenerate
+//! combination of them, handled by one general rule.
+//!
+//! # The collapse rule
+//!
+//! Every event is a *collapse at a point `P` at time `t`*: some active vertices arrive at
+//! `P` (the two ends of a vanishing edge; a reflex vertex; several vertices at once), and
+//! possibly one wavefront edge passes through `P` (the edge a reflex vertex splits). The
+//! vertices at `P` form maximal runs ("chains") along their circular lists. Each chain
+//! brings one incoming wavefront edge into `P` and takes one outgoing edge out of it; an
+//! edge through `P` brings both. Sorted counter-clockwise around `P` (exactly, on the input
+//! edge directions), every outgoing edge is joined to the next incoming edge after it: the
+//! wavefront region near `P` after the event is the intersection of the chains' interior
+//! wedges, and each of its angular pieces starts at an outgoing edge and ends at an
+//! incoming one. One rule therefore covers edge events, split events, vertex events
+//! (several reflex vertices meeting), multi-splits and whole lists collapsing at once.
+//!
+//! Two wavefront edges that point in opposite directions and lie on top of each other (two
+//! parallel edges meeting, like the long sides of a rectangle) give a *fold* vertex; it is
+//! zipped closed at once, along the overlap, into a skeleton arc.
+//!
+//! Events are processed in a total order: time, then kind, then vertex ids, so the result
+//! never depends on anything but the input.
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+use polis_geom::DVec2;
+
+use super::wavefront::{EdgeLine, Motion, Vertex, angle_cmp, is_reflex, motion};
+use super::{SkeletonArc, SkeletonNode};
+use crate::LotsError;
+
+/// Relative tolerance (times the polygon's size) within which two wavefront points at the
+/// same time count as one point.
+pub(crate) const COINCIDENCE_REL: f64 = 1e-9;
+
+const NONE: u32 = u32::MAX;
+
+#[derive(Debug, Clone, Copy)]
+struct Event {
+    t: f64,
+    /// 0 = edge event (a = start vertex, b = end vertex); 1 = split candidate (a = vertex,
+    /// b = input edge).
+    kind: u8,
+    a: u32,
+    b: u32,
+}
+
+impl PartialEq for Event {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Event {}
+impl PartialOrd for Event {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Event {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.t
+            .total_cmp(&other.t)
+            .then(self.kind.cmp(&other.kind))
+            .then(self.a.cmp(&other.a))
+            .then(self.b.cmp(&other.b))
+    }
+}
+
+/// A potential split: the time a vertex reaches the supporting line of an input edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Candidate {
+    t: f64,
+    edge: u32,
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Candidate {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.t.total_cmp(&other.t).then(self.edge.cmp(&other.edge))
+    }
+}
+
+/// One incoming or outgoing wavefront edge at a collapse point.
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    /// Direction away from the collapse point.
+    dir: DVec2,
+    outgoing: bool,
+    edge: u32,
+    /// For an incoming edge, the vertex it comes from; for an outgoing one, where it goes.
+    other: u32,
+}
+
+/// The whole simulation state. Buffers are kept between runs.
+#[derive(Debug, Default)]
+pub(crate) struct Engine {
+    pub edges: Vec<EdgeLine>,
+    /// Index of the first edge of each ring, plus the total at the end.
+    pub ring_starts: Vec<usize>,
+    pub verts: Vec<Vertex>,
+    pub nodes: Vec<SkeletonNode>,
+    pub arcs: Vec<SkeletonArc>,
+    queue: BinaryHeap<Reverse<Event>>,
+    candidates: Vec<BinaryHeap<Reverse<Candidate>>>,
+    /// For each input edge, vertices that started a wavefront piece of it.
+    pieces: Vec<Vec<u32>>,
+    mark: Vec<u32>,
+    stamp: u32,
+    pub now: f64,
+    pub eps: f64,
+    /// No event can happen after this time (the polygon is gone by then).
+    horizon: f64,
+    bbox_min: DVec2,
+    bbox_max: DVec2,
+    uniform: bool,
+    collapses: usize,
+    budget: usize,
+    scratch_set: Vec<u32>,
+    scratch_rays: Vec<Ray>,
+    scratch_new: Vec<u32>,
+}
+
+impl Engine {
+    /// Resets the engine for rings that are already validated and oriented, with one
+    /// positive weight per edge (ring by ring).
+    pub fn reset(&mut self, rings: &[&[DVec2]], weights: &[f64]) {
+        self.edges.clear();
+        self.ring_starts.clear();
+        self.verts.clear();
+        self.nodes.clear();
+        self.arcs.clear();
+        self.queue.clear();
+        self.candidates.clear();
+        self.pieces.clear();
+        self.mark.clear();
+        self.stamp = 0;
+        self.now = 0.0;
+        self.collapses = 0;
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for ring in rings {
+            self.ring_starts.push(self.edges.len());
+            let n = ring.len();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                lo = lo.min(a);
+                hi = hi.max(a);
+                let w = weights[self.edges.len()];
+                self.edges.push(EdgeLine::new(a, b, w));
+            }
+        }
+        self.ring_starts.push(self.edges.len());
+        let size = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        self.eps = COINCIDENCE_REL * size;
+        self.bbox_min = lo - DVec2::splat(self.eps);
+        self.bbox_max = hi + DVec2::splat(self.eps);
+        let wmin = weights.iter().copied().fold(f64::INFINITY, f64::min);
+        self.uniform = weights.iter().all(|&w| w == weights[0]);
+        // Every wavefront point stays inside the box, so its distance to any edge line, and
+        // hence any event time times the weight, is at most the box diagonal.
+        self.horizon = (hi - lo).length() / wmin * (1.0 + 1e-9) + self.eps;
+        self.pieces.resize(self.edges.len(), Vec::new());
+        let n_edges = self.edges.len();
+        self.budget = 16 * n_edges + 256;
+        // One vertex and one node per input vertex, in edge order.
+        for r in 0..rings.len() {
+            let (s, e) = (self.ring_starts[r], self.ring_starts[r + 1]);
+            let n = e - s;
+            for i in 0..n {
+                let id = (s + i) as u32;
+                let prev = (s + (i + n - 1) % n) as u32;
+                let next = (s + (i + 1) % n) as u32;
+                let p = self.edges[s + i].a;
+                self.nodes.push(SkeletonNode {
+                    position: p,
+                    time: 0.0,
+                });
+                self.verts.push(Vertex {
+                    p0: p,
+                    t0: 0.0,
+                    motion: Motion::Fold,
+                    in_edge: prev,
+                    out_edge: id,
+                    prev,
+                    next,
+                    node: id,
+                    alive: true,
+                });
+            }
+        }
+        self.candidates
+            .resize_with(self.verts.len(), BinaryHeap::new);
+        self.mark.resize(self.verts.len(), 0);
+        for v in 0..self.verts.len() as u32 {
+            let ein = &self.edges[self.verts[v as usize].in_edge as usize];
+            let eout = &self.edges[self.verts[v as usize].out_edge as usize];
+            self.verts[v as usize].motion = motion(ein, eout);
+        }
+        for v in 0..self.verts.len() as u32 {
+            self.pieces[self.verts[v as usize].out_edge as usize].push(v);
+            self.push_edge_event(v);
+            self.push_split_candidates(v);
+        }
+    }
+
+    fn vert(&self, v: u32) -> &Vertex {
+        &self.verts[v as usize]
+    }
+
+    fn vert_mut(&mut self, v: u32) -> &mut Vertex {
+        &mut self.verts[v as usize]
+    }
+
+    fn pos(&self, v: u32, t: f64) -> DVec2 {
+        self.vert(v).at(t)
+    }
+
+    fn add_node(&mut self, position: DVec2, time: f64) -> u32 {
+        self.nodes.push(SkeletonNode { position, time });
+        (self.nodes.len() - 1) as u32
+    }
+
+    /// Ends vertex `v` at node `node`: records the arc it traced and removes it.
+    fn end_vertex(&mut self, v: u32, node: u32) {
+        let x = *self.vert(v);
+        self.arcs.push(SkeletonArc {
+            from: x.node as usize,
+            to: node as usize,
+            left_edge: x.in_edge as usize,
+            right_edge: x.out_edge as usize,
+        });
+        self.vert_mut(v).alive = false;
+    }
+
+    fn new_vertex(
+        &mut self,
+        p: DVec2,
+        in_edge: u32,
+        out_edge: u32,
+        prev: u32,
+        next: u32,
+        node: u32,
+    ) -> u32 {
+        let m = motion(
+            &self.edges[in_edge as usize],
+            &self.edges[out_edge as usize],
+        );
+        self.verts.push(Vertex {
+            p0: p,
+            t0: self.now,
+            motion: m,
+            in_edge,
+            out_edge,
+            prev,
+            next,
+            node,
+            alive: true,
+        });
+        self.candidates.push(BinaryHeap::new());
+        self.mark.push(0);
+        let id = (self.verts.len() - 1) as u32;
+        self.vert_mut(prev).next = id;
+        self.vert_mut(next).prev = id;
+        id
+    }
+
+    /// Schedules the collapse of the wavefront edge from `u` to its successor.
+    fn push_edge_event(&mut self, u: u32) {
+        let x = *self.vert(u);
+        let w = x.next;
+        if w == u || !x.alive {
+            return;
+        }
+        let y = *self.vert(w);
+        if matches!(x.motion, Motion::Fold) || matches!(y.motion, Motion::Fold) || x.node == y.node
+        {
+            return;
+        }
+        let e = &self.edges[x.out_edge as usize];
+        let t = self.now;
+        let (pu, pw) = (x.at(t), y.at(t));
+        let gap = e.dir.dot(pw - pu);
+        let time = if gap <= self.eps || pu.distance(pw) <= self.eps {
+            t
+        } else {
+            let closing = e.dir.dot(x.velocity() - y.velocity());
+            if closing <= 0.0 {
+                return;
+            }
+            let tau = gap / closing;
+            let time = t + tau;
+            if !time.is_finite() || time > self.horizon {
+                return;
+            }
+            time
+        };
+        self.queue.push(Reverse(Event {
+            t: time,
+            kind: 0,
+            a: u,
+            b: w,
+        }));
+    }
+
+    /// Computes every input edge line vertex `v` will reach and queues the earliest.
+    fn push_split_candidates(&mut self, v: u32) {
+        let x = *self.vert(v);
+        if !x.alive || matches!(x.motion, Motion::Fold) {
+            return;
+        }
+        let din = self.edges[x.in_edge as usize].raw;
+        let dout = self.edges[x.out_edge as usize].raw;
+        // Unweighted, only reflex vertices can hit a non-adjacent edge; weighted, a convex
+        // vertex can too (Kelly 2008 §4.4.3.1), so every vertex is tested.
+        if self.uniform && !is_reflex(din, dout) {
+            return;
+        }
+        let vel = x.velocity();
+        let mut list = std::mem::take(&mut self.candidates[v as usize]);
+        list.clear();
+        let mut heap = list.into_vec();
+        for (i, e) in self.edges.iter().enumerate() {
+            let i = i as u32;
+            if i == x.in_edge || i == x.out_edge {
+                continue;
+            }
+            let slope = e.normal.dot(vel) - e.weight;
+            if slope >= 0.0 {
+                continue;
+            }
+            let ahead = e.ahead(x.p0, x.t0);
+            if ahead < -self.eps {
+                continue;
+            }
+            let t = x.t0 - ahead.max(0.0) / slope;
+            if t.is_nan() || t > self.horizon {
+                continue;
+            }
+            let p = x.p0 + vel * (t - x.t0);
+            if p.x < self.bbox_min.x
+                || p.y < self.bbox_min.y
+                || p.x > self.bbox_max.x
+                || p.y > self.bbox_max.y
+            {
+                continue;
+            }
+            heap.push(Reverse(Candidate { t, edge: i }));
+        }
+        self.candidates[v as usize] = BinaryHeap::from(heap);
+        self.push_next_candidate(v);
+    }
+
+    fn push_next_candidate(&mut self, v: u32) {
+        if let Some(Reverse(c)) = self.candidates[v as usize].pop() {
+            self.queue.push(Reverse(Event {
+                t: c.t,
+                kind: 1,
+                a: v,
+                b: c.edge,
+            }));
+        }
+    }
+
+    /// Runs events up to and including time `until`. Afterwards `now` is the time of the
+    /// last processed event (at most `until`).
+    pub fn run(&mut self, until: f64) -> Result<(), LotsError> {
+        while let Some(Reverse(ev)) = self.queue.peek().copied() {
+            if ev.t > until {
+                break;
+            }
+            self.queue.pop();
+            match ev.kind {
+                0 => {
+                    let (u, w) = (ev.a, ev.b);
+                    if !self.vert(u).alive || !self.vert(w).alive || self.vert(u).next != w {
+                        continue;
+                    }
+                    self.now = self.now.max(ev.t);
+                    let p = (self.pos(u, self.now) + self.pos(w, self.now)) * 0.5;
+                    self.collapse(p, &[u, w], NONE)?;
+                }
+                _ => {
+                    let v = ev.a;
+                    if !self.vert(v).alive {
+                        continue;
+                    }
+                    let t = self.now.max(ev.t);
+                    match self.validate_split(v, ev.b, t) {
+                        Some((seeds, through)) => {
+                            self.now = t;
+                            let p = self.pos(v, t);
+                            let seeds: Vec<u32> =
+                                seeds.into_iter().filter(|&s| s != NONE).collect();
+                            self.collapse(p, &seeds, through)?;
+                        }
+                        None => self.push_next_candidate(v),
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether vertex `v` really hits a wavefront piece of input edge `e` at time `t`.
+    /// Returns the seed vertices (v and any piece end at the hit point) and the piece it
+    /// passes through, if it hits a piece's interior.
+    fn validate_split(&mut self, v: u32, e: u32, t: f64) -> Option<([u32; 3], u32)> {
+        let p = self.pos(v, t);
+        let edge = self.edges[e as usize];
+        let sp = edge.along(p);
+        let mut pieces = std::mem::take(&mut self.pieces[e as usize]);
+        pieces.retain(|&u| {
+            let x = &self.verts[u as usize];
+            x.alive && x.out_edge == e
+        });
+        let mut found = None;
+        for &u in &pieces {
+            let w = self.vert(u).next;
+            if u == v || w == v {
+                continue;
+            }
+            let (pu, pw) = (self.pos(u, t), self.pos(w, t));
+            let (su, sw) = (edge.along(pu), edge.along(pw));
+            if su > sw + self.eps {
+                continue;
+            }
+            if sp < su - self.eps || sp > sw + self.eps {
+                continue;
+            }
+            // The hit point must be on the piece itself, not just on its line.
+            if edge.ahead(p, t).abs() > 1e3 * self.eps {
+                continue;
+            }
+            let at_u = p.distance(pu) <= self.eps || sp <= su + self.eps;
+            let at_w = p.distance(pw) <= self.eps || sp >= sw - self.eps;
+            // Vertices born at the same node were already sorted out by the event that
+            // created them: touching there is not a new event.
+            let node = self.vert(v).node;
+            if (at_u && self.vert(u).node == node) || (at_w && self.vert(w).node == node) {
+                continue;
+            }
+            found = Some(match (at_u, at_w) {
+                (false, false) => ([v, NONE, NONE], u),
+                (true, false) => ([v, u, NONE], NONE),
+                (false, true) => ([v, w, NONE], NONE),
+                (true, true) => ([v, u, w], NONE),
+            });
+            break;
+        }
+        self.pieces[e as usize] = pieces;
+        found
+    }
+
+    fn marked(&self, v: u32) -> bool {
+        self.mark[v as usize] == self.stamp
+    }
+
+    /// The general event: the given vertices (and any neighbours at the same point) meet at
+    /// `p` at time `now`; `through` is a vertex whose outgoing wavefront piece passes
+    /// through `p`, or `NONE`.
+    fn collapse(&mut self, p: DVec2, seeds: &[u32], through: u32) -> Result<(), LotsError> {
+        self.collapses += 1;
+        if self.collapses > self.budget {
+            return Err(LotsError::SkeletonFailed {
+                reason: "too many events",
+            });
+        }
+        let t = self.now;
+        self.stamp = self.stamp.wrapping_add(1);
+        let mut set = std::mem::take(&mut self.scratch_set);
+        set.clear();
+        for &s in seeds {
+            if self.vert(s).alive && !self.marked(s) {
+                self.mark[s as usize] = self.stamp;
+                set.push(s);
+            }
+        }
+        // Grow along the lists: neighbours at the same point join the collapse.
+        let mut i = 0;
+        while i < set.len() {
+            let x = *self.vert(set[i]);
+            for n in [x.prev, x.next] {
+                if !self.marked(n) && self.pos(n, t).distance(p) <= self.eps {
+                    self.mark[n as usize] = self.stamp;
+                    set.push(n);
+                }
+            }
+            i += 1;
+        }
+        set.sort_unstable();
+        let node = self.add_node(p, t);
+        // Chains and their rays.
+        let mut rays = std::mem::take(&mut self.scratch_rays);
+        rays.clear();
+        for &x in &set {
+            let vx = *self.vert(x);
+            if self.marked(vx.prev) {
+                continue;
+            }
+            let mut last = x;
+            while self.marked(self.vert(last).next) {
+                last = self.vert(last).next;
+            }
+            let vl = *self.vert(last);
+            rays.push(Ray {
+                dir: -self.edges[vx.in_edge as usize].raw,
+                outgoing: false,
+                edge: vx.in_edge,
+                other: vx.prev,
+            });
+            rays.push(Ray {
+                dir: self.edges[vl.out_edge as usize].raw,
+                outgoing: true,
+                edge: vl.out_edge,
+                other: vl.next,
+            });
+        }
+        if through != NONE
+            && self.vert(through).alive
+            && !self.marked(through)
+            && !self.marked(self.vert(through).next)
+        {
+            let u = *self.vert(through);
+            let d = self.edges[u.out_edge as usize].raw;
+            rays.push(Ray {
+                dir: -d,
+                outgoing: false,
+                edge: u.out_edge,
+                other: through,
+            });
+            rays.push(Ray {
+                dir: d,
+                outgoing: true,
+                edge: u.out_edge,
+                other: u.next,
+            });
+        }
+        for &x in &set {
+            self.end_vertex(x, node);
+        }
+        // Counter-clockwise around p; at equal angles an outgoing edge comes first (the
+        // zero-width wedge between them is a fold), then by edge id.
+        rays.sort_by(|a, b| {
+            angle_cmp(a.dir, b.dir)
+                .then(b.outgoing.cmp(&a.outgoing))
+                .then(a.edge.cmp(&b.edge))
+                .then(a.other.cmp(&b.other))
+        });
+        // Join each outgoing edge to the next incoming edge after it (cyclic matching).
+        let mut new = std::mem::take(&mut self.scratch_new);
+        new.clear();
+        let k = rays.len();
+        let mut used = vec![false; k];
+        let mut stack: Vec<usize> = Vec::new();
+        for step in 0..2 * k {
+            let r = step % k;
+            if used[r] {
+                continue;
+            }
+            if rays[r].outgoing {
+                if step < k {
+                    stack.push(r);
+                }
+            } else if let Some(o) = stack.pop() {
+                used[o] = true;
+                used[r] = true;
+                let (inc, out) = (rays[r], rays[o]);
+                let id = self.new_vertex(p, inc.edge, out.edge, inc.other, out.other, node);
+                new.push(id);
+            }
+        }
+        if used.iter().any(|u| !u) {
+            self.scratch_set = set;
+            self.scratch_rays = rays;
+            self.scratch_new = new;
+            return Err(LotsError::SkeletonFailed {
+                reason: "inconsistent wavefront at an event",
+            });
+        }
+        for &n in &new {
+            self.settle(n);
+        }
+        self.scratch_set = set;
+        self.scratch_rays = rays;
+        self.scratch_new = new;
+        Ok(())
+    }
+
+    /// Brings a freshly created vertex into a consistent state: closes two-vertex lists,
+    /// zips folds, and schedules the events of whatever vertex remains.
+    fn settle(&mut self, mut v: u32) {
+        let t = self.now;
+        loop {
+            let x = *self.vert(v);
+            if !x.alive {
+                return;
+            }
+            if x.next == v {
+                self.vert_mut(v).alive = false;
+                return;
+            }
+            if x.next == x.prev {
+                // Two vertices joined by two edges: the region between them has no area.
+                let m = x.next;
+                let q = self.pos(m, t);
+                let pv = self.pos(v, t);
+                let qn = if q.distance(pv) <= self.eps {
+                    x.node
+                } else {
+                    self.add_node(q, t)
+                };
+                self.end_vertex(m, qn);
+                self.arcs.push(SkeletonArc {
+                    from: x.node as usize,
+                    to: qn as usize,
+                    left_edge: self.vert(m).out_edge as usize,
+                    right_edge: x.out_edge as usize,
+                });
+                self.vert_mut(v).alive = false;
+                return;
+            }
+            if !matches!(x.motion, Motion::Fold) {
+                self.pieces[x.out_edge as usize].push(v);
+                self.push_edge_event(x.prev);
+                self.push_edge_event(v);
+                self.push_split_candidates(v);
+                return;
+            }
+            // A fold: the incoming and outgoing wavefront edges overlap from here towards
+            // the nearer of their far ends. Zip them closed.
+            let p = x.p0;
+            let (a, b) = (x.prev, x.next);
+            let u = self.edges[x.out_edge as usize].dir;
+            let (pa, pb) = (self.pos(a, t), self.pos(b, t));
+            let (da, db) = (u.dot(pa - p), u.dot(pb - p));
+            let va = *self.vert(a);
+            let vb = *self.vert(b);
+            if (da - db).abs() <= self.eps {
+                let q = (pa + pb) * 0.5;
+                let qn = self.add_node(q, t);
+                self.end_vertex(v, qn);
+                self.end_vertex(a, qn);
+                self.end_vertex(b, qn);
+                if va.prev == b {
+                    return;
+                }
+                v = self.new_vertex(q, va.in_edge, vb.out_edge, va.prev, vb.next, qn);
+            } else if da < db {
+                let qn = self.add_node(pa, t);
+                self.end_vertex(v, qn);
+                self.end_vertex(a, qn);
+                v = self.new_vertex(pa, va.in_edge, x.out_edge, va.prev, b, qn);
+            } else {
+                let qn = self.add_node(pb, t);
+                self.end_vertex(v, qn);
+                self.end_vertex(b, qn);
+                v = self.new_vertex(pb, x.in_edge, vb.out_edge, a, vb.next, qn);
+            }
+        }
+    }
+
+    /// Whether any vertex is still active.
+    pub fn any_alive(&self) -> bool {
+        self.verts.iter().any(|v| v.alive)
+    }
+}

@@ -1,0 +1,190 @@
+//! Property tests: random polygons biased to degenerate cases, checked independently.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+use common::*;
+use polis_geom::{DVec2, Polygon, PolygonWithHoles};
+use polis_lots::{StraightSkeleton, inset_shapes};
+use proptest::prelude::*;
+
+/// Star-shaped polygons; with `grid`, vertices snap to integers (collinear runs, parallel
+/// edges, simultaneous events).
+fn star(n: usize, seeds: &[(f64, f64)], grid: bool) -> Polygon {
+    let mut pts = Vec::new();
+    for i in 0..n {
+        let (da, r) = seeds[i % seeds.len()];
+        let a = std::f64::consts::TAU * (i as f64 + 0.8 * da) / n as f64;
+        let mut p = v(r * a.cos(), r * a.sin());
+        if grid {
+            p = p.round();
+        }
+        pts.push(p);
+    }
+    pts.dedup();
+    Polygon::new(pts)
+}
+
+/// A histogram polygon on an integer grid: many reflex vertices, collinear runs and
+/// parallel edges meeting at the same time.
+fn histogram(heights: &[u8]) -> Polygon {
+    let mut pts = vec![v(0., 0.), v(heights.len() as f64, 0.)];
+    for (i, &h) in heights.iter().enumerate().rev() {
+        let x1 = (i + 1) as f64;
+        let x0 = i as f64;
+        let h = h as f64 + 1.0;
+        pts.push(v(x1, h));
+        pts.push(v(x0, h));
+    }
+    let mut clean: Vec<DVec2> = Vec::new();
+    for p in pts {
+        if clean.last() != Some(&p) {
+            clean.push(p);
+        }
+    }
+    // Drop vertices in the middle of straight runs half of the time? Keep them: collinear
+    // vertices are a case to test.
+    Polygon::new(clean)
+}
+
+fn check_insets(
+    p: &PolygonWithHoles,
+    weights: Option<&[f64]>,
+    sk: &StraightSkeleton,
+) -> Result<(), TestCaseError> {
+    let edges = input_edges(p);
+    let w: Vec<f64> = weights.map_or_else(|| vec![1.0; edges.len()], |w| w.to_vec());
+    let tmax = sk.max_time();
+    let mut last_area = p.area();
+    for k in 1..6 {
+        let d = tmax * k as f64 / 5.5;
+        let shapes = inset_shapes(p, weights, d).unwrap();
+        let mut area = 0.0;
+        for s in &shapes {
+            let pw = s.to_polygon();
+            prop_assert!(
+                pw.validate().is_ok(),
+                "inset at {} invalid: {:?}",
+                d,
+                pw.validate()
+            );
+            for (ring, _) in std::iter::once((&s.outer, ())).chain(s.holes.iter().map(|h| (h, ())))
+            {
+                let n = ring.points.len();
+                for i in 0..n {
+                    let (a, b) = (ring.points[i], ring.points[(i + 1) % n]);
+                    prop_assert!(p.contains(a), "inset vertex {:?} outside", a);
+                    if let Some(e) = ring.sources[i] {
+                        let (ea, eb) = edges[e];
+                        for x in [a, b] {
+                            let dist = line_distance(x, ea, eb);
+                            prop_assert!(
+                                (dist - d * w[e]).abs() < 1e-7 * (1.0 + d),
+                                "distance {} want {}",
+                                dist,
+                                d * w[e]
+                            );
+                        }
+                    }
+                }
+            }
+            area += pw.area();
+        }
+        prop_assert!(
+            area <= last_area + 1e-9 * p.area(),
+            "area grew: {} > {}",
+            area,
+            last_area
+        );
+        last_area = area;
+    }
+    prop_assert!(
+        inset_shapes(p, weights, tmax * 1.001 + 1e-9)
+            .unwrap()
+            .is_empty()
+    );
+    Ok(())
+}
+
+/// Case count: 96 by default, `LOTS_CASES` to stress.
+fn cases() -> u32 {
+    std::env::var("LOTS_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(96)
+}
+
+/// Near-degenerate: a grid polygon with every vertex moved by up to `1e-9`.
+fn jitter(p: &Polygon, seeds: &[(f64, f64)]) -> Polygon {
+    p.map_points(|q| {
+        let k = (q.x * 7.0 + q.y * 13.0).abs() as usize;
+        let (a, b) = seeds[k % seeds.len()];
+        q + v(a - 0.5, b - 0.5) * 2e-9
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases()))]
+
+    #[test]
+    fn random_stars(n in 3usize..40, seeds in prop::collection::vec((0.0f64..1.0, 2.0f64..20.0), 1..40), grid in any::<bool>()) {
+        let p: PolygonWithHoles = star(n, &seeds, grid).into();
+        prop_assume!(p.validate().is_ok() && p.outer.signed_area() > 0.0);
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
+    fn random_histograms(heights in prop::collection::vec(0u8..5, 1..24)) {
+        let p: PolygonWithHoles = histogram(&heights).into();
+        prop_assume!(p.validate().is_ok());
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-9) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
+    fn near_degenerate_histograms(heights in prop::collection::vec(0u8..4, 1..16), seeds in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 1..8)) {
+        let p: PolygonWithHoles = jitter(&histogram(&heights), &seeds).into();
+        prop_assume!(p.validate().is_ok());
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
+    fn rotated_regular(n in 3usize..64, angle in 0.0f64..7.0, r in 0.1f64..1000.0) {
+        let p: PolygonWithHoles = Polygon::regular(n, v(3.0, -2.0), r).map_points(|q| DVec2::from_angle(angle).rotate(q)).into();
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
+    fn random_weighted_stars(n in 3usize..24, seeds in prop::collection::vec((0.0f64..1.0, 4.0f64..20.0), 1..24), ws in prop::collection::vec(prop_oneof![Just(1.0), Just(2.0), 0.3f64..3.0], 24)) {
+        let p: PolygonWithHoles = star(n, &seeds, false).into();
+        prop_assume!(p.validate().is_ok());
+        let w: Vec<f64> = (0..p.outer.len()).map(|i| ws[i % ws.len()]).collect();
+        let sk = StraightSkeleton::weighted(&p, &w).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, Some(&w), &sk)?;
+    }
+
+    #[test]
+    fn random_holes(n in 3usize..16, seeds in prop::collection::vec((0.0f64..1.0, 25.0f64..40.0), 1..16), holes in prop::collection::vec((-8i32..8, -8i32..8, 1i32..4, 1i32..4), 0..4)) {
+        let outer = star(n, &seeds, true);
+        let mut hs = Vec::new();
+        for (x, y, w, h) in holes {
+            let (x, y) = (x as f64 * 2.0, y as f64 * 2.0);
+            let mut r = Polygon::rect(v(x, y), v(x + w as f64, y + h as f64));
+            r.reverse();
+            hs.push(r);
+        }
+        let p = PolygonWithHoles::new(outer, hs);
+        prop_assume!(p.validate().is_ok() && p.is_normalized());
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+}
