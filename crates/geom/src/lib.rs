@@ -9,8 +9,8 @@
 //! | [`predicates`] | exact orientation and segment–segment classification |
 //! | [`polygon`] | [`Polygon`], [`PolygonWithHoles`]: area, centroid, point location, validation |
 //! | [`bbox`] | [`Aabb2`] |
-//! | [`graph`] | `PlanarGraph<N, E>`: a planar embedded graph with stable ids |
-//! | [`spatial`] | a spatial index over points and segments |
+//! | [`graph`] | [`PlanarGraph`]: a planar straight-line graph with stable ids, exact counter-clockwise adjacency, planar segment insertion |
+//! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); [`spatial::RTreeIndex`] as the measured alternative |
 //! | [`field`] | `Field`: input maps (population, water, elevation …) |
 //! | [`mesh`], [`scene`] | `Mesh` and `Scene`: the contract between generators and exporters |
 //!
@@ -56,6 +56,7 @@ pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
 pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};
 pub use scene::{Material, MaterialId, MeshId, MetaValue, Scene, Transform};
+pub use spatial::{SegmentIndex, SpatialIndex};
 
 /// The largest coordinate magnitude, in metres, that validation accepts (100,000 km).
 ///

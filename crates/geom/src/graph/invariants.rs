@@ -7,6 +7,7 @@ use glam::DVec2;
 use super::{EdgeId, NodeId, PlanarGraph, ccw_cmp};
 use crate::error::GeomError;
 use crate::predicates::{SegmentIntersection, point_on_segment, segment_intersection};
+use crate::spatial::{Shape, SpatialIndex};
 
 fn corrupt(msg: String) -> GeomError {
     GeomError::GraphCorrupt(msg)
@@ -101,6 +102,36 @@ impl<N, E> PlanarGraph<N, E> {
                         existing: w[0].1.raw(),
                     });
                 }
+            }
+        }
+        self.check_index()
+    }
+
+    /// The spatial indexes hold exactly the live nodes and edges, with their geometry.
+    fn check_index(&self) -> Result<(), GeomError> {
+        if self.node_index.len() != self.node_count() || self.edge_index.len() != self.edge_count()
+        {
+            return Err(corrupt(format!(
+                "the spatial indexes hold {} nodes / {} edges, the graph {} / {}",
+                self.node_index.len(),
+                self.edge_index.len(),
+                self.node_count(),
+                self.edge_count()
+            )));
+        }
+        for (n, p, _) in self.nodes() {
+            if self.node_index.get(n) != Some(Shape::Point(p)) {
+                return Err(corrupt(format!(
+                    "node {n} is missing or misplaced in the index"
+                )));
+            }
+        }
+        for (e, a, b, _) in self.edges() {
+            let s = Shape::Segment(self.position(a)?, self.position(b)?);
+            if self.edge_index.get(e) != Some(s) {
+                return Err(corrupt(format!(
+                    "edge {e} is missing or misplaced in the index"
+                )));
             }
         }
         Ok(())

@@ -54,6 +54,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::bbox::Aabb2;
 use crate::error::{GeomError, validate_point};
+use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, SpatialIndex};
 
 pub(crate) use order::ccw_cmp;
 
@@ -120,6 +121,10 @@ pub struct PlanarGraph<N, E> {
     pub(crate) edges: Vec<Option<Edge<E>>>,
     node_count: usize,
     edge_count: usize,
+    /// Every live node as a point.
+    pub(crate) node_index: SegmentIndex<NodeId>,
+    /// Every live edge as a segment.
+    pub(crate) edge_index: SegmentIndex<EdgeId>,
 }
 
 impl<N, E> Default for PlanarGraph<N, E> {
@@ -143,14 +148,69 @@ fn bad_edge(e: EdgeId) -> GeomError {
 }
 
 impl<N, E> PlanarGraph<N, E> {
-    /// An empty graph.
+    /// An empty graph (its spatial indexes use [`GridOptions::default`]).
     pub fn new() -> Self {
         PlanarGraph {
             nodes: Vec::new(),
             edges: Vec::new(),
             node_count: 0,
             edge_count: 0,
+            node_index: SegmentIndex::default(),
+            edge_index: SegmentIndex::default(),
         }
+    }
+
+    /// An empty graph whose spatial indexes use `options` (a speed knob only).
+    ///
+    /// # Errors
+    /// [`GeomError::InvalidParameter`] for a bad cell size.
+    pub fn with_index_options(options: GridOptions) -> Result<Self, GeomError> {
+        Ok(PlanarGraph {
+            node_index: SegmentIndex::new(options)?,
+            edge_index: SegmentIndex::new(options)?,
+            ..Self::new()
+        })
+    }
+
+    // ----- spatial queries -------------------------------------------------------------
+
+    /// The spatial index of the live nodes (as points), for queries beyond the ones below.
+    pub fn node_index(&self) -> &SegmentIndex<NodeId> {
+        &self.node_index
+    }
+
+    /// The spatial index of the live edges (as segments).
+    pub fn edge_index(&self) -> &SegmentIndex<EdgeId> {
+        &self.edge_index
+    }
+
+    /// The node nearest to `p` within `radius` metres (inclusive; ties by smaller id),
+    /// with its distance.
+    pub fn nearest_node(&self, p: DVec2, radius: f64) -> Option<(NodeId, f64)> {
+        self.node_index
+            .nearest_point(p, radius)
+            .map(|n| (n.key, n.distance))
+    }
+
+    /// The edge nearest to `p` within `radius` metres (inclusive; ties by smaller id).
+    pub fn nearest_edge(&self, p: DVec2, radius: f64) -> Option<SegmentNear<EdgeId>> {
+        self.edge_index.nearest_segment(p, radius)
+    }
+
+    /// Nodes inside the closed box `b`, in id order.
+    pub fn nodes_in_box(&self, b: &Aabb2) -> Vec<NodeId> {
+        self.node_index.query_box(b)
+    }
+
+    /// Edges sharing a point with the closed box `b`, in id order.
+    pub fn edges_in_box(&self, b: &Aabb2) -> Vec<EdgeId> {
+        self.edge_index.query_box(b)
+    }
+
+    /// Edges that cross, touch or overlap the segment `a–b`, ordered along it (see
+    /// [`SpatialIndex::segments_crossing`]).
+    pub fn edges_crossing(&self, a: DVec2, b: DVec2) -> Vec<SegmentHit<EdgeId>> {
+        self.edge_index.segments_crossing(a, b)
     }
 
     // ----- sizes and iteration -------------------------------------------------------
@@ -396,6 +456,7 @@ impl<N, E> PlanarGraph<N, E> {
     pub fn add_node(&mut self, pos: DVec2, payload: N) -> Result<NodeId, GeomError> {
         validate_point(self.nodes.len(), pos)?;
         let id = next_id(self.nodes.len(), "node")?;
+        self.node_index.insert_point(NodeId(id), pos)?;
         self.nodes.push(Some(Node {
             pos,
             payload,
@@ -426,6 +487,7 @@ impl<N, E> PlanarGraph<N, E> {
             });
         }
         let id = EdgeId(next_id(self.edges.len(), "edge")?);
+        self.edge_index.insert_segment(id, pa, pb)?;
         self.edges.push(Some(Edge {
             ends: [a, b],
             payload,
@@ -481,6 +543,7 @@ impl<N, E> PlanarGraph<N, E> {
             .get_mut(e.index())
             .and_then(Option::take)
             .ok_or_else(|| bad_edge(e))?;
+        self.edge_index.remove(e);
         self.edge_count -= 1;
         Ok(ed.payload)
     }
@@ -496,6 +559,7 @@ impl<N, E> PlanarGraph<N, E> {
             .get_mut(n.index())
             .and_then(Option::take)
             .ok_or_else(|| bad_node(n))?;
+        self.node_index.remove(n);
         self.node_count -= 1;
         Ok(node.payload)
     }
@@ -573,8 +637,12 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 ),
             });
         }
+        // Check there is room for one more edge id before changing anything.
+        next_id(self.edges.len() + 1, "edge")?;
+        let new_edge = EdgeId(self.edges.len() as u32);
         let m = self.add_node(point, node_payload)?;
-        let new_edge = EdgeId(next_id(self.edges.len(), "edge")?);
+        self.edge_index.insert_segment(e, pa, point)?;
+        self.edge_index.insert_segment(new_edge, point, pb)?;
         // Re-wire: e becomes a–m, new edge m–b.
         self.detach(b, e);
         if let Some(Some(ed)) = self.edges.get_mut(e.index()) {
