@@ -135,6 +135,18 @@ pub enum GeomError {
     /// An image could not be read as a grey-scale raster.
     #[error("could not read raster image: {0}")]
     Image(String),
+    /// A raster's data does not have `width × height` values.
+    #[error(
+        "a raster of {width} × {height} texels needs width × height values but got {len}; give one value per texel, row by row"
+    )]
+    RasterSize {
+        /// Texels per row.
+        width: usize,
+        /// Rows.
+        height: usize,
+        /// Number of values given.
+        len: usize,
+    },
     /// Two nodes of a graph are already joined by an edge.
     #[error(
         "nodes {a} and {b} are already joined by edge {existing}; a planar graph has no duplicate edges"

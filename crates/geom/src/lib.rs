@@ -51,6 +51,7 @@ pub mod spatial;
 
 pub use bbox::Aabb2;
 pub use error::{GeomError, Ring};
+pub use field::{Field, FieldExt};
 pub use graph::{EdgeId, NodeId, PlanarGraph};
 pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};

@@ -1,0 +1,280 @@
+//! Loading [`Raster`] fields from PNG images (cargo feature `png`).
+
+use std::io::Cursor;
+use std::path::Path;
+
+use super::Raster;
+use crate::{Aabb2, GeomError};
+
+/// The largest decoded image, in bytes, that [`Raster::from_png_bytes`] accepts (512 MiB:
+/// e.g. 16 384² grey 16-bit). Protects against headers that claim enormous sizes.
+pub const MAX_PNG_DECODED_BYTES: usize = 512 << 20;
+
+/// Rec. 709 luma weights applied to RGB channel values.
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+fn png_error(e: png::DecodingError) -> GeomError {
+    GeomError::Image(format!(
+        "PNG decoding failed ({e}); the input must be a complete, valid PNG file"
+    ))
+}
+
+impl Raster {
+    /// Decodes a PNG image into a raster over `extent` (metres), values in `[0, 1]`.
+    ///
+    /// * Grey 1/2/4/8-bit → `v / (2⁸ − 1)` after expansion to 8 bits; grey 16-bit →
+    ///   `v / 65535`.
+    /// * Grey + alpha: the alpha channel is ignored.
+    /// * RGB, RGBA and palette images: converted to luma `0.2126 R + 0.7152 G + 0.0722 B`
+    ///   on the stored (gamma-encoded) channel values; alpha is ignored.
+    /// * The image's top row is the raster's top row (largest `y`), as the image is shown.
+    ///
+    /// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG or decode to more
+    /// than [`MAX_PNG_DECODED_BYTES`]; the errors of [`Raster::new`] for a bad `extent`.
+    pub fn from_png_bytes(bytes: &[u8], extent: Aabb2) -> Result<Raster, GeomError> {
+        let mut decoder = png::Decoder::new(Cursor::new(bytes));
+        decoder.set_transformations(png::Transformations::EXPAND);
+        let mut reader = decoder.read_info().map_err(png_error)?;
+        let size = reader
+            .output_buffer_size()
+            .filter(|&s| s <= MAX_PNG_DECODED_BYTES)
+            .ok_or_else(|| {
+                let info = reader.info();
+                GeomError::Image(format!(
+                    "the PNG is {} × {} pixels, more than the {} MiB this loader accepts; downscale it",
+                    info.width,
+                    info.height,
+                    MAX_PNG_DECODED_BYTES >> 20
+                ))
+            })?;
+        let mut buf = vec![0u8; size];
+        let out = reader.next_frame(&mut buf).map_err(png_error)?;
+        let channels = match out.color_type {
+            png::ColorType::Grayscale => 1,
+            png::ColorType::GrayscaleAlpha => 2,
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            png::ColorType::Indexed => {
+                return Err(GeomError::Image(
+                    "the PNG palette could not be expanded; save the map as grey-scale".into(),
+                ));
+            }
+        };
+        let sample_bytes = match out.bit_depth {
+            png::BitDepth::Eight => 1,
+            png::BitDepth::Sixteen => 2,
+            other => {
+                return Err(GeomError::Image(format!(
+                    "unexpected bit depth {other:?} after expansion; save the map as 8- or 16-bit grey-scale"
+                )));
+            }
+        };
+        let width = out.width as usize;
+        let height = out.height as usize;
+        let pixel_bytes = channels * sample_bytes;
+        let read = |s: &[u8]| -> f32 {
+            match s {
+                [hi, lo] => f32::from(u16::from_be_bytes([*hi, *lo])) / 65535.0,
+                [v] => f32::from(*v) / 255.0,
+                _ => 0.0,
+            }
+        };
+        let mut data = Vec::with_capacity(width.saturating_mul(height));
+        for line in buf.chunks(out.line_size.max(1)).take(height) {
+            for px in line.chunks_exact(pixel_bytes).take(width) {
+                let mut ch = px.chunks_exact(sample_bytes).map(read);
+                let value = if channels <= 2 {
+                    ch.next().unwrap_or(0.0)
+                } else {
+                    let r = ch.next().unwrap_or(0.0);
+                    let g = ch.next().unwrap_or(0.0);
+                    let b = ch.next().unwrap_or(0.0);
+                    LUMA[0] * r + LUMA[1] * g + LUMA[2] * b
+                };
+                data.push(value.clamp(0.0, 1.0));
+            }
+        }
+        if data.len() != width.saturating_mul(height) {
+            return Err(GeomError::Image(format!(
+                "the PNG decoded to {} of {width} × {height} pixels; the file is truncated",
+                data.len()
+            )));
+        }
+        Raster::new(width, height, extent, data)
+    }
+
+    /// Reads a PNG file and decodes it as [`from_png_bytes`](Self::from_png_bytes) does.
+    ///
+    /// Errors: [`GeomError::Image`] naming the path when the file cannot be read, and the
+    /// errors of [`from_png_bytes`](Self::from_png_bytes).
+    pub fn from_png_path(path: impl AsRef<Path>, extent: Aabb2) -> Result<Raster, GeomError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|e| {
+            GeomError::Image(format!(
+                "cannot read {}: {e}; check the path of the map image",
+                path.display()
+            ))
+        })?;
+        Raster::from_png_bytes(&bytes, extent)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::Field;
+    use glam::DVec2;
+
+    fn encode(w: u32, h: u32, color: png::ColorType, depth: png::BitDepth, data: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut out, w, h);
+            enc.set_color(color);
+            enc.set_depth(depth);
+            let mut writer = enc.write_header().unwrap();
+            writer.write_image_data(data).unwrap();
+        }
+        out
+    }
+
+    fn extent() -> Aabb2 {
+        Aabb2::new(DVec2::new(0.0, 0.0), DVec2::new(300.0, 200.0))
+    }
+
+    #[test]
+    fn grey8_round_trip() {
+        // 3 × 2: top row 0, 51, 255; bottom row 102, 153, 204.
+        let pixels = [0u8, 51, 255, 102, 153, 204];
+        let bytes = encode(
+            3,
+            2,
+            png::ColorType::Grayscale,
+            png::BitDepth::Eight,
+            &pixels,
+        );
+        let r = Raster::from_png_bytes(&bytes, extent()).unwrap();
+        assert_eq!((r.width(), r.height()), (3, 2));
+        for (i, &p) in pixels.iter().enumerate() {
+            let (col, row) = (i % 3, i / 3);
+            assert_eq!(r.get(col, row).unwrap(), f32::from(p) / 255.0);
+            let c = r.texel_center(col, row);
+            assert_eq!(r.sample(c), f64::from(f32::from(p) / 255.0));
+        }
+        // The image's top row is at the top of the extent.
+        assert_eq!(r.sample(DVec2::new(250.0, 199.0)), 1.0);
+        assert_eq!(r.sample(DVec2::new(50.0, 199.0)), 0.0);
+    }
+
+    #[test]
+    fn grey16_and_low_bit_depths() {
+        let values: [u16; 4] = [0, 1000, 40000, 65535];
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_be_bytes()).collect();
+        let png16 = encode(
+            2,
+            2,
+            png::ColorType::Grayscale,
+            png::BitDepth::Sixteen,
+            &bytes,
+        );
+        let r = Raster::from_png_bytes(&png16, extent()).unwrap();
+        for (i, &v) in values.iter().enumerate() {
+            assert_eq!(r.get(i % 2, i / 2).unwrap(), f32::from(v) / 65535.0);
+        }
+        // 1-bit grey: 4 pixels in one byte, 1 0 1 1.
+        let png1 = encode(
+            4,
+            1,
+            png::ColorType::Grayscale,
+            png::BitDepth::One,
+            &[0b1011_0000],
+        );
+        let r = Raster::from_png_bytes(&png1, extent()).unwrap();
+        assert_eq!(r.data(), &[1.0, 0.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn grey_alpha_and_colour_are_converted() {
+        let ga = encode(
+            2,
+            1,
+            png::ColorType::GrayscaleAlpha,
+            png::BitDepth::Eight,
+            &[255, 0, 51, 255],
+        );
+        let r = Raster::from_png_bytes(&ga, extent()).unwrap();
+        assert_eq!(r.data(), &[1.0, 0.2]);
+        let rgb = encode(
+            3,
+            1,
+            png::ColorType::Rgb,
+            png::BitDepth::Eight,
+            &[255, 0, 0, 0, 255, 0, 255, 255, 255],
+        );
+        let r = Raster::from_png_bytes(&rgb, extent()).unwrap();
+        assert!((r.data()[0] - 0.2126).abs() < 1e-6);
+        assert!((r.data()[1] - 0.7152).abs() < 1e-6);
+        assert!((r.data()[2] - 1.0).abs() < 1e-6);
+        let rgba = encode(
+            1,
+            1,
+            png::ColorType::Rgba,
+            png::BitDepth::Eight,
+            &[0, 0, 255, 7],
+        );
+        let r = Raster::from_png_bytes(&rgba, extent()).unwrap();
+        assert!((r.data()[0] - 0.0722).abs() < 1e-6);
+    }
+
+    #[test]
+    fn errors_are_typed() {
+        assert!(matches!(
+            Raster::from_png_bytes(b"not a png", extent()),
+            Err(GeomError::Image(_))
+        ));
+        assert!(matches!(
+            Raster::from_png_bytes(&[], extent()),
+            Err(GeomError::Image(_))
+        ));
+        let good = encode(
+            2,
+            2,
+            png::ColorType::Grayscale,
+            png::BitDepth::Eight,
+            &[1, 2, 3, 4],
+        );
+        // Cuts inside the signature, the header and the image data.
+        for cut in [1, 8, 20, 33, 45] {
+            assert!(
+                matches!(
+                    Raster::from_png_bytes(&good[..cut], extent()),
+                    Err(GeomError::Image(_))
+                ),
+                "cut at {cut}"
+            );
+        }
+        assert!(matches!(
+            Raster::from_png_bytes(&good, Aabb2::EMPTY),
+            Err(GeomError::InvalidParameter { name: "extent", .. })
+        ));
+        let missing = Raster::from_png_path("/nonexistent/polis/map.png", extent()).unwrap_err();
+        assert!(missing.to_string().contains("/nonexistent/polis/map.png"));
+    }
+
+    #[test]
+    fn path_round_trip() {
+        let bytes = encode(
+            2,
+            1,
+            png::ColorType::Grayscale,
+            png::BitDepth::Eight,
+            &[0, 255],
+        );
+        let dir = std::env::temp_dir().join(format!("polis-geom-field-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("map.png");
+        std::fs::write(&path, &bytes).unwrap();
+        let r = Raster::from_png_path(&path, extent()).unwrap();
+        assert_eq!(r.data(), &[0.0, 1.0]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
