@@ -79,6 +79,9 @@ typed_id!(
     ImageId
 );
 
+/// How far from 1 the length of a [`Transform::Trs`] rotation quaternion may be.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
 /// A node's placement relative to its parent (world axes, metres).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Transform {
@@ -131,7 +134,7 @@ impl Transform {
     }
 
     /// Why the transform cannot be exported, if it cannot: non-finite values, a rotation
-    /// that is not a unit quaternion (within 1e-6), a zero scale, a projective or singular
+    /// that is not a unit quaternion (within [`ROTATION_TOLERANCE`]), a zero scale, a projective or singular
     /// matrix.
     fn problem(&self) -> Option<&'static str> {
         match *self {
@@ -142,7 +145,7 @@ impl Transform {
             } => {
                 if !translation.is_finite() || !rotation.is_finite() || !scale.is_finite() {
                     Some("a value is not finite")
-                } else if (rotation.length() - 1.0).abs() > 1e-6 {
+                } else if (rotation.length() - 1.0).abs() > ROTATION_TOLERANCE {
                     Some("the rotation is not a unit quaternion; normalise it")
                 } else if scale.x == 0.0 || scale.y == 0.0 || scale.z == 0.0 {
                     Some("a scale factor is zero")

@@ -105,15 +105,12 @@ impl Mesh {
     }
 
     /// Appends a closed prism: the polygon extruded from elevation `bottom` to `top`
-    /// (metres, `bottom < top`), with walls, a bottom cap facing down and a top cap facing
-    /// up. Holes become courtyards with inward-facing walls.
+    /// (metres, `bottom < top`), with walls ([`add_walls`](Self::add_walls)), a bottom cap
+    /// facing down and a top cap facing up. Holes become courtyards with inward-facing walls.
     ///
     /// The rings are used counter-clockwise (outer) and clockwise (holes) whatever their
     /// given orientation, so the result always has outward normals and positive volume
-    /// equal to area × height. Each wall (ring edge) is one flat-shaded quad with its own
-    /// four vertices: `u` is the distance along the ring from its first vertex, `v` is
-    /// `−elevation`, both in metres, so facade textures tile at true scale and line up
-    /// between stacked prisms.
+    /// equal to area × height.
     ///
     /// # Guarantees
     /// A closed, consistently wound surface ([`Mesh::check_closed`]) with outward normals,
@@ -127,33 +124,51 @@ impl Mesh {
         bottom: f64,
         top: f64,
     ) -> Result<(), GeomError> {
-        check_height("bottom", bottom)?;
-        check_height("top", top)?;
-        if bottom >= top {
-            return Err(GeomError::InvalidParameter {
-                name: "top",
-                reason: format!("top {top} m is not above bottom {bottom} m"),
-            });
-        }
-        let mut poly = polygon.clone();
-        poly.normalize();
+        let poly = normalized_for_walls(polygon, bottom, top)?;
         let triangles = triangulate(&poly)?;
         let mark = self.mark();
-        let result = self.add_prism_parts(&poly, &triangles, bottom, top);
+        let first_triangle = self.triangle_count();
+        self.push_walls(&poly, bottom, top);
+        self.add_cap(&poly, &triangles, |_, _| top, Facing::Up);
+        self.add_cap(&poly, &triangles, |_, _| bottom, Facing::Down);
+        let result = self.check_new_triangles(first_triangle);
         if result.is_err() {
             self.rollback(mark);
         }
         result
     }
 
-    fn add_prism_parts(
+    /// Appends only the walls of [`add_prism`](Self::add_prism): an open tube to close
+    /// with roof faces ([`add_lifted_polygon`](Self::add_lifted_polygon),
+    /// [`add_planar_polygon`](Self::add_planar_polygon) on gable ends) and a floor.
+    ///
+    /// Each wall (ring edge) is one flat-shaded quad with its own four vertices, facing
+    /// outward (rings are used counter-clockwise outer, clockwise holes). Texture
+    /// coordinates: `u` is the distance along the ring from its first vertex, `v` is
+    /// `−elevation`, both in metres, so facade textures tile at true scale, run around
+    /// corners and line up between stacked walls.
+    ///
+    /// Fails, leaving the mesh unchanged, on an invalid polygon or heights.
+    pub fn add_walls(
         &mut self,
-        poly: &PolygonWithHoles,
-        triangles: &[[u32; 3]],
+        polygon: &PolygonWithHoles,
         bottom: f64,
         top: f64,
     ) -> Result<(), GeomError> {
+        let poly = normalized_for_walls(polygon, bottom, top)?;
+        poly.validate()?;
+        let mark = self.mark();
         let first_triangle = self.triangle_count();
+        self.push_walls(&poly, bottom, top);
+        let result = self.check_new_triangles(first_triangle);
+        if result.is_err() {
+            self.rollback(mark);
+        }
+        result
+    }
+
+    /// The wall quads of a normalised, valid polygon.
+    fn push_walls(&mut self, poly: &PolygonWithHoles, bottom: f64, top: f64) {
         for (_, ring) in poly.rings() {
             let mut along = 0.0;
             for (a, b) in ring.edges() {
@@ -182,9 +197,6 @@ impl Mesh {
                 along += len;
             }
         }
-        self.add_cap(poly, triangles, |_, _| top, Facing::Up);
-        self.add_cap(poly, triangles, |_, _| bottom, Facing::Down);
-        self.check_new_triangles(first_triangle)
     }
 
     /// Triangulates `polygon` and appends it as one flat-shaded face, vertex `i` lifted to
@@ -249,7 +261,7 @@ impl Mesh {
     }
 
     /// Checks the triangles from `first` on for zero area after rounding to `f32`.
-    fn check_new_triangles(&self, first: usize) -> Result<(), GeomError> {
+    pub(super) fn check_new_triangles(&self, first: usize) -> Result<(), GeomError> {
         for (t, tri) in self.triangles().enumerate().skip(first) {
             let [a, b, c] = tri.map(|i| self.positions[i as usize]);
             if super::triangle_is_degenerate(a, b, c) {
@@ -259,11 +271,11 @@ impl Mesh {
         Ok(())
     }
 
-    fn mark(&self) -> (usize, usize) {
+    pub(super) fn mark(&self) -> (usize, usize) {
         (self.positions.len(), self.indices.len())
     }
 
-    fn rollback(&mut self, (vertices, indices): (usize, usize)) {
+    pub(super) fn rollback(&mut self, (vertices, indices): (usize, usize)) {
         self.positions.truncate(vertices);
         self.normals.truncate(vertices);
         self.uvs.truncate(vertices);
@@ -281,6 +293,26 @@ fn face_frame(n: DVec3) -> (DVec3, DVec3) {
         t.normalize()
     };
     (t, n.cross(t))
+}
+
+/// Checks the heights and returns the polygon with counter-clockwise outer ring and
+/// clockwise holes.
+fn normalized_for_walls(
+    polygon: &PolygonWithHoles,
+    bottom: f64,
+    top: f64,
+) -> Result<PolygonWithHoles, GeomError> {
+    check_height("bottom", bottom)?;
+    check_height("top", top)?;
+    if bottom >= top {
+        return Err(GeomError::InvalidParameter {
+            name: "top",
+            reason: format!("top {top} m is not above bottom {bottom} m"),
+        });
+    }
+    let mut poly = polygon.clone();
+    poly.normalize();
+    Ok(poly)
 }
 
 fn check_height(name: &'static str, h: f64) -> Result<(), GeomError> {

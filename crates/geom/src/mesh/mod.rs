@@ -30,6 +30,8 @@
 //! * [`triangulate`]: constrained Delaunay triangulation of a [`PolygonWithHoles`].
 //! * [`Mesh::add_flat_polygon`], [`Mesh::add_lifted_polygon`], [`Mesh::add_prism`] (and the
 //!   one-call [`flat_polygon`], [`prism`]): road surfaces, roofs, building blocks.
+//! * [`Mesh::add_walls`] and [`Mesh::add_planar_polygon`] in a [`PlaneFrame`]: open wall
+//!   tubes, gable ends, facades with window openings, any planar face.
 //! * [`Mesh::add_vertex`], [`Mesh::add_triangle`], [`Mesh::add_quad`]: anything else.
 //!
 //! Builders that fail leave the mesh as it was.
@@ -52,9 +54,11 @@ use crate::GeomError;
 use crate::scene::MaterialId;
 
 mod extrude;
+mod planar;
 mod triangulate;
 
 pub use extrude::{Facing, flat_polygon, prism};
+pub use planar::{FRAME_TOLERANCE, PlaneFrame};
 pub use triangulate::triangulate;
 
 /// Maps a layout point `p = (x, y)` at elevation `h` to 3-D world coordinates `(x, h, −y)`.
