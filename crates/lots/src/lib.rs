@@ -29,10 +29,18 @@
 
 pub use polis_geom as geom;
 
+pub mod block;
 mod error;
 pub mod inset;
+pub mod polygon_split;
 pub mod skeleton;
+pub mod subdivision;
 
+pub use block::{Block, BlockParams, Cell, Footpath, TexturedRing, blocks};
 pub use error::LotsError;
 pub use inset::{Inset, InsetRing, InsetShape, inset, inset_shapes, inset_weighted};
+pub use polygon_split::{Region, TaggedRing, split_by_line};
 pub use skeleton::{EdgeRef, SkeletonArc, SkeletonNode, StraightSkeleton};
+pub use subdivision::{
+    DiscardReason, Discarded, Lot, LotParams, LotStrategy, Subdivision, subdivide, subdivide_block,
+};
