@@ -119,6 +119,55 @@ impl Raster {
     }
 }
 
+impl Raster {
+    /// Encodes the raster as a 16-bit grey-scale PNG, mapping `lo` to black and `hi` to
+    /// white (values outside `[lo, hi]` are clamped); the top row is the top of the image.
+    /// Decoding the result with [`from_png_bytes`](Self::from_png_bytes) gives the values
+    /// mapped to `[0, 1]`, to within 1/65535.
+    ///
+    /// Useful to look at generated maps. Errors: [`GeomError::InvalidParameter`] unless
+    /// `lo < hi` are finite; [`GeomError::Image`] if the raster is wider or taller than a
+    /// PNG can be (2³¹ − 1 pixels).
+    pub fn to_png_bytes(&self, lo: f64, hi: f64) -> Result<Vec<u8>, GeomError> {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(GeomError::InvalidParameter {
+                name: "lo/hi",
+                reason: format!("the grey range [{lo}, {hi}] must be finite with lo < hi"),
+            });
+        }
+        let too_big = || {
+            GeomError::Image(format!(
+                "a {} × {} raster is too large for a PNG",
+                self.width(),
+                self.height()
+            ))
+        };
+        let w = u32::try_from(self.width()).map_err(|_| too_big())?;
+        let h = u32::try_from(self.height()).map_err(|_| too_big())?;
+        let scale = 65535.0 / (hi - lo);
+        let pixels: Vec<u8> = self
+            .data()
+            .iter()
+            .flat_map(|&v| {
+                let level = ((f64::from(v) - lo) * scale).round().clamp(0.0, 65535.0) as u16;
+                level.to_be_bytes()
+            })
+            .collect();
+        let encode_error =
+            |e: png::EncodingError| GeomError::Image(format!("PNG encoding failed: {e}"));
+        let mut out = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut out, w, h);
+            encoder.set_color(png::ColorType::Grayscale);
+            encoder.set_depth(png::BitDepth::Sixteen);
+            let mut writer = encoder.write_header().map_err(encode_error)?;
+            writer.write_image_data(&pixels).map_err(encode_error)?;
+            writer.finish().map_err(encode_error)?;
+        }
+        Ok(out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -258,6 +307,29 @@ mod tests {
         ));
         let missing = Raster::from_png_path("/nonexistent/polis/map.png", extent()).unwrap_err();
         assert!(missing.to_string().contains("/nonexistent/polis/map.png"));
+    }
+
+    #[test]
+    fn write_and_read_back() {
+        let r =
+            Raster::from_fn(5, 3, extent(), |c, row| c as f32 * 10.0 - row as f32 * 5.0).unwrap();
+        let bytes = r.to_png_bytes(-10.0, 40.0).unwrap();
+        let back = Raster::from_png_bytes(&bytes, extent()).unwrap();
+        assert_eq!((back.width(), back.height()), (5, 3));
+        for (a, b) in r.data().iter().zip(back.data()) {
+            let expected = (f64::from(*a) + 10.0) / 50.0;
+            assert!(
+                (f64::from(*b) - expected).abs() <= 1.0 / 65535.0,
+                "{a} → {b}"
+            );
+        }
+        // Clamping outside the range, and bad ranges.
+        let clamped =
+            Raster::from_png_bytes(&r.to_png_bytes(0.0, 10.0).unwrap(), extent()).unwrap();
+        assert_eq!(clamped.get(4, 0), Some(1.0));
+        assert_eq!(clamped.get(0, 2), Some(0.0));
+        assert!(r.to_png_bytes(1.0, 1.0).is_err());
+        assert!(r.to_png_bytes(f64::NAN, 1.0).is_err());
     }
 
     #[test]

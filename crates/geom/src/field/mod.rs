@@ -11,11 +11,12 @@
 //! |---|---|
 //! | [`Constant`] | the same value everywhere |
 //! | [`FnField`] | any closure |
-//! | [`Raster`] | an `f32` grid over a world-space box, bilinear; from grey-scale PNG (feature `png`) |
+//! | [`Raster`] | an `f32` grid over a world-space box, bilinear; from/to grey-scale PNG (feature `png`) |
 //! | [`SimplexNoise`] | seeded 2-D simplex noise in `[-1, 1]`, analytic gradient |
 //! | [`Fbm`] | fractal (fBm) sum of simplex octaves, in metres |
 //! | [`Population`] | the layered-simplex `populationAt` of the priority-queue slides |
 //! | [`combinators`] | scale, offset, sum, product, threshold, min, max, clamp, mask, blend, domain transform |
+//! | [`FieldSpec`] | any of the above described as data (serde), built into a `Box<dyn Field>` |
 //!
 //! [`FieldExt`] chains the combinators: `noise.scaled(0.5).offset(0.5).clamped(0.0, 1.0)`.
 //! Fields are used as trait objects (`Box<dyn Field>`, `Arc<dyn Field>`), and `&F`,
@@ -84,6 +85,7 @@ mod image;
 mod noise;
 mod population;
 mod raster;
+mod spec;
 
 pub use combinators::{
     Blend, Clamp, DomainTransform, Mask, Max, Min, Offset, Product, Scaled, Sum, Threshold,
@@ -93,6 +95,7 @@ pub use image::MAX_PNG_DECODED_BYTES;
 pub use noise::{Fbm, FbmParams, MAX_OCTAVES, SimplexNoise};
 pub use population::{Population, PopulationParams};
 pub use raster::Raster;
+pub use spec::FieldSpec;
 
 /// Step, in metres, of the central differences used by the default [`Field::gradient`].
 ///
