@@ -82,10 +82,10 @@ use glam::DVec2;
 pub mod combinators;
 #[cfg(feature = "png")]
 mod image;
-mod noise;
-mod population;
-mod raster;
-mod spec;
+pub mod noise;
+pub mod population;
+pub mod raster;
+pub mod spec;
 
 pub use combinators::{
     Blend, Clamp, DomainTransform, Mask, Max, Min, Offset, Product, Scaled, Sum, Threshold,
