@@ -64,7 +64,8 @@
 //!   not differentiable (raster texel borders, threshold steps, min/max switch lines) the
 //!   gradient is the one of the piece chosen at the point (see each type).
 //! * Noise loses precision far from the origin (beyond ~1e9 noise units) but still returns
-//!   values in `[-1, 1]`.
+//!   values in `[-1, 1]`, or NaN where scaling a finite point into noise units overflows
+//!   (coordinates near `f64::MAX`).
 //!
 //! ## References
 //!
