@@ -1,0 +1,287 @@
+//! Turns the raw sweep results into the public [`CellDecomposition`]: rings with ids and
+//! polygons, filament chains, the containment of whole components (the one geometric
+//! step), and self-contained cells.
+
+use polis_geom::{DVec2, EdgeId, NodeId, PointLocation, Polygon};
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{AABB, RTree};
+
+use crate::eberly::{Owner, Span, Sweep};
+use crate::output::{
+    Cell, CellDecomposition, CellId, ExtractionReport, Filament, FilamentKind, IsolatedNode, Ring,
+};
+use crate::topology::Topology;
+
+fn ring(topo: &Topology, sweep: &Sweep, span: Span) -> Ring {
+    let hs = &sweep.ring_buf[span.start as usize..(span.start + span.len) as usize];
+    let nodes: Vec<NodeId> = hs
+        .iter()
+        .map(|&h| NodeId::from_raw(topo.origin(h)))
+        .collect();
+    let edges: Vec<EdgeId> = hs.iter().map(|&h| EdgeId::from_raw(h >> 1)).collect();
+    let points: Vec<DVec2> = hs.iter().map(|&h| topo.p(topo.origin(h))).collect();
+    Ring {
+        nodes,
+        edges,
+        polygon: Polygon::new(points),
+    }
+}
+
+/// Whether ring `inner` lies inside ring `outer`, given that their interiors are either
+/// nested or disjoint. Exact: locates a node of `inner` that is not a node of `outer`
+/// (a nested ring shares at most one node with its container).
+fn ring_inside(inner: &Ring, outer: &Ring, mark: &mut [bool]) -> bool {
+    for n in &outer.nodes {
+        mark[n.index()] = true;
+    }
+    let probe = inner
+        .nodes
+        .iter()
+        .zip(inner.polygon.points())
+        .find(|(n, _)| !mark[n.index()]);
+    let inside = probe.is_some_and(|(_, &p)| outer.polygon.locate(p) == PointLocation::Inside);
+    for n in &outer.nodes {
+        mark[n.index()] = false;
+    }
+    inside
+}
+
+/// For every connected component, the innermost cycle of another component containing it.
+fn component_containers(
+    topo: &Topology,
+    sweep: &Sweep,
+    boundaries: &[Ring],
+    mark: &mut [bool],
+) -> Vec<Option<u32>> {
+    let mut out = vec![None; sweep.components.len()];
+    if sweep.components.len() < 2 || boundaries.is_empty() {
+        return out;
+    }
+    let tree = RTree::bulk_load(
+        boundaries
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let b = r.polygon.bbox();
+                GeomWithData::new(
+                    Rectangle::from_corners([b.min.x, b.min.y], [b.max.x, b.max.y]),
+                    i as u32,
+                )
+            })
+            .collect(),
+    );
+    let mut found: Vec<u32> = Vec::new();
+    for (k, &v) in sweep.components.iter().enumerate() {
+        let p = topo.p(v);
+        found.clear();
+        found.extend(
+            tree.locate_in_envelope_intersecting(AABB::from_point([p.x, p.y]))
+                .map(|x| x.data)
+                .filter(|&c| boundaries[c as usize].polygon.locate(p) == PointLocation::Inside),
+        );
+        found.sort_unstable();
+        let mut best: Option<u32> = None;
+        for &c in &found {
+            best = Some(match best {
+                Some(b) if !ring_inside(&boundaries[c as usize], &boundaries[b as usize], mark) => {
+                    b
+                }
+                _ => c,
+            });
+        }
+        out[k] = best;
+    }
+    out
+}
+
+/// Maximal chains of filament edges through degree-2 nodes.
+fn filament_chains(
+    topo: &Topology,
+    sweep: &Sweep,
+    resolve: &dyn Fn(Owner) -> Option<u32>,
+) -> Vec<Filament> {
+    let is_fil = |e: u32| {
+        sweep.cycle_uses[e as usize] == 0 && sweep.filament_owner[e as usize] != Owner::Unset
+    };
+    let mut used = vec![false; topo.ends.len()];
+    let mut out = Vec::new();
+    let mut chain = |start_h: u32, used: &mut Vec<bool>| {
+        let mut nodes = vec![topo.origin(start_h)];
+        let mut edges = Vec::new();
+        let mut h = start_h;
+        loop {
+            let e = h >> 1;
+            used[e as usize] = true;
+            edges.push(e);
+            let w = topo.target(h);
+            nodes.push(w);
+            if topo.deg0[w as usize] != 2 || w == nodes[0] {
+                break;
+            }
+            let s = topo.adj_start[w as usize] as usize;
+            let next = if topo.adj[s] == h ^ 1 {
+                topo.adj[s + 1]
+            } else {
+                topo.adj[s]
+            };
+            if !is_fil(next >> 1) || used[(next >> 1) as usize] {
+                break;
+            }
+            h = next;
+        }
+        let (d0, d1) = (
+            topo.deg0[nodes[0] as usize],
+            topo.deg0[nodes[nodes.len() - 1] as usize],
+        );
+        let kind = match (d0 == 1, d1 == 1) {
+            (true, true) => FilamentKind::Free,
+            (false, false) => FilamentKind::Connector,
+            _ => FilamentKind::DeadEnd,
+        };
+        if d0 == 1 && d1 != 1 {
+            nodes.reverse();
+            edges.reverse();
+        }
+        let owner = sweep.filament_owner[edges[0] as usize];
+        out.push(Filament {
+            points: nodes.iter().map(|&n| topo.p(n)).collect(),
+            nodes: nodes.into_iter().map(NodeId::from_raw).collect(),
+            edges: edges.into_iter().map(EdgeId::from_raw).collect(),
+            kind,
+            cell: resolve(owner).map(CellId),
+        });
+    };
+    // Chains start at nodes of degree != 2, in sweep order; what is left are closed
+    // chains of degree-2 nodes, which cannot be filaments but are handled anyway.
+    for pass in 0..2 {
+        for &v in &topo.order {
+            if pass == 0 && topo.deg0[v as usize] == 2 {
+                continue;
+            }
+            let (s, t) = (
+                topo.adj_start[v as usize] as usize,
+                topo.adj_start[v as usize + 1] as usize,
+            );
+            for k in s..t {
+                let h = topo.adj[k];
+                if is_fil(h >> 1) && !used[(h >> 1) as usize] {
+                    chain(h, &mut used);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Builds the decomposition from the sweep's raw results.
+pub(crate) fn assemble(
+    topo: &Topology,
+    sweep: &Sweep,
+    report: ExtractionReport,
+) -> CellDecomposition {
+    let boundaries: Vec<Ring> = sweep
+        .cycles
+        .iter()
+        .map(|c| ring(topo, sweep, c.span))
+        .collect();
+    let mut mark = vec![false; topo.pos.len()];
+    let containers = component_containers(topo, sweep, &boundaries, &mut mark);
+    let resolve = |o: Owner| -> Option<u32> {
+        match o {
+            Owner::Unset => None,
+            Owner::Cell(c) => Some(c),
+            Owner::Outside(k) => containers.get(k as usize).copied().flatten(),
+        }
+    };
+
+    let n = boundaries.len();
+    let mut parents: Vec<Option<u32>> = sweep.cycles.iter().map(|c| resolve(c.parent)).collect();
+    // A parent must precede its child; anything else would be a bug: cut the link.
+    for (i, p) in parents.iter_mut().enumerate() {
+        if p.is_some_and(|p| p as usize >= i) {
+            *p = None;
+        }
+    }
+    let mut depth = vec![0u32; n];
+    let mut children: Vec<Vec<CellId>> = vec![Vec::new(); n];
+    let mut roots = Vec::new();
+    for i in 0..n {
+        match parents[i] {
+            Some(p) => {
+                depth[i] = depth[p as usize] + 1;
+                children[p as usize].push(CellId(i as u32));
+            }
+            None => roots.push(CellId(i as u32)),
+        }
+    }
+
+    let mut holes: Vec<Vec<Ring>> = vec![Vec::new(); n];
+    let mut outlines = Vec::new();
+    for l in &sweep.loops {
+        let r = ring(topo, sweep, l.span);
+        match resolve(l.owner) {
+            Some(c) => holes[c as usize].push(r),
+            None => outlines.push(r),
+        }
+    }
+    let mut fils: Vec<Vec<Filament>> = vec![Vec::new(); n];
+    let mut outer_filaments = Vec::new();
+    for f in filament_chains(topo, sweep, &resolve) {
+        match f.cell {
+            Some(c) => fils[c.index()].push(f),
+            None => outer_filaments.push(f),
+        }
+    }
+    let mut isolated: Vec<Vec<IsolatedNode>> = vec![Vec::new(); n];
+    let mut outer_isolated = Vec::new();
+    for &(v, k) in &sweep.isolated {
+        let cell = resolve(Owner::Outside(k));
+        let node = IsolatedNode {
+            node: NodeId::from_raw(v),
+            point: topo.p(v),
+            cell: cell.map(CellId),
+        };
+        match cell {
+            Some(c) => isolated[c as usize].push(node),
+            None => outer_isolated.push(node),
+        }
+    }
+
+    let mut report = report;
+    report.components = sweep.components.len();
+    report.cycles = n;
+    report.cycle_edges = topo
+        .edge_list
+        .iter()
+        .filter(|&&e| sweep.cycle_uses[e as usize] > 0)
+        .count();
+    report.filament_edges = topo.edge_list.len() - report.cycle_edges;
+
+    let cells = boundaries
+        .into_iter()
+        .zip(holes)
+        .zip(fils)
+        .zip(isolated)
+        .enumerate()
+        .map(
+            |(i, (((boundary, holes), filaments), isolated_nodes))| Cell {
+                id: CellId(i as u32),
+                boundary,
+                parent: parents[i].map(CellId),
+                children: std::mem::take(&mut children[i]),
+                depth: depth[i],
+                holes,
+                filaments,
+                isolated_nodes,
+            },
+        )
+        .collect();
+    CellDecomposition {
+        cells,
+        roots,
+        outer_filaments,
+        outer_isolated_nodes: outer_isolated,
+        outlines,
+        report,
+    }
+}

@@ -1,0 +1,259 @@
+//! Eberly's minimal-cycle-basis sweep on the working graph.
+//!
+//! The vertices are visited in `(x, y)` order. At the leftmost live vertex `v0`, the
+//! clockwise-most edge `v0 → v1` (seen when arriving from straight above) is taken, and
+//! the walk continues by always turning counter-clockwise-most (the sharpest left turn).
+//! That walk runs around the face `F` to the left of `v0 → v1`, which is bounded because
+//! the wedge to the right of that edge at the leftmost vertex is the outside.
+//!
+//! Where Eberly's 2005 text handles revisited vertices with special cases, this
+//! implementation splits the closed walk into simple loops with a stack (a vertex seen
+//! again closes a loop): the loop through `v0 → v1` is the minimal cycle of `F`; every
+//! other loop is either an edge walked both ways (a filament: a dead end, a tree, or a
+//! connector to an island) or a clockwise loop around an island attached to the cycle at a
+//! cut vertex. The cycle's half-edges are marked; then `F` counts as outside, and every
+//! edge with the outside on both sides is removed — the cycle edges no other face needs
+//! and the filaments (Eberly's "filaments detached"). A vertex with no edges left is done.
+//!
+//! The first time the sweep reaches a connected component, the outside of that component
+//! is walked once the same way, which detaches the filaments and finds the islands'
+//! outlines there. Every half-edge is walked once, so after the `O(n log n)` sort the sweep
+//! is linear.
+//!
+//! Containment comes from the walks too: a face entered through the outline of an island
+//! lies directly inside the face that walked that outline, and a face entered through a
+//! cycle edge has the same parent as the cycle's face (same biconnected block). Only a
+//! whole connected component nested in another one needs a geometric test, done later.
+
+use crate::error::Error;
+use crate::topology::{NONE, Topology};
+
+/// Who owns a piece of a walk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Owner {
+    /// Nothing (not walked yet).
+    Unset,
+    /// Cell (minimal cycle) with this index.
+    Cell(u32),
+    /// The outside of connected component with this index; resolved geometrically.
+    Outside(u32),
+}
+
+/// A range of `Sweep::ring_buf`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Span {
+    pub(crate) start: u32,
+    pub(crate) len: u32,
+}
+
+/// A minimal cycle as found by the sweep.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RawCycle {
+    pub(crate) span: Span,
+    pub(crate) parent: Owner,
+}
+
+/// An island outline (clockwise loop) and the face it was walked from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RawLoop {
+    pub(crate) span: Span,
+    pub(crate) owner: Owner,
+}
+
+/// Buffers and raw results of the sweep.
+#[derive(Debug, Default)]
+pub(crate) struct Sweep {
+    /// Half-edge lies on the outside (its left face was walked).
+    out: Vec<bool>,
+    /// For a walked half-edge: the parent of faces entered across it.
+    tag: Vec<Owner>,
+    on_stack: Vec<u32>,
+    stack_v: Vec<u32>,
+    stack_h: Vec<u32>,
+    walk: Vec<u32>,
+    /// How many cycles use each edge.
+    pub(crate) cycle_uses: Vec<u8>,
+    /// For filament edges: the face they lie in.
+    pub(crate) filament_owner: Vec<Owner>,
+    /// Half-edges of all cycles and loops.
+    pub(crate) ring_buf: Vec<u32>,
+    pub(crate) cycles: Vec<RawCycle>,
+    pub(crate) loops: Vec<RawLoop>,
+    /// Leftmost node of every connected component, in sweep order.
+    pub(crate) components: Vec<u32>,
+    /// Isolated nodes with their component index.
+    pub(crate) isolated: Vec<(u32, u32)>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Walking a bounded face that becomes cell `cell`; cycle edges get `parent`.
+    Face { cell: u32, parent: Owner },
+    /// Walking the outside of component `comp`.
+    Outside { comp: u32 },
+}
+
+impl Sweep {
+    fn reset(&mut self, topo: &Topology) {
+        let hcount = topo.nxt.len();
+        let m = topo.ends.len();
+        let n = topo.pos.len();
+        self.out.clear();
+        self.out.resize(hcount, false);
+        self.tag.clear();
+        self.tag.resize(hcount, Owner::Unset);
+        self.on_stack.clear();
+        self.on_stack.resize(n, NONE);
+        self.cycle_uses.clear();
+        self.cycle_uses.resize(m, 0);
+        self.filament_owner.clear();
+        self.filament_owner.resize(m, Owner::Unset);
+        self.ring_buf.clear();
+        self.cycles.clear();
+        self.loops.clear();
+        self.components.clear();
+        self.isolated.clear();
+    }
+
+    /// Runs the sweep over the whole working graph (which it consumes: every edge is
+    /// removed by the end).
+    pub(crate) fn run(&mut self, topo: &mut Topology) -> Result<(), Error> {
+        self.reset(topo);
+        let mut i = 0;
+        while i < topo.order.len() {
+            let v0 = topo.order[i];
+            if topo.deg[v0 as usize] == 0 {
+                if topo.deg0[v0 as usize] == 0 {
+                    let comp = self.components.len() as u32;
+                    self.components.push(v0);
+                    self.isolated.push((v0, comp));
+                }
+                i += 1;
+                continue;
+            }
+            let e1 = topo.clockwise_most(v0);
+            if !self.out[(e1 ^ 1) as usize] {
+                // First visit of this connected component: walk its outside.
+                let comp = self.components.len() as u32;
+                self.components.push(v0);
+                self.walk_and_split(topo, e1 ^ 1, Mode::Outside { comp })?;
+            } else if self.out[e1 as usize] {
+                // Outside on both sides: cannot survive a walk, but never loop on it.
+                topo.remove_edge(e1 >> 1);
+            } else {
+                let cell = self.cycles.len() as u32;
+                let parent = self.tag[(e1 ^ 1) as usize];
+                self.walk_and_split(topo, e1, Mode::Face { cell, parent })?;
+                if self.cycles.len() as u32 != cell + 1 {
+                    return Err(Error::Internal(format!(
+                        "the walk from node {v0} closed no cycle"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Walks the face left of `start` (counter-clockwise-most turns), splits the closed
+    /// walk into loops, records them, marks the walk as outside and removes every edge
+    /// that now has the outside on both sides.
+    fn walk_and_split(&mut self, topo: &mut Topology, start: u32, mode: Mode) -> Result<(), Error> {
+        self.walk.clear();
+        let limit = topo.nxt.len();
+        let mut h = start;
+        loop {
+            self.walk.push(h);
+            // Arriving at the target of h: the sharpest left turn is the edge just
+            // clockwise of the way back.
+            h = topo.prv[(h ^ 1) as usize];
+            if h == start {
+                break;
+            }
+            if h == NONE || self.walk.len() > limit {
+                return Err(Error::Internal(format!(
+                    "the face walk from half-edge {start} does not close"
+                )));
+            }
+        }
+
+        let v0 = topo.origin(start);
+        self.stack_v.clear();
+        self.stack_h.clear();
+        self.stack_v.push(v0);
+        self.on_stack[v0 as usize] = 0;
+        let mut main_done = matches!(mode, Mode::Outside { .. });
+        for k in 0..self.walk.len() {
+            let h = self.walk[k];
+            let w = topo.target(h);
+            let at = self.on_stack[w as usize];
+            if at == NONE {
+                self.on_stack[w as usize] = self.stack_v.len() as u32;
+                self.stack_v.push(w);
+                self.stack_h.push(h);
+                continue;
+            }
+            let at = at as usize;
+            let is_main = !main_done && at == 0;
+            self.close_loop(at, h, mode, is_main);
+            main_done |= is_main;
+            for &v in &self.stack_v[at + 1..] {
+                self.on_stack[v as usize] = NONE;
+            }
+            self.stack_v.truncate(at + 1);
+            self.stack_h.truncate(at);
+        }
+        for &v in &self.stack_v {
+            self.on_stack[v as usize] = NONE;
+        }
+
+        for &h in &self.walk {
+            self.out[h as usize] = true;
+        }
+        for k in 0..self.walk.len() {
+            let h = self.walk[k];
+            if self.out[(h ^ 1) as usize] {
+                topo.remove_edge(h >> 1);
+            }
+        }
+        Ok(())
+    }
+
+    /// Records the loop made of `stack_h[at..]` and the closing half-edge `h`.
+    fn close_loop(&mut self, at: usize, h: u32, mode: Mode, is_main: bool) {
+        let here = match mode {
+            Mode::Face { cell, .. } => Owner::Cell(cell),
+            Mode::Outside { comp } => Owner::Outside(comp),
+        };
+        let len = self.stack_h.len() - at + 1;
+        if len == 2 && self.stack_h[at] == h ^ 1 && !is_main {
+            // An edge walked there and back: a filament edge in this face.
+            self.filament_owner[(h >> 1) as usize] = here;
+            self.tag[h as usize] = here;
+            self.tag[(h ^ 1) as usize] = here;
+            return;
+        }
+        let span = Span {
+            start: self.ring_buf.len() as u32,
+            len: len as u32,
+        };
+        self.ring_buf.extend_from_slice(&self.stack_h[at..]);
+        self.ring_buf.push(h);
+        if is_main {
+            let Mode::Face { parent, .. } = mode else {
+                return;
+            };
+            for k in span.start as usize..self.ring_buf.len() {
+                let x = self.ring_buf[k];
+                self.tag[x as usize] = parent;
+                let uses = &mut self.cycle_uses[(x >> 1) as usize];
+                *uses = uses.saturating_add(1);
+            }
+            self.cycles.push(RawCycle { span, parent });
+        } else {
+            for k in span.start as usize..self.ring_buf.len() {
+                self.tag[self.ring_buf[k] as usize] = here;
+            }
+            self.loops.push(RawLoop { span, owner: here });
+        }
+    }
+}

@@ -1,0 +1,55 @@
+//! [`CellParams`]: the options of cell extraction.
+
+use serde::{Deserialize, Serialize};
+
+/// What to do with two or more nodes at exactly the same position.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum CoincidentNodes {
+    /// Merge them into the one with the smallest id, drop edges that become duplicates,
+    /// and list both in the [`ExtractionReport`](crate::ExtractionReport).
+    #[default]
+    Merge,
+    /// Fail with [`Error::CoincidentNodes`](crate::Error::CoincidentNodes).
+    Reject,
+}
+
+/// Options of [`extract_with`](crate::extract_with) and
+/// [`CellExtractor::extract`](crate::CellExtractor::extract).
+///
+/// Neither option changes the cells of a valid planar graph: they decide how invalid
+/// input is treated and what is checked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CellParams {
+    /// Nodes at exactly the same position (no tolerance: snapping nearby points is the job
+    /// of the graph's planar insertion). Default: [`CoincidentNodes::Merge`].
+    pub coincident_nodes: CoincidentNodes,
+    /// Verify that no two edges cross or overlap and that no node lies inside an edge
+    /// before extracting, and fail with [`Error::NotPlanar`](crate::Error::NotPlanar)
+    /// naming the offending edges. Costs about as much as the extraction itself; switch it
+    /// off only for graphs known to be planar (e.g. built with planar insertion).
+    /// On a non-planar graph without the check the output is unspecified (but no panic).
+    /// Default: `true`.
+    pub check_planarity: bool,
+}
+
+impl Default for CellParams {
+    fn default() -> Self {
+        CellParams {
+            coincident_nodes: CoincidentNodes::Merge,
+            check_planarity: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults() {
+        let p = CellParams::default();
+        assert_eq!(p.coincident_nodes, CoincidentNodes::Merge);
+        assert!(p.check_planarity);
+    }
+}
