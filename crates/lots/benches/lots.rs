@@ -3,7 +3,7 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
-use polis_lots::StraightSkeleton;
+use polis_lots::{LotParams, LotStrategy, Region, StraightSkeleton, Subdivider, TaggedRing};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -11,7 +11,14 @@ fn main() {
     divan::main();
 }
 
-const SIZES: [usize; 4] = [10, 100, 1_000, 10_000];
+/// Polygon sizes: 10, 100, 1,000 and 10,000 vertices, or the comma-separated list in
+/// `LOTS_SIZES` (to time one size alone).
+fn sizes() -> Vec<usize> {
+    std::env::var("LOTS_SIZES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![10, 100, 1_000, 10_000])
+}
 
 /// Points on a circle at random angles: convex.
 fn convex(n: usize) -> PolygonWithHoles {
@@ -63,20 +70,76 @@ fn concave(n: usize) -> PolygonWithHoles {
     Polygon::new(pts).into()
 }
 
-#[divan::bench(args = SIZES)]
+#[divan::bench(args = sizes())]
 fn skeleton_convex(bencher: divan::Bencher<'_, '_>, n: usize) {
     let p = convex(n);
     bencher.bench(|| StraightSkeleton::new(divan::black_box(&p)).unwrap());
 }
 
-#[divan::bench(args = SIZES)]
+#[divan::bench(args = sizes())]
 fn skeleton_star(bencher: divan::Bencher<'_, '_>, n: usize) {
     let p = star(n);
     bencher.bench(|| StraightSkeleton::new(divan::black_box(&p)).unwrap());
 }
 
-#[divan::bench(args = SIZES)]
+#[divan::bench(args = sizes())]
 fn skeleton_concave(bencher: divan::Bencher<'_, '_>, n: usize) {
     let p = concave(n);
     bencher.bench(|| StraightSkeleton::new(divan::black_box(&p)).unwrap());
+}
+
+/// 10,000 Manhattan-size blocks (about 60 × 240 m, sizes and angles jittered).
+fn manhattan_blocks() -> Vec<Region> {
+    let mut rng = Pcg64Mcg::seed_from_u64(4);
+    (0..10_000)
+        .map(|i| {
+            let w = rng.random_range(55.0..65.0);
+            let h = rng.random_range(220.0..260.0);
+            let rot = DVec2::from_angle(rng.random_range(0.0..std::f64::consts::PI));
+            let origin = DVec2::new((i % 100) as f64 * 300.0, (i / 100) as f64 * 300.0);
+            let rect = Polygon::rect(DVec2::ZERO, DVec2::new(w, h));
+            Region {
+                outer: TaggedRing {
+                    points: rect
+                        .points()
+                        .iter()
+                        .map(|&p| origin + rot.rotate(p))
+                        .collect(),
+                    street: vec![true; 4],
+                },
+                holes: vec![],
+            }
+        })
+        .collect()
+}
+
+fn manhattan_params(strategy: LotStrategy) -> LotParams {
+    LotParams {
+        strategy,
+        lot_width: 7.6,
+        lot_depth: 30.0,
+        deviance: 0.2,
+        min_area: 20.0,
+        max_area: 7.6 * 30.0 * 1.3,
+        ..LotParams::default()
+    }
+}
+
+#[divan::bench(args = [LotStrategy::Kelly, LotStrategy::ParishMueller], sample_count = 10)]
+fn subdivide_10000_blocks(bencher: divan::Bencher<'_, '_>, strategy: LotStrategy) {
+    let blocks = manhattan_blocks();
+    let params = manhattan_params(strategy);
+    let mut worker = Subdivider::new();
+    bencher.bench_local(|| {
+        let mut lots = 0;
+        for (i, b) in blocks.iter().enumerate() {
+            let mut rng = Pcg64Mcg::seed_from_u64(i as u64);
+            lots += worker
+                .subdivide(b, i as u64, &params, &mut rng)
+                .unwrap()
+                .lots
+                .len();
+        }
+        lots
+    });
 }

@@ -69,7 +69,7 @@ impl Ord for Event {
 }
 
 /// A potential split: the time a vertex reaches the supporting line of an input edge.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Candidate {
     t: f64,
     edge: u32,
@@ -84,6 +84,20 @@ impl Ord for Candidate {
     fn cmp(&self, other: &Self) -> Ordering {
         self.t.total_cmp(&other.t).then(self.edge.cmp(&other.edge))
     }
+}
+
+/// How many split candidates of one vertex are kept at a time; the next batch is computed
+/// only if all of these turn out not to be real hits.
+const CANDIDATE_BATCH: usize = 12;
+
+/// The next few split candidates of one vertex, sorted.
+#[derive(Debug, Clone, Copy, Default)]
+struct CandidateBatch {
+    items: [Candidate; CANDIDATE_BATCH],
+    len: u8,
+    next: u8,
+    /// Whether the scan found no more candidates than these.
+    complete: bool,
 }
 
 /// One incoming or outgoing wavefront edge at a collapse point.
@@ -107,7 +121,9 @@ pub(crate) struct Engine {
     pub nodes: Vec<SkeletonNode>,
     pub arcs: Vec<SkeletonArc>,
     queue: BinaryHeap<Reverse<Event>>,
-    candidates: Vec<BinaryHeap<Reverse<Candidate>>>,
+    candidates: Vec<CandidateBatch>,
+    /// Per input edge: unit normal x, y, offset `n · a`, weight.
+    lines: Vec<[f64; 4]>,
     /// For each input edge, vertices that started a wavefront piece of it.
     pieces: Vec<Vec<u32>>,
     mark: Vec<u32>,
@@ -137,6 +153,7 @@ impl Engine {
         self.arcs.clear();
         self.queue.clear();
         self.candidates.clear();
+        self.lines.clear();
         self.pieces.clear();
         self.mark.clear();
         self.stamp = 0;
@@ -195,7 +212,12 @@ impl Engine {
             }
         }
         self.candidates
-            .resize_with(self.verts.len(), BinaryHeap::new);
+            .resize(self.verts.len(), CandidateBatch::default());
+        self.lines.extend(
+            self.edges
+                .iter()
+                .map(|e| [e.normal.x, e.normal.y, e.normal.dot(e.a), e.weight]),
+        );
         self.mark.resize(self.verts.len(), 0);
         for v in 0..self.verts.len() as u32 {
             let ein = &self.edges[self.verts[v as usize].in_edge as usize];
@@ -262,7 +284,7 @@ impl Engine {
             node,
             alive: true,
         });
-        self.candidates.push(BinaryHeap::new());
+        self.candidates.push(CandidateBatch::default());
         self.mark.push(0);
         let id = (self.verts.len() - 1) as u32;
         self.vert_mut(prev).next = id;
@@ -308,7 +330,7 @@ impl Engine {
         }));
     }
 
-    /// Computes every input edge line vertex `v` will reach and queues the earliest.
+    /// Finds the input edge lines vertex `v` will reach and queues the earliest.
     fn push_split_candidates(&mut self, v: u32) {
         let x = *self.vert(v);
         if !x.alive || matches!(x.motion, Motion::Fold) {
@@ -321,25 +343,49 @@ impl Engine {
         if self.uniform && !is_reflex(din, dout) {
             return;
         }
+        self.candidates[v as usize] = self.scan_candidates(&x, None);
+        self.push_next_candidate(v);
+    }
+
+    /// The `CANDIDATE_BATCH` earliest hits of vertex `x` on input edge lines after `after`
+    /// (in the order time, then edge).
+    fn scan_candidates(&self, x: &Vertex, after: Option<Candidate>) -> CandidateBatch {
+        let mut batch = CandidateBatch::default();
         let vel = x.velocity();
-        let mut list = std::mem::take(&mut self.candidates[v as usize]);
-        list.clear();
-        let mut heap = list.into_vec();
-        for (i, e) in self.edges.iter().enumerate() {
+        let (px, py) = (x.p0.x, x.p0.y);
+        let mut found = 0usize;
+        // Candidates later than this cannot enter the batch (the horizon, then the batch's
+        // last entry once it is full). Compared without dividing: with `slope < 0`,
+        // `t0 - ahead / slope < limit` iff `ahead < (limit - t0) · (-slope)`.
+        let mut limit = self.horizon;
+        for (i, l) in self.lines.iter().enumerate() {
+            let [nx, ny, c, w] = *l;
+            let slope = nx * vel.x + ny * vel.y - w;
+            if slope >= 0.0 {
+                continue;
+            }
+            let ahead = nx * px + ny * py - c - w * x.t0;
+            if ahead < -self.eps || ahead.max(0.0) > (limit - x.t0) * -slope * (1.0 + 1e-12) {
+                if ahead >= -self.eps {
+                    found += 1;
+                }
+                continue;
+            }
             let i = i as u32;
             if i == x.in_edge || i == x.out_edge {
                 continue;
             }
-            let slope = e.normal.dot(vel) - e.weight;
-            if slope >= 0.0 {
-                continue;
-            }
-            let ahead = e.ahead(x.p0, x.t0);
-            if ahead < -self.eps {
-                continue;
-            }
             let t = x.t0 - ahead.max(0.0) / slope;
             if t.is_nan() || t > self.horizon {
+                continue;
+            }
+            let cand = Candidate { t, edge: i };
+            if after.is_some_and(|a| cand <= a) {
+                continue;
+            }
+            let full = batch.len as usize == CANDIDATE_BATCH;
+            if full && cand >= batch.items[CANDIDATE_BATCH - 1] {
+                found += 1;
                 continue;
             }
             let p = x.p0 + vel * (t - x.t0);
@@ -350,21 +396,51 @@ impl Engine {
             {
                 continue;
             }
-            heap.push(Reverse(Candidate { t, edge: i }));
+            found += 1;
+            // Insertion into the sorted batch, dropping the largest when full.
+            let mut k = if full {
+                CANDIDATE_BATCH - 1
+            } else {
+                batch.len as usize
+            };
+            while k > 0 && batch.items[k - 1] > cand {
+                batch.items[k] = batch.items[k - 1];
+                k -= 1;
+            }
+            batch.items[k] = cand;
+            if !full {
+                batch.len += 1;
+            }
+            if batch.len as usize == CANDIDATE_BATCH {
+                limit = batch.items[CANDIDATE_BATCH - 1].t;
+            }
         }
-        self.candidates[v as usize] = BinaryHeap::from(heap);
-        self.push_next_candidate(v);
+        batch.complete = found <= CANDIDATE_BATCH;
+        batch
     }
 
     fn push_next_candidate(&mut self, v: u32) {
-        if let Some(Reverse(c)) = self.candidates[v as usize].pop() {
-            self.queue.push(Reverse(Event {
-                t: c.t,
-                kind: 1,
-                a: v,
-                b: c.edge,
-            }));
+        let mut b = self.candidates[v as usize];
+        if b.next == b.len {
+            if b.complete || b.len == 0 {
+                return;
+            }
+            let last = b.items[b.len as usize - 1];
+            b = self.scan_candidates(self.vert(v), Some(last));
+            if b.len == 0 {
+                self.candidates[v as usize] = b;
+                return;
+            }
         }
+        let c = b.items[b.next as usize];
+        b.next += 1;
+        self.candidates[v as usize] = b;
+        self.queue.push(Reverse(Event {
+            t: c.t,
+            kind: 1,
+            a: v,
+            b: c.edge,
+        }));
     }
 
     /// Runs events up to and including time `until`. Afterwards `now` is the time of the

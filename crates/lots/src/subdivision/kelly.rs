@@ -1,11 +1,9 @@
 //! Kelly's lot subdivision (Kelly 2008 §4.4.2, Figures 54 and 56).
 
-use std::collections::VecDeque;
-
 use rand::{Rng, RngExt};
 
-use super::{LotParams, Subdivision, finish, longest_edge, split_across};
-use crate::polygon_split::Region;
+use super::Ctx;
+use super::arena::Piece;
 
 /// The upper bound on splits per region: far beyond any real block, it only stops runaway
 /// loops on pathological input.
@@ -20,12 +18,14 @@ pub(crate) fn split_fraction<R: Rng + ?Sized>(
     deviance: f64,
     rng: &mut R,
 ) -> Option<f64> {
-    let factor = (length / size).round();
+    // Both quotients are positive: rounding half up is rounding half away from zero, and
+    // an integer conversion does it without a libm call.
+    let factor = round_positive(length / size);
     if factor < 2.0 {
         return None;
     }
     let fraction = 1.0 / factor;
-    let mid = (factor / 2.0).round() * fraction;
+    let mid = round_positive(factor / 2.0) * fraction;
     let noise = if deviance > 0.0 {
         deviance * (rng.random::<f64>() - 0.5) * fraction
     } else {
@@ -34,54 +34,63 @@ pub(crate) fn split_fraction<R: Rng + ?Sized>(
     Some(mid + noise)
 }
 
-pub(super) fn run<R: Rng + ?Sized>(
-    region: Region,
-    block_id: u64,
-    params: &LotParams,
-    rng: &mut R,
-    out: &mut Subdivision,
-) {
-    let mut queue = VecDeque::from([region]);
+/// `x.round()` for finite `0 <= x < 2^52`.
+fn round_positive(x: f64) -> f64 {
+    ((x + 0.5) as u64) as f64
+}
+
+pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R) {
+    let params = ctx.params;
+    // A FIFO queue: the pseudo-code of Figure 54.
+    ctx.pieces.clear();
+    ctx.pieces.push(region);
+    let mut head = 0;
     let mut splits = 0;
-    while let Some(r) = queue.pop_front() {
-        if !r.has_street() {
-            finish(r, block_id, params, out);
+    while head < ctx.pieces.len() {
+        let r = ctx.pieces[head];
+        head += 1;
+        if !ctx.arena.has_street(r) {
+            ctx.finish(r);
             continue;
         }
         // The longest street edge sets the lot width; failing that, the longest other edge
         // sets the depth.
-        let street = longest_edge(&r.outer, |i| r.outer.street[i]);
-        let mut plan = street.and_then(|(i, len)| {
+        let street = ctx.arena.street(r);
+        let road = ctx.arena.longest_edge(r, |i| street[i]);
+        let mut plan = road.and_then(|(i, len)| {
             split_fraction(len, params.lot_width, params.deviance, rng).map(|t| (i, t))
         });
         if plan.is_none() {
-            let other = longest_edge(&r.outer, |i| !r.outer.street[i]);
+            let street = ctx.arena.street(r);
+            let other = ctx.arena.longest_edge(r, |i| !street[i]);
             plan = other.and_then(|(i, len)| {
                 split_fraction(len, params.lot_depth, params.deviance, rng).map(|t| (i, t))
             });
         }
         let Some((edge, t)) = plan else {
-            finish(r, block_id, params, out);
+            ctx.finish(r);
             continue;
         };
         if splits >= MAX_SPLITS {
-            finish(r, block_id, params, out);
+            ctx.finish(r);
             continue;
         }
         splits += 1;
-        let (a, b) = r.outer.edge(edge);
-        let pieces = split_across(&r, a, b, t);
-        if pieces.len() < 2 {
-            finish(r, block_id, params, out);
-            continue;
-        }
-        for p in pieces {
-            if p.has_street() {
-                queue.push_back(p);
-            } else {
-                finish(p, block_id, params, out);
+        let (a, b) = ctx.arena.edge(r, edge);
+        let mut out = std::mem::take(ctx.scratch);
+        ctx.arena.split_across(r, a, b, t, &mut out);
+        if out.len() < 2 {
+            ctx.finish(r);
+        } else {
+            for &p in &out {
+                if ctx.arena.has_street(p) {
+                    ctx.pieces.push(p);
+                } else {
+                    ctx.finish(p);
+                }
             }
         }
+        *ctx.scratch = out;
     }
 }
 

@@ -19,6 +19,7 @@
 //! * Every piece is a simple polygon; every kept lot has at least one street edge.
 //! * Deterministic: the same input, parameters and generator state give the same lots.
 
+mod arena;
 mod kelly;
 mod parish_mueller;
 
@@ -29,6 +30,7 @@ use serde::{Deserialize, Serialize};
 use crate::LotsError;
 use crate::block::Block;
 use crate::polygon_split::{Region, TaggedRing};
+use arena::{Arena, Piece};
 
 /// Which subdivision algorithm to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -142,6 +144,8 @@ pub enum DiscardReason {
     TooSmall,
     /// Concave, with [`LotParams::discard_concave`] set (Parish & Müller).
     Concave,
+    /// A region whose hole could not be cut away (numerically degenerate input).
+    HoleNotCut,
 }
 
 /// A piece of the block that is not a lot.
@@ -199,18 +203,123 @@ pub fn subdivide<R: Rng + ?Sized>(
     params: &LotParams,
     rng: &mut R,
 ) -> Result<Subdivision, LotsError> {
-    params.validate()?;
-    validate_region(region)?;
-    let mut out = Subdivision::default();
-    let mut simple = Vec::new();
-    cut_holes(region.clone(), &mut simple);
-    for r in simple {
-        match params.strategy {
-            LotStrategy::Kelly => kelly::run(r, block_id, params, rng, &mut out),
-            LotStrategy::ParishMueller => parish_mueller::run(r, block_id, params, rng, &mut out),
-        }
+    Subdivider::new().subdivide(region, block_id, params, rng)
+}
+
+/// A reusable subdivision worker: keeps its buffers between calls.
+#[derive(Debug, Default)]
+pub struct Subdivider {
+    arena: Arena,
+    pieces: Vec<Piece>,
+    scratch: Vec<Piece>,
+}
+
+impl Subdivider {
+    /// A worker with empty buffers.
+    pub fn new() -> Self {
+        Self::default()
     }
-    Ok(out)
+
+    /// Same as [`subdivide`], reusing this worker's buffers.
+    pub fn subdivide<R: Rng + ?Sized>(
+        &mut self,
+        region: &Region,
+        block_id: u64,
+        params: &LotParams,
+        rng: &mut R,
+    ) -> Result<Subdivision, LotsError> {
+        params.validate()?;
+        validate_region(region)?;
+        let mut out = Subdivision::default();
+        let mut simple = Vec::new();
+        cut_holes(region.clone(), &mut simple);
+        self.arena.clear();
+        for r in simple {
+            if !r.holes.is_empty() {
+                let area = r.area();
+                out.discarded.push(Discarded {
+                    polygon: to_polygon(&r),
+                    reason: DiscardReason::HoleNotCut,
+                    area,
+                });
+                continue;
+            }
+            let piece = self.arena.push(&r.outer, None);
+            let mut ctx = Ctx {
+                arena: &mut self.arena,
+                pieces: &mut self.pieces,
+                scratch: &mut self.scratch,
+                block_id,
+                params,
+                out: &mut out,
+            };
+            match params.strategy {
+                LotStrategy::Kelly => kelly::run(&mut ctx, piece, rng),
+                LotStrategy::ParishMueller => parish_mueller::run(&mut ctx, piece, rng),
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// What the strategies work with.
+pub(crate) struct Ctx<'a> {
+    pub arena: &'a mut Arena,
+    pub pieces: &'a mut Vec<Piece>,
+    pub scratch: &'a mut Vec<Piece>,
+    pub block_id: u64,
+    pub params: &'a LotParams,
+    pub out: &'a mut Subdivision,
+}
+
+impl Ctx<'_> {
+    /// Sorts a finished piece into lots, green space or discarded.
+    pub fn finish(&mut self, p: Piece) {
+        let params = self.params;
+        let area = self.arena.area(p);
+        let polygon = || PolygonWithHoles::from(Polygon::new(self.arena.points(p).to_vec()));
+        if !self.arena.has_street(p) {
+            if params.green_space {
+                self.out.green_spaces.push(polygon());
+            } else {
+                self.out.discarded.push(Discarded {
+                    polygon: polygon(),
+                    reason: DiscardReason::NoStreetAccess,
+                    area,
+                });
+            }
+            return;
+        }
+        if area < params.min_area {
+            self.out.discarded.push(Discarded {
+                polygon: polygon(),
+                reason: DiscardReason::TooSmall,
+                area,
+            });
+            return;
+        }
+        if params.strategy == LotStrategy::ParishMueller && params.discard_concave && !p.convex {
+            self.out.discarded.push(Discarded {
+                polygon: polygon(),
+                reason: DiscardReason::Concave,
+                area,
+            });
+            return;
+        }
+        let street_edges = self
+            .arena
+            .street(p)
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &s)| s.then_some(i))
+            .collect();
+        self.out.lots.push(Lot {
+            polygon: Polygon::new(self.arena.points(p).to_vec()),
+            street_edges,
+            block_id: self.block_id,
+            area,
+        });
+    }
 }
 
 fn validate_region(region: &Region) -> Result<(), LotsError> {
@@ -267,12 +376,13 @@ fn cut_holes(region: Region, out: &mut Vec<Region>) {
             out.push(r);
             continue;
         }
-        let Some((i, _)) = longest_edge(hole, |_| true) else {
+        let Some(i) = longest_edge(hole) else {
             out.push(r);
             continue;
         };
         let (a, b) = hole.edge(i);
-        let pieces = split_across(&r, a, b, 0.5);
+        let mid = (a + b) * 0.5;
+        let pieces = crate::polygon_split::split_by_line(&r, mid, mid + (b - a).perp());
         if pieces.len() == 1 && pieces[0].holes.len() == r.holes.len() {
             out.push(r);
             continue;
@@ -281,96 +391,13 @@ fn cut_holes(region: Region, out: &mut Vec<Region>) {
     }
 }
 
-/// The longest edge of a ring among those `filter` accepts: (index, length).
-pub(crate) fn longest_edge(
-    ring: &TaggedRing,
-    filter: impl Fn(usize) -> bool,
-) -> Option<(usize, f64)> {
-    let mut best: Option<(usize, f64)> = None;
-    for i in 0..ring.points.len() {
-        if !filter(i) {
-            continue;
-        }
-        let (a, b) = ring.edge(i);
-        let l = a.distance(b);
-        if best.is_none_or(|(_, bl)| l > bl) {
-            best = Some((i, l));
-        }
-    }
-    best
-}
-
-/// Splits `region` by the line perpendicular to `a → b` through the point at fraction `t`
-/// of the way from `a` to `b`. If a vertex lies (almost) on that line the point is moved a
-/// little along the edge, so the split never runs along an edge or through a vertex.
-pub(crate) fn split_across(region: &Region, a: DVec2, b: DVec2, t: f64) -> Vec<Region> {
-    let d = b - a;
-    let len = d.length();
-    let n = d.perp();
-    let tol = 1e-7 * len;
-    let mut t = t;
-    for attempt in 0..8 {
-        let p = polis_geom::predicates::lerp_stable(a, b, t);
-        let near = region
-            .rings()
-            .flat_map(|r| r.points.iter())
-            .any(|&q| (q - p).dot(d).abs() <= tol * len);
-        if !near || attempt == 7 {
-            return crate::polygon_split::split_by_line(region, p, p + n);
-        }
-        t += 1e-5 * (attempt as f64 + 1.0) * if attempt % 2 == 0 { 1.0 } else { -1.0 };
-    }
-    vec![region.clone()]
-}
-
-use polis_geom::DVec2;
-
-/// Sorts a finished piece into lots, green space or discarded.
-pub(crate) fn finish(region: Region, block_id: u64, params: &LotParams, out: &mut Subdivision) {
-    let area = region.area();
-    let polygon = to_polygon(&region);
-    if !region.has_street() {
-        if params.green_space {
-            out.green_spaces.push(polygon);
-        } else {
-            out.discarded.push(Discarded {
-                polygon,
-                reason: DiscardReason::NoStreetAccess,
-                area,
-            });
-        }
-        return;
-    }
-    if area < params.min_area {
-        out.discarded.push(Discarded {
-            polygon,
-            reason: DiscardReason::TooSmall,
-            area,
-        });
-        return;
-    }
-    if params.strategy == LotStrategy::ParishMueller
-        && params.discard_concave
-        && !polygon.outer.is_convex()
-    {
-        out.discarded.push(Discarded {
-            polygon,
-            reason: DiscardReason::Concave,
-            area,
-        });
-        return;
-    }
-    let street_edges = region
-        .outer
-        .street
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &s)| s.then_some(i))
-        .collect();
-    out.lots.push(Lot {
-        polygon: polygon.outer,
-        street_edges,
-        block_id,
-        area,
-    });
+/// The longest edge of a ring: its index.
+fn longest_edge(ring: &TaggedRing) -> Option<usize> {
+    let n = ring.points.len();
+    (0..n)
+        .map(|i| (ring.edge(i), i))
+        .max_by(|((a0, a1), i), ((b0, b1), j)| {
+            a0.distance(*a1).total_cmp(&b0.distance(*b1)).then(j.cmp(i))
+        })
+        .map(|(_, i)| i)
 }

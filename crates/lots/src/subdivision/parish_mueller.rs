@@ -3,63 +3,60 @@
 
 use rand::{Rng, RngExt};
 
-use super::{LotParams, Subdivision, finish, split_across};
-use crate::polygon_split::Region;
+use super::Ctx;
+use super::arena::Piece;
 
 const MAX_SPLITS: usize = 100_000;
 
-pub(super) fn run<R: Rng + ?Sized>(
-    region: Region,
-    block_id: u64,
-    params: &LotParams,
-    rng: &mut R,
-    out: &mut Subdivision,
-) {
+pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R) {
+    let params = ctx.params;
     let cos_tol = params.parallel_tolerance_deg.to_radians().cos();
-    let mut stack = vec![region];
+    ctx.pieces.clear();
+    ctx.pieces.push(region);
     let mut splits = 0;
-    while let Some(r) = stack.pop() {
-        if r.area() <= params.max_area || splits >= MAX_SPLITS {
-            finish(r, block_id, params, out);
+    while let Some(r) = ctx.pieces.pop() {
+        if ctx.arena.area(r) <= params.max_area || splits >= MAX_SPLITS {
+            ctx.finish(r);
             continue;
         }
-        let ring = &r.outer;
-        let n = ring.points.len();
+        let pts = ctx.arena.points(r);
+        let n = pts.len();
+        let edge = |i: usize| (pts[i], pts[(i + 1) % n]);
         // The longest edge that has a roughly antiparallel partner; else the longest edge.
-        let mut order: Vec<(f64, usize)> = (0..n)
-            .map(|i| {
-                let (a, b) = ring.edge(i);
-                (a.distance(b), i)
-            })
-            .collect();
-        order.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-        let mut choice = None;
-        for &(len, i) in &order {
-            let (a, b) = ring.edge(i);
+        let mut best: Option<(f64, usize)> = None;
+        let mut longest: Option<(f64, usize)> = None;
+        for i in 0..n {
+            let (a, b) = edge(i);
+            let len = a.distance(b);
+            if longest.is_none_or(|(l, _)| len > l) {
+                longest = Some((len, i));
+            }
+            if best.is_some_and(|(l, _)| len <= l) {
+                continue;
+            }
             let d = (b - a) / len;
-            let partner = (0..n)
-                .filter(|&j| j != i)
-                .filter_map(|j| {
-                    let (c, e) = ring.edge(j);
-                    let l = c.distance(e);
-                    let dj = (e - c) / l;
-                    (-d.dot(dj) >= cos_tol).then_some((l, j))
-                })
-                .max_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
-            if partner.is_some() {
-                choice = Some(i);
-                break;
+            let has_partner = (0..n).any(|j| {
+                let (c, e) = edge(j);
+                j != i && -d.dot((e - c).normalize()) >= cos_tol
+            });
+            if has_partner {
+                best = Some((len, i));
             }
         }
-        let i = choice.unwrap_or(order[0].1);
-        let (a, b) = ring.edge(i);
+        let Some((_, i)) = best.or(longest) else {
+            ctx.finish(r);
+            continue;
+        };
+        let (a, b) = edge(i);
         let t = 0.5 + params.deviance * (rng.random::<f64>() - 0.5) * 0.5;
         splits += 1;
-        let pieces = split_across(&r, a, b, t);
-        if pieces.len() < 2 {
-            finish(r, block_id, params, out);
-            continue;
+        let mut out = std::mem::take(ctx.scratch);
+        ctx.arena.split_across(r, a, b, t, &mut out);
+        if out.len() < 2 {
+            ctx.finish(r);
+        } else {
+            ctx.pieces.extend(out.iter().rev());
         }
-        stack.extend(pieces.into_iter().rev());
+        *ctx.scratch = out;
     }
 }
