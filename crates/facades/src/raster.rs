@@ -1,0 +1,356 @@
+//! Texture mode: rasterise a facade (or part of one) into glTF-ready textures.
+//!
+//! * **albedo**: RGBA8, sRGB (glTF `baseColorTexture`);
+//! * **normal**: RGBA8 tangent-space normal map derived from the height field by central
+//!   differences (glTF `normalTexture`, +X right, +Y up, +Z out of the wall); the alpha
+//!   channel carries the height itself, mapped from ±[`HEIGHT_RANGE_M`] to 0–255, for
+//!   relief/parallax mapping as in Kelly §4.4.3.3 (glTF readers ignore it);
+//! * **metallic-roughness**: RGBA8 as glTF expects: G = roughness, B = metalness (R = 255,
+//!   no occlusion; A = 255).
+//!
+//! Rows are swept left to right with one interval cursor per layer, so a texel costs an
+//! amortised O(1) per layer (plus nested layers' binary searches).
+
+use polis_geom::{Aabb2, DVec2};
+use serde::{Deserialize, Serialize};
+
+use crate::MAX_TEXTURE_TEXELS;
+use crate::error::{FacadeError, Result, check_range};
+use crate::facade::Facade;
+use crate::stack::{LayerStack, RowState};
+
+/// Heights in `[−HEIGHT_RANGE_M, +HEIGHT_RANGE_M]` metres map to the normal map's alpha.
+pub const HEIGHT_RANGE_M: f32 = 0.5;
+
+/// How to rasterise.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RasterOptions {
+    /// Texels per metre. Default: 64 (a 1.1 m window is 70 texels wide).
+    pub pixels_per_metre: f64,
+    /// Multiplies the height slopes in the normal map (1 = physical). Default: 1.
+    pub normal_strength: f32,
+}
+
+impl Default for RasterOptions {
+    fn default() -> Self {
+        RasterOptions {
+            pixels_per_metre: 64.0,
+            normal_strength: 1.0,
+        }
+    }
+}
+
+/// Rasterised textures of a facade or of one tile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FacadeTextures {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Size covered, metres.
+    pub size_m: [f64; 2],
+    /// RGBA8 sRGB base colour, rows top-down.
+    pub albedo: Vec<u8>,
+    /// RGBA8 normal map (height in alpha), rows top-down.
+    pub normal: Vec<u8>,
+    /// RGBA8 metallic-roughness (G roughness, B metalness), rows top-down.
+    pub metallic_roughness: Vec<u8>,
+    /// The height field, metres, rows top-down.
+    pub height_m: Vec<f32>,
+}
+
+impl FacadeTextures {
+    /// Bytes held by the three RGBA8 textures (what a GPU would hold).
+    pub fn gpu_bytes(&self) -> usize {
+        self.albedo.len() + self.normal.len() + self.metallic_roughness.len()
+    }
+
+    /// The albedo as a PNG file.
+    ///
+    /// # Errors
+    /// [`FacadeError::Png`].
+    pub fn albedo_png(&self) -> Result<Vec<u8>> {
+        encode_png(self.width, self.height, png::ColorType::Rgba, &self.albedo)
+    }
+
+    /// The normal map (height in alpha) as a PNG file.
+    ///
+    /// # Errors
+    /// [`FacadeError::Png`].
+    pub fn normal_png(&self) -> Result<Vec<u8>> {
+        encode_png(self.width, self.height, png::ColorType::Rgba, &self.normal)
+    }
+
+    /// The metallic-roughness texture as a PNG file.
+    ///
+    /// # Errors
+    /// [`FacadeError::Png`].
+    pub fn metallic_roughness_png(&self) -> Result<Vec<u8>> {
+        encode_png(
+            self.width,
+            self.height,
+            png::ColorType::Rgba,
+            &self.metallic_roughness,
+        )
+    }
+}
+
+/// Encodes 8-bit pixels (rows top-down) as a PNG file.
+///
+/// # Errors
+/// [`FacadeError::Png`] if the data does not match the size or encoding fails.
+pub fn encode_png(width: u32, height: u32, color: png::ColorType, data: &[u8]) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(color);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc
+            .write_header()
+            .map_err(|e| FacadeError::Png(e.to_string()))?;
+        w.write_image_data(data)
+            .map_err(|e| FacadeError::Png(e.to_string()))?;
+        w.finish().map_err(|e| FacadeError::Png(e.to_string()))?;
+    }
+    Ok(out)
+}
+
+#[inline]
+fn to_u8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+/// Rasterises `region` (metres, in the stack's domain) of a stack into `width × height`
+/// texels, multiplying albedo by `tint`.
+///
+/// # Errors
+/// [`FacadeError::InvalidNumber`] for an empty or non-finite region,
+/// [`FacadeError::TextureTooLarge`] above [`MAX_TEXTURE_TEXELS`].
+pub fn rasterize_stack(
+    stack: &LayerStack,
+    region: &Aabb2,
+    width: u32,
+    height: u32,
+    tint: f32,
+    normal_strength: f32,
+) -> Result<FacadeTextures> {
+    let n = u64::from(width) * u64::from(height);
+    if width == 0 || height == 0 || n > MAX_TEXTURE_TEXELS {
+        return Err(FacadeError::TextureTooLarge {
+            width: u64::from(width),
+            height: u64::from(height),
+            limit: MAX_TEXTURE_TEXELS,
+        });
+    }
+    for v in [region.min.x, region.min.y, region.max.x, region.max.y] {
+        check_range(
+            "region coordinate",
+            v,
+            -crate::MAX_LENGTH_M,
+            crate::MAX_LENGTH_M,
+            "[-1e5, 1e5] m",
+        )?;
+    }
+    if !(region.width() > 0.0 && region.height() > 0.0) {
+        return Err(FacadeError::InvalidNumber {
+            what: "region size",
+            value: region.width().min(region.height()),
+            range: "> 0 m",
+        });
+    }
+    check_range(
+        "normal_strength",
+        f64::from(normal_strength),
+        0.0,
+        1e6,
+        "[0, 1e6]",
+    )?;
+    let n = n as usize;
+    let (w, h) = (width as usize, height as usize);
+    let mut albedo = vec![0u8; n * 4];
+    let mut mr = vec![0u8; n * 4];
+    let mut heights = vec![0f32; n];
+    let ds = region.width() / w as f64;
+    let dt = region.height() / h as f64;
+    let mut state = RowState::default();
+    let rows = albedo
+        .chunks_exact_mut(w * 4)
+        .zip(mr.chunks_exact_mut(w * 4))
+        .zip(heights.chunks_exact_mut(w));
+    for (y, ((arow, mrow), hrow)) in rows.enumerate() {
+        let t = region.max.y - (y as f64 + 0.5) * dt;
+        stack.begin_row(t, &mut state);
+        for (x, ((a, m), hh)) in arow
+            .chunks_exact_mut(4)
+            .zip(mrow.chunks_exact_mut(4))
+            .zip(hrow.iter_mut())
+            .enumerate()
+        {
+            let s = region.min.x + (x as f64 + 0.5) * ds;
+            let smp = stack.sample_in_row(s, t, &mut state);
+            a[0] = to_u8(smp.albedo[0] * tint);
+            a[1] = to_u8(smp.albedo[1] * tint);
+            a[2] = to_u8(smp.albedo[2] * tint);
+            a[3] = to_u8(smp.albedo[3]);
+            m[0] = 255;
+            m[1] = to_u8(smp.roughness);
+            m[2] = to_u8(smp.metallic);
+            m[3] = 255;
+            *hh = smp.height;
+        }
+    }
+    let normal = normals_from_heights(&heights, w, h, ds, dt, normal_strength);
+    Ok(FacadeTextures {
+        width,
+        height,
+        size_m: [region.width(), region.height()],
+        albedo,
+        normal,
+        metallic_roughness: mr,
+        height_m: heights,
+    })
+}
+
+/// A tangent-space normal map (RGBA8, height in alpha) from a height field (rows
+/// top-down) with texel sizes `ds` × `dt` metres, by central differences (one-sided at the
+/// borders).
+pub fn normals_from_heights(
+    heights: &[f32],
+    w: usize,
+    h: usize,
+    ds: f64,
+    dt: f64,
+    strength: f32,
+) -> Vec<u8> {
+    let mut out = vec![0u8; w * h * 4];
+    let at = |x: usize, y: usize| heights.get(y * w + x).copied().unwrap_or(0.0);
+    for y in 0..h {
+        let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+        for x in 0..w {
+            let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+            let dhds = (at(x1, y) - at(x0, y)) / (((x1 - x0).max(1)) as f64 * ds) as f32;
+            // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
+            let dhdt = (at(x, y0) - at(x, y1)) / (((y1 - y0).max(1)) as f64 * dt) as f32;
+            let (nx, ny, nz) = (-dhds * strength, -dhdt * strength, 1.0f32);
+            let inv = 1.0 / (nx * nx + ny * ny + nz * nz).sqrt();
+            if let Some(px) = out.get_mut((y * w + x) * 4..(y * w + x) * 4 + 4) {
+                px[0] = to_u8(nx * inv * 0.5 + 0.5);
+                px[1] = to_u8(ny * inv * 0.5 + 0.5);
+                px[2] = to_u8(nz * inv * 0.5 + 0.5);
+                px[3] = to_u8(at(x, y) / (2.0 * HEIGHT_RANGE_M) + 0.5);
+            }
+        }
+    }
+    out
+}
+
+impl Facade {
+    /// Rasterises the whole facade ("hero" mode: one texture per facade).
+    ///
+    /// The size is `round(width · ppm) × round(height · ppm)` texels (at least 1).
+    ///
+    /// # Errors
+    /// [`FacadeError::InvalidNumber`] for a bad resolution;
+    /// [`FacadeError::TextureTooLarge`].
+    pub fn rasterize(&self, opts: &RasterOptions) -> Result<FacadeTextures> {
+        let region = Aabb2::new(
+            DVec2::ZERO,
+            DVec2::new(self.spec().width_m, self.spec().height_m),
+        );
+        self.rasterize_region(&region, opts)
+    }
+
+    /// Rasterises a region of the facade (metres) at the options' resolution.
+    ///
+    /// # Errors
+    /// As [`rasterize`](Self::rasterize).
+    pub fn rasterize_region(&self, region: &Aabb2, opts: &RasterOptions) -> Result<FacadeTextures> {
+        let ppm = check_range(
+            "pixels_per_metre",
+            opts.pixels_per_metre,
+            1e-3,
+            1e4,
+            "[0.001, 10000]",
+        )?;
+        let px = |m: f64| -> Result<u32> {
+            let v = (m * ppm).round().max(1.0);
+            if v > f64::from(u32::MAX) {
+                return Err(FacadeError::TextureTooLarge {
+                    width: v as u64,
+                    height: 1,
+                    limit: MAX_TEXTURE_TEXELS,
+                });
+            }
+            Ok(v as u32)
+        };
+        rasterize_stack(
+            self.stack(),
+            region,
+            px(region.width())?,
+            px(region.height())?,
+            self.tint(),
+            opts.normal_strength,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::builtin;
+    use crate::facade::{FacadeSpec, PreparedStyle};
+
+    #[test]
+    fn raster_matches_point_evaluation() {
+        let p = PreparedStyle::new(builtin::brick_house()).unwrap();
+        let f = p.facade(&FacadeSpec::new(9.0, 7.0, 11)).unwrap();
+        let tex = f.rasterize(&RasterOptions::default()).unwrap();
+        assert_eq!((tex.width, tex.height), (576, 448));
+        let ds = 9.0 / 576.0;
+        let dt = 7.0 / 448.0;
+        for (x, y) in [(0, 0), (100, 200), (575, 447), (300, 30), (288, 400)] {
+            let s = (x as f64 + 0.5) * ds;
+            let t = 7.0 - (y as f64 + 0.5) * dt;
+            let m = f.sample(s, t);
+            let k = (y * 576 + x) * 4;
+            assert_eq!(tex.albedo[k], to_u8(m.albedo[0]), "({x},{y})");
+            assert_eq!(tex.metallic_roughness[k + 1], to_u8(m.roughness));
+            assert_eq!(tex.height_m[y * 576 + x], m.height);
+        }
+    }
+
+    #[test]
+    fn flat_heights_give_straight_normals_and_steps_tilt_them() {
+        let flat = normals_from_heights(&[0.0; 9], 3, 3, 0.1, 0.1, 1.0);
+        assert!(
+            flat.chunks(4)
+                .all(|p| p[0] == 128 && p[1] == 128 && p[2] == 255)
+        );
+        // Height rising to the right: the normal leans left (x < 0.5).
+        let ramp = normals_from_heights(&[0.0, 0.1, 0.2, 0.0, 0.1, 0.2], 3, 2, 0.1, 0.1, 1.0);
+        assert!(ramp[4] < 128);
+        // Height rising upwards (row 0 is the top): normal leans down (y < 0.5).
+        let up = normals_from_heights(&[0.2, 0.2, 0.0, 0.0], 2, 2, 0.1, 0.1, 1.0);
+        assert!(up[1] < 128);
+    }
+
+    #[test]
+    fn limits_and_bad_options() {
+        let p = PreparedStyle::new(builtin::industrial()).unwrap();
+        let f = p.facade(&FacadeSpec::new(30.0, 8.0, 1)).unwrap();
+        let bad = RasterOptions {
+            pixels_per_metre: f64::NAN,
+            ..RasterOptions::default()
+        };
+        assert!(f.rasterize(&bad).is_err());
+        let huge = RasterOptions {
+            pixels_per_metre: 9000.0,
+            ..RasterOptions::default()
+        };
+        assert!(matches!(
+            f.rasterize(&huge),
+            Err(FacadeError::TextureTooLarge { .. })
+        ));
+    }
+}

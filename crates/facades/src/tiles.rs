@@ -1,0 +1,317 @@
+//! Shared tile sets: bounded texture memory at city scale.
+//!
+//! Parish & Müller texture with "a semi-procedural approach [...] to keep memory usage
+//! small"; Kelly (§4.4.3.3, §5.6) applies *building tiles* with "a best fit algorithm
+//! [that] aims to match the tiles dimensions without splitting or dividing a tile". Here a
+//! style is rasterised once, on a prototype facade of `bays × floors` modules, and cut
+//! along its interval groups into at most nine tiles — the 3 × 3 combinations of the
+//! column parts (start margin, repeated bays, end margin) and the row parts (ground floor
+//! and plinth, repeated storeys, cornice and attic) — plus an entrance tile (one bay of
+//! the street-front ground floor). Every facade of the style is then covered by a handful
+//! of quads whose UVs repeat those tiles a whole number of modules: a repeated region of
+//! `n` bays shows the `bays`-wide tile `n / bays` times, which always ends on a module
+//! boundary, so no window is ever cut. Modules stretched by the fit stretch their tile
+//! accordingly.
+//!
+//! Limitations: layers that do not follow the primary grid (own axes, centred doors) are
+//! seen in the tiles as they fall on the prototype; per-cell random images repeat with the
+//! tile's period; inter-layer influences of the entrance apply only inside its tile.
+
+use polis_geom::{Aabb2, DVec2};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{FacadeError, Result};
+use crate::facade::{Facade, FacadeSpec, FaceRole, PreparedStyle};
+use crate::interval::{IntervalGroup, Part};
+use crate::raster::{FacadeTextures, RasterOptions};
+
+/// How a style's tile set is cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TileOptions {
+    /// Bays (column modules) per repeated tile. Default: 3.
+    pub bays: u32,
+    /// Storeys (row modules) per repeated tile. Default: 2.
+    pub floors: u32,
+}
+
+impl Default for TileOptions {
+    fn default() -> Self {
+        TileOptions { bays: 3, floors: 2 }
+    }
+}
+
+impl TileOptions {
+    /// Checks the counts (1..=64).
+    ///
+    /// # Errors
+    /// [`FacadeError::InvalidStyle`].
+    pub fn validate(&self) -> Result<()> {
+        if (1..=64).contains(&self.bays) && (1..=64).contains(&self.floors) {
+            Ok(())
+        } else {
+            Err(FacadeError::InvalidStyle {
+                style: "tiles".into(),
+                reason: "tile bays and floors must be in 1..=64".into(),
+            })
+        }
+    }
+}
+
+/// One tile of a [`TileSet`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tile {
+    /// Column part it covers.
+    pub cols: Part,
+    /// Row part it covers.
+    pub rows: Part,
+    /// Whether it is the entrance tile (one bay of the street-front ground floor).
+    pub entrance: bool,
+    /// Modules across (bays for repeated columns, else 1).
+    pub modules_u: u32,
+    /// Modules up (storeys for repeated rows, else 1).
+    pub modules_v: u32,
+    /// The textures.
+    pub textures: FacadeTextures,
+}
+
+/// The shared tiles of one style.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TileSet {
+    /// Style name.
+    pub style: String,
+    /// The tiles.
+    pub tiles: Vec<Tile>,
+}
+
+/// A quad of a facade textured with one tile.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TileQuad {
+    /// The rectangle on the facade, metres.
+    pub rect: Aabb2,
+    /// Index of the tile in the [`TileSet`].
+    pub tile: usize,
+    /// Tile repetitions across and up (whole modules: `n / bays`), to be used with a
+    /// repeating sampler.
+    pub repeats: [f64; 2],
+}
+
+impl TileQuad {
+    /// glTF texture coordinates at facade point `(s, t)` (u right, v down, image row 0 at
+    /// v = 0; the tile's top edge at v = 0, the quad's bottom at v = `repeats[1]`).
+    pub fn uv_at(&self, s: f64, t: f64) -> [f64; 2] {
+        let u = (s - self.rect.min.x) / self.rect.width() * self.repeats[0];
+        let v_up = (t - self.rect.min.y) / self.rect.height() * self.repeats[1];
+        [u, self.repeats[1].ceil() - v_up]
+    }
+}
+
+fn parts(g: &IntervalGroup) -> Vec<(Part, f64, f64)> {
+    [Part::Start, Part::Repeat, Part::End]
+        .into_iter()
+        .filter_map(|p| g.part_range(p).map(|(a, b)| (p, a, b)))
+        .collect()
+}
+
+impl TileSet {
+    /// Rasterises the tiles of a style at the given resolution.
+    ///
+    /// # Errors
+    /// Style errors, and rasterisation errors for bad options.
+    pub fn build(style: &PreparedStyle, opts: &RasterOptions) -> Result<TileSet> {
+        let st = style.style();
+        let to = st.tiles;
+        let rows_floors = st.rows.fixed_floors() + to.floors * st.rows.module_floors();
+        let spec = FacadeSpec {
+            width_m: st.columns.nominal_length(to.bays),
+            height_m: st.rows.nominal_length(to.floors),
+            floors: (st.rows.module_floors() > 0).then_some(rows_floors),
+            role: FaceRole::Side,
+            seed: 0x0711_75E7,
+        };
+        let proto = style.facade(&spec)?;
+        let mut tiles = Vec::new();
+        for &(rp, y0, y1) in &parts(proto.rows()) {
+            for &(cp, x0, x1) in &parts(proto.columns()) {
+                let region = Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1));
+                tiles.push(Tile {
+                    cols: cp,
+                    rows: rp,
+                    entrance: false,
+                    modules_u: if cp == Part::Repeat {
+                        proto.columns().repeat_count()
+                    } else {
+                        1
+                    },
+                    modules_v: if rp == Part::Repeat {
+                        proto.rows().repeat_count()
+                    } else {
+                        1
+                    },
+                    textures: proto.rasterize_region(&region, opts)?,
+                });
+            }
+        }
+        // The entrance: the middle bay of a street-front prototype's ground rows.
+        let street = style.facade(&FacadeSpec {
+            role: FaceRole::Street,
+            ..spec
+        })?;
+        if street.stack().layers().len() > proto.stack().layers().len()
+            && let (Some((y0, y1)), Some((x0, x1))) = (
+                street.rows().part_range(Part::Start),
+                street
+                    .columns()
+                    .repeat_range(street.columns().repeat_count() / 2),
+            )
+        {
+            let region = Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1));
+            tiles.push(Tile {
+                cols: Part::Repeat,
+                rows: Part::Start,
+                entrance: true,
+                modules_u: 1,
+                modules_v: 1,
+                textures: street.rasterize_region(&region, opts)?,
+            });
+        }
+        Ok(TileSet {
+            style: st.name.clone(),
+            tiles,
+        })
+    }
+
+    /// Bytes of texture memory the whole set holds.
+    pub fn gpu_bytes(&self) -> usize {
+        self.tiles.iter().map(|t| t.textures.gpu_bytes()).sum()
+    }
+
+    fn find(&self, cols: Part, rows: Part, entrance: bool) -> Option<usize> {
+        self.tiles
+            .iter()
+            .position(|t| t.cols == cols && t.rows == rows && t.entrance == entrance)
+    }
+}
+
+impl Facade {
+    /// Covers the facade with quads of a shared [`TileSet`] of its style: one per present
+    /// (column part × row part), the ground strip of a street front split around the
+    /// entrance bay. Regions whose tile is missing (a facade with margins the prototype
+    /// lacked) are skipped; blank faces get no quads.
+    pub fn tile_quads(&self, set: &TileSet) -> Vec<TileQuad> {
+        let mut out = Vec::new();
+        if self.report().blank_columns || self.report().blank_rows {
+            return out;
+        }
+        let cols = self.columns();
+        let rows = self.rows();
+        let tile_mod = |k: usize| {
+            set.tiles
+                .get(k)
+                .map_or([1, 1], |t| [t.modules_u, t.modules_v])
+        };
+        let n_cols = cols.repeat_count();
+        let n_rows = rows.repeat_count();
+        let has_entrance = self.spec().role == FaceRole::Street
+            && set.find(Part::Repeat, Part::Start, true).is_some();
+        for &(rp, y0, y1) in &parts(rows) {
+            for &(cp, x0, x1) in &parts(cols) {
+                let Some(k) = set.find(cp, rp, false) else {
+                    continue;
+                };
+                let [mu, mv] = tile_mod(k);
+                let reps = |part: Part, n: u32, m: u32| {
+                    if part == Part::Repeat {
+                        f64::from(n) / f64::from(m)
+                    } else {
+                        1.0
+                    }
+                };
+                let rv = reps(rp, n_rows, mv);
+                if has_entrance && cp == Part::Repeat && rp == Part::Start {
+                    let mid = n_cols / 2;
+                    let e = set.find(Part::Repeat, Part::Start, true).unwrap_or(k);
+                    if let Some((ex0, ex1)) = cols.repeat_range(mid) {
+                        let rect =
+                            |a: f64, b: f64| Aabb2::new(DVec2::new(a, y0), DVec2::new(b, y1));
+                        if mid > 0 {
+                            out.push(TileQuad {
+                                rect: rect(x0, ex0),
+                                tile: k,
+                                repeats: [f64::from(mid) / f64::from(mu), rv],
+                            });
+                        }
+                        out.push(TileQuad {
+                            rect: rect(ex0, ex1),
+                            tile: e,
+                            repeats: [1.0, 1.0],
+                        });
+                        let right = n_cols - mid - 1;
+                        if right > 0 {
+                            out.push(TileQuad {
+                                rect: rect(ex1, x1),
+                                tile: k,
+                                repeats: [f64::from(right) / f64::from(mu), rv],
+                            });
+                        }
+                        continue;
+                    }
+                }
+                out.push(TileQuad {
+                    rect: Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1)),
+                    tile: k,
+                    repeats: [reps(cp, n_cols, mu), rv],
+                });
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::builtin;
+
+    #[test]
+    fn quads_cover_the_facade_once_with_whole_modules() {
+        for style in builtin::builtin_styles() {
+            let p = PreparedStyle::new(style).unwrap();
+            let set = TileSet::build(
+                &p,
+                &RasterOptions {
+                    pixels_per_metre: 16.0,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            assert!(set.tiles.len() <= 10, "{} tiles", set.tiles.len());
+            for (w, h) in [(9.0, 8.0), (23.5, 14.2), (41.0, 60.0)] {
+                let f = p.facade(&FacadeSpec::new(w, h, 4)).unwrap();
+                if f.report().blank_columns || f.report().blank_rows {
+                    continue;
+                }
+                let quads = f.tile_quads(&set);
+                let area: f64 = quads.iter().map(|q| q.rect.area()).sum();
+                assert!(
+                    (area - w * h).abs() < 1e-6 * w * h,
+                    "{}: {area} vs {}",
+                    set.style,
+                    w * h
+                );
+                for q in &quads {
+                    let t = &set.tiles[q.tile];
+                    // Repeats are whole modules: repeats × tile modules is an integer.
+                    for (r, m) in [(q.repeats[0], t.modules_u), (q.repeats[1], t.modules_v)] {
+                        let modules = r * f64::from(m);
+                        assert!(
+                            (modules - modules.round()).abs() < 1e-9,
+                            "{} cut a module",
+                            set.style
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
