@@ -4,7 +4,7 @@
 
 use divan::counter::ItemsCount;
 use divan::{Bencher, black_box};
-use polis_geom::mesh::prism;
+use polis_geom::mesh::{Facing, Mesh, RefineOptions, prism};
 use polis_geom::{DVec2, Polygon, PolygonWithHoles, triangulate};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -89,4 +89,23 @@ fn prism_star_10k(bencher: Bencher<'_, '_>) {
     bencher
         .counter(ItemsCount::new(10_000usize))
         .bench(|| prism(black_box(&p), 0.0, 12.0, None));
+}
+
+/// A 100 × 100 m block refined to triangles of at most 25 m² and draped on a smooth
+/// elevation function (counter: blocks/s).
+#[divan::bench]
+fn drape_block_1ha(bencher: Bencher<'_, '_>) {
+    let p: PolygonWithHoles = Polygon::rect(DVec2::ZERO, DVec2::splat(100.0)).into();
+    let options = RefineOptions::default();
+    bencher.counter(ItemsCount::new(1usize)).bench(|| {
+        let mut m = Mesh::new(None);
+        m.add_draped_polygon(
+            black_box(&p),
+            &options,
+            |q| 0.05 * q.x + (0.1 * q.y).sin(),
+            0.0,
+            Facing::Up,
+        )
+        .map(|()| m)
+    });
 }

@@ -3,7 +3,9 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{HORIZONTAL_FACE_TOLERANCE, Mesh, to_world, triangulate};
+use super::{
+    HORIZONTAL_FACE_TOLERANCE, Mesh, RefineOptions, to_world, triangulate, triangulate_refined,
+};
 use crate::scene::MaterialId;
 use crate::{GeomError, MAX_COORDINATE, PolygonWithHoles};
 
@@ -102,6 +104,69 @@ impl Mesh {
             check_height("heights", h)?;
         }
         self.add_polygon_with(polygon, |i, _| heights[i], facing)
+    }
+
+    /// Appends the polygon as a surface draped on the elevation function `height` (metres
+    /// above the layout point): a road or a block on terrain.
+    ///
+    /// The polygon is triangulated with [`triangulate_refined`] (so the surface has
+    /// vertices inside to follow the ground, at most `options.max_area` m² per triangle),
+    /// every vertex is lifted to `height(p) + offset`, and normals are smooth: the
+    /// area-weighted average of the incident triangles' normals, on the side given by
+    /// `facing`. Texture coordinates are the layout position (`(x, −y)` facing up), in
+    /// metres on the map, so they stretch on steep slopes.
+    ///
+    /// Fails, leaving the mesh unchanged, on an invalid polygon or options, or a height
+    /// that is not finite or out of range.
+    pub fn add_draped_polygon(
+        &mut self,
+        polygon: &PolygonWithHoles,
+        options: &RefineOptions,
+        height: impl Fn(DVec2) -> f64,
+        offset: f64,
+        facing: Facing,
+    ) -> Result<(), GeomError> {
+        let refined = triangulate_refined(polygon, options)?;
+        let mut world = Vec::with_capacity(refined.points.len());
+        for &p in &refined.points {
+            let h = height(p) + offset;
+            check_height("height", h)?;
+            world.push(to_world(p, h));
+        }
+        let mut normals = vec![DVec3::ZERO; world.len()];
+        for t in &refined.triangles {
+            let [a, b, c] = t.map(|i| world[i as usize]);
+            let n = (b - a).cross(c - a);
+            for &i in t {
+                normals[i as usize] += n;
+            }
+        }
+        let sign = match facing {
+            Facing::Up => 1.0,
+            Facing::Down => -1.0,
+        };
+        let mark = self.mark();
+        let first_triangle = self.triangle_count();
+        let base = self.positions.len() as u32;
+        for ((&w, &n), &p) in world.iter().zip(&normals).zip(&refined.points) {
+            let uv = match facing {
+                Facing::Up => DVec2::new(p.x, -p.y),
+                Facing::Down => p,
+            };
+            self.add_vertex(w, sign * n.normalize_or(DVec3::Y), uv);
+        }
+        for t in &refined.triangles {
+            let [a, b, c] = t.map(|i| base + i);
+            match facing {
+                Facing::Up => self.indices.extend_from_slice(&[a, b, c]),
+                Facing::Down => self.indices.extend_from_slice(&[a, c, b]),
+            }
+        }
+        let result = self.check_new_triangles(first_triangle);
+        if result.is_err() {
+            self.rollback(mark);
+        }
+        result
     }
 
     /// Appends a closed prism: the polygon extruded from elevation `bottom` to `top`
@@ -441,6 +506,47 @@ mod tests {
                 .is_err()
         );
         assert_eq!(roof.triangle_count(), 2);
+    }
+
+    #[test]
+    fn draped_surface_follows_the_ground() {
+        // A road 8 m wide, 100 m long, on a slope of 5 % along x with a bump.
+        let road: PolygonWithHoles = Polygon::rect(DVec2::ZERO, DVec2::new(100.0, 8.0)).into();
+        let ground = |p: DVec2| 0.05 * p.x + (p.x * 0.1).sin();
+        let options = RefineOptions {
+            max_area: 4.0,
+            ..RefineOptions::default()
+        };
+        let mut m = Mesh::new(None);
+        m.add_draped_polygon(&road, &options, ground, 0.1, Facing::Up)
+            .unwrap();
+        m.validate().unwrap();
+        assert!(m.vertex_count() > 50);
+        for (p, n) in m.positions.iter().zip(&m.normals) {
+            let (lay, h) = super::super::to_layout(p.as_dvec3());
+            assert!((h - ground(lay) - 0.1).abs() < 1e-4);
+            assert!(n.y > 0.9, "normal {n} does not face up");
+        }
+        // Its plan area is the road's.
+        let plan: f64 = m
+            .triangles()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
+                0.5 * (b - a).cross(c - a).y
+            })
+            .sum();
+        assert!((plan - 800.0).abs() < 1e-2, "plan area {plan}");
+        let before = m.clone();
+        assert!(
+            m.add_draped_polygon(&road, &options, |_| f64::NAN, 0.0, Facing::Up)
+                .is_err()
+        );
+        assert_eq!(m, before);
+        let mut under = Mesh::new(None);
+        under
+            .add_draped_polygon(&road, &options, ground, 0.0, Facing::Down)
+            .unwrap();
+        assert!(under.normals.iter().all(|n| n.y < -0.9));
     }
 
     proptest! {

@@ -27,9 +27,12 @@
 //!
 //! ## Builders
 //!
-//! * [`triangulate`]: constrained Delaunay triangulation of a [`PolygonWithHoles`].
+//! * [`triangulate`]: constrained Delaunay triangulation of a [`PolygonWithHoles`];
+//!   [`triangulate_refined`] adds vertices for small, well-shaped triangles.
 //! * [`Mesh::add_flat_polygon`], [`Mesh::add_lifted_polygon`], [`Mesh::add_prism`] (and the
 //!   one-call [`flat_polygon`], [`prism`]): road surfaces, roofs, building blocks.
+//! * [`Mesh::add_draped_polygon`]: a refined, smooth-shaded surface following an elevation
+//!   function (roads and blocks on terrain).
 //! * [`Mesh::add_walls`] and [`Mesh::add_planar_polygon`] in a [`PlaneFrame`]: open wall
 //!   tubes, gable ends, facades with window openings, any planar face.
 //! * [`Mesh::add_vertex`], [`Mesh::add_triangle`], [`Mesh::add_quad`]: anything else.
@@ -46,6 +49,7 @@
 //!   vertex pass.
 //!
 //! [`Polygon::translated`]: crate::Polygon::translated
+//! [`PolygonWithHoles`]: crate::PolygonWithHoles
 
 use glam::{DMat3, DMat4, DVec2, DVec3, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -59,7 +63,7 @@ mod triangulate;
 
 pub use extrude::{Facing, flat_polygon, prism};
 pub use planar::{FRAME_TOLERANCE, PlaneFrame};
-pub use triangulate::triangulate;
+pub use triangulate::{RefineOptions, RefinedTriangulation, triangulate, triangulate_refined};
 
 /// Maps a layout point `p = (x, y)` at elevation `h` to 3-D world coordinates `(x, h, −y)`.
 ///

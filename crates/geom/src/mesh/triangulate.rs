@@ -2,8 +2,12 @@
 
 use std::collections::VecDeque;
 
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
 use spade::handles::{FixedFaceHandle, InnerTag};
-use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use spade::{
+    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
+};
 
 use crate::{GeomError, PolygonWithHoles};
 
@@ -48,6 +52,135 @@ use crate::{GeomError, PolygonWithHoles};
 /// spade's `ConstrainedDelaunayTriangulation` (Stoeoef/spade), which decides every
 /// orientation and in-circle test exactly.
 pub fn triangulate(polygon: &PolygonWithHoles) -> Result<Vec<[u32; 3]>, GeomError> {
+    let cdt = constrained(polygon)?;
+    let total = cdt.num_vertices();
+    let depth = constraint_depth(&cdt);
+    let mut triangles = Vec::with_capacity(total + 2 * polygon.holes.len());
+    for face in cdt.inner_faces() {
+        if depth.get(face.index()).is_some_and(|d| d % 2 == 1) {
+            // spade lists a face's vertices counter-clockwise; vertex indices are input
+            // indices because the bulk loader keeps the order of distinct vertices.
+            triangles.push(face.vertices().map(|v| v.fix().index() as u32));
+        }
+    }
+    Ok(triangles)
+}
+
+/// Options of [`triangulate_refined`]: how fine the triangles must be.
+///
+/// These are *how* knobs of a mesh, not of the city's layout: they change the number of
+/// vertices of a surface, never its outline.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RefineOptions {
+    /// The largest triangle area, in m². Default: 25 (about 7 m sides), fine enough to
+    /// follow a terrain sampled every 10 m.
+    pub max_area: f64,
+    /// The smallest angle, in degrees, that refinement tries to keep (values above about
+    /// 30 may not terminate and hit `max_additional_vertices`). Default: 25.
+    pub min_angle_deg: f64,
+    /// The most vertices refinement may add, a guard against run-away refinement.
+    /// Default: 1,000,000.
+    pub max_additional_vertices: usize,
+}
+
+impl Default for RefineOptions {
+    fn default() -> Self {
+        RefineOptions {
+            max_area: 25.0,
+            min_angle_deg: 25.0,
+            max_additional_vertices: 1_000_000,
+        }
+    }
+}
+
+/// A triangulation with added (Steiner) vertices, from [`triangulate_refined`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RefinedTriangulation {
+    /// The vertices: the polygon's, ring by ring as in [`triangulate`], then the added ones.
+    pub points: Vec<DVec2>,
+    /// Counter-clockwise triangles, indices into `points`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Whether refinement met the options before running out of additional vertices.
+    pub complete: bool,
+}
+
+/// Triangulates a polygon with holes and refines the triangles until none is larger than
+/// `options.max_area` and (as far as possible) none has an angle below
+/// `options.min_angle_deg`, adding vertices inside and on the boundary (boundary edges are
+/// split, never moved). For surfaces draped on an elevation field
+/// ([`Mesh::add_draped_polygon`](super::Mesh::add_draped_polygon)) and any mesh that needs
+/// well-shaped triangles.
+///
+/// # Guarantees
+/// The triangles cover exactly the polygon (the sum of their areas is its area), run
+/// counter-clockwise and have no zero area; the polygon's vertices come first, in ring
+/// order. Deterministic for a given spade version (pinned exactly in the workspace:
+/// spade may change its refinement order in patch releases).
+///
+/// # Errors
+/// As [`triangulate`]; [`GeomError::InvalidParameter`] for a `max_area` that is not
+/// positive and finite or a `min_angle_deg` outside `[0, 60)`.
+///
+/// # References
+/// J. Ruppert, *A Delaunay refinement algorithm for quality 2-dimensional mesh
+/// generation*, J. Algorithms 18 (1995); spade's `refine`.
+pub fn triangulate_refined(
+    polygon: &PolygonWithHoles,
+    options: &RefineOptions,
+) -> Result<RefinedTriangulation, GeomError> {
+    if !(options.max_area > 0.0 && options.max_area.is_finite()) {
+        return Err(GeomError::InvalidParameter {
+            name: "max_area",
+            reason: format!("{} m² is not a positive finite area", options.max_area),
+        });
+    }
+    if !(0.0..60.0).contains(&options.min_angle_deg) {
+        return Err(GeomError::InvalidParameter {
+            name: "min_angle_deg",
+            reason: format!("{}° is outside [0, 60)", options.min_angle_deg),
+        });
+    }
+    let mut cdt = constrained(polygon)?;
+    let params = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .with_max_allowed_area(options.max_area)
+        .with_angle_limit(AngleLimit::from_deg(options.min_angle_deg))
+        .with_max_additional_vertices(options.max_additional_vertices);
+    let result = cdt.refine(params);
+    if u32::try_from(cdt.num_vertices()).is_err() {
+        return Err(GeomError::InvalidParameter {
+            name: "max_area",
+            reason: "refinement exceeded the u32 index range; use a larger area".to_string(),
+        });
+    }
+    // Split constraint edges stay constraint edges, so the parity walk still finds the
+    // inside (the excluded-face set spade returns is not needed).
+    let depth = constraint_depth(&cdt);
+    let points = cdt
+        .vertices()
+        .map(|v| {
+            let p = v.position();
+            DVec2::new(p.x, p.y)
+        })
+        .collect();
+    let triangles = cdt
+        .inner_faces()
+        .filter(|f| depth.get(f.index()).is_some_and(|d| d % 2 == 1))
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect();
+    Ok(RefinedTriangulation {
+        points,
+        triangles,
+        complete: result.refinement_complete,
+    })
+}
+
+/// Validates the polygon and builds the constrained Delaunay triangulation of its rings,
+/// vertex `i` of spade being vertex `i` of the rings listed in order.
+fn constrained(
+    polygon: &PolygonWithHoles,
+) -> Result<ConstrainedDelaunayTriangulation<Point2<f64>>, GeomError> {
     polygon.validate()?;
     let total: usize = polygon.rings().map(|(_, r)| r.len()).sum();
     if u32::try_from(total).is_err() {
@@ -85,16 +218,7 @@ pub fn triangulate(polygon: &PolygonWithHoles) -> Result<Vec<[u32; 3]>, GeomErro
             total - cdt.num_vertices()
         )));
     }
-    let depth = constraint_depth(&cdt);
-    let mut triangles = Vec::with_capacity(total + 2 * polygon.holes.len());
-    for face in cdt.inner_faces() {
-        if depth.get(face.index()).is_some_and(|d| d % 2 == 1) {
-            // spade lists a face's vertices counter-clockwise; vertex indices are input
-            // indices because the bulk loader keeps the order of distinct vertices.
-            triangles.push(face.vertices().map(|v| v.fix().index() as u32));
-        }
-    }
-    Ok(triangles)
+    Ok(cdt)
 }
 
 /// For every face (indexed by face index), the least number of constraint edges crossed
@@ -290,6 +414,96 @@ pub(crate) mod tests {
         // Too small for spade's exact arithmetic: an error, not a panic.
         let tiny = Polygon::new(vec![v(0., 0.), v(1e-44, 0.), v(0., 1e-44)]);
         assert!(triangulate(&tiny.into()).is_err());
+    }
+
+    #[test]
+    fn value_stability() {
+        // An L-shape with a collinear vertex: the exact triangles are pinned, so a change
+        // of spade or of the inside filter shows up here.
+        let l = Polygon::new(
+            [
+                (0., 0.),
+                (2., 0.),
+                (4., 0.),
+                (4., 1.),
+                (1., 1.),
+                (1., 3.),
+                (0., 3.),
+            ]
+            .iter()
+            .map(|&(x, y)| DVec2::new(x, y))
+            .collect(),
+        );
+        let tris = triangulate(&l.clone().into()).unwrap();
+        assert_eq!(
+            tris,
+            vec![[0, 4, 6], [4, 0, 1], [1, 3, 4], [5, 6, 4], [2, 3, 1]]
+        );
+        check_triangulation(&l.into());
+    }
+
+    #[test]
+    fn refined_triangles_cover_the_polygon() {
+        let mut hole = Polygon::rect(DVec2::new(20.0, 20.0), DVec2::new(30.0, 25.0));
+        hole.reverse();
+        let p = PolygonWithHoles::new(
+            Polygon::rect(DVec2::ZERO, DVec2::new(60.0, 40.0)),
+            vec![hole],
+        );
+        let options = RefineOptions {
+            max_area: 10.0,
+            ..RefineOptions::default()
+        };
+        let r = triangulate_refined(&p, &options).unwrap();
+        assert!(r.complete);
+        assert_eq!(&r.points[..8], &vertices(&p)[..]);
+        assert!(r.points.len() > 100);
+        let mut sum = 0.0;
+        for t in &r.triangles {
+            let [a, b, c] = t.map(|i| r.points[i as usize]);
+            let area = 0.5 * orient2d_value(a, b, c);
+            assert!(area > 0.0 && area <= options.max_area * (1.0 + 1e-9));
+            assert_ne!(p.locate((a + b + c) / 3.0), PointLocation::Outside);
+            sum += area;
+        }
+        assert!((sum - p.area()).abs() < 1e-9 * p.area());
+        // Every added vertex lies in the closed polygon.
+        for &q in &r.points[8..] {
+            assert_ne!(p.locate(q), PointLocation::Outside);
+        }
+        // Same input, same output.
+        assert_eq!(triangulate_refined(&p, &options).unwrap(), r);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let o = RefineOptions {
+                max_area: bad,
+                ..options
+            };
+            assert!(triangulate_refined(&p, &o).is_err());
+        }
+        let o = RefineOptions {
+            min_angle_deg: 61.0,
+            ..options
+        };
+        assert!(triangulate_refined(&p, &o).is_err());
+        // A cap on added vertices ends refinement early but still covers the polygon.
+        let o = RefineOptions {
+            max_additional_vertices: 5,
+            ..options
+        };
+        let capped = triangulate_refined(&p, &o).unwrap();
+        assert!(!capped.complete);
+        let sum: f64 = capped
+            .triangles
+            .iter()
+            .map(|t| {
+                0.5 * orient2d_value(
+                    capped.points[t[0] as usize],
+                    capped.points[t[1] as usize],
+                    capped.points[t[2] as usize],
+                )
+            })
+            .sum();
+        assert!((sum - p.area()).abs() < 1e-9 * p.area());
     }
 
     proptest! {
