@@ -298,6 +298,15 @@ impl<R: Rules> Derivation<R> {
         }
     }
 
+    /// Starts over from `axiom` (step 0, generator reseeded), keeping every buffer: the
+    /// reusable-worker entry point when many strings are derived with the same rules.
+    pub fn restart(&mut self, axiom: &R::String) {
+        self.current.clone_from(axiom);
+        self.rng = Pcg64Mcg::seed_from_u64(self.options.seed);
+        self.step = 0;
+        self.passed = false;
+    }
+
     /// The current string.
     pub fn string(&self) -> &R::String {
         &self.current

@@ -11,7 +11,7 @@
 ///
 /// The engine keeps two strings and swaps them between steps (double buffering), so
 /// [`clear`](ModuleString::clear) must keep the allocation.
-pub trait ModuleString: Default {
+pub trait ModuleString: Default + Clone {
     /// Number of modules.
     fn len(&self) -> usize;
     /// `true` if there are no modules.

@@ -338,3 +338,28 @@ fn parse_string_and_limits() {
     ));
     assert_eq!(d.string().len(), 1 << 10);
 }
+
+#[test]
+fn orientation_queries_are_filled() {
+    let g = Grammar::parse("ω: +(90)&(90)?H(9,9,9)?U(9,9,9)?L(9,9)F(2)?P(9,9,9)").unwrap();
+    let mut d = g.derivation(DeriveOptions::default());
+    d.step().unwrap();
+    let s = d.string();
+    let close = |i: usize, want: &[f64]| {
+        let got = s.params(i);
+        assert_eq!(got.len(), want.len());
+        for (a, b) in got.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{got:?} vs {want:?}");
+        }
+    };
+    close(2, &[0.0, 0.0, -1.0]); // H after turning left and pitching down
+    close(3, &[-1.0, 0.0, 0.0]); // U
+    close(4, &[0.0, -1.0]); // L: only as many components as parameters
+    close(6, &[0.0, 0.0, -2.0]); // P
+    // A query module placed by hand into the string is filled too.
+    let g = Grammar::parse("ω: F\nF -> FF").unwrap();
+    let mut d = g.derivation(DeriveOptions::default());
+    d.restart(&g.parse_string("F?P(0,0)").unwrap());
+    d.step().unwrap();
+    assert_eq!(g.format_string(d.string()), "FF?P(0,2)");
+}

@@ -5,7 +5,7 @@
 use rand_pcg::Pcg64Mcg;
 
 use super::ast::{GrammarAst, ModuleCall, PatternItem, ProductionAst, Section};
-use super::expr::{self, Expr, Op};
+use super::expr::{self, BinaryOp, Expr, Op};
 use super::parse;
 use crate::command::{Command, ModuleKind, QueryKind};
 use crate::context::{BranchIndex, ContextItem, ContextView, match_left, match_right};
@@ -63,10 +63,15 @@ fn with_arg(c: Command, a: Option<f64>) -> Command {
     }
 }
 
+/// A compiled expression. The common shapes `x`, `3`, `x op 3`, `3 op x` and `x op y`
+/// are evaluated directly; everything else runs bytecode.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Arg {
     Const(f64),
     Var(u32),
+    VarConst(u32, BinaryOp, f64),
+    ConstVar(f64, BinaryOp, u32),
+    VarVar(u32, BinaryOp, u32),
     Code(u32, u32),
 }
 
@@ -84,7 +89,7 @@ struct CProduction {
     arity: u32,
     left: Vec<Pat>,
     right: Vec<Pat>,
-    condition: Option<(u32, u32)>,
+    condition: Option<Arg>,
     successor: Vec<SuccModule>,
     probability: Option<f64>,
 }
@@ -124,6 +129,7 @@ pub struct Grammar {
     defines: Vec<(String, f64)>,
     context_sensitive: bool,
     needs_pass: bool,
+    pass_symbols: Vec<bool>,
 }
 
 /// Where a statement of a parsed text starts, for compile errors.
@@ -227,6 +233,7 @@ impl Grammar {
             defines: Vec::new(),
             context_sensitive: false,
             needs_pass: false,
+            pass_symbols: Vec::new(),
             ast: GrammarAst::default(),
         };
         for (name, c) in BUILTIN_SYMBOLS {
@@ -272,18 +279,19 @@ impl Grammar {
         for (k, p) in ast.productions.iter().enumerate() {
             g.add_production(p, k, locations.get(k))?;
         }
-        let uses_pass = |id: u32| {
-            matches!(
-                g.commands.get(id as usize),
-                Some(Command::Query(_) | Command::Communicate)
-            )
-        };
+        let pass_symbols: Vec<bool> = g
+            .commands
+            .iter()
+            .map(|c| matches!(c, Command::Query(_) | Command::Communicate))
+            .collect();
+        let uses_pass = |id: u32| pass_symbols.get(id as usize).copied().unwrap_or(false);
         g.needs_pass = g.axiom.iter().any(|(s, _)| uses_pass(s))
             || [&g.productions, &g.decompositions].iter().any(|t| {
                 t.productions
                     .iter()
                     .any(|p| p.successor.iter().any(|m| uses_pass(m.symbol)))
             });
+        g.pass_symbols = pass_symbols;
         g.ast = ast;
         Ok(g)
     }
@@ -381,12 +389,10 @@ impl Grammar {
         let slot = |n: &str| formals.iter().position(|f| f == n).map(|k| k as u32);
         let condition = match &p.condition {
             None => None,
-            Some(c) => {
-                let e = substitute(c, &self.defines, &formals);
-                let start = self.code.len() as u32;
-                expr::compile(&e, &slot, &mut self.code).map_err(err)?;
-                Some((start, self.code.len() as u32))
-            }
+            Some(c) => Some(
+                self.compile_arg(&substitute(c, &self.defines, &formals), &slot)
+                    .map_err(err)?,
+            ),
         };
         let mut successor = Vec::with_capacity(p.successor.len());
         for m in &p.successor {
@@ -449,6 +455,52 @@ impl Grammar {
             l.push(id);
         }
         Ok(())
+    }
+
+    /// Compiles an expression (defines already substituted) into its fastest form.
+    fn compile_arg(
+        &mut self,
+        e: &Expr,
+        slot: &dyn Fn(&str) -> Option<u32>,
+    ) -> core::result::Result<Arg, String> {
+        let var = |e: &Expr| match e {
+            Expr::Var(n) => slot(n),
+            _ => None,
+        };
+        let num = |e: &Expr| match e {
+            Expr::Num(v) => Some(*v),
+            _ => None,
+        };
+        if !has_vars(e) && !e.is_random() {
+            return Ok(Arg::Const(expr::eval_const(e, &|_| None)?));
+        }
+        if let Some(k) = var(e) {
+            return Ok(Arg::Var(k));
+        }
+        if let Expr::Binary(op, a, b) = e {
+            match (var(a), num(a), var(b), num(b)) {
+                (Some(x), _, _, Some(c)) => return Ok(Arg::VarConst(x, *op, c)),
+                (_, Some(c), Some(y), _) => return Ok(Arg::ConstVar(c, *op, y)),
+                (Some(x), _, Some(y), _) => return Ok(Arg::VarVar(x, *op, y)),
+                _ => {}
+            }
+        }
+        let start = self.code.len() as u32;
+        expr::compile(e, slot, &mut self.code)?;
+        Ok(Arg::Code(start, self.code.len() as u32))
+    }
+
+    #[inline]
+    fn eval_arg(&self, a: Arg, scratch: &mut GrammarScratch, rng: &mut Pcg64Mcg) -> f64 {
+        let var = |k: u32| scratch.vars.get(k as usize).copied().unwrap_or(f64::NAN);
+        match a {
+            Arg::Const(v) => v,
+            Arg::Var(k) => var(k),
+            Arg::VarConst(x, op, c) => expr::binary(op, var(x), c),
+            Arg::ConstVar(c, op, y) => expr::binary(op, c, var(y)),
+            Arg::VarVar(x, op, y) => expr::binary(op, var(x), var(y)),
+            Arg::Code(s, e) => self.eval((s, e), scratch, rng),
+        }
     }
 
     /// The syntax tree this grammar was compiled from.
@@ -599,7 +651,7 @@ impl Grammar {
         }
         match p.condition {
             None => true,
-            Some(c) => expr::truth(self.eval(c, scratch, rng)),
+            Some(c) => expr::truth(self.eval_arg(c, scratch, rng)),
         }
     }
 
@@ -614,11 +666,7 @@ impl Grammar {
         for m in &p.successor {
             dst.begin(m.symbol);
             for a in &m.args {
-                let v = match *a {
-                    Arg::Const(v) => v,
-                    Arg::Var(k) => scratch.vars.get(k as usize).copied().unwrap_or(f64::NAN),
-                    Arg::Code(s, e) => self.eval((s, e), scratch, rng),
-                };
+                let v = self.eval_arg(*a, scratch, rng);
                 dst.push_param(v);
             }
         }
@@ -841,8 +889,16 @@ impl Rules for Grammar {
             *p = c;
         }
     }
-    fn needs_pass(&self, _s: &ParamString) -> bool {
+    fn needs_pass(&self, s: &ParamString) -> bool {
+        // The grammar's own rules may produce query/communication modules; a string set
+        // from outside (restart, string_mut) may hold them too.
         self.needs_pass
+            || (0..s.len()).any(|i| {
+                self.pass_symbols
+                    .get(s.symbol(i) as usize)
+                    .copied()
+                    .unwrap_or(false)
+            })
     }
     fn check_storage(&self, s: &ParamString) -> Result<()> {
         if s.arena_overflowed() {
