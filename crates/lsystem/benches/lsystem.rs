@@ -111,7 +111,7 @@ impl Module for T {
     }
 }
 
-fn typed_cf_rules() -> TypedRules<T> {
+fn typed_cf_rules() -> TypedRules<'static, T> {
     let mut r = TypedRules::new();
     r.add(
         Production::new(SYM_A, |m, o| {
@@ -173,7 +173,7 @@ impl Module for S {
     }
 }
 
-fn typed_cs_rules() -> TypedRules<S> {
+fn typed_cs_rules() -> TypedRules<'static, S> {
     let mut r = TypedRules::new();
     r.add(
         Production::new(SYM_I, |m, o| {
@@ -188,7 +188,7 @@ fn typed_cs_rules() -> TypedRules<S> {
     r
 }
 
-fn typed_grow<M: Module>(rules: &TypedRules<M>, axiom: Vec<M>, target: usize) -> Vec<M> {
+fn typed_grow<M: Module>(rules: &TypedRules<'_, M>, axiom: Vec<M>, target: usize) -> Vec<M> {
     let mut d = Derivation::new(rules, axiom, opts());
     while d.string().len() < target {
         d.step().unwrap_or_else(|e| panic!("{e}"));
@@ -234,7 +234,7 @@ fn text_step(b: Bencher<'_, '_>, data: &(Grammar, ParamString)) {
     });
 }
 
-fn typed_step(b: Bencher<'_, '_>, rules: &TypedRules<T>, s: &Vec<T>) {
+fn typed_step(b: Bencher<'_, '_>, rules: &TypedRules<'_, T>, s: &Vec<T>) {
     let mut d = Derivation::new(rules, s.clone(), opts());
     let out = d.step().map(|r| r.len).unwrap_or(0);
     b.counter(ItemsCount::new(out)).bench_local(|| {

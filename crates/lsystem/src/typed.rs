@@ -108,20 +108,20 @@ impl<M> Successor<'_, M> {
     }
 }
 
-type Condition<M> = Box<dyn Fn(&Match<'_, M>) -> bool + Send + Sync>;
-type SuccessorFn<M> = Box<dyn Fn(&Match<'_, M>, &mut Successor<'_, M>) + Send + Sync>;
+type Condition<'a, M> = Box<dyn Fn(&Match<'_, M>) -> bool + Send + Sync + 'a>;
+type SuccessorFn<'a, M> = Box<dyn Fn(&Match<'_, M>, &mut Successor<'_, M>) + Send + Sync + 'a>;
 
 /// A production `left < predecessor > right : condition -> successor : probability`.
-pub struct Production<M> {
+pub struct Production<'a, M> {
     predecessor: u32,
     left: Vec<ContextItem<u32>>,
     right: Vec<ContextItem<u32>>,
-    condition: Option<Condition<M>>,
-    successor: SuccessorFn<M>,
+    condition: Option<Condition<'a, M>>,
+    successor: SuccessorFn<'a, M>,
     probability: Option<f64>,
 }
 
-impl<M> std::fmt::Debug for Production<M> {
+impl<M> std::fmt::Debug for Production<'_, M> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Production")
             .field("predecessor", &self.predecessor)
@@ -133,11 +133,11 @@ impl<M> std::fmt::Debug for Production<M> {
     }
 }
 
-impl<M: Module> Production<M> {
+impl<'a, M: Module> Production<'a, M> {
     /// A context-free, unconditional production for modules whose symbol is `predecessor`.
     pub fn new(
         predecessor: u32,
-        successor: impl Fn(&Match<'_, M>, &mut Successor<'_, M>) + Send + Sync + 'static,
+        successor: impl Fn(&Match<'_, M>, &mut Successor<'_, M>) + Send + Sync + 'a,
     ) -> Self {
         Self {
             predecessor,
@@ -168,10 +168,7 @@ impl<M: Module> Production<M> {
     }
 
     /// A condition on the matched modules.
-    pub fn when(
-        mut self,
-        condition: impl Fn(&Match<'_, M>) -> bool + Send + Sync + 'static,
-    ) -> Self {
+    pub fn when(mut self, condition: impl Fn(&Match<'_, M>) -> bool + Send + Sync + 'a) -> Self {
         self.condition = Some(Box::new(condition));
         self
     }
@@ -287,14 +284,13 @@ impl<M: Module> ContextView for TypedView<'_, M> {
     }
 }
 
-#[derive(Default)]
-struct Table<M> {
-    productions: Vec<Production<M>>,
+struct Table<'a, M> {
+    productions: Vec<Production<'a, M>>,
     by_symbol: Vec<Vec<u32>>,
 }
 
-impl<M: Module> Table<M> {
-    fn add(&mut self, p: Production<M>) -> Result<()> {
+impl<'a, M: Module> Table<'a, M> {
+    fn add(&mut self, p: Production<'a, M>) -> Result<()> {
         p.validate()?;
         let sym = p.predecessor as usize;
         if self.by_symbol.len() <= sym {
@@ -379,7 +375,7 @@ impl<M: Module> Table<M> {
     #[inline]
     fn condition_ok(
         &self,
-        p: &Production<M>,
+        p: &Production<'a, M>,
         view: &TypedView<'_, M>,
         m: &M,
         i: usize,
@@ -401,7 +397,7 @@ impl<M: Module> Table<M> {
     #[inline]
     fn produce(
         &self,
-        p: &Production<M>,
+        p: &Production<'a, M>,
         view: &TypedView<'_, M>,
         m: &M,
         i: usize,
@@ -436,21 +432,23 @@ impl<M: Module> Table<M> {
 ///   [`ignore`](Self::ignore) are skipped by it.
 /// * Decomposition and interpretation rules are context-free: their context patterns are
 ///   ignored. Conditions should be pure functions of the match.
-pub struct TypedRules<M> {
-    productions: Table<M>,
-    decompositions: Table<M>,
-    interpretations: Table<M>,
+/// * Closures may borrow data for the lifetime `'a` (e.g. the maps a road generator reads
+///   in its global goals); use `TypedRules<'static, M>` for self-contained rules.
+pub struct TypedRules<'a, M> {
+    productions: Table<'a, M>,
+    decompositions: Table<'a, M>,
+    interpretations: Table<'a, M>,
     ignore: Vec<bool>,
     context_sensitive: bool,
 }
 
-impl<M: Module> Default for TypedRules<M> {
+impl<M: Module> Default for TypedRules<'_, M> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<M: Module> std::fmt::Debug for TypedRules<M> {
+impl<M: Module> std::fmt::Debug for TypedRules<'_, M> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("TypedRules")
             .field("productions", &self.productions.productions)
@@ -460,7 +458,7 @@ impl<M: Module> std::fmt::Debug for TypedRules<M> {
     }
 }
 
-impl<M: Module> TypedRules<M> {
+impl<'a, M: Module> TypedRules<'a, M> {
     /// No rules: every module maps to itself.
     pub fn new() -> Self {
         Self {
@@ -482,21 +480,21 @@ impl<M: Module> TypedRules<M> {
     }
 
     /// Adds a production (after the existing ones of its symbol).
-    pub fn add(&mut self, p: Production<M>) -> Result<&mut Self> {
+    pub fn add(&mut self, p: Production<'a, M>) -> Result<&mut Self> {
         self.context_sensitive |= !p.left.is_empty() || !p.right.is_empty();
         self.productions.add(p)?;
         Ok(self)
     }
 
     /// Adds a decomposition rule, applied recursively after every step.
-    pub fn add_decomposition(&mut self, p: Production<M>) -> Result<&mut Self> {
+    pub fn add_decomposition(&mut self, p: Production<'a, M>) -> Result<&mut Self> {
         self.decompositions.add(p)?;
         Ok(self)
     }
 
     /// Adds an interpretation (homomorphism) rule, applied recursively when the turtle
     /// reads the string; the string itself is not changed.
-    pub fn add_interpretation(&mut self, p: Production<M>) -> Result<&mut Self> {
+    pub fn add_interpretation(&mut self, p: Production<'a, M>) -> Result<&mut Self> {
         self.interpretations.add(p)?;
         Ok(self)
     }
@@ -515,7 +513,7 @@ impl<M: Module> TypedRules<M> {
         self
     }
 
-    fn view<'a>(&'a self, s: &'a [M]) -> TypedView<'a, M> {
+    fn view<'s>(&'s self, s: &'s [M]) -> TypedView<'s, M> {
         TypedView {
             s,
             ignore: &self.ignore,
@@ -526,7 +524,7 @@ impl<M: Module> TypedRules<M> {
 static EMPTY_BRANCHES: std::sync::LazyLock<BranchIndex> =
     std::sync::LazyLock::new(BranchIndex::default);
 
-impl<M: Module> Rules for TypedRules<M> {
+impl<M: Module> Rules for TypedRules<'_, M> {
     type String = Vec<M>;
     type Scratch = TypedScratch;
 

@@ -69,7 +69,7 @@ impl Module for M {
     }
 }
 
-fn algae() -> TypedRules<M> {
+fn algae() -> TypedRules<'static, M> {
     let mut r = TypedRules::new();
     r.add(Production::new(A, |_, o| o.extend([M::A, M::B])))
         .unwrap()
@@ -349,4 +349,17 @@ fn queries_and_communication_between_steps() {
     assert_eq!(d.string()[5], M::E(3.5));
     let states = d.turtle_states().unwrap();
     assert_eq!(states[3].position.y, 3.0);
+}
+
+#[test]
+fn closures_may_borrow_local_data() {
+    let lengths = [3.0, 4.0];
+    let mut r = TypedRules::new();
+    r.add(Production::new(A, |_, o| {
+        o.extend(lengths.iter().map(|&l| M::F(l)))
+    }))
+    .unwrap();
+    let mut d = Derivation::new(&r, vec![M::A], DeriveOptions::default());
+    d.step().unwrap();
+    assert_eq!(d.string(), &vec![M::F(3.0), M::F(4.0)]);
 }
