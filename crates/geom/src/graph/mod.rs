@@ -46,8 +46,12 @@
 //! # Ok::<(), polis_geom::GeomError>(())
 //! ```
 
+mod insert;
+#[cfg(test)]
+mod insert_tests;
 mod invariants;
 mod order;
+mod serde_impl;
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -56,6 +60,7 @@ use crate::bbox::Aabb2;
 use crate::error::{GeomError, validate_point};
 use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, SpatialIndex};
 
+pub use insert::{Insertion, SnapOptions};
 pub(crate) use order::ccw_cmp;
 
 /// The id of a node of a [`PlanarGraph`]. Stable: never reused after removal.

@@ -1,0 +1,533 @@
+//! Planar insertion: [`PlanarGraph::insert_segment`] and [`PlanarGraph::insert_point`].
+//!
+//! A new segment `p–q` is added so that the graph stays a planar straight-line graph:
+//!
+//! 1. Each end is *anchored*: to the nearest node within [`SnapOptions::snap_distance`];
+//!    else to the nearest edge within that distance (or an edge it lies on exactly),
+//!    which is split there (a T-junction); else a new node.
+//! 2. The anchored ends are joined by walking from the first to the second. At each step
+//!    the first *event* along the straight line from the current node to the current
+//!    target is handled, in order of position (ties: following an edge, then a node, then
+//!    a crossing, then by id):
+//!    * an existing edge overlapping the line from the current node (collinear overlap)
+//!      is *followed*: reused, not duplicated;
+//!    * an existing node within the snap distance of the line is routed through (it
+//!      becomes an intermediate target);
+//!    * an existing edge crossing the line is split at the crossing point, which becomes
+//!      an intermediate target (if an end of that edge lies within the snap distance of
+//!      the crossing, that end is used instead);
+//!    * with no event left, a straight edge joins the current node to the target.
+//!
+//! All decisions (crossing, touching, overlap, on-segment) use exact predicates; crossing
+//! points are computed in floating point afterwards, so a split edge may bend by a few
+//! units in the last place. Every created edge is checked against the edge index before
+//! the call returns.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use super::{EdgeId, NodeId, PlanarGraph};
+use crate::error::{GeomError, validate_point};
+use crate::predicates::{SegmentIntersection, closest_point_on_segment, point_on_segment};
+use crate::spatial::SpatialIndex;
+
+/// Relative size of floating-point rounding in computed points (crossings, projections):
+/// at a point `p`, distances up to `ROUNDING_TOLERANCE · max(1, |p.x|, |p.y|)` metres are
+/// treated as zero by planar insertion, whatever [`SnapOptions::snap_distance`] says.
+///
+/// A crossing point is rounded to the nearest `f64`, so it lies a few units in the last
+/// place off both lines; a third line through the same exact point then misses the
+/// rounded node by about that much. Such near-misses are merged, so that three or more
+/// segments through one point give one node. `1e-12` is about 5,000 ulps: a 10 nm margin
+/// at 10 km from the origin.
+pub const ROUNDING_TOLERANCE: f64 = 1e-12;
+
+/// The rounding tolerance at `p`, in metres (see [`ROUNDING_TOLERANCE`]).
+fn rounding_eps(p: DVec2) -> f64 {
+    ROUNDING_TOLERANCE * p.abs().max_element().max(1.0)
+}
+
+/// Tolerances of planar insertion ([`PlanarGraph::insert_segment`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SnapOptions {
+    /// Distance, in metres, within which a segment end snaps to an existing node (first)
+    /// or onto an existing edge (splitting it); existing nodes within this distance of a
+    /// new segment are routed through; and a segment whose snapped ends are this close or
+    /// closer is refused as zero-length. `0` snaps only coincidences up to rounding (see
+    /// [`ROUNDING_TOLERANCE`]). Must be finite and non-negative. Default: 0.01 m.
+    pub snap_distance: f64,
+}
+
+impl Default for SnapOptions {
+    fn default() -> Self {
+        SnapOptions {
+            snap_distance: 0.01,
+        }
+    }
+}
+
+impl SnapOptions {
+    fn validate(&self) -> Result<(), GeomError> {
+        let d = self.snap_distance;
+        if d.is_finite() && d >= 0.0 {
+            Ok(())
+        } else {
+            Err(GeomError::InvalidParameter {
+                name: "snap_distance",
+                reason: format!("{d} m; use a finite distance of at least 0"),
+            })
+        }
+    }
+}
+
+/// What [`PlanarGraph::insert_segment`] did.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Insertion {
+    /// The nodes the new segment runs through, from the (snapped) first end to the last.
+    pub nodes: Vec<NodeId>,
+    /// The edges from `nodes[i]` to `nodes[i + 1]`: created by this call or existing edges
+    /// the segment overlaps.
+    pub path: Vec<EdgeId>,
+    /// The edges this call created for the segment (a subset of `path`, in path order).
+    pub created: Vec<EdgeId>,
+    /// Existing edges split by this call, as `(edge, new piece)`: see
+    /// [`PlanarGraph::split_edge`]. The pieces carry clones of the edge's payload. (In the
+    /// rare case that a rounded crossing point lands exactly on an end of the new segment,
+    /// the crossed edge is replaced by two new edges through that node and listed as
+    /// `(removed edge, first new edge)`.)
+    pub split: Vec<(EdgeId, EdgeId)>,
+}
+
+/// Where a point lands after snapping.
+#[derive(Debug, Clone, Copy)]
+enum Anchor {
+    Node(NodeId),
+    OnEdge(EdgeId, DVec2),
+    Free(DVec2),
+}
+
+/// The next thing in the way of a straight connection.
+#[derive(Debug, Clone, Copy)]
+enum Event {
+    /// Reuse an existing edge leaving the current node along the line, to its other end.
+    Follow(EdgeId, NodeId),
+    /// Route through a node near the line.
+    Node(NodeId),
+    /// Split an edge crossing the line at this point.
+    Cross(EdgeId, DVec2),
+}
+
+impl Event {
+    fn rank(&self) -> u8 {
+        match self {
+            Event::Follow(..) => 0,
+            Event::Node(_) => 1,
+            Event::Cross(..) => 2,
+        }
+    }
+    fn id(&self) -> u32 {
+        match *self {
+            Event::Follow(e, _) | Event::Cross(e, _) => e.raw(),
+            Event::Node(n) => n.raw(),
+        }
+    }
+}
+
+impl<N, E: Clone> PlanarGraph<N, E> {
+    /// Inserts the segment `p–q` keeping the graph planar; new nodes get `N::default()`.
+    /// See [`insert_segment_with`](Self::insert_segment_with).
+    pub fn insert_segment(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: E,
+        options: &SnapOptions,
+    ) -> Result<Insertion, GeomError>
+    where
+        N: Default,
+    {
+        self.insert_segment_with(p, q, payload, options, |_| N::default())
+    }
+
+    /// Inserts the segment `p–q` keeping the graph planar: snaps its ends to nodes or
+    /// edges within [`SnapOptions::snap_distance`], splits existing edges where it crosses
+    /// them, reuses existing edges it overlaps, and routes through nodes lying within the
+    /// snap distance of it (see the [module docs](self)). New nodes get
+    /// `make_node(position)`; new edges get clones of `payload`.
+    ///
+    /// # Errors
+    /// [`GeomError::NonFinite`] / [`GeomError::OutOfRange`] for bad coordinates,
+    /// [`GeomError::InvalidParameter`] for bad options, [`GeomError::ZeroLengthEdge`] when
+    /// the snapped ends are within the snap distance of each other; the graph is unchanged
+    /// in these cases. [`GeomError::GraphCorrupt`] if the graph was not planar to begin
+    /// with (or on an internal failure); the graph may then be partly modified.
+    pub fn insert_segment_with(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: E,
+        options: &SnapOptions,
+        mut make_node: impl FnMut(DVec2) -> N,
+    ) -> Result<Insertion, GeomError> {
+        validate_point(0, p)?;
+        validate_point(1, q)?;
+        options.validate()?;
+        let snap = options.snap_distance;
+        let scale = p.abs().max(q.abs()).max_element().max(1.0);
+        let snap = snap.max(ROUNDING_TOLERANCE * scale);
+        let (ap, aq) = (self.anchor(p, snap), self.anchor(q, snap));
+        let (pp, pq) = (self.anchor_position(ap)?, self.anchor_position(aq)?);
+        let same_node = matches!((ap, aq), (Anchor::Node(x), Anchor::Node(y)) if x == y);
+        if same_node || pp == pq || pp.distance(pq) <= snap || q.distance(pp) <= snap {
+            return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
+        }
+        let mut out = Insertion::default();
+        let a = self.realize(ap, &mut make_node, &mut out)?;
+        // Re-anchor q: realising p may have split the edge q snaps to.
+        let b = self.anchor(q, snap);
+        let b = self.realize(b, &mut make_node, &mut out)?;
+        if a == b {
+            return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
+        }
+        self.connect(a, b, &payload, snap, &mut make_node, &mut out)?;
+        let mut touched = out.created.clone();
+        for &(e, piece) in &out.split {
+            touched.extend([e, piece].into_iter().filter(|&x| self.contains_edge(x)));
+        }
+        self.check_local(&touched)?;
+        Ok(out)
+    }
+
+    /// The node at `p` after snapping (to a node, else onto an edge, splitting it, else a
+    /// new node with `N::default()`). Returns the node and the split, if any.
+    pub fn insert_point(
+        &mut self,
+        p: DVec2,
+        options: &SnapOptions,
+    ) -> Result<(NodeId, Option<(EdgeId, EdgeId)>), GeomError>
+    where
+        N: Default,
+    {
+        self.insert_point_with(p, options, |_| N::default())
+    }
+
+    /// [`insert_point`](Self::insert_point) with new-node payloads from `make_node`.
+    pub fn insert_point_with(
+        &mut self,
+        p: DVec2,
+        options: &SnapOptions,
+        mut make_node: impl FnMut(DVec2) -> N,
+    ) -> Result<(NodeId, Option<(EdgeId, EdgeId)>), GeomError> {
+        validate_point(0, p)?;
+        options.validate()?;
+        let mut out = Insertion::default();
+        let snap = options.snap_distance.max(rounding_eps(p));
+        let anchor = self.anchor(p, snap);
+        let n = self.realize(anchor, &mut make_node, &mut out)?;
+        Ok((n, out.split.first().copied()))
+    }
+
+    fn anchor(&self, p: DVec2, snap: f64) -> Anchor {
+        if let Some((n, _)) = self.nearest_node(p, snap) {
+            return Anchor::Node(n);
+        }
+        // Exactly on an edge (exact test, independent of the distance rounding).
+        let on: Option<EdgeId> = self
+            .edge_index
+            .segments_crossing(p, p)
+            .first()
+            .map(|h| h.key);
+        if let Some(e) = on {
+            return self.anchor_on_edge(e, p);
+        }
+        if let Some(near) = self.nearest_edge(p, snap) {
+            return self.anchor_on_edge(near.key, near.closest);
+        }
+        Anchor::Free(p)
+    }
+
+    /// Anchor at `c` on edge `e`, or at an end of `e` if `c` coincides with it.
+    fn anchor_on_edge(&self, e: EdgeId, c: DVec2) -> Anchor {
+        match self.endpoints(e) {
+            Ok((a, b)) => {
+                if self.position(a).is_ok_and(|pa| pa == c) {
+                    Anchor::Node(a)
+                } else if self.position(b).is_ok_and(|pb| pb == c) {
+                    Anchor::Node(b)
+                } else {
+                    Anchor::OnEdge(e, c)
+                }
+            }
+            Err(_) => Anchor::Free(c),
+        }
+    }
+
+    fn anchor_position(&self, a: Anchor) -> Result<DVec2, GeomError> {
+        match a {
+            Anchor::Node(n) => self.position(n),
+            Anchor::OnEdge(_, c) | Anchor::Free(c) => Ok(c),
+        }
+    }
+
+    fn realize(
+        &mut self,
+        a: Anchor,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+    ) -> Result<NodeId, GeomError> {
+        match a {
+            Anchor::Node(n) => Ok(n),
+            Anchor::Free(p) => self.add_node(p, make_node(p)),
+            Anchor::OnEdge(e, c) => self.split_or_end(e, c, make_node, out),
+        }
+    }
+
+    /// Splits `e` at `c`; if `c` cannot split it (it rounds onto or beyond an end), the
+    /// end of `e` nearer to `c`.
+    fn split_or_end(
+        &mut self,
+        e: EdgeId,
+        c: DVec2,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+    ) -> Result<NodeId, GeomError> {
+        let (a, b) = self.endpoints(e)?;
+        let (pa, pb) = (self.position(a)?, self.position(b)?);
+        let d = pb - pa;
+        let t = (c - pa).dot(d) / d.length_squared();
+        if c != pa && c != pb && t > 0.0 && t < 1.0 {
+            let (m, piece) = self.split_edge(e, c, make_node(c))?;
+            out.split.push((e, piece));
+            self.absorb_edges_near(m, out)?;
+            Ok(m)
+        } else if c.distance_squared(pa) <= c.distance_squared(pb) {
+            Ok(a)
+        } else {
+            Ok(b)
+        }
+    }
+
+    /// Joins node `from` to node `to` by the walk described in the module docs.
+    fn connect(
+        &mut self,
+        from: NodeId,
+        to: NodeId,
+        payload: &E,
+        snap: f64,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+    ) -> Result<(), GeomError> {
+        out.nodes.push(from);
+        let mut cur = from;
+        let mut targets = vec![to];
+        let limit = 64 + 8 * (self.node_count() + self.edge_count());
+        let mut steps = 0usize;
+        while let Some(&target) = targets.last() {
+            steps += 1;
+            if steps > limit {
+                return Err(GeomError::GraphCorrupt(format!(
+                    "planar insertion from node {from} to node {to} did not converge; check_invariants() may tell why"
+                )));
+            }
+            if cur == target {
+                targets.pop();
+                continue;
+            }
+            match self.next_event(cur, target, snap, &out.nodes, &targets)? {
+                None => {
+                    let e = match self.find_edge(cur, target) {
+                        Some(e) => e,
+                        None => {
+                            let e = self.add_edge(cur, target, payload.clone())?;
+                            out.created.push(e);
+                            e
+                        }
+                    };
+                    out.path.push(e);
+                    out.nodes.push(target);
+                    cur = target;
+                    targets.pop();
+                }
+                Some(Event::Follow(e, x)) => {
+                    out.path.push(e);
+                    out.nodes.push(x);
+                    cur = x;
+                }
+                Some(Event::Node(x)) => targets.push(x),
+                Some(Event::Cross(e, c)) => {
+                    let x = self.split_at_crossing(e, c, cur, target, make_node, out)?;
+                    targets.push(x);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The first event on the straight line from `cur` to `target`, if any. Nodes already
+    /// on the path (`visited`) or waiting as targets (`pending`) are never routed through
+    /// again, which rules out cycles.
+    fn next_event(
+        &self,
+        cur: NodeId,
+        target: NodeId,
+        snap: f64,
+        visited: &[NodeId],
+        pending: &[NodeId],
+    ) -> Result<Option<Event>, GeomError> {
+        let fresh =
+            |n: NodeId| n != cur && n != target && !visited.contains(&n) && !pending.contains(&n);
+        let (pc, pt) = (self.position(cur)?, self.position(target)?);
+        let snap = snap.max(rounding_eps(pc.abs().max(pt.abs())));
+        let mut best: Option<(f64, Event)> = None;
+        let mut offer = |t: f64, ev: Event| {
+            let better = match best {
+                None => true,
+                Some((bt, bev)) => (t, ev.rank(), ev.id()) < (bt, bev.rank(), bev.id()),
+            };
+            if better {
+                best = Some((t, ev));
+            }
+        };
+        // Nodes within the snap distance of the open segment.
+        let bx = crate::Aabb2::new(pc, pt).expanded(snap);
+        for n in self.node_index.query_box(&bx) {
+            if !fresh(n) {
+                continue;
+            }
+            let pn = self.position(n)?;
+            let (closest, t) = closest_point_on_segment(pn, pc, pt);
+            let on = point_on_segment(pn, pc, pt);
+            if (on || closest.distance(pn) <= snap) && t > 0.0 && t < 1.0 {
+                offer(t, Event::Node(n));
+            }
+        }
+        // Edges meeting the segment.
+        for hit in self.edge_index.segments_crossing(pc, pt) {
+            match hit.kind {
+                SegmentIntersection::Crossing { point, .. } => {
+                    let (a, b) = self.endpoints(hit.key)?;
+                    let (pa, pb) = (self.position(a)?, self.position(b)?);
+                    // An end of the crossed edge close to the crossing: go through it.
+                    let (da, db) = (point.distance(pa), point.distance(pb));
+                    if da.min(db) <= snap {
+                        let n = if da <= db { a } else { b };
+                        if fresh(n) {
+                            offer(hit.t, Event::Node(n));
+                            continue;
+                        }
+                    }
+                    offer(hit.t, Event::Cross(hit.key, point));
+                }
+                SegmentIntersection::Overlap { start, .. } if start == pc => {
+                    let (a, b) = self.endpoints(hit.key)?;
+                    if a != cur && b != cur {
+                        return Err(GeomError::GraphCorrupt(format!(
+                            "node {cur} lies inside edge {}; the graph was not planar",
+                            hit.key
+                        )));
+                    }
+                    let x = if a == cur { b } else { a };
+                    offer(0.0, Event::Follow(hit.key, x));
+                }
+                // Touching points and other overlaps start at nodes on the line: those
+                // are node events.
+                _ => {}
+            }
+        }
+        Ok(best.map(|(_, ev)| ev))
+    }
+
+    /// Splits edge `e` where it crosses the line `cur → target` at `c`, returning the
+    /// node at the crossing.
+    fn split_at_crossing(
+        &mut self,
+        e: EdgeId,
+        c: DVec2,
+        cur: NodeId,
+        target: NodeId,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+    ) -> Result<NodeId, GeomError> {
+        let (pc, pt) = (self.position(cur)?, self.position(target)?);
+        // The rounded crossing point landed on an end of the new segment: bend the
+        // crossed edge through that node instead of creating a coincident node.
+        for (n, pn) in [(cur, pc), (target, pt)] {
+            if c == pn {
+                let piece = self.reroute_through(e, n)?;
+                if let Some(piece) = piece {
+                    out.split.push((e, piece));
+                }
+                return Ok(n);
+            }
+        }
+        self.split_or_end(e, c, make_node, out)
+    }
+
+    /// Bends every edge passing within rounding distance of the new node `m` (but not
+    /// ending at it) through `m`, so that a computed point on several lines becomes one
+    /// node of all of them.
+    fn absorb_edges_near(&mut self, m: NodeId, out: &mut Insertion) -> Result<(), GeomError> {
+        let pm = self.position(m)?;
+        let eps = rounding_eps(pm);
+        for near in self.edge_index.segments_within(pm, eps) {
+            let (a, b) = self.endpoints(near.key)?;
+            if a == m || b == m {
+                continue;
+            }
+            let (pa, pb) = (self.position(a)?, self.position(b)?);
+            if pa.distance(pm) <= eps || pb.distance(pm) <= eps {
+                // Passes near m only at its end: two nodes within rounding; leave them.
+                continue;
+            }
+            if let Some(piece) = self.reroute_through(near.key, m)? {
+                out.split.push((near.key, piece));
+            }
+        }
+        Ok(())
+    }
+
+    /// Replaces edge `e = a–b` by new edges `a–n` and `n–b` (returning the first one
+    /// created), skipping a piece that already exists.
+    fn reroute_through(&mut self, e: EdgeId, n: NodeId) -> Result<Option<EdgeId>, GeomError> {
+        let (a, b) = self.endpoints(e)?;
+        let payload = self.remove_edge(e)?;
+        let mut piece = None;
+        if self.find_edge(a, n).is_none() {
+            let id = self.add_edge(a, n, payload.clone())?;
+            piece = Some(id);
+        }
+        if self.find_edge(n, b).is_none() {
+            let id = self.add_edge(n, b, payload)?;
+            piece = piece.or(Some(id));
+        }
+        Ok(piece)
+    }
+
+    /// Checks that the given edges meet other edges only at common end nodes.
+    fn check_local(&self, edges: &[EdgeId]) -> Result<(), GeomError> {
+        for &e in edges {
+            let (a, b) = self.endpoints(e)?;
+            let (pa, pb) = (self.position(a)?, self.position(b)?);
+            for hit in self.edge_index.segments_crossing(pa, pb) {
+                if hit.key == e {
+                    continue;
+                }
+                let (c, d) = self.endpoints(hit.key)?;
+                let ok = match hit.kind {
+                    SegmentIntersection::Touching { point, .. } => {
+                        (point == pa && (c == a || d == a)) || (point == pb && (c == b || d == b))
+                    }
+                    _ => false,
+                };
+                if !ok {
+                    return Err(GeomError::GraphCorrupt(format!(
+                        "after insertion, edge {e} meets edge {} away from a common node ({:?}); please report this input",
+                        hit.key, hit.kind
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+}

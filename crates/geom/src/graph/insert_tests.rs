@@ -1,0 +1,345 @@
+//! Tests of planar insertion: hand-made degenerate cases and property tests.
+
+use glam::DVec2;
+use proptest::prelude::*;
+
+use super::*;
+use crate::predicates::{SegmentIntersection, distance_to_segment, segment_intersection};
+
+fn v(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+const EXACT: SnapOptions = SnapOptions { snap_distance: 0.0 };
+
+type G = PlanarGraph<(), u32>;
+
+fn node_at(g: &G, p: DVec2) -> NodeId {
+    g.nearest_node(p, 0.0)
+        .map(|(n, _)| n)
+        .unwrap_or_else(|| panic!("no node at {p}"))
+}
+
+#[test]
+fn crossing_creates_a_node_and_four_edges() {
+    let mut g = G::new();
+    let r1 = g.insert_segment(v(0., 0.), v(2., 2.), 1, &EXACT).unwrap();
+    assert_eq!(r1.created.len(), 1);
+    let r2 = g.insert_segment(v(0., 2.), v(2., 0.), 2, &EXACT).unwrap();
+    g.check_invariants().unwrap();
+    assert_eq!(g.node_count(), 5);
+    assert_eq!(g.edge_count(), 4);
+    let m = node_at(&g, v(1., 1.));
+    assert_eq!(g.degree(m).unwrap(), 4);
+    assert_eq!(r2.nodes.len(), 3);
+    assert_eq!(r2.nodes[1], m);
+    assert_eq!(r2.created.len(), 2);
+    assert_eq!(r2.split.len(), 1);
+    // The split piece keeps the crossed edge's payload.
+    let (old, piece) = r2.split[0];
+    assert_eq!(*g.edge_payload(old).unwrap(), 1);
+    assert_eq!(*g.edge_payload(piece).unwrap(), 1);
+    // Around the crossing: alternating payloads, counter-clockwise from east-north-east.
+    let around: Vec<u32> = g
+        .edges_at(m)
+        .unwrap()
+        .iter()
+        .map(|&e| *g.edge_payload(e).unwrap())
+        .collect();
+    assert_eq!(around, vec![1, 2, 1, 2]);
+}
+
+#[test]
+fn t_junction_and_snapping_to_an_edge() {
+    let mut g = G::new();
+    g.insert_segment(v(0., 0.), v(10., 0.), 1, &EXACT).unwrap();
+    // Ends exactly on the edge: a T.
+    let r = g.insert_segment(v(4., 0.), v(4., 5.), 2, &EXACT).unwrap();
+    assert_eq!(r.split.len(), 1);
+    assert_eq!(g.degree(node_at(&g, v(4., 0.))).unwrap(), 3);
+    // Ends 5 mm off the edge: snaps with a 1 cm tolerance.
+    let snap = SnapOptions::default();
+    let r = g
+        .insert_segment(v(7., 0.005), v(7., -5.), 3, &snap)
+        .unwrap();
+    assert_eq!(r.split.len(), 1);
+    assert_eq!(g.position(r.nodes[0]).unwrap(), v(7., 0.));
+    // 5 mm from an existing node: snaps to the node, no split.
+    let r = g
+        .insert_segment(v(4.004, 0.003), v(4., -5.), 4, &snap)
+        .unwrap();
+    assert!(r.split.is_empty());
+    assert_eq!(r.nodes[0], node_at(&g, v(4., 0.)));
+    g.check_invariants().unwrap();
+    assert_eq!(g.degree(node_at(&g, v(4., 0.))).unwrap(), 4);
+}
+
+#[test]
+fn collinear_overlap_reuses_edges() {
+    let mut g = G::new();
+    g.insert_segment(v(2., 0.), v(4., 0.), 1, &EXACT).unwrap();
+    g.insert_segment(v(6., 0.), v(8., 0.), 2, &EXACT).unwrap();
+    // Covers both, sticks out at both ends.
+    let r = g.insert_segment(v(0., 0.), v(10., 0.), 3, &EXACT).unwrap();
+    g.check_invariants().unwrap();
+    assert_eq!(g.edge_count(), 5);
+    assert_eq!(r.path.len(), 5);
+    assert_eq!(r.created.len(), 3);
+    let xs: Vec<f64> = r.nodes.iter().map(|&n| g.position(n).unwrap().x).collect();
+    assert_eq!(xs, vec![0., 2., 4., 6., 8., 10.]);
+    // Inserting a piece that is already there creates nothing.
+    let r = g.insert_segment(v(8., 0.), v(2., 0.), 4, &EXACT).unwrap();
+    assert!(r.created.is_empty());
+    assert_eq!(r.path.len(), 3);
+    // A piece inside an existing edge splits it twice and reuses the middle.
+    let r = g.insert_segment(v(0.5, 0.), v(1.5, 0.), 5, &EXACT).unwrap();
+    assert!(r.created.is_empty());
+    assert_eq!(r.split.len(), 2);
+    assert_eq!(g.edge_count(), 7);
+    g.check_invariants().unwrap();
+}
+
+#[test]
+fn routes_through_nodes_on_the_way() {
+    let mut g = G::new();
+    let lone = g.add_node(v(5., 0.), ()).unwrap();
+    g.insert_segment(v(3., -1.), v(3., 1.), 1, &EXACT).unwrap();
+    // Passes exactly through the lone node and the vertical's middle.
+    let r = g.insert_segment(v(0., 0.), v(10., 0.), 2, &EXACT).unwrap();
+    assert_eq!(r.nodes.len(), 4);
+    assert_eq!(r.nodes[2], lone);
+    // A node 3 mm off a new segment is routed through with a 1 cm tolerance.
+    let near = g.add_node(v(5., 4.003), ()).unwrap();
+    let r = g
+        .insert_segment(v(0., 4.), v(10., 4.), 3, &SnapOptions::default())
+        .unwrap();
+    assert_eq!(r.nodes, vec![r.nodes[0], near, r.nodes[2]]);
+    g.check_invariants().unwrap();
+}
+
+#[test]
+fn refuses_bad_input_without_changing_the_graph() {
+    let mut g = G::new();
+    g.insert_segment(v(0., 0.), v(1., 0.), 1, &EXACT).unwrap();
+    let before = serde_json::to_string(&g).unwrap();
+    let snap = SnapOptions::default();
+    let cases = [
+        (v(3., 3.), v(3., 3.)),
+        (v(3., 3.), v(3.005, 3.)),
+        (v(0.001, 0.), v(0., 0.002)), // both snap to the node at the origin
+        (v(f64::NAN, 0.), v(1., 1.)),
+        (v(1e12, 0.), v(1., 1.)),
+        (v(0., f64::INFINITY), v(1., 1.)),
+    ];
+    for (p, q) in cases {
+        assert!(g.insert_segment(p, q, 9, &snap).is_err(), "{p} {q}");
+    }
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let o = SnapOptions { snap_distance: bad };
+        assert!(g.insert_segment(v(5., 5.), v(6., 6.), 9, &o).is_err());
+    }
+    assert_eq!(serde_json::to_string(&g).unwrap(), before);
+}
+
+#[test]
+fn street_grid_has_the_expected_faces() {
+    // 5 horizontal and 5 vertical streets: 25 junctions, 40 edges, 16 blocks.
+    let mut g = G::new();
+    for i in 0..5 {
+        let c = f64::from(i) * 100.0;
+        g.insert_segment(v(c, 0.), v(c, 400.), 1, &EXACT).unwrap();
+        g.insert_segment(v(0., c), v(400., c), 2, &EXACT).unwrap();
+    }
+    g.check_invariants().unwrap();
+    assert_eq!(g.node_count(), 25);
+    assert_eq!(g.edge_count(), 40);
+    // Euler: V - E + F = 2 with one component.
+    assert_eq!(g.connected_components().len(), 1);
+    let faces = 2 + g.edge_count() - g.node_count();
+    assert_eq!(faces, 17);
+}
+
+#[test]
+fn regression_no_ping_pong_between_close_nodes() {
+    // Found by proptest: a crossing node 5.1 cm from an end node, snap 5 cm. The walk
+    // used to bounce between the two nodes for ever.
+    let mut g = G::new();
+    let o = SnapOptions {
+        snap_distance: 0.05,
+    };
+    g.insert_segment(v(4.0, 5.022353999911049), v(1.7439689490473573, 0.0), 0, &o)
+        .unwrap();
+    let r = g
+        .insert_segment(v(0.0, 2.0), v(1.8069708005622833, 0.0), 1, &o)
+        .unwrap();
+    assert_eq!(r.nodes.len(), 4);
+    g.check_invariants().unwrap();
+}
+
+#[test]
+fn regression_three_lines_through_one_point() {
+    // Three lines through (3, 2.5) and two more crossings: one node per crossing point,
+    // whatever the order (the rounded copies of (3, 2.5) merge).
+    let segs = [
+        (v(3.0, 0.0), v(4.0, 2.0)),
+        (v(5.0, 1.0), v(1.0, 4.0)),
+        (v(6.0, 0.0), v(0.0, 5.0)),
+        (v(3.0, 0.0), v(3.0, 5.0)),
+    ];
+    for rev in [false, true] {
+        let mut g = G::new();
+        let order: Vec<_> = if rev {
+            segs.iter().rev().collect()
+        } else {
+            segs.iter().collect()
+        };
+        for &&(p, q) in &order {
+            g.insert_segment(p, q, 0, &EXACT).unwrap();
+        }
+        g.check_invariants().unwrap();
+        let n = node_at_approx(&g, v(3.0, 2.5));
+        assert_eq!(g.degree(n).unwrap(), 6);
+        assert_eq!(g.node_count(), 10);
+    }
+}
+
+fn node_at_approx(g: &G, p: DVec2) -> NodeId {
+    g.nearest_node(p, 1e-9)
+        .map(|(n, _)| n)
+        .unwrap_or_else(|| panic!("no node near {p}"))
+}
+
+fn coord() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        4 => (0i32..=6).prop_map(f64::from),
+        1 => 0.0f64..6.0,
+    ]
+}
+
+fn segment() -> impl Strategy<Value = (DVec2, DVec2)> {
+    ((coord(), coord()), (coord(), coord())).prop_map(|((a, b), (c, d))| (v(a, b), v(c, d)))
+}
+
+fn int_segment() -> impl Strategy<Value = (DVec2, DVec2)> {
+    let c = || (0i32..=6).prop_map(f64::from);
+    ((c(), c()), (c(), c())).prop_map(|((a, b), (x, y))| (v(a, b), v(x, y)))
+}
+
+fn float_segment() -> impl Strategy<Value = (DVec2, DVec2)> {
+    let p = (-50.0f64..50.0, -50.0f64..50.0).prop_map(|(x, y)| v(x, y));
+    (p.clone(), p)
+}
+
+/// Inserts all segments, then checks planarity, that every input segment is covered by
+/// the graph within `tol`, and that every crossing of two inserted inputs is a node.
+fn check_insertions(segs: &[(DVec2, DVec2)], snap: f64, tol: f64) -> Result<(), TestCaseError> {
+    let opts = SnapOptions {
+        snap_distance: snap,
+    };
+    let mut g = G::new();
+    let mut inserted = Vec::new();
+    for (i, &(p, q)) in segs.iter().enumerate() {
+        match g.insert_segment(p, q, i as u32, &opts) {
+            Ok(r) => {
+                prop_assert_eq!(r.nodes.len(), r.path.len() + 1);
+                for (k, &e) in r.path.iter().enumerate() {
+                    let (a, b) = g.endpoints(e).unwrap();
+                    prop_assert!(
+                        (a, b) == (r.nodes[k], r.nodes[k + 1])
+                            || (b, a) == (r.nodes[k], r.nodes[k + 1])
+                    );
+                }
+                inserted.push((p, q));
+            }
+            Err(GeomError::ZeroLengthEdge { .. }) => {
+                prop_assert!(p.distance(q) <= 3.0 * snap + tol, "refused {} {}", p, q);
+            }
+            Err(e) => return Err(TestCaseError::fail(format!("segment {i} {p} {q}: {e}"))),
+        }
+        if let Err(e) = g.check_invariants() {
+            return Err(TestCaseError::fail(format!(
+                "after segment {i} ({p} {q}): {e}"
+            )));
+        }
+    }
+    let near_edge = |x: DVec2| g.nearest_edge(x, tol + 3.0 * snap).is_some();
+    for &(p, q) in &inserted {
+        prop_assert!(g.nearest_node(p, snap + tol).is_some(), "no node at {}", p);
+        prop_assert!(g.nearest_node(q, snap + tol).is_some(), "no node at {}", q);
+        for t in [0.1, 0.5, 0.9] {
+            let x = p.lerp(q, t);
+            prop_assert!(near_edge(x), "{} on {}–{} is not covered", x, p, q);
+        }
+    }
+    for (i, &(a0, a1)) in inserted.iter().enumerate() {
+        for &(b0, b1) in &inserted[i + 1..] {
+            if let SegmentIntersection::Crossing { point, .. } =
+                segment_intersection(a0, a1, b0, b1)
+            {
+                // Paths bend by up to a snap distance towards nodes near them, which moves
+                // a crossing along the lines by that over the sine of their angle.
+                let (da, db) = ((a1 - a0).normalize(), (b1 - b0).normalize());
+                let sin = da.perp_dot(db).abs().max(1e-3);
+                prop_assert!(
+                    g.nearest_node(point, 4.0 * snap / sin + tol).is_some(),
+                    "crossing at {} is not a node",
+                    point
+                );
+            }
+        }
+    }
+    // Every edge lies along some inserted segment.
+    for (e, _, _, _) in g.edges() {
+        let (a, b) = g.segment(e).unwrap();
+        let mid = (a + b) * 0.5;
+        let along = inserted
+            .iter()
+            .any(|&(p, q)| distance_to_segment(mid, p, q) <= 3.0 * snap + tol);
+        prop_assert!(along, "edge {} ({}–{}) lies on no input", e, a, b);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(150))]
+
+    #[test]
+    fn grid_segments_stay_planar_exact(segs in prop::collection::vec(segment(), 1..25)) {
+        check_insertions(&segs, 0.0, 1e-9)?;
+    }
+
+    #[test]
+    fn grid_segments_stay_planar_snapped(segs in prop::collection::vec(segment(), 1..25)) {
+        check_insertions(&segs, 0.05, 1e-9)?;
+    }
+
+    #[test]
+    fn float_segments_stay_planar(segs in prop::collection::vec(float_segment(), 1..30)) {
+        check_insertions(&segs, 0.01, 1e-9)?;
+    }
+
+    #[test]
+    fn insertion_order_does_not_change_the_picture(segs in prop::collection::vec(int_segment(), 1..12)) {
+        // Same segments forwards and backwards give graphs with the same node positions.
+        // A micrometre snap merges the rounded copies of one rational crossing point.
+        let opts = SnapOptions { snap_distance: 1e-6 };
+        let build = |order: &mut dyn Iterator<Item = &(DVec2, DVec2)>| {
+            let mut g = G::new();
+            for &(p, q) in order {
+                let _ = g.insert_segment(p, q, 0, &opts);
+            }
+            let mut pts: Vec<(f64, f64)> = g.nodes().map(|(_, p, _)| (p.x, p.y)).collect();
+            pts.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+            (pts, g.edge_count())
+        };
+        let (fwd, ef) = build(&mut segs.iter());
+        let (bwd, eb) = build(&mut segs.iter().rev());
+        // Integer inputs: crossings are rational; positions may differ by rounding.
+        prop_assert_eq!(fwd.len(), bwd.len());
+        prop_assert_eq!(ef, eb);
+        for a in &fwd {
+            let twin = bwd.iter().any(|b| (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9);
+            prop_assert!(twin, "node {:?} has no twin", a);
+        }
+    }
+}
