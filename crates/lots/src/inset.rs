@@ -165,6 +165,7 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
             }
         }
         clean_ring(&mut ring, engine.eps);
+        separate_pinches(&mut ring, engine.eps);
         if ring.points.len() < 3 {
             continue;
         }
@@ -202,6 +203,55 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
         }
     }
     shapes
+}
+
+/// At the exact time of an event a ring can touch itself in a point (a hole meeting the
+/// outside, two parts about to separate). Each visit of such a point is moved by `2·eps`
+/// into its own corner, which makes the ring simple and changes no edge by more than that.
+fn separate_pinches(ring: &mut InsetRing, eps: f64) {
+    let n = ring.points.len();
+    if n < 4 {
+        return;
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        let (p, q) = (ring.points[a], ring.points[b]);
+        p.x.total_cmp(&q.x)
+            .then(p.y.total_cmp(&q.y))
+            .then(a.cmp(&b))
+    });
+    let mut pinched: Vec<usize> = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        let p = ring.points[i];
+        for &j in &order[k + 1..] {
+            let q = ring.points[j];
+            if q.x - p.x > eps {
+                break;
+            }
+            if p.distance(q) <= eps {
+                pinched.push(i);
+                pinched.push(j);
+            }
+        }
+    }
+    pinched.sort_unstable();
+    pinched.dedup();
+    let moved: Vec<(usize, DVec2)> = pinched
+        .iter()
+        .map(|&i| {
+            let p = ring.points[i];
+            let a = ring.points[(i + n - 1) % n];
+            let b = ring.points[(i + 1) % n];
+            let inward = (p - a).normalize_or_zero().perp() + (b - p).normalize_or_zero().perp();
+            let dir = inward
+                .try_normalize()
+                .unwrap_or_else(|| (p - a).normalize_or_zero().perp());
+            (i, p + dir * (2.0 * eps))
+        })
+        .collect();
+    for (i, p) in moved {
+        ring.points[i] = p;
+    }
 }
 
 /// Removes zero-length edges: the surviving edge keeps the source of the edge that had

@@ -1,14 +1,49 @@
 //! # polis-lots
 //!
-//! From a city cell to building lots: the straight skeleton (weighted, with split events),
-//! insets, blocks with footpaths, and lot subdivision with street access.
+//! From a city cell to building lots: the straight skeleton (weighted, with split events,
+//! holes), exact insets, blocks with footpaths, and lot subdivision with street access.
+//!
+//! ```text
+//! Cell (boundary, holes, road width per edge)
+//!   │  weighted inset by half of each road width      (straight skeleton wavefront)
+//!   ▼
+//! Block ── footpath strip (inset by the footpath width, lengths for texture coordinates)
+//!   │  parcels: the land inside the footpath, every edge facing a street
+//!   ▼
+//! Lots (Kelly 2008 or Parish & Müller 2001), street edges tracked through every split
+//! ```
 //!
 //! | module | what |
 //! |---|---|
-//! | [`skeleton`] | [`StraightSkeleton`]: nodes with times, arcs, and the face each input edge sweeps |
-//! | [`inset`](mod@inset) | [`inset`], [`inset_weighted`], [`inset_shapes`]: the wavefront at a time |
+//! | [`skeleton`] | [`StraightSkeleton`]: nodes with times, arcs, the face each input edge sweeps |
+//! | [`inset`](mod@inset) | [`inset`], [`inset_weighted`], [`inset_shapes`], [`Inset`]: the wavefront at a time |
+//! | [`block`] | [`Cell`] → [`Block`]s with [`Footpath`]s and parcels ([`blocks`]) |
+//! | [`subdivision`] | [`subdivide`], [`subdivide_block`], [`Subdivider`]: [`Lot`]s ([`LotParams`]) |
+//! | [`polygon_split`] | [`split_by_line`]: a region cut by a line into all its pieces |
 //!
 //! ## Example
+//!
+//! ```
+//! use polis_geom::{DVec2, Polygon};
+//! use polis_lots::{BlockParams, Cell, LotParams, blocks, subdivide_block};
+//! use rand::SeedableRng;
+//!
+//! // A 100 m square cell with 10 m roads all round.
+//! let cell = Cell {
+//!     id: 1,
+//!     polygon: Polygon::rect(DVec2::ZERO, DVec2::new(100.0, 100.0)).into(),
+//!     road_widths: vec![10.0; 4],
+//! };
+//! let block = &blocks(&cell, &BlockParams::default())?[0];
+//! assert!((block.polygon.area() - 90.0 * 90.0).abs() < 1e-9);
+//! let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(block.id());
+//! let lots = subdivide_block(block, &LotParams::default(), &mut rng)?;
+//! assert!(!lots.lots.is_empty());
+//! assert!(lots.lots.iter().all(|lot| !lot.street_edges.is_empty()));
+//! # Ok::<(), polis_lots::LotsError>(())
+//! ```
+//!
+//! The skeleton on its own:
 //!
 //! ```
 //! use polis_geom::{DVec2, Polygon};
@@ -22,10 +57,38 @@
 //! # Ok::<(), polis_lots::LotsError>(())
 //! ```
 //!
+//! ## Guarantees
+//!
+//! * Input is validated ([`polis_geom::PolygonWithHoles::validate`], orientation, one
+//!   positive finite value per edge); bad input is a [`LotsError`], never a panic.
+//! * Skeleton nodes lie at distance `time · weight` from the lines of the edges whose faces
+//!   they bound; the faces tile the polygon. Insets are simple, inside the input, at the
+//!   exact offset, shrinking with the distance. Split events are never skipped.
+//! * Lots and discarded pieces partition the subdivided region; kept lots face a street.
+//! * Deterministic: no hash-map order or time reaches the output; randomness only from the
+//!   generator the caller passes.
+//!
+//! ## Numeric policy
+//!
+//! Every side, turn and angular-order decision uses `polis_geom`'s exact predicates.
+//! Wavefront points closer than `1e-9` of the polygon's size at the same time are one
+//! point; edges within a sine of `1e-8` of parallel are parallel (see
+//! [`skeleton`]'s limitations).
+//!
+//! ## Limitations
+//!
+//! * The skeleton tests every reflex vertex against every edge line (the
+//!   Felkel–Obdržálek bound, O(n·r) with r reflex vertices), so it grows quadratically on
+//!   polygons with thousands of reflex vertices (see `BENCHMARKS.md`).
+//! * Consecutive parallel edges with different weights meet in a perpendicular step.
+//!
 //! ## References
 //!
-//! Felkel & Obdržálek 1998; Aichholzer et al. 1995; Eppstein & Erickson 1999; Kelly 2008
-//! §4.4; Parish & Müller 2001 §4.1.
+//! Aichholzer, Aurenhammer, Alberts, Gärtner, *A Novel Type of Skeleton for Polygons*
+//! (1995); Felkel, Obdržálek, *Straight Skeleton Implementation* (1998); Eppstein,
+//! Erickson, *Raising Roofs, Crashing Cycles, and Playing Pool* (1999); Kelly, *An
+//! Interactive System for Procedural City Generation* (2008) §4.4.1–4.4.3; Parish, Müller,
+//! *Procedural Modeling of Cities* (2001) §4.1.
 
 pub use polis_geom as geom;
 

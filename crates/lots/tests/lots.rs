@@ -258,3 +258,42 @@ proptest! {
         prop_assert_eq!(&s, &again);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    #[test]
+    fn cells_to_blocks_to_lots(
+        n in 3usize..16,
+        seeds in prop::collection::vec((0.0f64..1.0, 60.0f64..150.0), 1..16),
+        widths in prop::collection::vec(prop_oneof![Just(10.0), Just(20.0), 4.0f64..30.0], 16),
+        footpath in prop_oneof![Just(0.0), 1.0f64..4.0],
+        seed in any::<u64>(),
+    ) {
+        let p = blob(n, &seeds);
+        let pw: PolygonWithHoles = p.clone().into();
+        prop_assume!(pw.validate().is_ok());
+        let cell = Cell { id: seed, polygon: pw.clone(), road_widths: (0..p.len()).map(|i| widths[i % widths.len()]).collect() };
+        let bs = blocks(&cell, &BlockParams { footpath_width: footpath }).unwrap();
+        for b in &bs {
+            prop_assert!(b.polygon.validate().is_ok());
+            let parcels: f64 = b.parcels.iter().map(Region::area).sum();
+            let strips: f64 = b.footpath.strips.iter().map(PolygonWithHoles::area).sum();
+            if footpath > 0.0 {
+                prop_assert!((parcels + strips - b.polygon.area()).abs() < 1e-9 * b.polygon.area(), "{} + {} != {}", parcels, strips, b.polygon.area());
+                for s in &b.footpath.strips {
+                    prop_assert!(s.validate().is_ok());
+                }
+            }
+            for parcel in &b.parcels {
+                let s = subdivide(parcel, b.id(), &kelly(10.0, 25.0, 0.5), &mut Pcg64Mcg::seed_from_u64(seed)).unwrap();
+                let ppw = PolygonWithHoles::new(
+                    Polygon::new(parcel.outer.points.clone()),
+                    parcel.holes.iter().map(|h| Polygon::new(h.points.clone())).collect(),
+                );
+                if let Err(e) = check_partition(&ppw, &s) { prop_assert!(false, "{}", e); }
+                prop_assert!(s.lots.iter().all(|l| !l.street_edges.is_empty()));
+            }
+        }
+    }
+}

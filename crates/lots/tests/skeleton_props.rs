@@ -145,6 +145,41 @@ proptest! {
     }
 
     #[test]
+    fn histograms_with_holes(heights in prop::collection::vec(0u8..4, 2..12), holes in prop::collection::vec((0usize..12, 0u8..3, any::<bool>()), 1..5)) {
+        let base = histogram(&heights).map_points(|q| q * 4.0 + v(0.0, 8.0 * f64::from(q.y > 0.0)));
+        let mut hs = Vec::new();
+        for (x, y, big) in holes {
+            let x = (x % heights.len()) as f64 * 4.0 + 1.0;
+            let y = f64::from(y) * 2.0 + 1.0;
+            let size = if big { 2.0 } else { 1.0 };
+            let mut r = Polygon::rect(v(x, y), v(x + size, y + size));
+            r.reverse();
+            hs.push(r);
+        }
+        let p = PolygonWithHoles::new(base, hs);
+        prop_assume!(p.validate().is_ok() && p.is_normalized());
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-9) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
+    fn insets_exactly_at_event_times(heights in prop::collection::vec(0u8..5, 1..16)) {
+        let p: PolygonWithHoles = histogram(&heights).into();
+        prop_assume!(p.validate().is_ok());
+        let sk = StraightSkeleton::new(&p).unwrap();
+        let mut times: Vec<f64> = sk.nodes().iter().map(|n| n.time).filter(|&t| t > 0.0).collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        for t in times {
+            for s in inset_shapes(&p, None, t).unwrap() {
+                let pw = s.to_polygon();
+                prop_assert!(pw.validate().is_ok(), "inset at event time {} invalid: {:?} {:?}", t, pw.validate(), pw);
+            }
+        }
+    }
+
+    #[test]
     fn near_degenerate_histograms(heights in prop::collection::vec(0u8..4, 1..16), seeds in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 1..8)) {
         let p: PolygonWithHoles = jitter(&histogram(&heights), &seeds).into();
         prop_assume!(p.validate().is_ok());

@@ -96,7 +96,7 @@ struct CandidateBatch {
     items: [Candidate; CANDIDATE_BATCH],
     len: u8,
     next: u8,
-    /// Whether the scan found no more candidates than these.
+    /// Whether these are all the candidates there are.
     complete: bool,
 }
 
@@ -122,8 +122,13 @@ pub(crate) struct Engine {
     pub arcs: Vec<SkeletonArc>,
     queue: BinaryHeap<Reverse<Event>>,
     candidates: Vec<CandidateBatch>,
-    /// Per input edge: unit normal x, y, offset `n · a`, weight.
-    lines: Vec<[f64; 4]>,
+    /// Per input edge, structure of arrays: unit normal x, y, offset `n · a`, weight.
+    line_nx: Vec<f64>,
+    line_ny: Vec<f64>,
+    line_c: Vec<f64>,
+    line_w: Vec<f64>,
+    /// Scratch: hit time of the vertex being scanned on every edge line.
+    hit_times: Vec<f64>,
     /// For each input edge, vertices that started a wavefront piece of it.
     pieces: Vec<Vec<u32>>,
     mark: Vec<u32>,
@@ -153,7 +158,10 @@ impl Engine {
         self.arcs.clear();
         self.queue.clear();
         self.candidates.clear();
-        self.lines.clear();
+        self.line_nx.clear();
+        self.line_ny.clear();
+        self.line_c.clear();
+        self.line_w.clear();
         self.pieces.clear();
         self.mark.clear();
         self.stamp = 0;
@@ -213,11 +221,12 @@ impl Engine {
         }
         self.candidates
             .resize(self.verts.len(), CandidateBatch::default());
-        self.lines.extend(
-            self.edges
-                .iter()
-                .map(|e| [e.normal.x, e.normal.y, e.normal.dot(e.a), e.weight]),
-        );
+        for e in &self.edges {
+            self.line_nx.push(e.normal.x);
+            self.line_ny.push(e.normal.y);
+            self.line_c.push(e.normal.dot(e.a));
+            self.line_w.push(e.weight);
+        }
         self.mark.resize(self.verts.len(), 0);
         for v in 0..self.verts.len() as u32 {
             let ein = &self.edges[self.verts[v as usize].in_edge as usize];
@@ -349,34 +358,42 @@ impl Engine {
 
     /// The `CANDIDATE_BATCH` earliest hits of vertex `x` on input edge lines after `after`
     /// (in the order time, then edge).
-    fn scan_candidates(&self, x: &Vertex, after: Option<Candidate>) -> CandidateBatch {
+    fn scan_candidates(&mut self, x: &Vertex, after: Option<Candidate>) -> CandidateBatch {
         let mut batch = CandidateBatch::default();
         let vel = x.velocity();
         let (px, py) = (x.p0.x, x.p0.y);
-        let mut found = 0usize;
-        // Candidates later than this cannot enter the batch (the horizon, then the batch's
-        // last entry once it is full). Compared without dividing: with `slope < 0`,
-        // `t0 - ahead / slope < limit` iff `ahead < (limit - t0) · (-slope)`.
+        // First pass, branch-free so that it vectorises: the time the vertex reaches each
+        // edge line (infinite if it never does, or if it is already behind the line).
+        let mut times = std::mem::take(&mut self.hit_times);
+        let m = self.line_nx.len();
+        times.clear();
+        times.resize(m, f64::INFINITY);
+        let (nxs, nys, cs, ws) = (
+            &self.line_nx[..m],
+            &self.line_ny[..m],
+            &self.line_c[..m],
+            &self.line_w[..m],
+        );
+        let (t0, eps) = (x.t0, self.eps);
+        for (i, slot) in times.iter_mut().enumerate() {
+            let slope = nxs[i] * vel.x + nys[i] * vel.y - ws[i];
+            let ahead = nxs[i] * px + nys[i] * py - cs[i] - ws[i] * t0;
+            let t = t0 - ahead.max(0.0) / slope;
+            *slot = if slope < 0.0 && ahead >= -eps {
+                t
+            } else {
+                f64::INFINITY
+            };
+        }
+        // Second pass: the few that can enter the batch. Candidates later than `limit`
+        // (the horizon, then the batch's last entry once it is full) cannot.
         let mut limit = self.horizon;
-        for (i, l) in self.lines.iter().enumerate() {
-            let [nx, ny, c, w] = *l;
-            let slope = nx * vel.x + ny * vel.y - w;
-            if slope >= 0.0 {
-                continue;
-            }
-            let ahead = nx * px + ny * py - c - w * x.t0;
-            if ahead < -self.eps || ahead.max(0.0) > (limit - x.t0) * -slope * (1.0 + 1e-12) {
-                if ahead >= -self.eps {
-                    found += 1;
-                }
+        for (i, &t) in times.iter().enumerate() {
+            if t.is_nan() || t > limit {
                 continue;
             }
             let i = i as u32;
             if i == x.in_edge || i == x.out_edge {
-                continue;
-            }
-            let t = x.t0 - ahead.max(0.0) / slope;
-            if t.is_nan() || t > self.horizon {
                 continue;
             }
             let cand = Candidate { t, edge: i };
@@ -385,7 +402,6 @@ impl Engine {
             }
             let full = batch.len as usize == CANDIDATE_BATCH;
             if full && cand >= batch.items[CANDIDATE_BATCH - 1] {
-                found += 1;
                 continue;
             }
             let p = x.p0 + vel * (t - x.t0);
@@ -396,7 +412,6 @@ impl Engine {
             {
                 continue;
             }
-            found += 1;
             // Insertion into the sorted batch, dropping the largest when full.
             let mut k = if full {
                 CANDIDATE_BATCH - 1
@@ -415,7 +430,9 @@ impl Engine {
                 limit = batch.items[CANDIDATE_BATCH - 1].t;
             }
         }
-        batch.complete = found <= CANDIDATE_BATCH;
+        // A batch that is not full holds every candidate there is.
+        batch.complete = (batch.len as usize) < CANDIDATE_BATCH;
+        self.hit_times = times;
         batch
     }
 
@@ -426,7 +443,8 @@ impl Engine {
                 return;
             }
             let last = b.items[b.len as usize - 1];
-            b = self.scan_candidates(self.vert(v), Some(last));
+            let x = *self.vert(v);
+            b = self.scan_candidates(&x, Some(last));
             if b.len == 0 {
                 self.candidates[v as usize] = b;
                 return;
