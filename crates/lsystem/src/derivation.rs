@@ -34,6 +34,9 @@ use crate::error::{LsystemError, Result};
 use crate::string::ModuleString;
 use crate::turtle::{Turtle, TurtleOptions, TurtleSink, TurtleState};
 
+/// Hard cap of [`DeriveOptions::max_depth`].
+const MAX_DEPTH_CAP: usize = 4096;
+
 /// Options of a derivation: seed, growth guards and the turtle used between steps.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -46,7 +49,8 @@ pub struct DeriveOptions {
     pub max_len: usize,
     /// Largest number of derivation steps. Default: 10 000.
     pub max_steps: usize,
-    /// Deepest recursion of decomposition and interpretation rules. Default: 64.
+    /// Deepest recursion of decomposition and interpretation rules (capped at 4096 so the
+    /// recursion always fits the stack). Default: 64.
     pub max_depth: usize,
     /// Turtle used to fill query modules and to place communication modules. Default:
     /// [`TurtleOptions::default`].
@@ -394,7 +398,7 @@ impl<R: Rules> Derivation<R> {
     }
 
     fn ensure_levels(&mut self) {
-        let want = self.options.max_depth.saturating_add(1).min(4096);
+        let want = self.options.max_depth.saturating_add(1).min(MAX_DEPTH_CAP);
         if self.levels.len() < want {
             self.levels.resize_with(want, R::String::default);
         }
@@ -602,7 +606,7 @@ impl<R: Rules> Derivation<R> {
         let mut levels: Vec<R::String> = Vec::new();
         if self.rules.has_interpretation() {
             levels.resize_with(
-                self.options.max_depth.saturating_add(1).min(4096),
+                self.options.max_depth.saturating_add(1).min(MAX_DEPTH_CAP),
                 Default::default,
             );
         } else {

@@ -112,8 +112,20 @@ fn module_string() -> impl Strategy<Value = String> {
 
 // ---- the parser never panics; printing round-trips -------------------------------
 
+/// Case count of the parser properties: 256, or `LSYSTEM_PROPTEST_CASES` for a long run.
+fn parser_cases() -> u32 {
+    std::env::var("LSYSTEM_PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(256)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(ProptestConfig {
+        cases: parser_cases(),
+        max_global_rejects: parser_cases().saturating_mul(4),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn arbitrary_text_never_panics(s in ".{0,200}") {
