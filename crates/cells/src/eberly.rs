@@ -83,6 +83,8 @@ pub(crate) struct Sweep {
     pub(crate) components: Vec<u32>,
     /// Isolated nodes with their component index.
     pub(crate) isolated: Vec<(u32, u32)>,
+    /// Half-edges walked in the last run (each exactly once).
+    pub(crate) walked: usize,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -113,6 +115,7 @@ impl Sweep {
         self.loops.clear();
         self.components.clear();
         self.isolated.clear();
+        self.walked = 0;
     }
 
     /// Runs the sweep over the whole working graph (which it consumes: every edge is
@@ -176,6 +179,7 @@ impl Sweep {
             }
         }
 
+        self.walked += self.walk.len();
         let v0 = topo.origin(start);
         self.stack_v.clear();
         self.stack_h.clear();
@@ -255,5 +259,98 @@ impl Sweep {
             }
             self.loops.push(RawLoop { span, owner: here });
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::ExtractionReport;
+    use crate::params::CellParams;
+    use polis_geom::{DVec2, PlanarGraph};
+
+    fn run(g: &PlanarGraph<(), ()>) -> (Topology, Sweep) {
+        let mut t = Topology::default();
+        let mut r = ExtractionReport::default();
+        t.build(g, &CellParams::default(), &mut r).unwrap();
+        let mut s = Sweep::default();
+        s.run(&mut t).unwrap();
+        (t, s)
+    }
+
+    /// A 4 × 4 grid with a dead end in every cell and a ring inside one cell.
+    fn busy() -> PlanarGraph<(), ()> {
+        let mut g = PlanarGraph::new();
+        let mut id = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                id.push(
+                    g.add_node(DVec2::new(f64::from(i) * 10.0, f64::from(j) * 10.0), ())
+                        .unwrap(),
+                );
+            }
+        }
+        for j in 0..4 {
+            for i in 0..4 {
+                let k = j * 4 + i;
+                if i < 3 {
+                    g.add_edge(id[k], id[k + 1], ()).unwrap();
+                }
+                if j < 3 {
+                    g.add_edge(id[k], id[k + 4], ()).unwrap();
+                }
+                if i < 3 && j < 3 {
+                    let p = g.position(id[k]).unwrap() + DVec2::new(3.0, 2.0);
+                    let d = g.add_node(p, ()).unwrap();
+                    g.add_edge(id[k], d, ()).unwrap();
+                }
+            }
+        }
+        let ring: Vec<_> = [(14.0, 14.0), (18.0, 14.0), (18.0, 18.0), (14.0, 18.0)]
+            .iter()
+            .map(|&(x, y)| g.add_node(DVec2::new(x, y), ()).unwrap())
+            .collect();
+        for i in 0..4 {
+            g.add_edge(ring[i], ring[(i + 1) % 4], ()).unwrap();
+        }
+        g
+    }
+
+    #[test]
+    fn every_half_edge_is_walked_once_and_every_edge_removed() {
+        let g = busy();
+        let (t, s) = run(&g);
+        assert_eq!(s.walked, 2 * g.edge_count());
+        assert!(t.live.iter().all(|&l| !l));
+        assert!(t.deg.iter().all(|&d| d == 0));
+        assert_eq!(s.cycles.len(), 9 + 1);
+        assert_eq!(s.components.len(), 2);
+        // The island's outside was walked as component 1 and its cycle waits for it.
+        let island = s
+            .cycles
+            .iter()
+            .find(|c| t.p(t.origin(s.ring_buf[c.span.start as usize])) == DVec2::new(14.0, 14.0))
+            .unwrap();
+        assert_eq!(island.parent, Owner::Outside(1));
+        assert_eq!(s.loops.len(), 2);
+    }
+
+    #[test]
+    fn grid_cells_are_found_left_to_right() {
+        let g = busy();
+        let (t, s) = run(&g);
+        let first_x: Vec<f64> = s
+            .cycles
+            .iter()
+            .map(|c| t.p(t.origin(s.ring_buf[c.span.start as usize])).x)
+            .collect();
+        assert!(first_x.windows(2).all(|w| w[0] <= w[1]), "{first_x:?}");
+        // Dead ends were detached inside their cells.
+        let inside = s
+            .filament_owner
+            .iter()
+            .filter(|o| matches!(o, Owner::Cell(_)))
+            .count();
+        assert_eq!(inside, 9);
     }
 }

@@ -52,4 +52,17 @@ mod tests {
         assert_eq!(p.coincident_nodes, CoincidentNodes::Merge);
         assert!(p.check_planarity);
     }
+
+    #[test]
+    fn serde_round_trip_and_defaults_for_missing_fields() {
+        let p = CellParams {
+            coincident_nodes: CoincidentNodes::Reject,
+            check_planarity: false,
+        };
+        let s = serde_json::to_string(&p).unwrap();
+        assert_eq!(serde_json::from_str::<CellParams>(&s).unwrap(), p);
+        let partial: CellParams = serde_json::from_str(r#"{"check_planarity":false}"#).unwrap();
+        assert_eq!(partial.coincident_nodes, CoincidentNodes::Merge);
+        assert!(!partial.check_planarity);
+    }
 }

@@ -2,8 +2,9 @@
 //! no node may lie inside an edge.
 //!
 //! Edges are bucketed in a uniform grid (each edge in the cells its segment passes
-//! through, found conservatively column by column); pairs sharing a bucket are classified
-//! with the exact [`segment_intersection`]. Expected `O(n)` on road-like graphs.
+//! through, found conservatively column by column); every pair sharing a bucket is
+//! classified once with the exact [`segment_intersection`]. No sorting: expected `O(n)` on
+//! road-like graphs, `O(d²)` around a node of degree `d`.
 
 use polis_geom::predicates::{SegmentIntersection, point_on_segment, segment_intersection};
 use polis_geom::{DVec2, EdgeId, NodeId};
@@ -17,23 +18,77 @@ pub const MAX_REPORTED_CONFLICTS: usize = 16;
 /// Buffers of the planarity check.
 #[derive(Debug, Default)]
 pub(crate) struct PlanarityCheck {
+    /// Bucket `c` holds `items[start[c]..start[c + 1]]`.
     start: Vec<u32>,
     items: Vec<u32>,
-    cell_of: Vec<(u32, u32)>,
-    pairs: Vec<(u32, u32)>,
+    /// For every item, the last item it was tested against (deduplicates pairs).
+    stamp: Vec<u32>,
+    isolated: Vec<u32>,
 }
 
-/// An item of the grid: edge `e` as `2e`, isolated node `v` as `2v + 1`.
-#[inline]
-fn edge_item(e: u32) -> u32 {
-    e << 1
+/// The uniform grid over the graph's bounding box.
+struct Grid {
+    lo: DVec2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// Slack added around every segment's y-range, covering rounding in `y_at`.
+    eps: f64,
+}
+
+impl Grid {
+    fn col(&self, x: f64) -> usize {
+        (((x - self.lo.x) / self.cell).max(0.0) as usize).min(self.nx - 1)
+    }
+
+    fn row(&self, y: f64) -> usize {
+        (((y - self.lo.y) / self.cell).max(0.0) as usize).min(self.ny - 1)
+    }
+
+    /// Calls `f` with every bucket the segment `a–b` passes through, conservatively: a
+    /// bucket it comes within `eps` of may be included, none it touches is missed (the
+    /// column range is widened by one on each side against rounding in `col`).
+    fn for_each_cell(&self, a: DVec2, b: DVec2, mut f: impl FnMut(usize)) {
+        let (xmin, xmax) = (a.x.min(b.x), a.x.max(b.x));
+        let c0 = self.col(xmin).saturating_sub(1);
+        let c1 = (self.col(xmax) + 1).min(self.nx - 1);
+        let y_at = |x: f64| {
+            let t = ((x - a.x) / (b.x - a.x)).clamp(0.0, 1.0);
+            a.y + (b.y - a.y) * t
+        };
+        for c in c0..=c1 {
+            let xa = (self.lo.x + c as f64 * self.cell - self.eps).max(xmin);
+            let xb = (self.lo.x + (c + 1) as f64 * self.cell + self.eps).min(xmax);
+            if xa > xb {
+                continue;
+            }
+            let (ylo, yhi) = if xmin == xmax {
+                (a.y.min(b.y), a.y.max(b.y))
+            } else {
+                let (ya, yb) = (y_at(xa), y_at(xb));
+                (ya.min(yb), ya.max(yb))
+            };
+            let (r0, r1) = (self.row(ylo - self.eps), self.row(yhi + self.eps));
+            for r in r0..=r1 {
+                f(r * self.nx + c);
+            }
+        }
+    }
 }
 
 impl PlanarityCheck {
     /// Checks the working graph; `Err(NotPlanar)` lists the conflicts.
     pub(crate) fn check(&mut self, topo: &Topology) -> Result<(), Error> {
-        let m = topo.edge_list.len();
-        if m < 2 && topo.order.len() < 2 {
+        let m = topo.ends.len();
+        self.isolated.clear();
+        self.isolated.extend(
+            topo.order
+                .iter()
+                .copied()
+                .filter(|&v| topo.deg0[v as usize] == 0),
+        );
+        let count = topo.edge_list.len() + self.isolated.len();
+        if count < 2 {
             return Ok(());
         }
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
@@ -45,174 +100,163 @@ impl PlanarityCheck {
             hi = hi.max(pa.max(pb));
             total_len += (pb - pa).abs().max_element();
         }
-        let isolated: Vec<u32> = topo
-            .order
-            .iter()
-            .copied()
-            .filter(|&v| topo.deg0[v as usize] == 0)
-            .collect();
-        for &v in &isolated {
+        for &v in &self.isolated {
             lo = lo.min(topo.p(v));
             hi = hi.max(topo.p(v));
         }
         if lo.x > hi.x {
             return Ok(());
         }
-        // Cell size: about the mean edge extent, with at most ~4 cells per item.
-        let items = (m + isolated.len()).max(1);
+        // Cell size: about the mean edge extent, at most ~4 cells per item, at most 4096
+        // cells per side.
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let mean = if m > 0 { total_len / m as f64 } else { extent };
-        let min_cell = extent / (2.0 * (items as f64).sqrt()).max(1.0);
+        let mean = if topo.edge_list.is_empty() {
+            extent
+        } else {
+            total_len / topo.edge_list.len() as f64
+        };
+        let min_cell = extent / (2.0 * (count as f64).sqrt()).max(1.0);
         let cell = mean
             .max(min_cell)
             .max(extent / 4096.0)
             .max(f64::MIN_POSITIVE);
-        let nx = (((hi.x - lo.x) / cell) as usize + 1).min(4096);
-        let ny = (((hi.y - lo.y) / cell) as usize + 1).min(4096);
-        let col = |x: f64| (((x - lo.x) / cell) as usize).min(nx - 1);
-        let row = |y: f64| (((y - lo.y) / cell) as usize).min(ny - 1);
+        let grid = Grid {
+            lo,
+            cell,
+            nx: (((hi.x - lo.x) / cell) as usize + 1).min(4096),
+            ny: (((hi.y - lo.y) / cell) as usize + 1).min(4096),
+            eps: 1e-9 * cell + 1e-12 * lo.abs().max(hi.abs()).max_element(),
+        };
 
-        // Buckets: (cell, item) pairs, then sorted into CSR.
-        self.cell_of.clear();
+        // Buckets as CSR, by counting.
+        let buckets = grid.nx * grid.ny;
+        self.start.clear();
+        self.start.resize(buckets + 1, 0);
         for &e in &topo.edge_list {
             let [a, b] = topo.ends[e as usize];
-            let (pa, pb) = (topo.p(a), topo.p(b));
-            let (c0, c1) = (col(pa.x.min(pb.x)), col(pa.x.max(pb.x)));
-            for c in c0..=c1 {
-                // y-range of the segment over this column, widened by one row.
-                let (r0, r1) = if c0 == c1 {
-                    (row(pa.y.min(pb.y)), row(pa.y.max(pb.y)))
-                } else {
-                    let xa = lo.x + c as f64 * cell;
-                    let xb = xa + cell;
-                    let y_at = |x: f64| {
-                        let t = ((x - pa.x) / (pb.x - pa.x)).clamp(0.0, 1.0);
-                        pa.y + (pb.y - pa.y) * t
-                    };
-                    let (ya, yb) = (y_at(xa), y_at(xb));
-                    (
-                        row(ya.min(yb)).saturating_sub(1),
-                        (row(ya.max(yb)) + 1).min(ny - 1),
-                    )
-                };
-                for r in r0..=r1 {
-                    self.cell_of.push(((r * nx + c) as u32, edge_item(e)));
-                }
-            }
+            grid.for_each_cell(topo.p(a), topo.p(b), |c| self.start[c + 1] += 1);
         }
-        for &v in &isolated {
+        for &v in &self.isolated {
             let p = topo.p(v);
-            self.cell_of
-                .push(((row(p.y) * nx + col(p.x)) as u32, (v << 1) | 1));
+            self.start[grid.row(p.y) * grid.nx + grid.col(p.x) + 1] += 1;
         }
-        self.cell_of.sort_unstable();
-        self.start.clear();
+        for c in 0..buckets {
+            self.start[c + 1] += self.start[c];
+        }
         self.items.clear();
-        let mut k = 0;
-        while k < self.cell_of.len() {
-            let c = self.cell_of[k].0;
-            self.start.push(self.items.len() as u32);
-            while k < self.cell_of.len() && self.cell_of[k].0 == c {
-                self.items.push(self.cell_of[k].1);
-                k += 1;
+        self.items.resize(self.start[buckets] as usize, 0);
+        {
+            let mut fill: Vec<u32> = self.start[..buckets].to_vec();
+            let items = &mut self.items;
+            for &e in &topo.edge_list {
+                let [a, b] = topo.ends[e as usize];
+                grid.for_each_cell(topo.p(a), topo.p(b), |c| {
+                    items[fill[c] as usize] = e;
+                    fill[c] += 1;
+                });
+            }
+            for &v in &self.isolated {
+                let p = topo.p(v);
+                let c = grid.row(p.y) * grid.nx + grid.col(p.x);
+                items[fill[c] as usize] = m as u32 + v;
+                fill[c] += 1;
             }
         }
-        self.start.push(self.items.len() as u32);
 
-        // Candidate pairs from every bucket, deduplicated.
-        self.pairs.clear();
-        for w in self.start.windows(2) {
-            let bucket = &self.items[w[0] as usize..w[1] as usize];
-            for (i, &x) in bucket.iter().enumerate() {
-                for &y in &bucket[i + 1..] {
-                    if x & 1 == 1 && y & 1 == 1 {
-                        continue;
-                    }
-                    self.pairs.push((x.min(y), x.max(y)));
-                }
-            }
-        }
-        self.pairs.sort_unstable();
-        self.pairs.dedup();
-
+        // Every item against the later items sharing a bucket, each pair once.
+        self.stamp.clear();
+        self.stamp.resize(m + topo.pos.len(), u32::MAX);
         let mut conflicts = Vec::new();
         let mut total = 0;
-        for &(x, y) in &self.pairs {
-            if let Some(c) = classify(topo, x, y) {
-                total += 1;
-                if conflicts.len() < MAX_REPORTED_CONFLICTS {
-                    conflicts.push(c);
+        let (start, items, stamp) = (&self.start, &self.items, &mut self.stamp);
+        let mut test = |x: u32, c: usize, total: &mut usize, conflicts: &mut Vec<Conflict>| {
+            for &y in &items[start[c] as usize..start[c + 1] as usize] {
+                if y <= x || stamp[y as usize] == x || (x as usize >= m && y as usize >= m) {
+                    continue;
+                }
+                stamp[y as usize] = x;
+                if let Some(k) = classify(topo, m as u32, x, y) {
+                    *total += 1;
+                    if conflicts.len() < MAX_REPORTED_CONFLICTS {
+                        conflicts.push(k);
+                    }
                 }
             }
+        };
+        for &e in &topo.edge_list {
+            let [a, b] = topo.ends[e as usize];
+            grid.for_each_cell(topo.p(a), topo.p(b), |c| {
+                test(e, c, &mut total, &mut conflicts);
+            });
         }
         if total > 0 {
+            conflicts.sort_by_key(|c| match *c {
+                Conflict::Crossing { first, second, .. } | Conflict::Overlap { first, second } => {
+                    (first.raw(), second.raw())
+                }
+                Conflict::NodeOnEdge { node, edge, .. } => (edge.raw(), u32::MAX - node.raw()),
+            });
             return Err(Error::NotPlanar { conflicts, total });
         }
         Ok(())
     }
 }
 
-/// The conflict between two grid items, if any.
-fn classify(topo: &Topology, x: u32, y: u32) -> Option<Conflict> {
-    let seg = |i: u32| {
-        let [a, b] = topo.ends[(i >> 1) as usize];
+/// The conflict between two grid items (edge `e` as `e`, isolated node `v` as `m + v`),
+/// if any.
+fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
+    let seg = |e: u32| {
+        let [a, b] = topo.ends[e as usize];
         ([a, b], topo.p(a), topo.p(b))
     };
-    match (x & 1, y & 1) {
-        (0, 0) => {
-            let (e, f) = (x >> 1, y >> 1);
-            let (ee, a0, a1) = seg(x);
-            let (fe, b0, b1) = seg(y);
-            let first = EdgeId::from_raw(e.min(f));
-            let second = EdgeId::from_raw(e.max(f));
-            match segment_intersection(a0, a1, b0, b1) {
-                SegmentIntersection::Disjoint => None,
-                SegmentIntersection::Crossing { point, .. } => Some(Conflict::Crossing {
+    if x >= m || y >= m {
+        let (e, v) = if x < m { (x, y - m) } else { (y, x - m) };
+        let (_, a, b) = seg(e);
+        let p = topo.p(v);
+        return point_on_segment(p, a, b).then_some(Conflict::NodeOnEdge {
+            node: NodeId::from_raw(v),
+            edge: EdgeId::from_raw(e),
+            point: p,
+        });
+    }
+    let (e, f) = (x, y);
+    let (ee, a0, a1) = seg(e);
+    let (fe, b0, b1) = seg(f);
+    let first = EdgeId::from_raw(e.min(f));
+    let second = EdgeId::from_raw(e.max(f));
+    match segment_intersection(a0, a1, b0, b1) {
+        SegmentIntersection::Disjoint => None,
+        SegmentIntersection::Crossing { point, .. } => Some(Conflict::Crossing {
+            first,
+            second,
+            point,
+        }),
+        SegmentIntersection::Overlap { .. } => Some(Conflict::Overlap { first, second }),
+        SegmentIntersection::Touching { point, .. } => {
+            // Fine only at a node both edges end at.
+            if ee.iter().any(|n| fe.contains(n) && topo.p(*n) == point) {
+                return None;
+            }
+            let node_of = |ends: [u32; 2]| ends.into_iter().find(|&n| topo.p(n) == point);
+            if let Some(n) = node_of(ee) {
+                Some(Conflict::NodeOnEdge {
+                    node: NodeId::from_raw(n),
+                    edge: EdgeId::from_raw(f),
+                    point,
+                })
+            } else if let Some(n) = node_of(fe) {
+                Some(Conflict::NodeOnEdge {
+                    node: NodeId::from_raw(n),
+                    edge: EdgeId::from_raw(e),
+                    point,
+                })
+            } else {
+                Some(Conflict::Crossing {
                     first,
                     second,
                     point,
-                }),
-                SegmentIntersection::Overlap { .. } => Some(Conflict::Overlap { first, second }),
-                SegmentIntersection::Touching { point, .. } => {
-                    // Fine only at a node both edges end at.
-                    let shared = ee.iter().any(|n| fe.contains(n) && topo.p(*n) == point);
-                    if shared {
-                        return None;
-                    }
-                    let node_of = |ends: [u32; 2]| ends.into_iter().find(|&n| topo.p(n) == point);
-                    if let Some(n) = node_of(ee) {
-                        Some(Conflict::NodeOnEdge {
-                            node: NodeId::from_raw(n),
-                            edge: EdgeId::from_raw(f),
-                            point,
-                        })
-                    } else if let Some(n) = node_of(fe) {
-                        Some(Conflict::NodeOnEdge {
-                            node: NodeId::from_raw(n),
-                            edge: EdgeId::from_raw(e),
-                            point,
-                        })
-                    } else {
-                        Some(Conflict::Crossing {
-                            first,
-                            second,
-                            point,
-                        })
-                    }
-                }
+                })
             }
         }
-        (0, _) | (_, 0) => {
-            let (ei, vi) = if x & 1 == 0 { (x, y) } else { (y, x) };
-            let v = vi >> 1;
-            let (_, a, b) = seg(ei);
-            let p = topo.p(v);
-            point_on_segment(p, a, b).then_some(Conflict::NodeOnEdge {
-                node: NodeId::from_raw(v),
-                edge: EdgeId::from_raw(ei >> 1),
-                point: p,
-            })
-        }
-        _ => None,
     }
 }

@@ -81,6 +81,8 @@ pub(crate) struct Topology {
     pub(crate) order: Vec<u32>,
     /// Live edge indices of the working graph, increasing.
     pub(crate) edge_list: Vec<u32>,
+    /// Sort buffer.
+    keyed: Vec<(u64, u64, u32)>,
 }
 
 /// The largest edge bound supported (half-edge indices must fit in `u32`).
@@ -128,13 +130,24 @@ impl Topology {
             self.rep[i] = id.raw();
             self.order.push(id.raw());
         }
-        let pos = &self.pos;
-        self.order.sort_unstable_by(|&a, &b| {
-            let (pa, pb) = (pos[a as usize], pos[b as usize]);
-            pa.x.total_cmp(&pb.x)
-                .then(pa.y.total_cmp(&pb.y))
-                .then(a.cmp(&b))
-        });
+        // Sort by (x, y, id) on integer keys that order like the coordinates (-0 and +0
+        // are the same coordinate: adding +0.0 turns -0.0 into +0.0).
+        let key = |x: f64| {
+            let bits = (x + 0.0).to_bits();
+            if bits >> 63 == 1 {
+                !bits
+            } else {
+                bits | (1 << 63)
+            }
+        };
+        self.keyed.clear();
+        self.keyed.extend(self.order.iter().map(|&v| {
+            let p = self.pos[v as usize];
+            (key(p.x), key(p.y), v)
+        }));
+        self.keyed.sort_unstable();
+        self.order.clear();
+        self.order.extend(self.keyed.iter().map(|k| k.2));
 
         // Coincident nodes are neighbours in the sorted order; the first of a run has the
         // smallest id.

@@ -124,6 +124,10 @@ fn kelly_figure_41() {
     assert_eq!(d.report.components, 1);
     assert_eq!(d.roots, vec![CellId(0), CellId(1), CellId(2)]);
     assert!((d.total_area() - (12.0 + 9.0 + 9.0)).abs() < 1e-12);
+    // The output serialises (e.g. to hand cells to another process).
+    let json = serde_json::to_string(&d).unwrap();
+    let back: CellDecomposition = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, d);
 }
 
 fn grid(nx: usize, ny: usize) -> G {
