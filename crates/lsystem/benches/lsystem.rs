@@ -23,7 +23,58 @@ use polis_lsystem::{
 
 fn main() {
     report_memory();
+    report_cpu_time();
     divan::main();
+}
+
+/// On-CPU time of this thread in nanoseconds (Linux `schedstat`), if available.
+fn cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// Throughput per second of on-CPU time: on a shared, loaded machine wall-clock samples
+/// include time spent waiting for a core; this does not.
+fn report_cpu_time() {
+    const RUNS: u32 = 10;
+    fn measure(name: &str, mut step: impl FnMut() -> usize) {
+        let _ = step(); // warm buffers
+        let (Some(t0), w0) = (cpu_ns(), std::time::Instant::now()) else {
+            return;
+        };
+        let mut produced = 0usize;
+        for _ in 0..RUNS {
+            produced += step();
+        }
+        let Some(t1) = cpu_ns() else { return };
+        let cpu = (t1 - t0) as f64 * 1e-9;
+        let wall = w0.elapsed().as_secs_f64();
+        println!(
+            "  {name:<24} {:>7.1} M modules per CPU-second ({:>5.1} ms CPU, {:>5.1} ms wall per step)",
+            produced as f64 / cpu / 1e6,
+            cpu * 1e3 / f64::from(RUNS),
+            wall * 1e3 / f64::from(RUNS)
+        );
+    }
+    println!("polis-lsystem throughput per on-CPU second ({RUNS} steps each):");
+    let (g, s) = &*CF;
+    let mut d = Derivation::new(g, s.clone(), opts());
+    measure("context_free_text", || {
+        d.restart(s);
+        d.step().map(|r| r.len).unwrap_or(0)
+    });
+    let rules = typed_cf_rules();
+    let mut d = Derivation::new(&rules, TYPED_CF.clone(), opts());
+    measure("context_free_typed", || {
+        d.restart(&TYPED_CF);
+        d.step().map(|r| r.len).unwrap_or(0)
+    });
+    let (g, s) = &*CS;
+    let mut d = Derivation::new(g, s.clone(), opts());
+    measure("context_sensitive_text", || d.step().map(|r| r.len).unwrap_or(0));
+    let rules = typed_cs_rules();
+    let mut d = Derivation::new(&rules, TYPED_CS.clone(), opts());
+    measure("context_sensitive_typed", || d.step().map(|r| r.len).unwrap_or(0));
 }
 
 const CF_TEXT: &str = "
