@@ -71,10 +71,14 @@ fn report_cpu_time() {
     });
     let (g, s) = &*CS;
     let mut d = Derivation::new(g, s.clone(), opts());
-    measure("context_sensitive_text", || d.step().map(|r| r.len).unwrap_or(0));
+    measure("context_sensitive_text", || {
+        d.step().map(|r| r.len).unwrap_or(0)
+    });
     let rules = typed_cs_rules();
     let mut d = Derivation::new(&rules, TYPED_CS.clone(), opts());
-    measure("context_sensitive_typed", || d.step().map(|r| r.len).unwrap_or(0));
+    measure("context_sensitive_typed", || {
+        d.step().map(|r| r.len).unwrap_or(0)
+    });
 }
 
 const CF_TEXT: &str = "

@@ -75,6 +75,83 @@ impl Default for DeriveOptions {
 /// Calls come in string order. Environments that need to see every request before
 /// answering (e.g. light competition) can record indices in
 /// [`communicate`](Self::communicate) and write answers in [`end_pass`](Self::end_pass).
+///
+/// # Example: a road that grows until the coast (Parish & Müller's `R` / `?I`)
+///
+/// ```
+/// use polis_lsystem::{
+///     Command, Derivation, DeriveOptions, Environment, Module, Production, TurtleState,
+///     TypedRules,
+/// };
+///
+/// #[derive(Clone, Copy, Debug, PartialEq)]
+/// enum State { Unassigned, Succeed, Failed }
+///
+/// #[derive(Clone, Debug, PartialEq)]
+/// enum Road {
+///     R,               // a growing road end
+///     I(f64, State),   // ?I(length, state): answered by the local constraints
+///     F(f64),          // a built segment
+/// }
+///
+/// impl Module for Road {
+///     fn symbol(&self) -> u32 {
+///         match self { Road::R => 0, Road::I(..) => 1, Road::F(_) => 2 }
+///     }
+///     fn command(&self) -> Command {
+///         match self {
+///             Road::I(..) => Command::Communicate,
+///             Road::F(l) => Command::Forward(Some(*l)),
+///             Road::R => Command::None,
+///         }
+///     }
+/// }
+///
+/// /// Local constraints: nothing may be built beyond y = 25; shorten what would cross it.
+/// struct Coast;
+/// impl Environment<Vec<Road>> for Coast {
+///     fn communicate(&mut self, s: &mut Vec<Road>, i: usize, t: &TurtleState) {
+///         if let Some(Road::I(len, state @ State::Unassigned)) = s.get_mut(i) {
+///             let room = 25.0 - t.position.y;
+///             if room >= 1.0 {
+///                 *len = len.min(room);
+///                 *state = State::Succeed;
+///             } else {
+///                 *state = State::Failed;
+///             }
+///         }
+///     }
+/// }
+///
+/// let mut rules = TypedRules::new();
+/// // R > ?I(l, SUCCEED) -> F(l) R ?I(10, UNASSIGNED)
+/// rules.add(
+///     Production::new(0, |m, o| {
+///         if let Some(Road::I(l, _)) = m.right(0) {
+///             o.extend([Road::F(*l), Road::R, Road::I(10.0, State::Unassigned)]);
+///         }
+///     })
+///     .right([1])
+///     .when(|m| matches!(m.right(0), Some(Road::I(_, State::Succeed)))),
+/// )?;
+/// // R > ?I(l, FAILED) -> ε
+/// rules.add(
+///     Production::new(0, |_, _| {})
+///         .right([1])
+///         .when(|m| matches!(m.right(0), Some(Road::I(_, State::Failed)))),
+/// )?;
+/// // ?I(l, state) : state != UNASSIGNED -> ε
+/// rules.add(
+///     Production::new(1, |_, _| {})
+///         .when(|m| !matches!(m.module(), Road::I(_, State::Unassigned))),
+/// )?;
+///
+/// let axiom = vec![Road::R, Road::I(10.0, State::Unassigned)];
+/// let mut d = Derivation::new(rules, axiom, DeriveOptions::default());
+/// d.derive_with(5, &mut Coast)?;
+/// assert_eq!(d.string(), &vec![Road::F(10.0), Road::F(10.0), Road::F(5.0)]);
+/// # Ok::<(), polis_lsystem::LsystemError>(())
+/// ```
 pub trait Environment<S> {
     /// Called before the first communication module of a pass. `step` is the number of
     /// derivation steps done so far.
