@@ -25,7 +25,6 @@ use serde::{Deserialize, Serialize};
 use crate::LotsError;
 use crate::skeleton::events::Engine;
 use crate::skeleton::prepare;
-use crate::skeleton::wavefront::Motion;
 
 /// One ring of an inset shape, with the input edge each of its edges comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -148,17 +147,9 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
         loop {
             seen[v] = true;
             let x = &engine.verts[v];
-            let p = x.at(d);
-            if let Motion::Step(_) = x.motion {
-                let ein = &engine.edges[x.in_edge as usize];
-                let eout = &engine.edges[x.out_edge as usize];
-                ring.points.push(ein.project(p, d));
-                ring.sources.push(None);
-                ring.points.push(eout.project(p, d));
-            } else {
-                ring.points.push(p);
-            }
-            ring.sources.push(Some(x.out_edge as usize));
+            ring.points.push(x.at(d));
+            let e = x.out_edge as usize;
+            ring.sources.push((e < engine.input_edges()).then_some(e));
             v = x.next as usize;
             if v == start || seen[v] || ring.points.len() > engine.verts.len() * 2 {
                 break;

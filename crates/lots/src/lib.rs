@@ -80,7 +80,8 @@
 //! * The skeleton tests every reflex vertex against every edge line (the
 //!   Felkel–Obdržálek bound, O(n·r) with r reflex vertices), so it grows quadratically on
 //!   polygons with thousands of reflex vertices (see `BENCHMARKS.md`).
-//! * Consecutive parallel edges with different weights meet in a perpendicular step.
+//! * Consecutive parallel edges with different weights meet in a perpendicular step (a
+//!   virtual edge of weight 0), the convention for this case, which has no bisector.
 //!
 //! ## References
 //!

@@ -27,7 +27,7 @@ use std::collections::BinaryHeap;
 
 use polis_geom::DVec2;
 
-use super::wavefront::{EdgeLine, Motion, Vertex, angle_cmp, is_reflex, motion};
+use super::wavefront::{EdgeLine, Motion, Vertex, angle_cmp, is_reflex, meet, motion};
 use super::{SkeletonArc, SkeletonNode};
 use crate::LotsError;
 
@@ -127,6 +127,8 @@ pub(crate) struct Engine {
     line_ny: Vec<f64>,
     line_c: Vec<f64>,
     line_w: Vec<f64>,
+    /// For each virtual step edge (after the input edges): the input edges it joins.
+    step_pairs: Vec<(u32, u32)>,
     /// Scratch: hit time of the vertex being scanned on every edge line.
     hit_times: Vec<f64>,
     /// For each input edge, vertices that started a wavefront piece of it.
@@ -158,6 +160,7 @@ impl Engine {
         self.arcs.clear();
         self.queue.clear();
         self.candidates.clear();
+        self.step_pairs.clear();
         self.line_nx.clear();
         self.line_ny.clear();
         self.line_c.clear();
@@ -233,11 +236,88 @@ impl Engine {
             let eout = &self.edges[self.verts[v as usize].out_edge as usize];
             self.verts[v as usize].motion = motion(ein, eout);
         }
-        for v in 0..self.verts.len() as u32 {
-            self.pieces[self.verts[v as usize].out_edge as usize].push(v);
-            self.push_edge_event(v);
-            self.push_split_candidates(v);
+        let initial = self.verts.len() as u32;
+        for v in 0..initial {
+            if matches!(self.verts[v as usize].motion, Motion::Step(_)) {
+                self.split_step(v);
+            }
         }
+        for v in 0..self.verts.len() as u32 {
+            if self.verts[v as usize].alive {
+                self.pieces[self.verts[v as usize].out_edge as usize].push(v);
+            }
+        }
+        for v in 0..self.verts.len() as u32 {
+            if self.verts[v as usize].alive {
+                self.push_edge_event(v);
+                self.push_split_candidates(v);
+            }
+        }
+    }
+
+    /// The number of input edges; later edges are virtual step edges.
+    pub fn input_edges(&self) -> usize {
+        self.ring_starts.last().copied().unwrap_or(0)
+    }
+
+    /// Replaces vertex `v` between two parallel edges of different weights by a step: a
+    /// virtual wavefront edge of weight 0 along their common normal, with one vertex on
+    /// each of the two lines. Returns the two new vertices.
+    fn split_step(&mut self, v: u32) -> (u32, u32) {
+        let x = *self.vert(v);
+        let ea = self.edges[x.in_edge as usize];
+        let eb = self.edges[x.out_edge as usize];
+        let n = (ea.normal + eb.normal).normalize();
+        // The step runs from the line that is ahead back to the one behind.
+        let dir = if ea.weight > eb.weight { -n } else { n };
+        let p = x.p0;
+        let step = EdgeLine::new(p, p + dir, 0.0);
+        self.edges.push(step);
+        self.line_nx.push(step.normal.x);
+        self.line_ny.push(step.normal.y);
+        self.line_c.push(step.normal.dot(step.a));
+        self.line_w.push(0.0);
+        self.pieces.push(Vec::new());
+        self.step_pairs.push((x.in_edge, x.out_edge));
+        let s = (self.edges.len() - 1) as u32;
+        let base = self.verts.len() as u32;
+        let (va, vb) = (base, base + 1);
+        self.verts.push(Vertex {
+            p0: p,
+            t0: x.t0,
+            motion: motion(&ea, &step),
+            in_edge: x.in_edge,
+            out_edge: s,
+            prev: x.prev,
+            next: vb,
+            node: x.node,
+            alive: true,
+        });
+        self.verts.push(Vertex {
+            p0: p,
+            t0: x.t0,
+            motion: motion(&step, &eb),
+            in_edge: s,
+            out_edge: x.out_edge,
+            prev: va,
+            next: x.next,
+            node: x.node,
+            alive: true,
+        });
+        self.candidates.push(CandidateBatch::default());
+        self.candidates.push(CandidateBatch::default());
+        self.mark.push(0);
+        self.mark.push(0);
+        self.vert_mut(x.prev).next = va;
+        self.vert_mut(x.next).prev = vb;
+        self.vert_mut(v).alive = false;
+        (va, vb)
+    }
+
+    /// For a virtual step edge, the input edges before and after it.
+    pub fn step_pair(&self, e: usize) -> Option<(u32, u32)> {
+        e.checked_sub(self.input_edges())
+            .and_then(|k| self.step_pairs.get(k).copied())
     }
 
     fn vert(&self, v: u32) -> &Vertex {
@@ -278,10 +358,14 @@ impl Engine {
         next: u32,
         node: u32,
     ) -> u32 {
-        let m = motion(
+        let (ea, eb) = (
             &self.edges[in_edge as usize],
             &self.edges[out_edge as usize],
         );
+        let m = motion(ea, eb);
+        // In exact arithmetic `p` is on both lines; snapping to their crossing keeps the
+        // offset distances exact (and places the vertex right after a weighted step).
+        let p = meet(ea, eb, self.now, p).unwrap_or(p);
         self.verts.push(Vertex {
             p0: p,
             t0: self.now,
@@ -717,6 +801,12 @@ impl Engine {
                     right_edge: x.out_edge as usize,
                 });
                 self.vert_mut(v).alive = false;
+                return;
+            }
+            if matches!(x.motion, Motion::Step(_)) {
+                let (va, vb) = self.split_step(v);
+                self.settle(va);
+                self.settle(vb);
                 return;
             }
             if !matches!(x.motion, Motion::Fold) {

@@ -20,9 +20,13 @@
 //!
 //! # Limitations
 //!
-//! * Consecutive parallel edges with *different* weights have no proper weighted bisector;
-//!   the vertex between them moves along their common normal at the mean speed and the
-//!   wavefront gets a short perpendicular step there (see [`inset_shapes`](crate::inset_shapes)).
+//! * Consecutive parallel edges with *different* weights (in the input, or once the edge
+//!   between them has vanished) have no weighted bisector. The wavefront gets a
+//!   perpendicular step there: a virtual edge of weight 0 along the common normal, with one
+//!   vertex on each offset line. Its two arcs run along the same ray and are reported as
+//!   separating the two input edges; the distance guarantee above holds for each arc's own
+//!   line only. Insets stay exact (the step edge has no source, see
+//!   [`inset_shapes`](crate::inset_shapes)).
 //! * Points closer than `1e-9` times the polygon's size at the same time are merged into
 //!   one event; nearly simultaneous events are therefore treated as simultaneous.
 //!
@@ -114,9 +118,24 @@ impl StraightSkeleton {
             });
         }
         let faces = assemble_faces(&engine);
+        // Arcs along a weighted step separate the two input edges the step joins.
+        let arcs = engine
+            .arcs
+            .iter()
+            .map(|a| {
+                let mut a = *a;
+                if let Some((before, _)) = engine.step_pair(a.left_edge) {
+                    a.left_edge = before as usize;
+                }
+                if let Some((_, after)) = engine.step_pair(a.right_edge) {
+                    a.right_edge = after as usize;
+                }
+                a
+            })
+            .collect();
         Ok(StraightSkeleton {
             nodes: engine.nodes,
-            arcs: engine.arcs,
+            arcs,
             faces,
             weights,
             ring_starts: engine.ring_starts,

@@ -53,12 +53,6 @@ impl EdgeLine {
         self.normal.dot(x - self.a) - self.weight * t
     }
 
-    /// `x` moved onto this edge's wavefront line at time `t`, along the normal.
-    #[inline]
-    pub fn project(&self, x: DVec2, t: f64) -> DVec2 {
-        x - self.normal * self.ahead(x, t)
-    }
-
     /// Position of `x` along the edge direction, measured from the start point.
     #[inline]
     pub fn along(&self, x: DVec2) -> f64 {
@@ -71,8 +65,10 @@ impl EdgeLine {
 pub(crate) enum Motion {
     /// An ordinary vertex on both lines.
     Moving(DVec2),
-    /// The two edges are parallel, point the same way, and have different weights: the
-    /// vertex moves along their common normal and the wavefront has a short step there.
+    /// The two edges are parallel, point the same way, and have different weights: there
+    /// is no vertex on both lines. The event loop replaces it at once by a step (a virtual
+    /// edge of weight 0 along the common normal with a vertex on each line); the velocity
+    /// given is the mean one.
     Step(DVec2),
     /// The two edges point in opposite directions and lie on top of each other: a zero-
     /// width fold that is zipped closed at once.
@@ -105,6 +101,21 @@ pub(crate) fn motion(a: &EdgeLine, b: &EdgeLine) -> Motion {
         (wa * nb.y - wb * na.y) / det,
         (wb * na.x - wa * nb.x) / det,
     ))
+}
+
+/// Where the wavefront lines of `a` and `b` cross at time `t`, solved relative to the
+/// nearby point `near` (for accuracy); `None` when they are parallel.
+pub(crate) fn meet(a: &EdgeLine, b: &EdgeLine, t: f64, near: DVec2) -> Option<DVec2> {
+    if a.dir.perp_dot(b.dir).abs() <= PARALLEL_SINE {
+        return None;
+    }
+    let (na, nb) = (a.normal, b.normal);
+    let ra = -a.ahead(near, t);
+    let rb = -b.ahead(near, t);
+    let det = na.perp_dot(nb);
+    let y = DVec2::new((ra * nb.y - rb * na.y) / det, (na.x * rb - nb.x * ra) / det);
+    let p = near + y;
+    p.is_finite().then_some(p)
 }
 
 /// Whether the turn from incoming edge direction `din` to outgoing `dout` is reflex
