@@ -918,6 +918,36 @@ mod tests {
         assert_eq!(s.world_matrices().len(), 5);
     }
 
+    proptest::proptest! {
+        /// Random forests validate; one more child link always breaks the tree.
+        #[test]
+        fn random_forests_and_one_extra_link(
+            parents in proptest::collection::vec(proptest::prelude::any::<Option<proptest::sample::Index>>(), 1..40),
+            from in proptest::prelude::any::<proptest::sample::Index>(),
+            to in proptest::prelude::any::<proptest::sample::Index>(),
+        ) {
+            let mut s = Scene::new();
+            for (i, p) in parents.iter().enumerate() {
+                match p {
+                    Some(p) if i > 0 => {
+                        s.add_node(NodeId(p.index(i) as u32), format!("n{i}")).unwrap();
+                    }
+                    _ => {
+                        s.add_root(format!("n{i}"));
+                    }
+                }
+            }
+            s.validate().unwrap();
+            let n = s.nodes.len();
+            let (a, b) = (from.index(n), to.index(n));
+            s.nodes[a].children.push(NodeId(b as u32));
+            let is_not_a_tree = matches!(s.validate(), Err(GeomError::SceneNotATree { .. }));
+            proptest::prop_assert!(is_not_a_tree);
+            // World matrices still terminate.
+            proptest::prop_assert_eq!(s.world_matrices().len(), n);
+        }
+    }
+
     #[test]
     fn validation_catches_bad_values() {
         let mut s = sample();

@@ -143,6 +143,11 @@ impl Aabb3 {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
 
+    /// Whether `other` lies inside this box (an empty `other` lies inside any box).
+    pub fn contains_box(&self, other: &Aabb3) -> bool {
+        other.is_empty() || (self.contains(other.min) && self.contains(other.max))
+    }
+
     /// The size along each axis (zero for an empty box).
     pub fn size(&self) -> Vec3 {
         if self.is_empty() {
@@ -799,6 +804,55 @@ mod tests {
         assert_eq!(m, unit_cube());
         m.flip();
         assert!((m.signed_volume() + 1.0).abs() < 1e-9);
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn transforms_keep_closed_solids(
+            scale in (0.1f64..10.0, 0.1f64..10.0, 0.1f64..10.0),
+            mirror in proptest::prelude::any::<bool>(),
+            angle in -3.2f64..3.2,
+            axis in (-1.0f64..1.0, 0.1f64..1.0, -1.0f64..1.0),
+            shift in (-1e3f64..1e3, -1e3f64..1e3, -1e3f64..1e3),
+        ) {
+            let s = DVec3::new(if mirror { -scale.0 } else { scale.0 }, scale.1, scale.2);
+            let m = DMat4::from_scale_rotation_translation(
+                s,
+                glam::DQuat::from_axis_angle(DVec3::new(axis.0, axis.1, axis.2).normalize(), angle),
+                DVec3::new(shift.0, shift.1, shift.2),
+            );
+            let mut cube = unit_cube();
+            cube.transform(&m).unwrap();
+            cube.validate().unwrap();
+            cube.check_closed().unwrap();
+            let expected = (s.x * s.y * s.z).abs();
+            // f32 positions: each coordinate is off by up to half an ulp of the largest.
+            let reach = f64::from(cube.bbox().min.abs().max(cube.bbox().max.abs()).max_element());
+            let tolerance = 4.0 * cube.surface_area() * reach * f64::from(f32::EPSILON) + 1e-9;
+            proptest::prop_assert!((cube.signed_volume() - expected).abs() < tolerance);
+            // Normals still point away from the centre.
+            let centre = m.transform_point3(DVec3::splat(0.5)).as_vec3();
+            for tri in cube.triangles() {
+                let [a, b, c] = tri.map(|i| cube.positions[i as usize]);
+                let mid = (a + b + c) / 3.0;
+                proptest::prop_assert!((mid - centre).dot(cube.normals[tri[0] as usize]) > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn boxes() {
+        let m = unit_cube();
+        let b = m.bbox();
+        assert!(b.contains_box(&b));
+        assert!(b.contains_box(&Aabb3::EMPTY));
+        assert!(!Aabb3::EMPTY.contains_box(&b));
+        let mut big = b;
+        big.extend(Vec3::splat(2.0));
+        assert!(big.contains_box(&b) && !b.contains_box(&big));
+        assert_eq!(big.size(), Vec3::splat(2.0));
+        assert_eq!(Aabb3::EMPTY.size(), Vec3::ZERO);
+        assert_eq!(b.union(&Aabb3::EMPTY), b);
     }
 
     #[test]
