@@ -221,9 +221,8 @@ proptest! {
             let (da, db) = (edges[a.left_edge].1 - edges[a.left_edge].0, edges[a.right_edge].1 - edges[a.right_edge].0);
             da.perp_dot(db) == 0.0 && da.dot(db) > 0.0 && w[a.left_edge] != w[a.right_edge]
         });
-        if !steps {
-            if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
-        }
+        let checked = if steps { Ok(()) } else { check_skeleton(&p, &sk, 1e-8) };
+        if let Err(e) = checked { prop_assert!(false, "{}", e); }
         check_insets(&p, Some(&w), &sk)?;
     }
 
