@@ -77,7 +77,8 @@
 //!
 //! ## Limitations
 //!
-//! * Text-grammar module names are one character (`?X`/`@X`: two).
+//! * Text-grammar module names are one character (`?X`/`@X`: two) unless declared with
+//!   `#module`.
 //! * Decomposition and interpretation rules are context-free; modules produced by
 //!   interpretation rules are drawn only (they receive no query values).
 //! * Stochastic weights are constants; trigonometric functions use `f64` from `std`, whose

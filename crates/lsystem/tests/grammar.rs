@@ -379,3 +379,38 @@ fn value_stability_stochastic() {
 }
 
 const PINNED: &str = "AB(1.8585818951969546)[+]B(2.2540664132059396)B(1.3330663250439445)";
+
+#[test]
+fn declared_multi_character_modules() {
+    let src = "
+        #module Apex Leaf Internode
+        ω: Apex(1)
+        Apex(n) : n < 3 -> Internode(n)[+Leaf]Apex(n+1)
+        Apex(n) : n >= 3 -> Leaf
+        Internode(n) < Leaf -> LeafLeaf
+    ";
+    let g = Grammar::parse(src).unwrap();
+    let mut d = g.derivation(DeriveOptions::default());
+    d.derive(3).unwrap();
+    assert_eq!(
+        g.format_string(d.string()),
+        "Internode(1)[+Leaf]Internode(2)[+Leaf]Leaf"
+    );
+    d.step().unwrap();
+    // Internode(2) < Leaf: the top Leaf doubles; a Leaf in a branch sees `+` first
+    // (not in the ignore set), so it stays.
+    assert_eq!(
+        g.format_string(d.string()),
+        "Internode(1)[+Leaf]Internode(2)[+Leaf]LeafLeaf"
+    );
+    let text = g.to_text();
+    assert!(text.contains("Leaf Leaf"), "{text}");
+    let again = Grammar::parse(&text).unwrap();
+    assert_eq!(again.ast(), g.ast());
+    assert_eq!(
+        g.format_string(&g.parse_string("LeafApex(2)").unwrap()),
+        "LeafApex(2)"
+    );
+    assert!(Grammar::parse("#module X").is_err());
+    assert!(Grammar::parse("#module sin").is_err());
+}

@@ -137,6 +137,7 @@ proptest! {
         "ω:", "#define", "#ignore", "#axiom", "#decomposition", "#interpretation", "#comm", "A", "B(x)",
         "(", ")", "<", ">", ":", "->", "→", "ε", "x", "1.5e", "1e999", "?", "?P", "@o", "[", "]", "%",
         "&&", "||", "!", "^", "/*", "*/", "//", "\n", ";", " ", ",", "p1:", "rand()", "-", "+",
+        "#module Ab", "Ab", "Ab(x)", "#module",
     ]), 0..40)) {
         let s = parts.concat();
         if let Ok(g) = Grammar::parse(&s) {

@@ -76,6 +76,8 @@ pub struct Define {
 /// A whole grammar text.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct GrammarAst {
+    /// Declared multi-character module names (`#module`).
+    pub modules: Vec<String>,
     /// Constants, in order.
     pub defines: Vec<Define>,
     /// Symbols ignored by context matching.

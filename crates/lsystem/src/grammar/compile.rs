@@ -541,7 +541,7 @@ impl Grammar {
     /// this grammar's symbols, e.g. to start from another axiom.
     pub fn parse_string(&self, text: &str) -> Result<ParamString> {
         let names: Vec<String> = self.defines.iter().map(|(n, _)| n.clone()).collect();
-        let calls = parse::parse_modules(text, &names)?;
+        let calls = parse::parse_modules(text, &names, &self.ast.modules)?;
         let mut s = ParamString::new();
         for m in &calls {
             let Some(id) = self.symbol_id(&m.symbol) else {

@@ -18,7 +18,8 @@
 //!
 //! ```text
 //! grammar     = { [ statement ] ( newline | ";" ) } ;
-//! statement   = define | ignore | communic | axiom | section | production ;
+//! statement   = declare | define | ignore | communic | axiom | section | production ;
+//! declare     = "#module" [ ":" ] { name } ;                (* multi-character module names *)
 //! define      = "#define" name expr ;                       (* constant, may use earlier defines *)
 //! ignore      = "#ignore" [ ":" ] { symbol } ;              (* skipped by context matching *)
 //! communic    = ( "#communication" | "#comm" ) [ ":" ] { symbol } ;
@@ -32,7 +33,7 @@
 //! pattern     = symbol [ "(" name { "," name } ")" ] ;
 //! successor   = "ε" | { module } ;
 //! module      = symbol [ "(" expr { "," expr } ")" ] ;
-//! symbol      = letter | "?" letter | "@" letter
+//! symbol      = declared | letter | "?" letter | "@" letter
 //!             | "+" | "-" | "&" | "^" | "\" | "/" | "|" | "$" | "[" | "]"
 //!             | "!" | "'" | "%" | "{" | "}" | "." | "~" ;
 //! expr        = or [ "?" expr ":" expr ] ;
@@ -49,8 +50,10 @@
 //!
 //! # Meaning
 //!
-//! * Module symbols are single characters, or two characters for `?X` (query and
-//!   communication modules) and `@X`. A module matches a pattern when symbol **and number of
+//! * Module symbols are single characters, two characters for `?X` (query and
+//!   communication modules) and `@X`, or names declared with `#module` (e.g.
+//!   `#module Leaf Apex`), which are matched first, longest first, so `LeafA` reads as
+//!   `Leaf` `A`. A declared name followed by `:` starts a production, not a label. A module matches a pattern when symbol **and number of
 //!   parameters** agree (ABOP). Whitespace between modules is optional: `F[+F]F`.
 //! * A predecessor binds its parameter names, and so do the context modules; names are
 //!   bound left context first, then predecessor, then right context, and must be distinct.

@@ -26,6 +26,7 @@ pub(crate) fn parse(text: &str) -> Result<(GrammarAst, Vec<Location>)> {
         ast: GrammarAst::default(),
         axiom_seen: false,
         locations: Vec::new(),
+        modules: Vec::new(),
     };
     p.line_starts.push(0);
     for (i, c) in p.chars.iter().enumerate() {
@@ -39,7 +40,11 @@ pub(crate) fn parse(text: &str) -> Result<(GrammarAst, Vec<Location>)> {
 
 /// Parses a module string with constant arguments (e.g. an axiom), resolving names
 /// with `defines`.
-pub(crate) fn parse_modules(text: &str, defines: &[String]) -> Result<Vec<ModuleCall>> {
+pub(crate) fn parse_modules(
+    text: &str,
+    defines: &[String],
+    modules: &[String],
+) -> Result<Vec<ModuleCall>> {
     let mut p = Parser {
         chars: text.chars().collect(),
         pos: 0,
@@ -51,7 +56,11 @@ pub(crate) fn parse_modules(text: &str, defines: &[String]) -> Result<Vec<Module
         ast: GrammarAst::default(),
         axiom_seen: false,
         locations: Vec::new(),
+        modules: Vec::new(),
     };
+    for m in modules {
+        p.declare(m);
+    }
     for (i, c) in p.chars.iter().enumerate() {
         if *c == '\n' {
             p.line_starts.push(i + 1);
@@ -76,6 +85,8 @@ struct Parser {
     ast: GrammarAst,
     axiom_seen: bool,
     locations: Vec<Location>,
+    /// Declared multi-character module names, longest first.
+    modules: Vec<Vec<char>>,
 }
 
 fn is_ident_start(c: char) -> bool {
@@ -87,6 +98,20 @@ fn is_ident_char(c: char) -> bool {
 }
 
 impl Parser {
+    fn declare(&mut self, name: &str) {
+        let chars: Vec<char> = name.chars().collect();
+        if !self.modules.contains(&chars) {
+            self.modules.push(chars);
+            self.modules
+                .sort_by(|a, b| b.len().cmp(&a.len()).then(a.cmp(b)));
+        }
+    }
+
+    fn is_module_name(&self, word: &str) -> bool {
+        let chars: Vec<char> = word.chars().collect();
+        self.modules.contains(&chars)
+    }
+
     fn peek(&self) -> Option<char> {
         self.chars.get(self.pos).copied()
     }
@@ -280,6 +305,36 @@ impl Parser {
                 self.defines.push(name.clone());
                 self.ast.defines.push(Define { name, value });
             }
+            "module" | "modules" => {
+                self.optional_colon()?;
+                loop {
+                    self.skip_ws()?;
+                    if self.at_end_of_statement() {
+                        break;
+                    }
+                    let n_at = self.pos;
+                    match self.ident() {
+                        Some(n) if n.chars().count() >= 2 => {
+                            if Func::lookup(&n).is_some() || n == "pi" || n == "axiom" {
+                                return Err(self.err(
+                                    n_at,
+                                    format!("`{n}` is reserved and cannot be a module name"),
+                                ));
+                            }
+                            if !self.ast.modules.contains(&n) {
+                                self.ast.modules.push(n.clone());
+                            }
+                            self.declare(&n);
+                        }
+                        _ => {
+                            return Err(self.err(
+                                n_at,
+                                "#module declares names of two or more letters, digits or `_`, starting with a letter",
+                            ));
+                        }
+                    }
+                }
+            }
             "ignore" | "communication" | "comm" => {
                 self.optional_colon()?;
                 let mut syms = Vec::new();
@@ -359,7 +414,8 @@ impl Parser {
         let mut label = None;
         if let Some(word) = self.ident() {
             self.skip_ws()?;
-            if word.chars().count() >= 2 && self.peek() == Some(':') {
+            if word.chars().count() >= 2 && self.peek() == Some(':') && !self.is_module_name(&word)
+            {
                 self.pos += 1;
                 if word == "axiom" {
                     return self.axiom(start);
@@ -378,6 +434,12 @@ impl Parser {
 
     fn symbol(&mut self) -> Option<String> {
         let c = self.peek()?;
+        for m in &self.modules {
+            if self.chars.get(self.pos..self.pos + m.len()) == Some(m.as_slice()) {
+                self.pos += m.len();
+                return Some(m.iter().collect());
+            }
+        }
         if c.is_ascii_alphabetic() {
             self.pos += 1;
             return Some(c.to_string());

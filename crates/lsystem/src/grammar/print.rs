@@ -123,6 +123,12 @@ fn write_items(out: &mut String, items: &[PatternItem]) {
 /// Writes a whole grammar: defines, ignore and communication sets, axiom, then the
 /// productions in order with a section directive wherever the section changes.
 pub fn write_grammar(out: &mut String, g: &GrammarAst) -> fmt::Result {
+    if !g.modules.is_empty() {
+        writeln!(out, "#module {}", g.modules.join(" "))?;
+    }
+    // With multi-character names, modules are separated by spaces so that `A B` never
+    // reads back as a module `AB`.
+    let sep = if g.modules.is_empty() { "" } else { " " };
     for d in &g.defines {
         write!(out, "#define {} ", d.name)?;
         write_expr(out, &d.value)?;
@@ -136,7 +142,10 @@ pub fn write_grammar(out: &mut String, g: &GrammarAst) -> fmt::Result {
     }
     if !g.axiom.is_empty() {
         out.push_str("#axiom ");
-        for m in &g.axiom {
+        for (k, m) in g.axiom.iter().enumerate() {
+            if k > 0 {
+                out.push_str(sep);
+            }
             write_call(out, m)?;
         }
         out.push('\n');
@@ -171,7 +180,10 @@ pub fn write_grammar(out: &mut String, g: &GrammarAst) -> fmt::Result {
         if p.successor.is_empty() {
             out.push('ε');
         } else {
-            for m in &p.successor {
+            for (k, m) in p.successor.iter().enumerate() {
+                if k > 0 {
+                    out.push_str(sep);
+                }
                 write_call(out, m)?;
             }
         }
