@@ -52,7 +52,7 @@ pub mod spatial;
 pub use bbox::Aabb2;
 pub use error::{GeomError, Ring};
 pub use field::{Field, FieldExt};
-pub use graph::{EdgeId, NodeId, PlanarGraph};
+pub use graph::{EdgeId, NodeId, PlanarGraph, SnapOptions};
 pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
 pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};

@@ -60,7 +60,7 @@ use crate::bbox::Aabb2;
 use crate::error::{GeomError, validate_point};
 use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, SpatialIndex};
 
-pub use insert::{Insertion, SnapOptions};
+pub use insert::{Insertion, ROUNDING_TOLERANCE, SnapOptions};
 pub(crate) use order::ccw_cmp;
 
 /// The id of a node of a [`PlanarGraph`]. Stable: never reused after removal.

@@ -63,6 +63,11 @@ type Cell = (i64, i64);
 /// de-duplication); longer ones are rasterised along their line.
 const BOX_CELLS_MAX: i64 = 4;
 
+/// Segments spanning more than this many cells (columns plus rows) are not entered in
+/// cells at all but kept in a short list that every query scans: a few very long
+/// segments (a 100 km highway on 1 m cells) then cost neither memory nor insert time.
+const BIG_SPAN: i64 = 4096;
+
 /// What a cell lists: the shape itself (copied into every cell it is entered in, so a
 /// query reads each cell's list contiguously instead of chasing pointers).
 #[derive(Debug, Clone, Copy)]
@@ -111,6 +116,8 @@ pub struct GridIndex<K> {
     /// serves many neighbouring cells, and their lists sit side by side.
     chunks: HashMap<Cell, Chunk<K>, FxBuild>,
     occupied: usize,
+    /// Segments too long for the cells (see `BIG_SPAN`).
+    big: Vec<Entry<K>>,
     lookup: HashMap<K, Shape, FxBuild>,
     /// Range of cells ever occupied (never shrinks): queries are clipped to it.
     extent: Option<(Cell, Cell)>,
@@ -148,6 +155,7 @@ impl<K: IndexKey> GridIndex<K> {
             inv: 1.0 / options.cell_size,
             chunks: HashMap::default(),
             occupied: 0,
+            big: Vec::new(),
             lookup: HashMap::default(),
             extent: None,
         }
@@ -176,6 +184,14 @@ impl<K: IndexKey> GridIndex<K> {
         let (i1, j1) = (self.cell_coord(b.max.x), self.cell_coord(b.max.y));
         let count = (i1 - i0 + 1).saturating_mul(j1 - j0 + 1);
         ((i0, j0), count > BOX_CELLS_MAX)
+    }
+
+    /// Whether a shape goes to the list of big segments instead of the cells.
+    fn is_big(&self, shape: &Shape) -> bool {
+        let b = shape.bbox();
+        let span = (self.cell_coord(b.max.x) - self.cell_coord(b.min.x))
+            .saturating_add(self.cell_coord(b.max.y) - self.cell_coord(b.min.y));
+        span > BIG_SPAN
     }
 
     /// Calls `f` for every cell the shape is entered in.
@@ -321,6 +337,14 @@ impl<K: IndexKey> GridIndex<K> {
         (i0 <= i1 && j0 <= j1).then_some(((i0, j0), (i1, j1)))
     }
 
+    fn visit_big<F: FnMut(K, &Shape)>(&self, b: &Aabb2, f: &mut F) {
+        for e in &self.big {
+            if e.bbox.intersects(b) {
+                f(e.key, &e.shape);
+            }
+        }
+    }
+
     fn scan_all<F: FnMut(K, &Shape)>(&self, b: &Aabb2, mut f: F) {
         for (&k, s) in &self.lookup {
             if s.bbox().intersects(b) {
@@ -343,6 +367,10 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
             raster,
         };
         self.lookup.insert(key, shape);
+        if self.is_big(&shape) {
+            self.big.push(entry);
+            return Ok(old);
+        }
         let mut touched: Vec<Cell> = Vec::new();
         self.cells_of(&shape, raster, |c| touched.push(c));
         for c in touched {
@@ -371,6 +399,10 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
 
     fn remove(&mut self, key: K) -> Option<Shape> {
         let shape = self.lookup.remove(&key)?;
+        if self.is_big(&shape) {
+            self.big.retain(|e| e.key != key);
+            return Some(shape);
+        }
         let (_, raster) = self.placement(&shape);
         let mut touched: Vec<Cell> = Vec::new();
         self.cells_of(&shape, raster, |c| touched.push(c));
@@ -407,14 +439,21 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         *self = Self::build(self.options);
     }
 
-    fn for_each_candidate<F: FnMut(K, &Shape)>(&self, b: &Aabb2, f: F) {
-        let Some(((i0, j0), (i1, j1))) = self.clipped_range(b) else {
+    fn for_each_candidate<F: FnMut(K, &Shape)>(&self, b: &Aabb2, mut f: F) {
+        if b.is_empty() {
+            return;
+        }
+        let range = self.clipped_range(b);
+        if let Some(((i0, j0), (i1, j1))) = range {
+            let count = (i1 - i0 + 1).saturating_mul(j1 - j0 + 1);
+            if count as u64 > self.lookup.len() as u64 {
+                return self.scan_all(b, f);
+            }
+        }
+        self.visit_big(b, &mut f);
+        let Some(((i0, j0), (i1, j1))) = range else {
             return;
         };
-        let count = (i1 - i0 + 1).saturating_mul(j1 - j0 + 1);
-        if count as u64 > self.lookup.len() as u64 {
-            return self.scan_all(b, f);
-        }
         // A box-stored entry is reported at its lowest cell clipped to the range.
         let first = move |c: Cell| (c.0.max(i0), c.1.max(j0));
         self.visit_cells(
@@ -425,16 +464,19 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         );
     }
 
-    fn for_each_candidate_along<F: FnMut(K, &Shape)>(&self, a: DVec2, b: DVec2, f: F) {
+    fn for_each_candidate_along<F: FnMut(K, &Shape)>(&self, a: DVec2, b: DVec2, mut f: F) {
         let bb = Aabb2::new(a, b);
-        let Some(range) = self.clipped_range(&bb) else {
+        if bb.is_empty() {
             return;
-        };
-        let mut cells = Vec::new();
-        self.segment_cells(a, b, Some(range), &mut |c| cells.push(c));
-        if cells.len() > self.lookup.len() {
-            return self.scan_all(&bb, f);
         }
+        let mut cells = Vec::new();
+        if let Some(range) = self.clipped_range(&bb) {
+            self.segment_cells(a, b, Some(range), &mut |c| cells.push(c));
+            if cells.len() > self.lookup.len() {
+                return self.scan_all(&bb, f);
+            }
+        }
+        self.visit_big(&bb, &mut f);
         match cells[..] {
             // One cell: every entry in it is listed once there.
             [only] => self.visit_cells(

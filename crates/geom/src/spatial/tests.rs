@@ -261,3 +261,32 @@ fn long_segment_far_from_origin() {
     assert_eq!(g.remove(3), Some(Shape::Segment(a, b)));
     assert_eq!(g.occupied_cells(), 0);
 }
+
+#[test]
+fn very_long_segments_live_outside_the_cells() {
+    // 10 km on 1 m cells: kept in the list of big segments, found by every query kind.
+    let mut g = GridIndex::<u32>::new(GridOptions { cell_size: 1.0 }).unwrap();
+    g.insert_segment(1, v(0.0, 0.0), v(10_000.0, 5_000.0))
+        .unwrap();
+    g.insert_segment(2, v(100.0, 49.0), v(100.0, 52.0)).unwrap();
+    assert_eq!(g.occupied_cells(), 4);
+    let b = Aabb2::new(v(99.0, 48.0), v(101.0, 53.0));
+    assert_eq!(g.query_box(&b), vec![1, 2]);
+    // Far from every small segment: outside the occupied extent, still found.
+    assert_eq!(
+        g.query_box(&Aabb2::new(v(8000.0, 3990.0), v(8010.0, 4010.0))),
+        vec![1]
+    );
+    assert_eq!(
+        g.nearest_segment(v(6000.0, 3000.5), 1.0).map(|n| n.key),
+        Some(1)
+    );
+    let hits = g.segments_crossing(v(99.0, 52.0), v(101.0, 49.0));
+    assert_eq!(hits.iter().map(|h| h.key).collect::<Vec<_>>(), vec![2, 1]);
+    assert_eq!(
+        g.remove(1),
+        Some(Shape::Segment(v(0.0, 0.0), v(10_000.0, 5_000.0)))
+    );
+    assert_eq!(g.query_box(&b), vec![2]);
+    assert_eq!(g.len(), 1);
+}
