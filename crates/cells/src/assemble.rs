@@ -16,10 +16,16 @@ fn ring(topo: &Topology, sweep: &Sweep, span: Span) -> Ring {
     let hs = &sweep.ring_buf[span.start as usize..(span.start + span.len) as usize];
     let nodes: Vec<NodeId> = hs
         .iter()
-        .map(|&h| NodeId::from_raw(topo.origin(h)))
+        .map(|&h| NodeId::from_raw(topo.node[topo.origin[h as usize] as usize]))
         .collect();
-    let edges: Vec<EdgeId> = hs.iter().map(|&h| EdgeId::from_raw(h >> 1)).collect();
-    let points: Vec<DVec2> = hs.iter().map(|&h| topo.p(topo.origin(h))).collect();
+    let edges: Vec<EdgeId> = hs
+        .iter()
+        .map(|&h| EdgeId::from_raw(topo.edge[h as usize]))
+        .collect();
+    let points: Vec<DVec2> = hs
+        .iter()
+        .map(|&h| topo.p(topo.origin[h as usize]))
+        .collect();
     Ring {
         nodes,
         edges,
@@ -100,31 +106,27 @@ fn filament_chains(
     sweep: &Sweep,
     resolve: &dyn Fn(Owner) -> Option<u32>,
 ) -> Vec<Filament> {
-    let is_fil = |e: u32| {
-        sweep.cycle_uses[e as usize] == 0 && sweep.filament_owner[e as usize] != Owner::Unset
-    };
-    let mut used = vec![false; topo.ends.len()];
+    let key = |k: u32| k.min(topo.twin[k as usize]) as usize;
+    let is_fil =
+        |k: u32| sweep.cycle_uses[key(k)] == 0 && sweep.filament_owner[key(k)] != Owner::Unset;
+    let mut used = vec![false; topo.slots()];
     let mut out = Vec::new();
-    let mut chain = |start_h: u32, used: &mut Vec<bool>| {
-        let mut nodes = vec![topo.origin(start_h)];
+    let mut chain = |start: u32, used: &mut Vec<bool>| {
+        let mut nodes = vec![topo.origin[start as usize]];
         let mut edges = Vec::new();
-        let mut h = start_h;
+        let mut h = start;
         loop {
-            let e = h >> 1;
-            used[e as usize] = true;
-            edges.push(e);
-            let w = topo.target(h);
+            used[key(h)] = true;
+            edges.push(topo.edge[h as usize]);
+            let w = topo.target[h as usize];
             nodes.push(w);
             if topo.deg0[w as usize] != 2 || w == nodes[0] {
                 break;
             }
-            let s = topo.adj_start[w as usize] as usize;
-            let next = if topo.adj[s] == h ^ 1 {
-                topo.adj[s + 1]
-            } else {
-                topo.adj[s]
-            };
-            if !is_fil(next >> 1) || used[(next >> 1) as usize] {
+            let s = topo.adj_start[w as usize];
+            let back = topo.twin[h as usize];
+            let next = if s == back { s + 1 } else { s };
+            if !is_fil(next) || used[key(next)] {
                 break;
             }
             h = next;
@@ -142,10 +144,13 @@ fn filament_chains(
             nodes.reverse();
             edges.reverse();
         }
-        let owner = sweep.filament_owner[edges[0] as usize];
+        let owner = sweep.filament_owner[key(start)];
         out.push(Filament {
-            points: nodes.iter().map(|&n| topo.p(n)).collect(),
-            nodes: nodes.into_iter().map(NodeId::from_raw).collect(),
+            points: nodes.iter().map(|&r| topo.p(r)).collect(),
+            nodes: nodes
+                .into_iter()
+                .map(|r| NodeId::from_raw(topo.node[r as usize]))
+                .collect(),
             edges: edges.into_iter().map(EdgeId::from_raw).collect(),
             kind,
             cell: resolve(owner).map(CellId),
@@ -154,18 +159,13 @@ fn filament_chains(
     // Chains start at nodes of degree != 2, in sweep order; what is left are closed
     // chains of degree-2 nodes, which cannot be filaments but are handled anyway.
     for pass in 0..2 {
-        for &v in &topo.order {
-            if pass == 0 && topo.deg0[v as usize] == 2 {
+        for r in 0..topo.len() {
+            if pass == 0 && topo.deg0[r] == 2 {
                 continue;
             }
-            let (s, t) = (
-                topo.adj_start[v as usize] as usize,
-                topo.adj_start[v as usize + 1] as usize,
-            );
-            for k in s..t {
-                let h = topo.adj[k];
-                if is_fil(h >> 1) && !used[(h >> 1) as usize] {
-                    chain(h, &mut used);
+            for k in topo.adj_start[r]..topo.adj_start[r + 1] {
+                if is_fil(k) && !used[key(k)] {
+                    chain(k, &mut used);
                 }
             }
         }
@@ -184,7 +184,7 @@ pub(crate) fn assemble(
         .iter()
         .map(|c| ring(topo, sweep, c.span))
         .collect();
-    let mut mark = vec![false; topo.pos.len()];
+    let mut mark = vec![false; topo.node_bound];
     let containers = component_containers(topo, sweep, &boundaries, &mut mark);
     let resolve = |o: Owner| -> Option<u32> {
         match o {
@@ -237,7 +237,7 @@ pub(crate) fn assemble(
     for &(v, k) in &sweep.isolated {
         let cell = resolve(Owner::Outside(k));
         let node = IsolatedNode {
-            node: NodeId::from_raw(v),
+            node: NodeId::from_raw(topo.node[v as usize]),
             point: topo.p(v),
             cell: cell.map(CellId),
         };
@@ -250,12 +250,11 @@ pub(crate) fn assemble(
     let mut report = report;
     report.components = sweep.components.len();
     report.cycles = n;
-    report.cycle_edges = topo
-        .edge_list
-        .iter()
-        .filter(|&&e| sweep.cycle_uses[e as usize] > 0)
+    let slots = topo.slots() as u32;
+    report.cycle_edges = (0..slots)
+        .filter(|&k| k < topo.twin[k as usize] && sweep.cycle_uses[k as usize] > 0)
         .count();
-    report.filament_edges = topo.edge_list.len() - report.cycle_edges;
+    report.filament_edges = topo.slots() / 2 - report.cycle_edges;
 
     let cells = boundaries
         .into_iter()

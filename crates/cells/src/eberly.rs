@@ -71,9 +71,9 @@ pub(crate) struct Sweep {
     stack_v: Vec<u32>,
     stack_h: Vec<u32>,
     walk: Vec<u32>,
-    /// How many cycles use each edge.
+    /// How many cycles use each edge (indexed by the edge's smaller slot).
     pub(crate) cycle_uses: Vec<u8>,
-    /// For filament edges: the face they lie in.
+    /// For filament edges (indexed by the smaller slot): the face they lie in.
     pub(crate) filament_owner: Vec<Owner>,
     /// Half-edges of all cycles and loops.
     pub(crate) ring_buf: Vec<u32>,
@@ -97,9 +97,8 @@ enum Mode {
 
 impl Sweep {
     fn reset(&mut self, topo: &Topology) {
-        let hcount = topo.nxt.len();
-        let m = topo.ends.len();
-        let n = topo.pos.len();
+        let hcount = topo.slots();
+        let n = topo.len();
         self.out.clear();
         self.out.resize(hcount, false);
         self.tag.clear();
@@ -107,9 +106,9 @@ impl Sweep {
         self.on_stack.clear();
         self.on_stack.resize(n, NONE);
         self.cycle_uses.clear();
-        self.cycle_uses.resize(m, 0);
+        self.cycle_uses.resize(hcount, 0);
         self.filament_owner.clear();
-        self.filament_owner.resize(m, Owner::Unset);
+        self.filament_owner.resize(hcount, Owner::Unset);
         self.ring_buf.clear();
         self.cycles.clear();
         self.loops.clear();
@@ -123,8 +122,8 @@ impl Sweep {
     pub(crate) fn run(&mut self, topo: &mut Topology) -> Result<(), Error> {
         self.reset(topo);
         let mut i = 0;
-        while i < topo.order.len() {
-            let v0 = topo.order[i];
+        while i < topo.len() {
+            let v0 = i as u32;
             if topo.deg[v0 as usize] == 0 {
                 if topo.deg0[v0 as usize] == 0 {
                     let comp = self.components.len() as u32;
@@ -135,17 +134,18 @@ impl Sweep {
                 continue;
             }
             let e1 = topo.clockwise_most(v0);
-            if !self.out[(e1 ^ 1) as usize] {
+            let back = topo.twin[e1 as usize];
+            if !self.out[back as usize] {
                 // First visit of this connected component: walk its outside.
                 let comp = self.components.len() as u32;
                 self.components.push(v0);
-                self.walk_and_split(topo, e1 ^ 1, Mode::Outside { comp })?;
+                self.walk_and_split(topo, back, Mode::Outside { comp })?;
             } else if self.out[e1 as usize] {
                 // Outside on both sides: cannot survive a walk, but never loop on it.
-                topo.remove_edge(e1 >> 1);
+                topo.remove_edge(e1);
             } else {
                 let cell = self.cycles.len() as u32;
-                let parent = self.tag[(e1 ^ 1) as usize];
+                let parent = self.tag[back as usize];
                 self.walk_and_split(topo, e1, Mode::Face { cell, parent })?;
                 if self.cycles.len() as u32 != cell + 1 {
                     return Err(Error::Internal(format!(
@@ -162,13 +162,13 @@ impl Sweep {
     /// that now has the outside on both sides.
     fn walk_and_split(&mut self, topo: &mut Topology, start: u32, mode: Mode) -> Result<(), Error> {
         self.walk.clear();
-        let limit = topo.nxt.len();
+        let limit = topo.slots();
         let mut h = start;
         loop {
             self.walk.push(h);
             // Arriving at the target of h: the sharpest left turn is the edge just
             // clockwise of the way back.
-            h = topo.prv[(h ^ 1) as usize];
+            h = topo.prv[topo.twin[h as usize] as usize];
             if h == start {
                 break;
             }
@@ -180,7 +180,7 @@ impl Sweep {
         }
 
         self.walked += self.walk.len();
-        let v0 = topo.origin(start);
+        let v0 = topo.origin[start as usize];
         self.stack_v.clear();
         self.stack_h.clear();
         self.stack_v.push(v0);
@@ -188,7 +188,7 @@ impl Sweep {
         let mut main_done = matches!(mode, Mode::Outside { .. });
         for k in 0..self.walk.len() {
             let h = self.walk[k];
-            let w = topo.target(h);
+            let w = topo.target[h as usize];
             let at = self.on_stack[w as usize];
             if at == NONE {
                 self.on_stack[w as usize] = self.stack_v.len() as u32;
@@ -198,7 +198,7 @@ impl Sweep {
             }
             let at = at as usize;
             let is_main = !main_done && at == 0;
-            self.close_loop(at, h, mode, is_main);
+            self.close_loop(topo, at, h, mode, is_main);
             main_done |= is_main;
             for &v in &self.stack_v[at + 1..] {
                 self.on_stack[v as usize] = NONE;
@@ -215,25 +215,26 @@ impl Sweep {
         }
         for k in 0..self.walk.len() {
             let h = self.walk[k];
-            if self.out[(h ^ 1) as usize] {
-                topo.remove_edge(h >> 1);
+            if self.out[topo.twin[h as usize] as usize] {
+                topo.remove_edge(h);
             }
         }
         Ok(())
     }
 
     /// Records the loop made of `stack_h[at..]` and the closing half-edge `h`.
-    fn close_loop(&mut self, at: usize, h: u32, mode: Mode, is_main: bool) {
+    fn close_loop(&mut self, topo: &Topology, at: usize, h: u32, mode: Mode, is_main: bool) {
         let here = match mode {
             Mode::Face { cell, .. } => Owner::Cell(cell),
             Mode::Outside { comp } => Owner::Outside(comp),
         };
         let len = self.stack_h.len() - at + 1;
-        if len == 2 && self.stack_h[at] == h ^ 1 && !is_main {
+        let back = topo.twin[h as usize];
+        if len == 2 && self.stack_h[at] == back && !is_main {
             // An edge walked there and back: a filament edge in this face.
-            self.filament_owner[(h >> 1) as usize] = here;
+            self.filament_owner[h.min(back) as usize] = here;
             self.tag[h as usize] = here;
-            self.tag[(h ^ 1) as usize] = here;
+            self.tag[back as usize] = here;
             return;
         }
         let span = Span {
@@ -249,7 +250,7 @@ impl Sweep {
             for k in span.start as usize..self.ring_buf.len() {
                 let x = self.ring_buf[k];
                 self.tag[x as usize] = parent;
-                let uses = &mut self.cycle_uses[(x >> 1) as usize];
+                let uses = &mut self.cycle_uses[x.min(topo.twin[x as usize]) as usize];
                 *uses = uses.saturating_add(1);
             }
             self.cycles.push(RawCycle { span, parent });
@@ -329,7 +330,9 @@ mod tests {
         let island = s
             .cycles
             .iter()
-            .find(|c| t.p(t.origin(s.ring_buf[c.span.start as usize])) == DVec2::new(14.0, 14.0))
+            .find(|c| {
+                t.p(t.origin[s.ring_buf[c.span.start as usize] as usize]) == DVec2::new(14.0, 14.0)
+            })
             .unwrap();
         assert_eq!(island.parent, Owner::Outside(1));
         assert_eq!(s.loops.len(), 2);
@@ -342,7 +345,7 @@ mod tests {
         let first_x: Vec<f64> = s
             .cycles
             .iter()
-            .map(|c| t.p(t.origin(s.ring_buf[c.span.start as usize])).x)
+            .map(|c| t.p(t.origin[s.ring_buf[c.span.start as usize] as usize]).x)
             .collect();
         assert!(first_x.windows(2).all(|w| w[0] <= w[1]), "{first_x:?}");
         // Dead ends were detached inside their cells.

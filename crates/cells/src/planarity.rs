@@ -24,6 +24,16 @@ pub(crate) struct PlanarityCheck {
     /// For every item, the last item it was tested against (deduplicates pairs).
     stamp: Vec<u32>,
     isolated: Vec<u32>,
+    /// One slot per edge (the smaller of the two).
+    edges: Vec<u32>,
+}
+
+/// The segment of slot `k`.
+fn seg_points(topo: &Topology, k: u32) -> (DVec2, DVec2) {
+    (
+        topo.p(topo.origin[k as usize]),
+        topo.p(topo.target[k as usize]),
+    )
 }
 
 /// The uniform grid over the graph's bounding box.
@@ -79,23 +89,21 @@ impl Grid {
 impl PlanarityCheck {
     /// Checks the working graph; `Err(NotPlanar)` lists the conflicts.
     pub(crate) fn check(&mut self, topo: &Topology) -> Result<(), Error> {
-        let m = topo.ends.len();
+        let m = topo.slots();
         self.isolated.clear();
-        self.isolated.extend(
-            topo.order
-                .iter()
-                .copied()
-                .filter(|&v| topo.deg0[v as usize] == 0),
-        );
-        let count = topo.edge_list.len() + self.isolated.len();
+        self.isolated
+            .extend((0..topo.len() as u32).filter(|&v| topo.deg0[v as usize] == 0));
+        self.edges.clear();
+        self.edges
+            .extend((0..m as u32).filter(|&k| k < topo.twin[k as usize]));
+        let count = self.edges.len() + self.isolated.len();
         if count < 2 {
             return Ok(());
         }
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         let mut total_len = 0.0;
-        for &e in &topo.edge_list {
-            let [a, b] = topo.ends[e as usize];
-            let (pa, pb) = (topo.p(a), topo.p(b));
+        for &e in &self.edges {
+            let (pa, pb) = seg_points(topo, e);
             lo = lo.min(pa.min(pb));
             hi = hi.max(pa.max(pb));
             total_len += (pb - pa).abs().max_element();
@@ -110,10 +118,10 @@ impl PlanarityCheck {
         // Cell size: about the mean edge extent, at most ~4 cells per item, at most 4096
         // cells per side.
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let mean = if topo.edge_list.is_empty() {
+        let mean = if self.edges.is_empty() {
             extent
         } else {
-            total_len / topo.edge_list.len() as f64
+            total_len / self.edges.len() as f64
         };
         let min_cell = extent / (2.0 * (count as f64).sqrt()).max(1.0);
         let cell = mean
@@ -132,9 +140,9 @@ impl PlanarityCheck {
         let buckets = grid.nx * grid.ny;
         self.start.clear();
         self.start.resize(buckets + 1, 0);
-        for &e in &topo.edge_list {
-            let [a, b] = topo.ends[e as usize];
-            grid.for_each_cell(topo.p(a), topo.p(b), |c| self.start[c + 1] += 1);
+        for &e in &self.edges {
+            let (a, b) = seg_points(topo, e);
+            grid.for_each_cell(a, b, |c| self.start[c + 1] += 1);
         }
         for &v in &self.isolated {
             let p = topo.p(v);
@@ -148,9 +156,9 @@ impl PlanarityCheck {
         {
             let mut fill: Vec<u32> = self.start[..buckets].to_vec();
             let items = &mut self.items;
-            for &e in &topo.edge_list {
-                let [a, b] = topo.ends[e as usize];
-                grid.for_each_cell(topo.p(a), topo.p(b), |c| {
+            for &e in &self.edges {
+                let (a, b) = seg_points(topo, e);
+                grid.for_each_cell(a, b, |c| {
                     items[fill[c] as usize] = e;
                     fill[c] += 1;
                 });
@@ -165,7 +173,7 @@ impl PlanarityCheck {
 
         // Every item against the later items sharing a bucket, each pair once.
         self.stamp.clear();
-        self.stamp.resize(m + topo.pos.len(), u32::MAX);
+        self.stamp.resize(m + topo.len(), u32::MAX);
         let mut conflicts = Vec::new();
         let mut total = 0;
         let (start, items, stamp) = (&self.start, &self.items, &mut self.stamp);
@@ -183,9 +191,9 @@ impl PlanarityCheck {
                 }
             }
         };
-        for &e in &topo.edge_list {
-            let [a, b] = topo.ends[e as usize];
-            grid.for_each_cell(topo.p(a), topo.p(b), |c| {
+        for &e in &self.edges {
+            let (a, b) = seg_points(topo, e);
+            grid.for_each_cell(a, b, |c| {
                 test(e, c, &mut total, &mut conflicts);
             });
         }
@@ -202,11 +210,11 @@ impl PlanarityCheck {
     }
 }
 
-/// The conflict between two grid items (edge `e` as `e`, isolated node `v` as `m + v`),
-/// if any.
+/// The conflict between two grid items (edge slot `k` as `k`, isolated node of rank `v`
+/// as `m + v`, `m` the number of slots), if any.
 fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
     let seg = |e: u32| {
-        let [a, b] = topo.ends[e as usize];
+        let (a, b) = (topo.origin[e as usize], topo.target[e as usize]);
         ([a, b], topo.p(a), topo.p(b))
     };
     if x >= m || y >= m {
@@ -214,16 +222,17 @@ fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
         let (_, a, b) = seg(e);
         let p = topo.p(v);
         return point_on_segment(p, a, b).then_some(Conflict::NodeOnEdge {
-            node: NodeId::from_raw(v),
-            edge: EdgeId::from_raw(e),
+            node: NodeId::from_raw(topo.node[v as usize]),
+            edge: EdgeId::from_raw(topo.edge[e as usize]),
             point: p,
         });
     }
     let (e, f) = (x, y);
     let (ee, a0, a1) = seg(e);
     let (fe, b0, b1) = seg(f);
-    let first = EdgeId::from_raw(e.min(f));
-    let second = EdgeId::from_raw(e.max(f));
+    let (ie, jf) = (topo.edge[e as usize], topo.edge[f as usize]);
+    let first = EdgeId::from_raw(ie.min(jf));
+    let second = EdgeId::from_raw(ie.max(jf));
     match segment_intersection(a0, a1, b0, b1) {
         SegmentIntersection::Disjoint => None,
         SegmentIntersection::Crossing { point, .. } => Some(Conflict::Crossing {
@@ -240,14 +249,14 @@ fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
             let node_of = |ends: [u32; 2]| ends.into_iter().find(|&n| topo.p(n) == point);
             if let Some(n) = node_of(ee) {
                 Some(Conflict::NodeOnEdge {
-                    node: NodeId::from_raw(n),
-                    edge: EdgeId::from_raw(f),
+                    node: NodeId::from_raw(topo.node[n as usize]),
+                    edge: EdgeId::from_raw(jf),
                     point,
                 })
             } else if let Some(n) = node_of(fe) {
                 Some(Conflict::NodeOnEdge {
-                    node: NodeId::from_raw(n),
-                    edge: EdgeId::from_raw(e),
+                    node: NodeId::from_raw(topo.node[n as usize]),
+                    edge: EdgeId::from_raw(ie),
                     point,
                 })
             } else {

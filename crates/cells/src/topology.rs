@@ -1,10 +1,12 @@
 //! The working copy of the input graph: a compact half-edge rotation system with O(1)
 //! edge removal.
 //!
-//! Node indices are the raw [`NodeId`]s of the input graph and edge indices its raw
-//! [`EdgeId`]s, so no id translation is needed on output. Edge `e` has the two half-edges
-//! `2e` (from its first end to its second) and `2e + 1` (back); the twin of `h` is `h ^ 1`.
-//! Around every node the live half-edges leaving it form a circular doubly linked list in
+//! Nodes are renumbered by their *rank* in Eberly's sweep order (`(x, y)`, ties by id), and
+//! half-edges by their slot in a compressed adjacency array grouped by origin rank: the
+//! sweep then works on memory close to the sweep line, which matters more than anything
+//! else for speed on large graphs. Slot `k` runs from `origin[k]` to `target[k]`; `twin[k]`
+//! is the reverse; `node[r]` and `edge[k]` give the input graph's ids back. Around every
+//! node the live half-edges leaving it form a circular doubly linked list in
 //! counter-clockwise order, copied from the graph's exact rotation system.
 
 use std::cmp::Ordering;
@@ -51,57 +53,62 @@ pub(crate) fn ccw_cmp(o: DVec2, p: DVec2, q: DVec2, start: Start) -> Ordering {
 /// The working graph. See the module docs.
 #[derive(Debug, Default)]
 pub(crate) struct Topology {
-    /// Position by node index.
+    /// Position by rank.
     pub(crate) pos: Vec<DVec2>,
-    /// Representative of each node index after merging (itself if not merged); `NONE`
-    /// for dead slots.
-    pub(crate) rep: Vec<u32>,
-    /// Ends by edge index (`[NONE; 2]` for dead or dropped edges).
-    pub(crate) ends: Vec<[u32; 2]>,
-    /// Whether the edge is still in the working graph.
-    pub(crate) live: Vec<bool>,
-    /// Original adjacency (CSR): half-edges leaving node `v` are
-    /// `adj[adj_start[v]..adj_start[v + 1]]`, counter-clockwise.
+    /// Input node id (raw) by rank.
+    pub(crate) node: Vec<u32>,
+    /// Half-edges leaving rank `r` are the slots `adj_start[r]..adj_start[r + 1]`,
+    /// counter-clockwise.
     pub(crate) adj_start: Vec<u32>,
-    pub(crate) adj: Vec<u32>,
-    /// Counter-clockwise successor of a half-edge around its origin, among live ones.
-    pub(crate) nxt: Vec<u32>,
-    /// Clockwise successor (counter-clockwise predecessor).
-    pub(crate) prv: Vec<u32>,
+    /// Degree before extraction, by rank.
+    pub(crate) deg0: Vec<u32>,
+    /// Live degree, by rank.
+    pub(crate) deg: Vec<u32>,
     /// Some live half-edge leaving the node, `NONE` when isolated.
     pub(crate) head: Vec<u32>,
-    /// Live degree.
-    pub(crate) deg: Vec<u32>,
-    /// Degree in the working graph before extraction started.
-    pub(crate) deg0: Vec<u32>,
     /// The clockwise-most live half-edge leaving the node seen from straight down, once
     /// computed (`NONE` before).
     pub(crate) first: Vec<u32>,
-    /// Representative nodes sorted by `(x, y)`, ties by index: Eberly's sweep order.
-    pub(crate) order: Vec<u32>,
-    /// Live edge indices of the working graph, increasing.
-    pub(crate) edge_list: Vec<u32>,
-    /// Sort buffer.
+    /// By slot: origin rank, target rank, reverse slot, input edge id (raw).
+    pub(crate) origin: Vec<u32>,
+    pub(crate) target: Vec<u32>,
+    pub(crate) twin: Vec<u32>,
+    pub(crate) edge: Vec<u32>,
+    /// Counter-clockwise / clockwise successor of a slot around its origin, among live ones.
+    pub(crate) nxt: Vec<u32>,
+    pub(crate) prv: Vec<u32>,
+    /// Whether the slot's edge is still in the working graph (both slots of an edge agree).
+    pub(crate) live: Vec<bool>,
+    /// The input graph's node and edge bounds.
+    pub(crate) node_bound: usize,
+    pub(crate) edge_bound: usize,
+    // Build buffers.
     keyed: Vec<(u64, u64, u32)>,
+    rank_of: Vec<u32>,
+    ends: Vec<[u32; 2]>,
+    kept: Vec<u32>,
+    slot_of: Vec<[u32; 2]>,
+    around: Vec<(u32, u32)>,
 }
 
-/// The largest edge bound supported (half-edge indices must fit in `u32`).
+/// The largest edge bound supported (slot indices must fit in `u32`).
 pub(crate) const MAX_EDGES: usize = (u32::MAX / 2 - 1) as usize;
 
 impl Topology {
+    /// Position of rank `r`.
     #[inline]
-    pub(crate) fn origin(&self, h: u32) -> u32 {
-        self.ends[(h >> 1) as usize][(h & 1) as usize]
+    pub(crate) fn p(&self, r: u32) -> DVec2 {
+        self.pos[r as usize]
     }
 
-    #[inline]
-    pub(crate) fn target(&self, h: u32) -> u32 {
-        self.ends[(h >> 1) as usize][((h & 1) ^ 1) as usize]
+    /// Number of nodes (ranks).
+    pub(crate) fn len(&self) -> usize {
+        self.pos.len()
     }
 
-    #[inline]
-    pub(crate) fn p(&self, v: u32) -> DVec2 {
-        self.pos[v as usize]
+    /// Number of half-edge slots.
+    pub(crate) fn slots(&self) -> usize {
+        self.origin.len()
     }
 
     /// Rebuilds the working graph from `g`, merging or rejecting coincident nodes.
@@ -113,25 +120,17 @@ impl Topology {
     ) -> Result<(), Error> {
         let n = g.node_bound();
         let m = g.edge_bound();
-        if m > MAX_EDGES {
+        if m > MAX_EDGES || n > MAX_EDGES {
             return Err(Error::TooLarge {
                 edges: m,
                 limit: MAX_EDGES,
             });
         }
-        self.pos.clear();
-        self.pos.resize(n, DVec2::ZERO);
-        self.rep.clear();
-        self.rep.resize(n, NONE);
-        self.order.clear();
-        for (id, p, _) in g.nodes() {
-            let i = id.index();
-            self.pos[i] = p;
-            self.rep[i] = id.raw();
-            self.order.push(id.raw());
-        }
-        // Sort by (x, y, id) on integer keys that order like the coordinates (-0 and +0
-        // are the same coordinate: adding +0.0 turns -0.0 into +0.0).
+        self.node_bound = n;
+        self.edge_bound = m;
+
+        // Sweep order on integer keys that order like the coordinates (-0 and +0 are the
+        // same coordinate: adding +0.0 turns -0.0 into +0.0); ties by id.
         let key = |x: f64| {
             let bits = (x + 0.0).to_bits();
             if bits >> 63 == 1 {
@@ -141,50 +140,50 @@ impl Topology {
             }
         };
         self.keyed.clear();
-        self.keyed.extend(self.order.iter().map(|&v| {
-            let p = self.pos[v as usize];
-            (key(p.x), key(p.y), v)
-        }));
+        self.keyed
+            .extend(g.nodes().map(|(id, p, _)| (key(p.x), key(p.y), id.raw())));
         self.keyed.sort_unstable();
-        self.order.clear();
-        self.order.extend(self.keyed.iter().map(|k| k.2));
 
-        // Coincident nodes are neighbours in the sorted order; the first of a run has the
-        // smallest id.
-        let mut merged = false;
-        for k in 1..self.order.len() {
-            let (a, b) = (self.order[k - 1], self.order[k]);
-            if self.pos[a as usize] == self.pos[b as usize] {
-                let into = self.rep[a as usize];
+        // Ranks; coincident nodes are neighbours in the order and join the first (smallest
+        // id) of their run.
+        self.rank_of.clear();
+        self.rank_of.resize(n, NONE);
+        self.pos.clear();
+        self.node.clear();
+        for k in 0..self.keyed.len() {
+            let (kx, ky, id) = self.keyed[k];
+            if k > 0 && self.keyed[k - 1].0 == kx && self.keyed[k - 1].1 == ky {
+                let r = self.pos.len() as u32 - 1;
+                let into = self.node[r as usize];
+                let point = self.pos[r as usize];
                 if params.coincident_nodes == CoincidentNodes::Reject {
                     return Err(Error::CoincidentNodes {
                         first: NodeId::from_raw(into),
-                        second: NodeId::from_raw(b),
-                        point: self.pos[b as usize],
+                        second: NodeId::from_raw(id),
+                        point,
                     });
                 }
-                self.rep[b as usize] = into;
-                merged = true;
+                self.rank_of[id as usize] = r;
                 report.merged_nodes.push(NodeMerge {
-                    node: NodeId::from_raw(b),
+                    node: NodeId::from_raw(id),
                     into: NodeId::from_raw(into),
-                    point: self.pos[b as usize],
+                    point,
                 });
+                continue;
             }
+            self.rank_of[id as usize] = self.pos.len() as u32;
+            self.pos.push(g.position(NodeId::from_raw(id))?);
+            self.node.push(id);
         }
-        if merged {
-            let rep = &self.rep;
-            self.order.retain(|&v| rep[v as usize] == v);
-        }
+        let merged = !report.merged_nodes.is_empty();
+        let rn = self.pos.len();
 
-        // Edges.
+        // Edges in rank space.
         self.ends.clear();
         self.ends.resize(m, [NONE; 2]);
-        self.live.clear();
-        self.live.resize(m, false);
-        self.edge_list.clear();
+        self.kept.clear();
         for (e, a, b, _) in g.edges() {
-            let (ra, rb) = (self.rep[a.index()], self.rep[b.index()]);
+            let (ra, rb) = (self.rank_of[a.index()], self.rank_of[b.index()]);
             if ra == NONE || rb == NONE {
                 return Err(Error::Internal(format!("edge {e} ends at a dead node")));
             }
@@ -196,98 +195,119 @@ impl Topology {
                 continue;
             }
             self.ends[e.index()] = [ra, rb];
-            self.live[e.index()] = true;
-            self.edge_list.push(e.raw());
+            self.kept.push(e.raw());
         }
         if merged {
             self.drop_duplicates(report);
         }
 
-        // Adjacency, counter-clockwise around every representative node.
+        // Compressed adjacency, counter-clockwise around every rank.
         self.deg0.clear();
-        self.deg0.resize(n, 0);
-        for &e in &self.edge_list {
+        self.deg0.resize(rn, 0);
+        for &e in &self.kept {
             let [a, b] = self.ends[e as usize];
             self.deg0[a as usize] += 1;
             self.deg0[b as usize] += 1;
         }
         self.adj_start.clear();
-        self.adj_start.reserve(n + 1);
+        self.adj_start.reserve(rn + 1);
         let mut acc = 0u32;
-        for v in 0..n {
+        for r in 0..rn {
             self.adj_start.push(acc);
-            acc += self.deg0[v];
+            acc += self.deg0[r];
         }
         self.adj_start.push(acc);
-        self.adj.clear();
-        self.adj.resize(acc as usize, NONE);
+        let h = acc as usize;
+        for v in [
+            &mut self.origin,
+            &mut self.target,
+            &mut self.twin,
+            &mut self.edge,
+            &mut self.nxt,
+            &mut self.prv,
+        ] {
+            v.clear();
+            v.resize(h, NONE);
+        }
+        self.slot_of.clear();
+        self.slot_of.resize(m, [NONE; 2]);
         if merged {
-            let mut fill: Vec<u32> = self.adj_start[..n].to_vec();
-            for &e in &self.edge_list {
-                for d in 0..2u32 {
-                    let v = self.ends[e as usize][d as usize] as usize;
-                    self.adj[fill[v] as usize] = 2 * e + d;
-                    fill[v] += 1;
-                }
+            // Gather from all merged nodes, then sort exactly.
+            let mut lists: Vec<Vec<(u32, u32)>> = vec![Vec::new(); rn];
+            for &e in &self.kept {
+                let [a, b] = self.ends[e as usize];
+                lists[a as usize].push((e, b));
+                lists[b as usize].push((e, a));
             }
-            for v in 0..n {
-                let (s, t) = (self.adj_start[v] as usize, self.adj_start[v + 1] as usize);
-                if t - s < 2 {
-                    continue;
-                }
-                let o = self.pos[v];
-                let (pos, ends) = (&self.pos, &self.ends);
-                let far = |h: u32| pos[ends[(h >> 1) as usize][((h & 1) ^ 1) as usize] as usize];
-                self.adj[s..t].sort_unstable_by(|&h1, &h2| {
-                    ccw_cmp(o, far(h1), far(h2), Start::East).then(h1.cmp(&h2))
+            for (r, list) in lists.into_iter().enumerate() {
+                let o = self.pos[r];
+                let pos = &self.pos;
+                self.around = list;
+                self.around.sort_unstable_by(|x, y| {
+                    ccw_cmp(o, pos[x.1 as usize], pos[y.1 as usize], Start::East)
+                        .then(x.0.cmp(&y.0))
                 });
+                self.place(r);
             }
         } else {
-            for v in 0..n {
-                if self.rep[v] != v as u32 {
-                    continue;
+            for r in 0..rn {
+                self.around.clear();
+                for &e in g.edges_at(NodeId::from_raw(self.node[r]))? {
+                    let [a, b] = self.ends[e.index()];
+                    self.around
+                        .push((e.raw(), if a == r as u32 { b } else { a }));
                 }
-                let s = self.adj_start[v] as usize;
-                for (k, &e) in g.edges_at(NodeId::from_raw(v as u32))?.iter().enumerate() {
-                    let d = u32::from(self.ends[e.index()][0] != v as u32);
-                    self.adj[s + k] = 2 * e.raw() + d;
-                }
+                self.place(r);
             }
         }
+        for &e in &self.kept {
+            let [k0, k1] = self.slot_of[e as usize];
+            self.twin[k0 as usize] = k1;
+            self.twin[k1 as usize] = k0;
+        }
 
-        // Live circular lists.
-        let hcount = 2 * m;
-        self.nxt.clear();
-        self.nxt.resize(hcount, NONE);
-        self.prv.clear();
-        self.prv.resize(hcount, NONE);
+        self.live.clear();
+        self.live.resize(h, true);
         self.head.clear();
-        self.head.resize(n, NONE);
+        self.head.resize(rn, NONE);
         self.first.clear();
-        self.first.resize(n, NONE);
+        self.first.resize(rn, NONE);
         self.deg.clear();
         self.deg.extend_from_slice(&self.deg0);
-        for v in 0..n {
-            let (s, t) = (self.adj_start[v] as usize, self.adj_start[v + 1] as usize);
+        for r in 0..rn {
+            let (s, t) = (self.adj_start[r], self.adj_start[r + 1]);
             if s == t {
                 continue;
             }
-            self.head[v] = self.adj[s];
+            self.head[r] = s;
             for k in s..t {
-                let h = self.adj[k];
-                let h2 = self.adj[if k + 1 == t { s } else { k + 1 }];
-                self.nxt[h as usize] = h2;
-                self.prv[h2 as usize] = h;
+                let k2 = if k + 1 == t { s } else { k + 1 };
+                self.nxt[k as usize] = k2;
+                self.prv[k2 as usize] = k;
             }
         }
         Ok(())
+    }
+
+    /// Writes `around` (edge, neighbour rank), in counter-clockwise order, into the slots
+    /// of rank `r`.
+    fn place(&mut self, r: usize) {
+        let s = self.adj_start[r] as usize;
+        for (i, &(e, w)) in self.around.iter().enumerate() {
+            let k = s + i;
+            self.origin[k] = r as u32;
+            self.target[k] = w;
+            self.edge[k] = e;
+            let d = usize::from(self.ends[e as usize][0] != r as u32);
+            self.slot_of[e as usize][d] = k as u32;
+        }
     }
 
     /// Drops all but the smallest-id edge of every pair of nodes joined more than once
     /// (possible only after merging coincident nodes).
     fn drop_duplicates(&mut self, report: &mut ExtractionReport) {
         let mut keyed: Vec<(u32, u32, u32)> = self
-            .edge_list
+            .kept
             .iter()
             .map(|&e| {
                 let [a, b] = self.ends[e as usize];
@@ -301,7 +321,6 @@ impl Topology {
             let mut j = k + 1;
             while j < keyed.len() && keyed[j].0 == a && keyed[j].1 == b {
                 let e = keyed[j].2;
-                self.live[e as usize] = false;
                 self.ends[e as usize] = [NONE; 2];
                 report.dropped_edges.push(DroppedEdge {
                     edge: EdgeId::from_raw(e),
@@ -313,48 +332,44 @@ impl Topology {
             }
             k = j;
         }
-        let live = &self.live;
-        self.edge_list.retain(|&e| live[e as usize]);
+        let ends = &self.ends;
+        self.kept.retain(|&e| ends[e as usize][0] != NONE);
     }
 
-    /// The clockwise-most live half-edge leaving `v` when arriving from straight above
+    /// The clockwise-most live half-edge leaving `r` when arriving from straight above
     /// (Eberly's start at the leftmost vertex: the edge with the smallest angle in
-    /// `(-90°, 90°]`). `v` must have a live edge.
-    pub(crate) fn clockwise_most(&mut self, v: u32) -> u32 {
-        let vi = v as usize;
-        if self.first[vi] != NONE {
-            return self.first[vi];
+    /// `(-90°, 90°]`). `r` must have a live edge.
+    pub(crate) fn clockwise_most(&mut self, r: u32) -> u32 {
+        let ri = r as usize;
+        if self.first[ri] != NONE {
+            return self.first[ri];
         }
-        let o = self.pos[vi];
-        let start = self.head[vi];
+        let o = self.pos[ri];
+        let start = self.head[ri];
         let mut best = start;
-        let mut h = self.nxt[start as usize];
-        while h != start && h != NONE {
-            if ccw_cmp(
-                o,
-                self.p(self.target(h)),
-                self.p(self.target(best)),
-                Start::Down,
-            )
-            .is_lt()
-            {
-                best = h;
+        let mut k = self.nxt[start as usize];
+        while k != start && k != NONE {
+            let (pk, pb) = (
+                self.p(self.target[k as usize]),
+                self.p(self.target[best as usize]),
+            );
+            if ccw_cmp(o, pk, pb, Start::Down).is_lt() {
+                best = k;
             }
-            h = self.nxt[h as usize];
+            k = self.nxt[k as usize];
         }
-        self.first[vi] = best;
+        self.first[ri] = best;
         best
     }
 
-    /// Removes edge `e` from the live lists (its ids stay valid for output).
-    pub(crate) fn remove_edge(&mut self, e: u32) {
-        if !self.live[e as usize] {
+    /// Removes the edge of slot `k` (both slots) from the live lists.
+    pub(crate) fn remove_edge(&mut self, k: u32) {
+        if !self.live[k as usize] {
             return;
         }
-        self.live[e as usize] = false;
-        for d in 0..2u32 {
-            let h = 2 * e + d;
-            let v = self.origin(h) as usize;
+        for h in [k, self.twin[k as usize]] {
+            self.live[h as usize] = false;
+            let v = self.origin[h as usize] as usize;
             let (p, n) = (self.prv[h as usize], self.nxt[h as usize]);
             if self.deg[v] <= 1 {
                 self.head[v] = NONE;
@@ -401,27 +416,37 @@ mod tests {
     }
 
     #[test]
-    fn clockwise_most_and_removal() {
+    fn ranks_slots_and_clockwise_most() {
         let mut g: PlanarGraph<(), ()> = PlanarGraph::new();
-        let c = g.add_node(v(0.0, 0.0), ()).unwrap();
         let up = g.add_node(v(0.0, 1.0), ()).unwrap();
+        let c = g.add_node(v(0.0, 0.0), ()).unwrap();
         let ne = g.add_node(v(1.0, 1.0), ()).unwrap();
         let se = g.add_node(v(1.0, -2.0), ()).unwrap();
+        let z = g.add_node(v(-0.0, -1.0), ()).unwrap();
+        g.remove_node(z).unwrap();
         let e_up = g.add_edge(c, up, ()).unwrap();
         let _e_ne = g.add_edge(c, ne, ()).unwrap();
         let e_se = g.add_edge(se, c, ()).unwrap();
         let mut t = Topology::default();
         let mut r = ExtractionReport::default();
         t.build(&g, &CellParams::default(), &mut r).unwrap();
-        assert_eq!(t.order[0], c.raw());
-        let h = t.clockwise_most(c.raw());
-        assert_eq!(h, 2 * e_se.raw() + 1);
-        t.remove_edge(e_se.raw());
-        let h = t.clockwise_most(c.raw());
-        assert_eq!(t.target(h), ne.raw());
-        assert_eq!(t.deg[c.index()], 2);
-        t.remove_edge(h >> 1);
-        assert_eq!(t.clockwise_most(c.raw()), 2 * e_up.raw());
+        assert_eq!(t.node, vec![c.raw(), up.raw(), se.raw(), ne.raw()]);
+        assert_eq!(t.slots(), 6);
+        for k in 0..6 {
+            let w = t.twin[k] as usize;
+            assert_eq!(t.twin[w] as usize, k);
+            assert_eq!(t.origin[k], t.target[w]);
+            assert_eq!(t.edge[k], t.edge[w]);
+        }
+        let k = t.clockwise_most(0);
+        assert_eq!(t.edge[k as usize], e_se.raw());
+        t.remove_edge(k);
+        let k = t.clockwise_most(0);
+        assert_eq!(t.node[t.target[k as usize] as usize], ne.raw());
+        assert_eq!(t.deg[0], 2);
+        t.remove_edge(t.twin[k as usize]);
+        let k = t.clockwise_most(0);
+        assert_eq!(t.edge[k as usize], e_up.raw());
     }
 
     #[test]
@@ -429,7 +454,7 @@ mod tests {
         let mut g: PlanarGraph<(), ()> = PlanarGraph::new();
         let a = g.add_node(v(0.0, 0.0), ()).unwrap();
         let b = g.add_node(v(1.0, 0.0), ()).unwrap();
-        let a2 = g.add_node(v(0.0, 0.0), ()).unwrap();
+        let a2 = g.add_node(v(-0.0, 0.0), ()).unwrap();
         let c = g.add_node(v(0.0, 1.0), ()).unwrap();
         let e0 = g.add_edge(a, b, ()).unwrap();
         let e1 = g.add_edge(a2, b, ()).unwrap();
@@ -446,8 +471,11 @@ mod tests {
             r.dropped_edges[0].reason,
             DropReason::Duplicate { kept: e0 }
         );
-        assert_eq!(t.deg[a.index()], 2);
-        assert_eq!(t.order.len(), 3);
+        assert_eq!(t.len(), 3);
+        assert_eq!(t.deg[0], 2);
+        // Counter-clockwise from east around the merged node: b, then c.
+        assert_eq!(t.node[t.target[0] as usize], b.raw());
+        assert_eq!(t.node[t.target[1] as usize], c.raw());
         let reject = CellParams {
             coincident_nodes: CoincidentNodes::Reject,
             ..CellParams::default()
