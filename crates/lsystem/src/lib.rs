@@ -81,8 +81,9 @@
 //!   `#module`.
 //! * Decomposition and interpretation rules are context-free; modules produced by
 //!   interpretation rules are drawn only (they receive no query values).
-//! * Stochastic weights are constants; trigonometric functions use `f64` from `std`, whose
-//!   last-bit results may differ across platforms.
+//! * Stochastic weights are constants. The turtle's rotations use glam's `libm` sine and
+//!   cosine (identical on every platform), but the math functions of text expressions
+//!   (`sin`, `exp`, `^` …) use `f64` from `std`, whose last bit may differ across platforms.
 //! * One thread per derivation (derive independent strings in parallel).
 //!
 //! ## References

@@ -24,7 +24,7 @@
 //! the rest of the drawing; popping an empty stack is ignored and counted in
 //! [`Turtle::unbalanced`].
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::command::Command;
@@ -251,9 +251,13 @@ fn finite_or_zero(v: f64) -> f64 {
     if v.is_finite() { v } else { 0.0 }
 }
 
+/// Rotates the pair `(a, b)` by `degrees` in its plane. The sine and cosine come from
+/// glam, which the workspace builds with its `libm` feature, so turtle geometry is the same
+/// on every platform.
 #[inline]
 fn rotate(a: DVec3, b: DVec3, degrees: f64) -> (DVec3, DVec3) {
-    let (s, c) = finite_or_zero(degrees).to_radians().sin_cos();
+    let cs = DVec2::from_angle(finite_or_zero(degrees).to_radians());
+    let (s, c) = (cs.y, cs.x);
     (a * c + b * s, b * c - a * s)
 }
 

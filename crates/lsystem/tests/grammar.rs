@@ -414,3 +414,16 @@ fn declared_multi_character_modules() {
     assert!(Grammar::parse("#module X").is_err());
     assert!(Grammar::parse("#module sin").is_err());
 }
+
+#[test]
+fn the_issue_notation_parses_and_applies() {
+    let src = "ω: A(1)B(2)C(3)\np1: A(x) < B(y) > C(z) : x < y -> D(x+1) [+E] : 0.3";
+    let g = Grammar::parse(src).unwrap();
+    let mut d = g.derivation(DeriveOptions::default());
+    d.step().unwrap();
+    assert_eq!(g.format_string(d.string()), "A(1)D(2)[+E]C(3)");
+    let p = &g.ast().productions[0];
+    assert_eq!(p.label.as_deref(), Some("p1"));
+    assert_eq!(p.left.len(), 1);
+    assert_eq!(p.right.len(), 1);
+}
