@@ -1,0 +1,189 @@
+use super::*;
+use crate::sink::MemorySink;
+use crate::testing::{drawn_triangles, sample_scene};
+
+/// Reads an OBJ and its MTL with `tobj`, the MTL from the sink.
+pub(crate) fn load(obj: &[u8], files: &MemorySink) -> (Vec<tobj::Model>, Vec<tobj::Material>) {
+    let opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: false,
+        ..Default::default()
+    };
+    let (models, mats) = tobj::load_obj_buf(&mut std::io::Cursor::new(obj), &opts, |p| {
+        let name = p.to_str().unwrap();
+        let bytes = files
+            .files
+            .get(name)
+            .ok_or(tobj::LoadError::OpenFileFailed)?;
+        tobj::load_mtl_buf(&mut std::io::Cursor::new(bytes))
+    })
+    .expect("tobj reads the OBJ");
+    (models, mats.expect("tobj reads the MTL"))
+}
+
+fn write(scene: &Scene) -> (Vec<u8>, MemorySink, ObjReport) {
+    let mut obj = Vec::new();
+    let mut files = MemorySink::new();
+    let report = write_obj(scene, &ObjOptions::default(), &mut obj, &mut files).unwrap();
+    assert_eq!(report.bytes as usize, obj.len());
+    (obj, files, report)
+}
+
+#[test]
+fn reads_back_with_tobj() {
+    let scene = sample_scene();
+    let (obj, files, report) = write(&scene);
+    let (models, mats) = load(&obj, &files);
+    // Groups: city, house 0..2, mirror.
+    assert_eq!(report.groups, 5);
+    // tobj splits per group and material: 1 + 2 + 1 + 2 + 1.
+    assert_eq!(models.len(), 7);
+    let names: Vec<&str> = models.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "city_0",
+            "house_0_2",
+            "house_0_2",
+            "house_1_3",
+            "house_2_4",
+            "house_2_4",
+            "mirror_5"
+        ]
+    );
+    // Triangles per material match the scene as drawn.
+    let tris: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    assert_eq!(tris, drawn_triangles(&scene).values().sum::<usize>());
+    assert_eq!(tris, report.triangles);
+    // Materials: three scene materials + the default.
+    assert_eq!(mats.len(), 4);
+    assert_eq!(report.materials, 4);
+    assert_eq!(mats[0].name, "m0_brick_wall");
+    assert_eq!(mats[0].diffuse, Some([0.7, 0.4, 0.3]));
+    assert_eq!(
+        mats[0].diffuse_texture.as_deref(),
+        Some("scene_0_brick.png")
+    );
+    assert_eq!(
+        mats[0].normal_texture.as_deref(),
+        Some("scene_1_normal_map.png")
+    );
+    assert_eq!(mats[1].dissolve, Some(0.4));
+    assert_eq!(
+        mats[1].unknown_param.get("Pm").map(String::as_str),
+        Some("0.8")
+    );
+    assert_eq!(mats[3].name, DEFAULT_MATERIAL);
+    assert_eq!(models[0].mesh.material_id, Some(3));
+    assert_eq!(models[1].mesh.material_id, Some(0));
+    // Texture files are PNG.
+    assert_eq!(report.textures, 2);
+    for name in ["scene_0_brick.png", "scene_1_normal_map.png"] {
+        let bytes = &files.files[name];
+        png::Decoder::new(std::io::Cursor::new(bytes.clone()))
+            .read_info()
+            .unwrap();
+    }
+    assert!(files.files.contains_key("scene.mtl"));
+}
+
+#[test]
+fn geometry_is_in_world_space_with_obj_texture_coordinates() {
+    let scene = sample_scene();
+    let (obj, files, _) = write(&scene);
+    let (models, _) = load(&obj, &files);
+    let worlds = scene.world_matrices();
+    // house 2 (node 4), first model = the house prism.
+    let house = &scene.meshes[0];
+    let m = &models[4].mesh;
+    // tobj renumbers vertices in order of first use: compare triangle corners.
+    assert_eq!(m.indices.len(), house.indices.len());
+    for (k, (&got, &want)) in m.indices.iter().zip(&house.indices).enumerate() {
+        let (g, w) = (got as usize, want as usize);
+        let p = worlds[4]
+            .transform_point3(house.positions[w].as_dvec3())
+            .as_vec3();
+        let q = Vec3::new(
+            m.positions[3 * g],
+            m.positions[3 * g + 1],
+            m.positions[3 * g + 2],
+        );
+        assert_eq!(q, p, "corner {k}");
+        let uv = house.uvs[w];
+        assert_eq!(m.texcoords[2 * g], uv.x);
+        assert_eq!(m.texcoords[2 * g + 1], 1.0 - uv.y);
+    }
+    // Every model: indices in range, unit normals, front faces agree with normals (the
+    // mirrored house included).
+    for model in &models {
+        let m = &model.mesh;
+        let n = m.positions.len() / 3;
+        assert!(m.indices.iter().all(|&i| (i as usize) < n));
+        let v = |i: u32| {
+            let i = i as usize;
+            Vec3::new(
+                m.positions[3 * i],
+                m.positions[3 * i + 1],
+                m.positions[3 * i + 2],
+            )
+        };
+        for t in m.indices.chunks_exact(3) {
+            let face = (v(t[1]) - v(t[0])).cross(v(t[2]) - v(t[0])).normalize();
+            let i = t[0] as usize;
+            let nrm = Vec3::new(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]);
+            assert!((nrm.length() - 1.0).abs() < 1e-5);
+            assert!(face.dot(nrm) > 0.99, "{}: winding", model.name);
+        }
+    }
+}
+
+#[test]
+fn byte_identical_and_validated() {
+    let scene = sample_scene();
+    let (a, fa, _) = write(&scene);
+    let (b, fb, _) = write(&scene.clone());
+    assert_eq!(a, b);
+    assert_eq!(fa, fb);
+
+    let mut bad = scene.clone();
+    bad.meshes[2].normals[0] = Vec3::ZERO;
+    let mut obj = Vec::new();
+    let mut files = MemorySink::new();
+    let e = write_obj(&bad, &ObjOptions::default(), &mut obj, &mut files).unwrap_err();
+    assert!(matches!(e, ExportError::InvalidScene(_)));
+    assert!(obj.is_empty() && files.files.is_empty());
+    for stem in ["", "a b", "../x", ".hidden"] {
+        let opts = ObjOptions {
+            stem: stem.to_string(),
+        };
+        assert!(matches!(
+            write_obj(&scene, &opts, &mut obj, &mut files),
+            Err(ExportError::InvalidOption { name: "stem", .. })
+        ));
+    }
+    assert!(obj.is_empty());
+}
+
+#[test]
+fn closure_sinks_receive_side_files() {
+    let scene = sample_scene();
+    let mut names = Vec::new();
+    let mut sink = |name: &str, bytes: &[u8]| {
+        names.push((name.to_string(), bytes.len()));
+        Ok(())
+    };
+    let opts = ObjOptions {
+        stem: "city.v2".to_string(),
+    };
+    write_obj(&scene, &opts, std::io::sink(), &mut sink).unwrap();
+    let got: Vec<&str> = names.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        got,
+        [
+            "city.v2.mtl",
+            "city.v2_0_brick.png",
+            "city.v2_1_normal_map.png"
+        ]
+    );
+    assert!(names.iter().all(|(_, len)| *len > 0));
+}
