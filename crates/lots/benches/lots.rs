@@ -125,8 +125,7 @@ fn manhattan_params(strategy: LotStrategy) -> LotParams {
     }
 }
 
-#[divan::bench(args = [LotStrategy::Kelly, LotStrategy::ParishMueller], sample_count = 10)]
-fn subdivide_10000_blocks(bencher: divan::Bencher<'_, '_>, strategy: LotStrategy) {
+fn subdivide_all(bencher: divan::Bencher<'_, '_>, strategy: LotStrategy) {
     let blocks = manhattan_blocks();
     let params = manhattan_params(strategy);
     let mut worker = Subdivider::new();
@@ -142,4 +141,16 @@ fn subdivide_10000_blocks(bencher: divan::Bencher<'_, '_>, strategy: LotStrategy
         }
         lots
     });
+}
+
+/// Kelly's subdivision of 10,000 Manhattan blocks into 7.6 × 30 m lots.
+#[divan::bench(sample_count = 10)]
+fn subdivide_10000_blocks_kelly(bencher: divan::Bencher<'_, '_>) {
+    subdivide_all(bencher, LotStrategy::Kelly);
+}
+
+/// Parish & Müller's subdivision of the same blocks (lots under 1.3 × 7.6 × 30 m²).
+#[divan::bench(sample_count = 10)]
+fn subdivide_10000_blocks_parish_mueller(bencher: divan::Bencher<'_, '_>) {
+    subdivide_all(bencher, LotStrategy::ParishMueller);
 }

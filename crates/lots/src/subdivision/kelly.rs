@@ -34,9 +34,9 @@ pub(crate) fn split_fraction<R: Rng + ?Sized>(
     Some(mid + noise)
 }
 
-/// `x.round()` for finite `0 <= x < 2^52`.
+/// `x.round()` for finite `0 <= x < 2^52` (saturating beyond).
 fn round_positive(x: f64) -> f64 {
-    ((x + 0.5) as u64) as f64
+    ((x + 0.5) as i64) as f64
 }
 
 pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R) {
@@ -49,14 +49,14 @@ pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R
     while head < ctx.pieces.len() {
         let r = ctx.pieces[head];
         head += 1;
-        if !ctx.arena.has_street(r) {
-            ctx.finish(r);
-            continue;
-        }
         // The longest street edge sets the lot width; failing that, the longest other edge
         // sets the depth.
         let street = ctx.arena.street(r);
         let road = ctx.arena.longest_edge(r, |i| street[i]);
+        if road.is_none() {
+            ctx.finish(r);
+            continue;
+        }
         let mut plan = road.and_then(|(i, len)| {
             split_fraction(len, params.lot_width, params.deviance, rng).map(|t| (i, t))
         });
