@@ -167,3 +167,51 @@ fn bad_input_is_an_error() {
     assert!(StraightSkeleton::weighted(&sq, &[1.0, 0.0, 1.0, 1.0]).is_err());
     let _ = DVec2::ZERO;
 }
+
+#[test]
+fn large_random_polygons_check_out() {
+    // A 2,000-vertex star (about half reflex) and a 1,000-vertex comb.
+    let star = Polygon::new(
+        (0..2000)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 2000.0;
+                let r = 60.0 + 40.0 * ((i * 7919) % 1000) as f64 / 1000.0;
+                v(r * a.cos(), r * a.sin())
+            })
+            .collect(),
+    );
+    skel(&star);
+    let mut pts = vec![(0., -10.), (500., -10.)];
+    for i in (0..250).rev() {
+        let x = 2.0 * i as f64;
+        let depth = 1.0 + ((i * 37) % 8) as f64;
+        pts.push((x + 2.0, 10.0));
+        pts.push((x + 1.6, 10.0 - depth));
+        pts.push((x + 0.4, 10.0 - depth));
+    }
+    pts.push((0., 10.));
+    skel(&poly(&pts));
+}
+
+#[test]
+fn deterministic() {
+    let p: PolygonWithHoles = poly(&[
+        (0., 0.),
+        (10., 0.),
+        (10., 10.),
+        (6., 5.5),
+        (4., 5.5),
+        (0., 10.),
+    ])
+    .into();
+    let a = StraightSkeleton::weighted(&p, &[1.0, 2.0, 0.5, 1.0, 1.5, 1.0]).unwrap();
+    let b = StraightSkeleton::weighted(&p, &[1.0, 2.0, 0.5, 1.0, 1.5, 1.0]).unwrap();
+    assert_eq!(a, b);
+    let json = serde_json::to_string(&a).unwrap();
+    let back: StraightSkeleton = serde_json::from_str(&json).unwrap();
+    // serde_json's float parsing may differ in the last bit.
+    assert_eq!(a.arcs(), back.arcs());
+    for (x, y) in a.nodes().iter().zip(back.nodes()) {
+        assert!((x.position - y.position).length() < 1e-12 && (x.time - y.time).abs() < 1e-12);
+    }
+}

@@ -227,6 +227,33 @@ proptest! {
     }
 
     #[test]
+    fn tiny_edges_and_nearly_collinear_runs(
+        n in 3usize..24,
+        seeds in prop::collection::vec((0.0f64..1.0, 5.0f64..20.0), 1..24),
+        tweaks in prop::collection::vec((0usize..3, -10i32..-5), 24),
+    ) {
+        let base = star(n, &seeds, false);
+        let mut pts = Vec::new();
+        for (i, (a, b)) in base.edges().enumerate() {
+            pts.push(a);
+            let (kind, exp) = tweaks[i % tweaks.len()];
+            let tiny = 10f64.powi(exp);
+            match kind {
+                // A vertex a hair's breadth after this one: a tiny edge.
+                0 => pts.push(a + (b - a).normalize() * tiny * 10.0),
+                // A nearly collinear midpoint.
+                1 => pts.push((a + b) * 0.5 + (b - a).perp().normalize() * tiny),
+                _ => {}
+            }
+        }
+        let p: PolygonWithHoles = Polygon::new(pts).into();
+        prop_assume!(p.validate().is_ok() && p.outer.signed_area() > 0.0);
+        let sk = StraightSkeleton::new(&p).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-7) { prop_assert!(false, "{}", e); }
+        check_insets(&p, None, &sk)?;
+    }
+
+    #[test]
     fn histograms_with_holes(heights in prop::collection::vec(0u8..4, 2..12), holes in prop::collection::vec((0usize..12, 0u8..3, any::<bool>()), 1..5)) {
         let base = histogram(&heights).map_points(|q| q * 4.0 + v(0.0, 8.0 * f64::from(q.y > 0.0)));
         let mut hs = Vec::new();
