@@ -499,10 +499,14 @@ impl<'a, M: Module> TypedRules<'a, M> {
         Ok(self)
     }
 
-    /// Adds symbols to the ignore set of context matching.
+    /// Adds symbols to the ignore set of context matching. Ids above [`MAX_SYMBOL`] are
+    /// skipped (they cannot be ignored).
     pub fn ignore(&mut self, symbols: impl IntoIterator<Item = u32>) -> &mut Self {
         for s in symbols {
-            let s = (s as usize).min(MAX_SYMBOL);
+            let s = s as usize;
+            if s > MAX_SYMBOL {
+                continue;
+            }
             if self.ignore.len() <= s {
                 self.ignore.resize(s + 1, false);
             }
