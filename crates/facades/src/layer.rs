@@ -98,7 +98,7 @@ impl Eval {
         Eval::Custom(EvalFn(Arc::new(f)))
     }
 
-    fn uses_box(&self) -> bool {
+    pub(crate) fn uses_box(&self) -> bool {
         matches!(
             self,
             Eval::And | Eval::Image(_) | Eval::Nested(_) | Eval::Stack(_) | Eval::Custom(_)
@@ -242,7 +242,7 @@ impl Layer {
     }
 
     #[inline]
-    fn selected(&self, i: usize, j: usize) -> bool {
+    pub(crate) fn selected(&self, i: usize, j: usize) -> bool {
         let ok = |m: &Option<Vec<bool>>, k: usize| {
             m.as_ref()
                 .is_none_or(|m| m.get(k).copied().unwrap_or(false))
@@ -251,7 +251,7 @@ impl Layer {
     }
 
     #[inline]
-    fn scale_of(&self, i: usize, j: usize) -> [f64; 2] {
+    pub(crate) fn scale_of(&self, i: usize, j: usize) -> [f64; 2] {
         match &self.cell_scale {
             Some(sc) => sc.get(j * self.u.len() + i).copied().unwrap_or([1.0, 1.0]),
             None => [1.0, 1.0],
@@ -261,7 +261,7 @@ impl Layer {
     /// The unscaled box of cell `(i, j)` as `[x0, x1, y0, y1]`, or `None` if the evaluation
     /// needs a box and a profile is nowhere active.
     #[inline]
-    fn unscaled_box(&self, hu: &Hit, hv: &Hit) -> Option<[f64; 4]> {
+    pub(crate) fn unscaled_box(&self, hu: &Hit, hv: &Hit) -> Option<[f64; 4]> {
         let cell = [hu.start, hu.end, hv.start, hv.end];
         if !self.eval.uses_box() {
             return Some(cell);

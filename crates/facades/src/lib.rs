@@ -97,6 +97,7 @@ pub mod raster;
 pub mod sample;
 pub mod stack;
 pub mod style;
+pub mod sweep;
 pub mod tiles;
 
 pub use axis::{AxisStyle, Segment};

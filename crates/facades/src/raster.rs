@@ -8,8 +8,9 @@
 //! * **metallic-roughness**: RGBA8 as glTF expects: G = roughness, B = metalness (R = 255,
 //!   no occlusion; A = 255).
 //!
-//! Rows are swept left to right with one interval cursor per layer, so a texel costs an
-//! amortised O(1) per layer (plus nested layers' binary searches).
+//! Rows are rasterised by runs ([`crate::sweep`]): each layer's active runs on a row are
+//! found analytically and painted bottom-up, then coloured; only image maps, nested
+//! layers and closures are probed texel by texel.
 
 use polis_geom::{Aabb2, DVec2};
 use serde::{Deserialize, Serialize};
@@ -17,7 +18,9 @@ use serde::{Deserialize, Serialize};
 use crate::MAX_TEXTURE_TEXELS;
 use crate::error::{FacadeError, Result, check_range};
 use crate::facade::Facade;
-use crate::stack::{LayerStack, RowState};
+use crate::sample::FacadeSample;
+use crate::stack::LayerStack;
+use crate::sweep::RowSweep;
 
 /// Heights in `[−HEIGHT_RANGE_M, +HEIGHT_RANGE_M]` metres map to the normal map's alpha.
 pub const HEIGHT_RANGE_M: f32 = 0.5;
@@ -173,30 +176,39 @@ pub fn rasterize_stack(
     let mut heights = vec![0f32; n];
     let ds = region.width() / w as f64;
     let dt = region.height() / h as f64;
-    let mut state = RowState::default();
+    let mut sweep = RowSweep::new(region.min.x, ds, w);
+    let mut row = vec![FacadeSample::default(); w];
     let rows = albedo
         .chunks_exact_mut(w * 4)
         .zip(mr.chunks_exact_mut(w * 4))
         .zip(heights.chunks_exact_mut(w));
     for (y, ((arow, mrow), hrow)) in rows.enumerate() {
         let t = region.max.y - (y as f64 + 0.5) * dt;
-        stack.begin_row(t, &mut state);
-        for (x, ((a, m), hh)) in arow
+        sweep.row(stack, t, &mut row);
+        // Runs of equal samples are common (walls, mortar, glass): convert once per run.
+        let mut prev: Option<(FacadeSample, [u8; 4], [u8; 4])> = None;
+        for (((a, m), hh), smp) in arow
             .chunks_exact_mut(4)
             .zip(mrow.chunks_exact_mut(4))
             .zip(hrow.iter_mut())
-            .enumerate()
+            .zip(&row)
         {
-            let s = region.min.x + (x as f64 + 0.5) * ds;
-            let smp = stack.sample_in_row(s, t, &mut state);
-            a[0] = to_u8(smp.albedo[0] * tint);
-            a[1] = to_u8(smp.albedo[1] * tint);
-            a[2] = to_u8(smp.albedo[2] * tint);
-            a[3] = to_u8(smp.albedo[3]);
-            m[0] = 255;
-            m[1] = to_u8(smp.roughness);
-            m[2] = to_u8(smp.metallic);
-            m[3] = 255;
+            let (pa, pm) = match prev {
+                Some((p, pa, pm)) if p == *smp => (pa, pm),
+                _ => {
+                    let pa = [
+                        to_u8(smp.albedo[0] * tint),
+                        to_u8(smp.albedo[1] * tint),
+                        to_u8(smp.albedo[2] * tint),
+                        to_u8(smp.albedo[3]),
+                    ];
+                    let pm = [255, to_u8(smp.roughness), to_u8(smp.metallic), 255];
+                    prev = Some((*smp, pa, pm));
+                    (pa, pm)
+                }
+            };
+            a.copy_from_slice(&pa);
+            m.copy_from_slice(&pm);
             *hh = smp.height;
         }
     }
@@ -224,22 +236,47 @@ pub fn normals_from_heights(
     strength: f32,
 ) -> Vec<u8> {
     let mut out = vec![0u8; w * h * 4];
-    let at = |x: usize, y: usize| heights.get(y * w + x).copied().unwrap_or(0.0);
-    for y in 0..h {
+    if w == 0 || h == 0 || heights.len() < w * h {
+        return out;
+    }
+    // One-sided differences at the borders span one texel, central ones two.
+    let kx = |span: usize| strength / (span.max(1) as f64 * ds) as f32;
+    for (y, orow) in out.chunks_exact_mut(w * 4).enumerate() {
         let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
-        for x in 0..w {
+        let ky = strength / ((y1 - y0).max(1) as f64 * dt) as f32;
+        let (Some(up), Some(cur), Some(dn)) = (
+            heights.get(y0 * w..y0 * w + w),
+            heights.get(y * w..y * w + w),
+            heights.get(y1 * w..y1 * w + w),
+        ) else {
+            continue;
+        };
+        let mut last_c = f32::NAN;
+        let mut last_alpha = 0u8;
+        for (x, px) in orow.chunks_exact_mut(4).enumerate() {
             let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
-            let dhds = (at(x1, y) - at(x0, y)) / (((x1 - x0).max(1)) as f64 * ds) as f32;
-            // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
-            let dhdt = (at(x, y0) - at(x, y1)) / (((y1 - y0).max(1)) as f64 * dt) as f32;
-            let (nx, ny, nz) = (-dhds * strength, -dhdt * strength, 1.0f32);
-            let inv = 1.0 / (nx * nx + ny * ny + nz * nz).sqrt();
-            if let Some(px) = out.get_mut((y * w + x) * 4..(y * w + x) * 4 + 4) {
-                px[0] = to_u8(nx * inv * 0.5 + 0.5);
-                px[1] = to_u8(ny * inv * 0.5 + 0.5);
-                px[2] = to_u8(nz * inv * 0.5 + 0.5);
-                px[3] = to_u8(at(x, y) / (2.0 * HEIGHT_RANGE_M) + 0.5);
+            let (Some(&l), Some(&r), Some(&u), Some(&d), Some(&c)) =
+                (cur.get(x0), cur.get(x1), up.get(x), dn.get(x), cur.get(x))
+            else {
+                continue;
+            };
+            if c != last_c {
+                last_c = c;
+                last_alpha = to_u8(c * (0.5 / HEIGHT_RANGE_M) + 0.5);
             }
+            if l == r && u == d {
+                px.copy_from_slice(&[128, 128, 255, last_alpha]);
+                continue;
+            }
+            // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
+            let (nx, ny) = (-(r - l) * kx(x1 - x0), -(u - d) * ky);
+            let inv = 1.0 / (nx * nx + ny * ny + 1.0).sqrt();
+            px.copy_from_slice(&[
+                to_u8(nx * inv * 0.5 + 0.5),
+                to_u8(ny * inv * 0.5 + 0.5),
+                to_u8(inv * 0.5 + 0.5),
+                last_alpha,
+            ]);
         }
     }
     out

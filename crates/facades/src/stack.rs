@@ -318,9 +318,50 @@ impl LayerStack {
         }
     }
 
+    /// The border colour (if any) that replaces layer `k`'s colour at `s` on the row
+    /// prepared by [`begin_row`](Self::begin_row): O(log spans).
+    #[inline]
+    pub(crate) fn border_col_in_row(&self, k: usize, s: f64, state: &RowState) -> Option<&Col> {
+        let (borders, slot) = (self.borders.get(k)?, state.spans.get(k)?);
+        for ((_, _, col), (spans, _)) in borders.iter().zip(slot) {
+            let p = spans.partition_point(|sp| sp.1 < s);
+            if spans.get(p).is_some_and(|sp| sp.0 <= s) {
+                return Some(col);
+            }
+        }
+        None
+    }
+
+    /// As [`border_col_in_row`](Self::border_col_in_row) for non-decreasing `s` along the
+    /// row: amortised O(1) with the row state's cursors.
+    #[inline]
+    pub(crate) fn border_col_advance(
+        &self,
+        k: usize,
+        s: f64,
+        state: &mut RowState,
+    ) -> Option<&Col> {
+        let (borders, slot) = (self.borders.get(k)?, state.spans.get_mut(k)?);
+        for ((_, _, col), (spans, cur)) in borders.iter().zip(slot.iter_mut()) {
+            while spans.get(*cur).is_some_and(|sp| sp.1 < s) {
+                *cur += 1;
+            }
+            if spans.get(*cur).is_some_and(|sp| sp.0 <= s) {
+                return Some(col);
+            }
+        }
+        None
+    }
+
+    /// Whether layer `k` is the target of any border influence.
+    #[inline]
+    pub(crate) fn has_borders(&self, k: usize) -> bool {
+        self.borders.get(k).is_some_and(|b| !b.is_empty())
+    }
+
     /// The sample at `(s, t)` during a row sweep begun with [`begin_row`](Self::begin_row)
     /// at this `t`; `s` must not decrease between calls (amortised O(1) per layer).
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn sample_in_row(&self, s: f64, t: f64, state: &mut RowState) -> FacadeSample {
         for k in (0..self.layers.len()).rev() {
             let (Some(layer), Some(Some(hv)), Some(cursor)) =
@@ -334,18 +375,7 @@ impl LayerStack {
             let Some(p) = layer.probe_hits(s, t, &hu, hv) else {
                 continue;
             };
-            let mut col = &layer.col;
-            if let (Some(borders), Some(slot)) = (self.borders.get(k), state.spans.get_mut(k)) {
-                for ((_, _, bcol), (spans, cur)) in borders.iter().zip(slot.iter_mut()) {
-                    while spans.get(*cur).is_some_and(|sp| sp.1 < s) {
-                        *cur += 1;
-                    }
-                    if spans.get(*cur).is_some_and(|sp| sp.0 <= s) {
-                        col = bcol;
-                        break;
-                    }
-                }
-            }
+            let col = self.border_col_advance(k, s, state).unwrap_or(&layer.col);
             return layer.shade(&p, col);
         }
         self.background.unwrap_or_default()
