@@ -35,7 +35,9 @@
 //!   function (roads and blocks on terrain).
 //! * [`Mesh::add_walls`] and [`Mesh::add_planar_polygon`] in a [`PlaneFrame`]: open wall
 //!   tubes, gable ends, facades with window openings, any planar face.
-//! * [`Mesh::add_vertex`], [`Mesh::add_triangle`], [`Mesh::add_quad`]: anything else.
+//! * [`Mesh::add_vertex`], [`Mesh::add_triangle`], [`Mesh::add_quad`]: anything else;
+//!   [`Mesh::from_triangles`], [`Mesh::compute_smooth_normals`], [`Mesh::split_flat`] for
+//!   geometry from other tools.
 //!
 //! Builders that fail leave the mesh as it was.
 //!
@@ -58,6 +60,7 @@ use crate::GeomError;
 use crate::scene::MaterialId;
 
 mod extrude;
+mod normals;
 mod planar;
 mod triangulate;
 
