@@ -190,6 +190,71 @@ impl StraightSkeleton {
         })
     }
 
+    /// Checks the structure's own consistency: arcs join existing nodes forward in time,
+    /// every face starts with its input edge (the input vertices are the first nodes) and
+    /// has no negative area, and the faces' areas add up to `polygon_area` within the
+    /// relative tolerance `tol`. Returns what is wrong.
+    pub fn check_invariants(&self, polygon_area: f64, tol: f64) -> Result<(), String> {
+        let n = self.input_vertex_count();
+        if self.faces.len() != n || self.weights.len() != n || self.nodes.len() < n {
+            return Err(format!(
+                "{} faces, {} weights and {} nodes for {n} input edges",
+                self.faces.len(),
+                self.weights.len(),
+                self.nodes.len()
+            ));
+        }
+        for (k, a) in self.arcs.iter().enumerate() {
+            let (Some(from), Some(to)) = (self.nodes.get(a.from), self.nodes.get(a.to)) else {
+                return Err(format!("arc {k} names a node that does not exist"));
+            };
+            if to.time < from.time - tol * from.time.abs().max(1.0) {
+                return Err(format!("arc {k} runs backwards in time"));
+            }
+            if a.left_edge >= n || a.right_edge >= n {
+                return Err(format!("arc {k} names an edge that does not exist"));
+            }
+        }
+        let mut total = 0.0;
+        for (e, f) in self.faces.iter().enumerate() {
+            let next = if e + 1
+                == self
+                    .ring_starts
+                    .iter()
+                    .copied()
+                    .find(|&s| s > e)
+                    .unwrap_or(n)
+            {
+                self.ring_starts
+                    .iter()
+                    .copied()
+                    .filter(|&s| s <= e)
+                    .max()
+                    .unwrap_or(0)
+            } else {
+                e + 1
+            };
+            let pts = f.points();
+            if pts.len() < 3
+                || pts[0] != self.nodes[e].position
+                || pts[1] != self.nodes[next].position
+            {
+                return Err(format!("face {e} does not start with its input edge"));
+            }
+            let a = f.signed_area();
+            if a < -tol * polygon_area {
+                return Err(format!("face {e} has negative area {a}"));
+            }
+            total += a;
+        }
+        if (total - polygon_area).abs() > tol * polygon_area {
+            return Err(format!(
+                "the faces cover {total} m², the polygon {polygon_area} m²"
+            ));
+        }
+        Ok(())
+    }
+
     /// The time of the last event: when the polygon has vanished completely.
     pub fn max_time(&self) -> f64 {
         self.nodes.iter().map(|n| n.time).fold(0.0, f64::max)

@@ -94,5 +94,6 @@ pub fn check_skeleton(p: &PolygonWithHoles, sk: &StraightSkeleton, tol: f64) -> 
     if (total - area).abs() > tol * area.max(1.0) * 10.0 {
         return Err(format!("faces add up to {total}, polygon area is {area}"));
     }
-    Ok(())
+    // And the structure's own check agrees.
+    sk.check_invariants(area, 1e-6)
 }
