@@ -6,7 +6,9 @@
 //! classified once with the exact [`segment_intersection`]. No sorting: expected `O(n)` on
 //! road-like graphs, `O(d²)` around a node of degree `d`.
 
-use polis_geom::predicates::{SegmentIntersection, point_on_segment, segment_intersection};
+use polis_geom::predicates::{
+    Orientation, SegmentIntersection, orient2d, point_on_segment, segment_intersection,
+};
 use polis_geom::{DVec2, EdgeId, NodeId};
 
 use crate::error::{Conflict, Error};
@@ -210,6 +212,18 @@ impl PlanarityCheck {
     }
 }
 
+/// The shared end and the two other ends of two edges with one common end node.
+fn shared_end(a: [u32; 2], b: [u32; 2]) -> Option<(u32, u32, u32)> {
+    for i in 0..2 {
+        for j in 0..2 {
+            if a[i] == b[j] && a[1 - i] != b[1 - j] {
+                return Some((a[i], a[1 - i], b[1 - j]));
+            }
+        }
+    }
+    None
+}
+
 /// The conflict between two grid items (edge slot `k` as `k`, isolated node of rank `v`
 /// as `m + v`, `m` the number of slots), if any.
 fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
@@ -233,6 +247,16 @@ fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
     let (ie, jf) = (topo.edge[e as usize], topo.edge[f as usize]);
     let first = EdgeId::from_raw(ie.min(jf));
     let second = EdgeId::from_raw(ie.max(jf));
+    // Edges sharing an end node meet elsewhere only when they overlap: both leave the
+    // shared node in exactly the same direction.
+    if let Some((o, p, q)) = shared_end(ee, fe) {
+        let (o, p, q) = (topo.p(o), topo.p(p), topo.p(q));
+        let same_side = |a: f64, b: f64, c: f64| (b > a) == (c > a) && (b < a) == (c < a);
+        let overlap = orient2d(o, p, q) == Orientation::Collinear
+            && same_side(o.x, p.x, q.x)
+            && same_side(o.y, p.y, q.y);
+        return overlap.then_some(Conflict::Overlap { first, second });
+    }
     match segment_intersection(a0, a1, b0, b1) {
         SegmentIntersection::Disjoint => None,
         SegmentIntersection::Crossing { point, .. } => Some(Conflict::Crossing {

@@ -139,6 +139,7 @@ impl Topology {
                 bits | (1 << 63)
             }
         };
+        let unkey = |k: u64| f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k });
         self.keyed.clear();
         self.keyed
             .extend(g.nodes().map(|(id, p, _)| (key(p.x), key(p.y), id.raw())));
@@ -172,7 +173,7 @@ impl Topology {
                 continue;
             }
             self.rank_of[id as usize] = self.pos.len() as u32;
-            self.pos.push(g.position(NodeId::from_raw(id))?);
+            self.pos.push(DVec2::new(unkey(kx), unkey(ky)));
             self.node.push(id);
         }
         let merged = !report.merged_nodes.is_empty();
@@ -249,21 +250,31 @@ impl Topology {
                 });
                 self.place(r);
             }
-        } else {
-            for r in 0..rn {
-                self.around.clear();
-                for &e in g.edges_at(NodeId::from_raw(self.node[r]))? {
-                    let [a, b] = self.ends[e.index()];
-                    self.around
-                        .push((e.raw(), if a == r as u32 { b } else { a }));
-                }
-                self.place(r);
+            for &e in &self.kept {
+                let [k0, k1] = self.slot_of[e as usize];
+                self.twin[k0 as usize] = k1;
+                self.twin[k1 as usize] = k0;
             }
-        }
-        for &e in &self.kept {
-            let [k0, k1] = self.slot_of[e as usize];
-            self.twin[k0 as usize] = k1;
-            self.twin[k1 as usize] = k0;
+        } else {
+            // In the graph's id order (its memory order); the two slots of an edge pair
+            // up in the order they are met.
+            for (id, _, _) in g.nodes() {
+                let r = self.rank_of[id.index()];
+                let s = self.adj_start[r as usize] as usize;
+                for (i, (e, m)) in g.neighbors(id)?.enumerate() {
+                    let k = s + i;
+                    self.origin[k] = r;
+                    self.target[k] = self.rank_of[m.index()];
+                    self.edge[k] = e.raw();
+                    let first = self.slot_of[e.index()][0];
+                    if first == NONE {
+                        self.slot_of[e.index()][0] = k as u32;
+                    } else {
+                        self.twin[k] = first;
+                        self.twin[first as usize] = k as u32;
+                    }
+                }
+            }
         }
 
         self.live.clear();
