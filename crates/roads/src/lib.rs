@@ -1,6 +1,89 @@
-//! polis-roads: road networks grown by Parish & Müller's extended open L-system (global goals, local constraints, road patterns).
+//! # polis-roads
 //!
-//! **Status: not yet implemented.** This crate is a placeholder in the workspace; the
-//! issue tracker names what it will own. Nothing here pretends to work yet.
+//! Road networks grown by Parish & Müller's extended open L-system (*Procedural Modeling
+//! of Cities*, SIGGRAPH 2001, §3) on [`polis_lsystem`], with Kelly's snap algorithm
+//! (Citygen, 2008, §4.3.3) for the self-sensitive constraints. The output is a planar
+//! [`RoadNetwork`] (`PlanarGraph<Junction, Road>`) for the cells stage.
+//!
+//! ```text
+//!  R ?I ──p2: GlobalGoals (population rays, patterns blended by maps)──▶ B B R ?I
+//!           ?I ──p8: environment: LocalConstraints (legal? prune/bridge/rotate;
+//!                    snap: crossing / junction / road; min angle)──▶ SUCCEED → graph
+//! ```
+//!
+//! ## Key types
+//!
+//! | type | what |
+//! |---|---|
+//! | [`RoadParams`] | every knob, with units and defaults (serde) |
+//! | [`RoadInputs`] | the input maps as [`polis_geom::Field`]s; [`RoadInputs::procedural`] needs no files |
+//! | [`GlobalGoals`], [`DefaultGoals`] | `globalGoals` of p2: highways, streets, patterns ([`Pattern`]) |
+//! | [`LocalConstraints`], [`DefaultConstraints`] | `localConstraints` of p8 |
+//! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
+//! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
+//! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
+//!
+//! ## Example
+//!
+//! ```
+//! use polis_roads::{Pattern, RoadParams, generate_default, network_stats};
+//!
+//! let params = RoadParams { pattern: Pattern::NewYork, max_segments: 300, ..RoadParams::default() };
+//! let city = generate_default(&params)?;
+//! city.network.check_invariants()?; // planar: every crossing is a junction
+//! assert!(city.report.segments <= 300);
+//! assert!(network_stats(&city.network).street_length_m > 0.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! ## Guarantees
+//!
+//! * The network is always a valid planar straight-line graph (insertion through
+//!   `PlanarGraph::insert_segment`, which splits at every crossing with exact predicates).
+//! * No non-bridge road has a legality sample (every `legality_step_m`) in water, a park,
+//!   outside the map or above the slope limit; bridges are at most `max_bridge_length_m`.
+//! * Deterministic: same parameters, maps and seed give the same graph, ids included.
+//! * Never panics on parameters: [`RoadParams::validate`] rejects bad values with a
+//!   typed [`RoadError`].
+//!
+//! ## Limitations
+//!
+//! * Legality is sampled (every `legality_step_m`, default 4 m): a sliver of water
+//!   thinner than that can be missed.
+//! * Streets do not lower the population around them (the open-L-system feedback the
+//!   paper mentions); the population threshold alone stops them.
+//! * The turtle modules `+F` and the brackets of p5 are not kept in the string (see
+//!   [`modules`]).
+//!
+//! ## References
+//!
+//! * Y. I. H. Parish, P. Müller, *Procedural Modeling of Cities*, SIGGRAPH 2001, §3.
+//! * G. Kelly, *An Interactive System for Procedural City Generation*, 2008, §3.4.1, §4.3.3.
+//! * The priority-queue slides (initialisation with two opposite segments, branch delay,
+//!   population threshold) after S. Barrett, *L-Systems Considered Harmful*, 2008.
 
 pub use polis_geom as geom;
+pub use polis_lsystem as lsystem;
+
+pub mod constraints;
+pub mod error;
+pub mod generator;
+pub mod goals;
+pub mod inputs;
+pub mod legality;
+pub mod modules;
+pub mod network;
+pub mod params;
+pub mod smooth;
+pub mod snap;
+
+pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
+pub use error::{Result, RoadError};
+pub use generator::{
+    Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
+};
+pub use goals::{DefaultGoals, GlobalGoals};
+pub use inputs::RoadInputs;
+pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
+pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
+pub use params::{Pattern, RoadParams};

@@ -1,0 +1,260 @@
+//! Local constraints (§3.3, §3.3.1): legality (prune, bridge, rotate) and
+//! self-sensitivity (crossings, snapping to junctions and roads, minimum angles).
+
+use polis_geom::{DVec2, NodeId};
+use serde::{Deserialize, Serialize};
+
+use crate::inputs::RoadInputs;
+use crate::legality::{Illegal, Legality};
+use crate::modules::{QueryState, RoadAttr};
+use crate::network::{RoadClass, RoadNetwork, angle_diff, angle_of, dir};
+use crate::params::RoadParams;
+use crate::snap::{SnapEvent, SnapQuery, snap};
+
+/// The `localConstraints` function of p8: adjust a proposed segment to the environment
+/// and the existing network, or reject it.
+///
+/// On [`QueryState::Succeed`] the generator inserts `road.start → road.end` into the
+/// network (planar insertion: crossings become junctions), flagged with `road.bridge`.
+pub trait LocalConstraints: Send {
+    /// Adjusts `road` (its `end`, `angle`, `length`, `bridge`, `snapped`) and returns
+    /// `Succeed` or `Failed`.
+    fn adjust(&mut self, road: &mut RoadAttr, network: &RoadNetwork) -> QueryState;
+
+    /// Counters of what the constraints did (for reports). Default: none.
+    fn stats(&self) -> ConstraintStats {
+        ConstraintStats::default()
+    }
+}
+
+/// What [`DefaultConstraints`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct ConstraintStats {
+    /// Proposals seen.
+    pub proposals: usize,
+    /// Segments shortened to stay legal.
+    pub pruned: usize,
+    /// Segments rotated to stay legal.
+    pub rotated: usize,
+    /// Highway segments turned into bridges.
+    pub bridges: usize,
+    /// Segments ended at a crossing with an existing road.
+    pub crossings: usize,
+    /// Segments extended or shortened to an existing junction.
+    pub junction_snaps: usize,
+    /// Segments extended to meet an existing road.
+    pub road_snaps: usize,
+    /// Rejected: no legal variant found.
+    pub failed_illegal: usize,
+    /// Rejected: angle between roads below the minimum.
+    pub failed_angle: usize,
+    /// Rejected: too short after adjustment.
+    pub failed_short: usize,
+}
+
+/// The default local constraints of Parish & Müller with Kelly's snap algorithm.
+#[derive(Debug, Clone)]
+pub struct DefaultConstraints {
+    params: RoadParams,
+    legality: Legality,
+    stats: ConstraintStats,
+}
+
+/// Distance (metres) under which a point counts as the start junction.
+const SAME_POINT_M: f64 = 1e-6;
+
+impl DefaultConstraints {
+    /// Constraints for `params` over `inputs`.
+    pub fn new(params: &RoadParams, inputs: &RoadInputs) -> Self {
+        DefaultConstraints {
+            params: params.clone(),
+            legality: Legality::new(inputs, params),
+            stats: ConstraintStats::default(),
+        }
+    }
+
+    /// The legality tests used.
+    pub fn legality(&self) -> &Legality {
+        &self.legality
+    }
+
+    /// Step 1 of §3.3: make the segment legal (prune, bridge, rotate). Returns the new
+    /// end and whether it is a bridge, or `None`.
+    fn make_legal(
+        &mut self,
+        a: DVec2,
+        angle: f64,
+        len: f64,
+        class: RoadClass,
+    ) -> Option<(DVec2, f64, bool)> {
+        let b = a + dir(angle) * len;
+        let Some(v) = self.legality.segment(a, b) else {
+            return Some((b, angle, false));
+        };
+        let p = &self.params;
+        // Prune to the last legal sample, refined by bisection toward the violation.
+        let (mut lo, mut hi) = (v.t_legal, v.t);
+        for _ in 0..10 {
+            let mid = 0.5 * (lo + hi);
+            if self.legality.segment_ok(a, a + (b - a) * mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let pruned = lo * len;
+        if pruned >= (1.0 - p.max_prune_factor) * len && pruned >= p.min_segment_length_m.max(1e-3)
+        {
+            self.stats.pruned += 1;
+            return Some((a + (b - a) * lo, angle, false));
+        }
+        // Highways bridge water up to the maximum length.
+        if class == RoadClass::Highway && v.what == Illegal::Water && p.max_bridge_length_m > 0.0 {
+            let step = self.legality.step();
+            let d = dir(angle);
+            let mut s = v.t * len;
+            while s + step <= p.max_bridge_length_m {
+                s += step;
+                if self.legality.point(a + d * s).is_none() {
+                    let landing = a + d * (s + step).min(p.max_bridge_length_m);
+                    if self.legality.bridgeable(a, landing) {
+                        self.stats.bridges += 1;
+                        return Some((landing, angle, true));
+                    }
+                    break;
+                }
+            }
+        }
+        // Rotate within the maximal angle, nearest first, left before right.
+        let step = p.rotate_step_deg.to_radians();
+        let max = p.max_rotate_deg.to_radians();
+        let mut k = 1.0;
+        while k * step <= max + 1e-12 {
+            for s in [1.0, -1.0] {
+                let ang = angle + s * k * step;
+                let e = a + dir(ang) * len;
+                if self.legality.segment_ok(a, e) {
+                    self.stats.rotated += 1;
+                    return Some((e, ang, false));
+                }
+            }
+            k += 1.0;
+        }
+        self.stats.failed_illegal += 1;
+        None
+    }
+
+    /// Whether a road leaving junction `n` toward `toward` keeps the minimum angle to
+    /// every road already there.
+    fn angle_ok_at(&self, net: &RoadNetwork, n: NodeId, toward: DVec2) -> bool {
+        let min = self.params.min_angle_deg.to_radians();
+        let (Ok(p), Ok(edges)) = (net.position(n), net.edges_at(n)) else {
+            return true;
+        };
+        if toward.distance(p) <= 0.0 {
+            return false;
+        }
+        let a = angle_of(toward - p);
+        edges.iter().all(|&e| {
+            net.other_end(e, n)
+                .and_then(|o| net.position(o))
+                .is_ok_and(|q| angle_diff(angle_of(q - p), a) >= min)
+        })
+    }
+
+    /// Whether the segment `a–b` meets edge `e` at no less than the minimum angle.
+    fn angle_ok_edge(&self, net: &RoadNetwork, e: polis_geom::EdgeId, a: DVec2, b: DVec2) -> bool {
+        let min = self.params.min_angle_deg.to_radians();
+        let Ok((u, v)) = net.segment(e) else {
+            return true;
+        };
+        let d = angle_diff(angle_of(v - u), angle_of(b - a));
+        d.min(std::f64::consts::PI - d) >= min
+    }
+}
+
+impl LocalConstraints for DefaultConstraints {
+    fn adjust(&mut self, road: &mut RoadAttr, net: &RoadNetwork) -> QueryState {
+        self.stats.proposals += 1;
+        let a = road.start;
+        if !(a.is_finite()
+            && road.angle.is_finite()
+            && road.length.is_finite()
+            && road.length > 0.0)
+        {
+            self.stats.failed_illegal += 1;
+            return QueryState::Failed;
+        }
+        let p = self.params.clone();
+        let Some((mut end, angle, bridge)) =
+            self.make_legal(a, road.angle, road.length, road.class)
+        else {
+            return QueryState::Failed;
+        };
+        let start_node = net.nearest_node(a, SAME_POINT_M).map(|(n, _)| n);
+        if let Some(s) = start_node
+            && !self.angle_ok_at(net, s, end)
+        {
+            self.stats.failed_angle += 1;
+            return QueryState::Failed;
+        }
+        let q = SnapQuery {
+            a,
+            b: end,
+            radius: p.snap_radius_m,
+            start_node,
+            only: match road.class {
+                RoadClass::Highway => Some(RoadClass::Highway),
+                RoadClass::Street => None,
+            },
+        };
+        let mut snapped = false;
+        if let Some(ev) = snap(net, &q) {
+            let ok = match ev {
+                SnapEvent::Junction { node, .. } => self.angle_ok_at(net, node, a),
+                SnapEvent::Cross { edge, .. } | SnapEvent::Road { edge, .. } => {
+                    self.angle_ok_edge(net, edge, a, ev.point())
+                }
+            };
+            if !ok {
+                self.stats.failed_angle += 1;
+                return QueryState::Failed;
+            }
+            match ev {
+                SnapEvent::Junction { .. } => self.stats.junction_snaps += 1,
+                SnapEvent::Cross { .. } => self.stats.crossings += 1,
+                SnapEvent::Road { .. } => self.stats.road_snaps += 1,
+            }
+            end = ev.point();
+            snapped = true;
+        }
+        let len = a.distance(end);
+        if len.is_nan() || len < p.min_segment_length_m.max(1e-3) {
+            self.stats.failed_short += 1;
+            return QueryState::Failed;
+        }
+        if snapped {
+            let legal = if bridge {
+                len <= p.max_bridge_length_m + 1e-9
+                    && (self.legality.bridgeable(a, end)
+                        || self.legality.point(end) == Some(Illegal::Water))
+            } else {
+                self.legality.segment_ok(a, end)
+            };
+            if !legal {
+                self.stats.failed_illegal += 1;
+                return QueryState::Failed;
+            }
+        }
+        road.end = end;
+        road.angle = if snapped { angle_of(end - a) } else { angle };
+        road.length = len;
+        road.bridge = bridge;
+        road.snapped = snapped;
+        QueryState::Succeed
+    }
+
+    fn stats(&self) -> ConstraintStats {
+        self.stats
+    }
+}

@@ -1,0 +1,492 @@
+//! Global goals (§3.2): population density and road patterns fill the parameters of the
+//! ideal successor in p2.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use polis_geom::DVec2;
+use polis_lsystem::rand_pcg::Pcg64Mcg;
+use rand::Rng;
+
+use crate::error::{Result, RoadError};
+use crate::inputs::RoadInputs;
+use crate::legality::Legality;
+use crate::modules::{Proposal, RoadAttr, RuleAttr};
+use crate::network::{RoadClass, angle_diff, angle_of, dir};
+use crate::params::{Pattern, RoadParams};
+
+/// The `globalGoals` function of p2: given an accepted segment, propose the continuation
+/// and two branches.
+///
+/// Implement it to add a goal without touching a production; wrap [`DefaultGoals`] to
+/// change only part of its answer (see the `road_custom_goal` example).
+pub trait GlobalGoals: Send + Sync {
+    /// The axiom: the initial road segments (Parish & Müller's single `R ?I`; the slides
+    /// start with two opposite segments).
+    fn axiom(&self) -> Vec<(RuleAttr, RoadAttr)>;
+
+    /// `[continuation, branch 1, branch 2]` after the accepted segment `road` grown by a
+    /// road with `rule`. A negative delay means "no successor". `rng` is the derivation's
+    /// seeded generator.
+    fn successors(&self, rule: &RuleAttr, road: &RoadAttr, rng: &mut Pcg64Mcg) -> [Proposal; 3];
+}
+
+/// A uniform number in `[0, 1)` (top 53 bits of one draw).
+pub fn unit_f64(rng: &mut Pcg64Mcg) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+const PATTERNS: [Pattern; 4] = [
+    Pattern::Basic,
+    Pattern::NewYork,
+    Pattern::Paris,
+    Pattern::SanFrancisco,
+];
+
+/// The default global goals: population-seeking highways (ray sampling with inverse
+/// distance weights), the four patterns of Table 1 blended by weight maps (Fig. 7),
+/// population-thresholded street branching and the highway-to-street delay.
+#[derive(Debug, Clone)]
+pub struct DefaultGoals {
+    params: RoadParams,
+    inputs: RoadInputs,
+    start: DVec2,
+    centre: DVec2,
+}
+
+/// Per-pattern proposal: direction (radians) and length (metres).
+#[derive(Debug, Clone, Copy)]
+struct Aim {
+    angle: f64,
+    length: f64,
+}
+
+impl DefaultGoals {
+    /// Goals for `params` over `inputs`. Finds the start (population peak on legal
+    /// ground) and the Paris centre (population peak) unless given.
+    ///
+    /// # Errors
+    /// [`RoadError::InvalidParameter`] for bad parameters; [`RoadError::NoLegalStart`]
+    /// when no legal start point exists.
+    pub fn new(params: &RoadParams, inputs: &RoadInputs) -> Result<Self> {
+        params.validate()?;
+        let legality = Legality::new(inputs, params);
+        let b = params.bounds();
+        let mut best_legal: Option<(f64, DVec2)> = None;
+        let mut best_any: Option<(f64, DVec2)> = None;
+        const N: usize = 64;
+        for j in 0..N {
+            for i in 0..N {
+                let p = DVec2::new(
+                    b.min.x + b.width() * (i as f64 + 0.5) / N as f64,
+                    b.min.y + b.height() * (j as f64 + 0.5) / N as f64,
+                );
+                let v = inputs.population.sample(p);
+                if !v.is_finite() {
+                    continue;
+                }
+                if best_any.is_none_or(|(bv, _)| v > bv) {
+                    best_any = Some((v, p));
+                }
+                if legality.point(p).is_none() && best_legal.is_none_or(|(bv, _)| v > bv) {
+                    best_legal = Some((v, p));
+                }
+            }
+        }
+        let start = match params.start {
+            Some(s) => {
+                let s = DVec2::from_array(s);
+                if legality.point(s).is_some() {
+                    return Err(RoadError::InvalidParameter {
+                        name: "start",
+                        reason: format!(
+                            "({}, {}) is outside the map or in an illegal area; move it onto legal land",
+                            s.x, s.y
+                        ),
+                    });
+                }
+                s
+            }
+            None => best_legal.ok_or(RoadError::NoLegalStart)?.1,
+        };
+        let centre = match params.paris_centre {
+            Some(c) => DVec2::from_array(c),
+            None => best_any.map_or(b.center(), |(_, p)| p),
+        };
+        Ok(DefaultGoals {
+            params: params.clone(),
+            inputs: inputs.clone(),
+            start,
+            centre,
+        })
+    }
+
+    /// The start point of the axiom.
+    pub fn start(&self) -> DVec2 {
+        self.start
+    }
+
+    /// The centre of the Paris pattern.
+    pub fn centre(&self) -> DVec2 {
+        self.centre
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &RoadParams {
+        &self.params
+    }
+
+    /// Normalised pattern weights at `p` (Basic, New York, Paris, San Francisco).
+    pub fn pattern_weights(&self, p: DVec2) -> [f64; 4] {
+        let mut w = [0.0; 4];
+        if self.inputs.pattern_weights.is_empty() {
+            w[pattern_slot(self.params.pattern)] = 1.0;
+            return w;
+        }
+        for (pat, f) in &self.inputs.pattern_weights {
+            let v = f.sample(p);
+            if v.is_finite() && v > 0.0 {
+                w[pattern_slot(*pat)] += v;
+            }
+        }
+        let s: f64 = w.iter().sum();
+        if s > 0.0 {
+            for x in &mut w {
+                *x /= s;
+            }
+        } else {
+            w = [1.0, 0.0, 0.0, 0.0];
+        }
+        w
+    }
+
+    /// Inverse-distance-weighted population along the ray from `p` in direction `a`
+    /// (§3.2.1, Fig. 4).
+    pub fn ray_score(&self, p: DVec2, a: f64) -> f64 {
+        let n = self.params.highway_ray_samples;
+        let d = dir(a);
+        let mut sum = 0.0;
+        for i in 1..=n {
+            let dist = self.params.highway_ray_length_m * f64::from(i) / f64::from(n);
+            let v = self.inputs.population.sample(p + d * dist);
+            if v.is_finite() {
+                sum += v / dist;
+            }
+        }
+        sum
+    }
+
+    /// The best of `highway_rays` rays within `±half_fan` of `a` (ties: closest to `a`).
+    pub fn best_ray(&self, p: DVec2, a: f64, half_fan: f64) -> f64 {
+        let n = self.params.highway_rays.max(1);
+        let mut best = (f64::NEG_INFINITY, a);
+        for i in 0..n {
+            let off = if n == 1 {
+                0.0
+            } else {
+                -half_fan + 2.0 * half_fan * f64::from(i) / f64::from(n - 1)
+            };
+            let cand = a + off;
+            let s = self.ray_score(p, cand);
+            if s > best.0 + 1e-12 || (s >= best.0 - 1e-12 && off.abs() < angle_diff(best.1, a)) {
+                best = (s, cand);
+            }
+        }
+        best.1
+    }
+
+    fn class_length(&self, class: RoadClass) -> f64 {
+        match class {
+            RoadClass::Highway => self.params.highway_length_m,
+            RoadClass::Street => self.params.street_length_m,
+        }
+    }
+
+    fn grid_angle(&self, p: DVec2) -> f64 {
+        let deg = match &self.inputs.grid_angle {
+            Some(f) => {
+                let v = f.sample(p);
+                if v.is_finite() {
+                    v
+                } else {
+                    self.params.grid_angle_deg
+                }
+            }
+            None => self.params.grid_angle_deg,
+        };
+        deg.to_radians()
+    }
+
+    /// Basic rule: highways follow population, streets go on with a small deviation.
+    fn basic(&self, p: DVec2, a: f64, class: RoadClass, branch: bool, rng: &mut Pcg64Mcg) -> Aim {
+        let angle = match class {
+            RoadClass::Highway if !branch => {
+                self.best_ray(p, a, self.params.highway_max_turn_deg.to_radians())
+            }
+            _ => {
+                let dev = self.params.street_deviation_deg.to_radians();
+                a + (2.0 * unit_f64(rng) - 1.0) * dev
+            }
+        };
+        Aim {
+            angle,
+            length: self.class_length(class),
+        }
+    }
+
+    /// New York rule: the nearest grid axis; block length along the grid angle, block
+    /// width across it (streets).
+    fn new_york(&self, p: DVec2, a: f64, class: RoadClass) -> Aim {
+        let g = self.grid_angle(p);
+        let k = ((a - g) / FRAC_PI_2).round();
+        let angle = g + k * FRAC_PI_2;
+        let along = (k as i64).rem_euclid(2) == 0;
+        let length = match class {
+            RoadClass::Highway => self.params.highway_length_m,
+            RoadClass::Street if along => self.params.block_length_m,
+            RoadClass::Street => self.params.block_width_m,
+        };
+        Aim { angle, length }
+    }
+
+    /// Paris rule: radial or concentric (a chord of the circle through `p`) around the
+    /// centre, whichever is closer to `a`.
+    fn paris(&self, p: DVec2, a: f64, class: RoadClass) -> Aim {
+        let len = self.class_length(class);
+        let v = p - self.centre;
+        let r = v.length();
+        if r < 1e-6 {
+            return Aim {
+                angle: a,
+                length: len,
+            };
+        }
+        let radial = angle_of(v);
+        let d = angle_diff(a, radial);
+        if d <= PI / 4.0 || r < len {
+            return Aim {
+                angle: radial,
+                length: len,
+            };
+        }
+        if d >= 3.0 * PI / 4.0 {
+            // Inward: stop at the centre rather than overshoot it.
+            return Aim {
+                angle: radial + PI,
+                length: len.min(r),
+            };
+        }
+        let side = if v.perp_dot(dir(a)) >= 0.0 { 1.0 } else { -1.0 };
+        let phi = side * len / r;
+        let q = self.centre
+            + DVec2::new(
+                v.x * phi.cos() - v.y * phi.sin(),
+                v.x * phi.sin() + v.y * phi.cos(),
+            );
+        Aim {
+            angle: angle_of(q - p),
+            length: q.distance(p),
+        }
+    }
+
+    /// San Francisco rule: the direction within the highway fan of least elevation change.
+    fn san_francisco(&self, p: DVec2, a: f64, class: RoadClass) -> Aim {
+        let len = self.class_length(class);
+        let h0 = self.inputs.elevation.sample(p);
+        let n = self.params.highway_rays.max(3);
+        let half = self.params.highway_max_turn_deg.to_radians().max(0.35);
+        let mut best = (f64::INFINITY, a);
+        for i in 0..n {
+            let off = -half + 2.0 * half * f64::from(i) / f64::from(n - 1);
+            let c = a + off;
+            let dh = (self.inputs.elevation.sample(p + dir(c) * len) - h0).abs();
+            let dh = if dh.is_finite() { dh } else { f64::INFINITY };
+            if dh < best.0 - 1e-9 || (dh <= best.0 + 1e-9 && off.abs() < angle_diff(best.1, a)) {
+                best = (dh, c);
+            }
+        }
+        Aim {
+            angle: best.1,
+            length: len,
+        }
+    }
+
+    /// A San Francisco connector: along the elevation gradient on the side of `a`.
+    fn sf_connector(&self, p: DVec2, a: f64) -> Aim {
+        let g = self.inputs.elevation.gradient(p);
+        let angle = if g.is_finite() && g.length() > 1e-6 {
+            let up = angle_of(g);
+            if angle_diff(up, a) <= FRAC_PI_2 {
+                up
+            } else {
+                up + PI
+            }
+        } else {
+            a
+        };
+        Aim {
+            angle,
+            length: self.params.sf_connector_length_m,
+        }
+    }
+
+    /// The pattern-blended proposal (§3.2.2: "summed up and weighted").
+    fn blend(&self, p: DVec2, a: f64, class: RoadClass, branch: bool, rng: &mut Pcg64Mcg) -> Aim {
+        let w = self.pattern_weights(p);
+        let mut v = DVec2::ZERO;
+        let mut len = 0.0;
+        let mut best = (
+            0.0,
+            Aim {
+                angle: a,
+                length: self.class_length(class),
+            },
+        );
+        for (k, pat) in PATTERNS.iter().enumerate() {
+            let wk = w[k];
+            if wk <= 0.0 {
+                continue;
+            }
+            let aim = match pat {
+                Pattern::Basic => self.basic(p, a, class, branch, rng),
+                Pattern::NewYork => self.new_york(p, a, class),
+                Pattern::Paris => self.paris(p, a, class),
+                Pattern::SanFrancisco if branch && class == RoadClass::Street => {
+                    self.sf_connector(p, a)
+                }
+                Pattern::SanFrancisco => self.san_francisco(p, a, class),
+            };
+            v += dir(aim.angle) * wk;
+            len += aim.length * wk;
+            if wk > best.0 {
+                best = (wk, aim);
+            }
+        }
+        if v.length() < 1e-9 || !len.is_finite() || len <= 0.0 {
+            return best.1;
+        }
+        Aim {
+            angle: angle_of(v),
+            length: len,
+        }
+    }
+
+    fn proposal(
+        &self,
+        delay: i32,
+        rule: RuleAttr,
+        start: DVec2,
+        aim: Aim,
+        class: RoadClass,
+    ) -> Proposal {
+        Proposal {
+            delay,
+            rule,
+            road: RoadAttr::new(start, aim.angle, aim.length, class),
+        }
+    }
+}
+
+fn pattern_slot(p: Pattern) -> usize {
+    match p {
+        Pattern::Basic => 0,
+        Pattern::NewYork => 1,
+        Pattern::Paris => 2,
+        Pattern::SanFrancisco => 3,
+    }
+}
+
+impl GlobalGoals for DefaultGoals {
+    fn axiom(&self) -> Vec<(RuleAttr, RoadAttr)> {
+        let p = self.start;
+        let a = match self.params.start_angle_deg {
+            Some(d) => d.to_radians(),
+            None => self.best_ray(p, 0.0, PI),
+        };
+        let w = self.pattern_weights(p);
+        // Align the axiom with the dominant pattern where it has a direction.
+        let a = if w[1] >= 0.5 {
+            self.new_york(p, a, RoadClass::Highway).angle
+        } else if w[2] >= 0.5 && p.distance(self.centre) > 1e-6 {
+            angle_of(p - self.centre)
+        } else {
+            a
+        };
+        let rule = RuleAttr {
+            class: RoadClass::Highway,
+            depth: 0,
+            age: 0,
+        };
+        let len = self.params.highway_length_m;
+        vec![
+            (rule, RoadAttr::new(p, a, len, RoadClass::Highway)),
+            (rule, RoadAttr::new(p, a + PI, len, RoadClass::Highway)),
+        ]
+    }
+
+    fn successors(&self, rule: &RuleAttr, road: &RoadAttr, rng: &mut Pcg64Mcg) -> [Proposal; 3] {
+        let p = road.end;
+        let a = if road.end.distance(road.start) > 0.0 {
+            angle_of(road.end - road.start)
+        } else {
+            road.angle
+        };
+        let class = rule.class;
+        let pop = self.inputs.population.sample(p);
+        let pop = if pop.is_finite() { pop } else { 0.0 };
+        let prm = &self.params;
+        let stop = road.snapped;
+        // Continuation.
+        let cont_rule = RuleAttr {
+            age: rule.age.saturating_add(1),
+            ..*rule
+        };
+        let cont_aim = self.blend(p, a, class, false, rng);
+        let cont_delay = if stop || (class == RoadClass::Street && pop < prm.street_min_population)
+        {
+            -1
+        } else {
+            0
+        };
+        let cont = self.proposal(cont_delay, cont_rule, p, cont_aim, class);
+        // Branches, one on each side.
+        let mut branches = [cont; 2];
+        for (i, side) in [1.0f64, -1.0].into_iter().enumerate() {
+            let r = unit_f64(rng);
+            let (bclass, delay) = match class {
+                RoadClass::Highway if r < prm.highway_branch_probability => {
+                    (RoadClass::Highway, prm.branch_delay)
+                }
+                RoadClass::Highway => {
+                    let r2 = unit_f64(rng);
+                    if pop > prm.population_threshold && r2 < prm.street_branch_probability {
+                        (
+                            RoadClass::Street,
+                            prm.branch_delay.saturating_add(prm.highway_street_delay),
+                        )
+                    } else {
+                        (RoadClass::Street, -1)
+                    }
+                }
+                RoadClass::Street => {
+                    if pop > prm.population_threshold && r < prm.street_branch_probability {
+                        (RoadClass::Street, prm.branch_delay)
+                    } else {
+                        (RoadClass::Street, -1)
+                    }
+                }
+            };
+            let delay = if stop { -1 } else { delay };
+            let aim = self.blend(p, a + side * FRAC_PI_2, bclass, true, rng);
+            let brule = RuleAttr {
+                class: bclass,
+                depth: rule.depth.saturating_add(1),
+                age: 0,
+            };
+            if let Some(slot) = branches.get_mut(i) {
+                *slot = self.proposal(delay, brule, p, aim, bclass);
+            }
+        }
+        let [b1, b2] = branches;
+        [cont, b1, b2]
+    }
+}

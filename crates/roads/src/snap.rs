@@ -1,0 +1,183 @@
+//! Kelly's snap algorithm (Citygen §4.3.3): the proximity and intersection status of a
+//! proposed segment `a–b` against the existing network.
+//!
+//! * **Extended bounding box exclusion** (§4.3.3.1): only junctions in the segment's
+//!   bounding box grown by the snap size, and only roads met by the segment (found by the
+//!   spatial index's segment query, which already orders them along `a–b`), are tested.
+//! * **Ordered tests with an `r`-value benchmark** (§4.3.3.2–5): events are prioritised
+//!   by their position `r` along `a–b` (0 at the root `a`). Test 1 (junction proximity)
+//!   keeps the smallest `r` of a junction within the snap size of the segment body (or,
+//!   for `1 < r ≤ 1 + snap/|ab|`, within the snap size of `b`); test 2 (road intersection)
+//!   only looks at crossings before that `r`; test 3 (road proximity of `b`), whose events
+//!   have the lowest priority, runs only when the first two found nothing.
+
+use polis_geom::predicates::closest_point_on_segment;
+use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
+
+use crate::network::{RoadClass, RoadNetwork};
+
+/// What the snap algorithm found first along a proposed segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SnapEvent {
+    /// The segment crosses a road at `point` (`r` along the segment): make a crossing.
+    Cross {
+        /// The road crossed.
+        edge: EdgeId,
+        /// The crossing point.
+        point: DVec2,
+        /// Its parameter along the segment.
+        r: f64,
+    },
+    /// A junction lies within the snap size of the segment: extend or shorten to it.
+    Junction {
+        /// The junction.
+        node: NodeId,
+        /// Its position.
+        point: DVec2,
+        /// Its (projected) parameter along the segment.
+        r: f64,
+    },
+    /// The segment's end is within the snap size of a road: extend it to meet the road.
+    Road {
+        /// The road.
+        edge: EdgeId,
+        /// The closest point of the road to the segment's end.
+        point: DVec2,
+    },
+}
+
+impl SnapEvent {
+    /// Where the segment should end.
+    pub fn point(&self) -> DVec2 {
+        match *self {
+            SnapEvent::Cross { point, .. }
+            | SnapEvent::Junction { point, .. }
+            | SnapEvent::Road { point, .. } => point,
+        }
+    }
+}
+
+/// A snap query.
+#[derive(Debug, Clone, Copy)]
+pub struct SnapQuery {
+    /// Root of the proposed segment.
+    pub a: DVec2,
+    /// Target of the proposed segment.
+    pub b: DVec2,
+    /// Snap size (metres).
+    pub radius: f64,
+    /// The junction the segment grows from (its roads are ignored).
+    pub start_node: Option<NodeId>,
+    /// Only roads of this class are snapped to (`None`: all). Highways use
+    /// `Some(Highway)`: they cut through streets without stopping.
+    pub only: Option<RoadClass>,
+}
+
+fn edge_ok(net: &RoadNetwork, e: EdgeId, q: &SnapQuery) -> bool {
+    let Ok((u, v)) = net.endpoints(e) else {
+        return false;
+    };
+    if q.start_node.is_some_and(|s| s == u || s == v) {
+        return false;
+    }
+    match (q.only, net.edge_payload(e)) {
+        (None, Ok(_)) => true,
+        (Some(c), Ok(r)) => r.class == c,
+        (_, Err(_)) => false,
+    }
+}
+
+fn node_ok(net: &RoadNetwork, n: NodeId, q: &SnapQuery) -> bool {
+    if q.start_node == Some(n) {
+        return false;
+    }
+    let Ok(edges) = net.edges_at(n) else {
+        return false;
+    };
+    // A junction adjacent to the start is reached by an existing road already.
+    if let Some(s) = q.start_node
+        && edges
+            .iter()
+            .any(|&e| net.other_end(e, n).is_ok_and(|o| o == s))
+    {
+        return false;
+    }
+    match q.only {
+        None => true,
+        Some(c) => edges
+            .iter()
+            .any(|&e| net.edge_payload(e).is_ok_and(|r| r.class == c)),
+    }
+}
+
+/// Runs the three ordered tests and returns the highest-priority event, if any.
+pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
+    let (a, b) = (q.a, q.b);
+    let d = b - a;
+    let len2 = d.length_squared();
+    if !(len2 > 0.0 && len2.is_finite()) {
+        return None;
+    }
+    let len = len2.sqrt();
+    let radius = q.radius.max(0.0);
+    let mut best: Option<SnapEvent> = None;
+    // Above this r nothing can win any more (Kelly's benchmark).
+    let mut best_r = 1.0 + radius / len;
+    // Test 1: junction proximity inside the extended bounding box.
+    let ext = Aabb2::new(a, b).expanded(radius);
+    for n in net.nodes_in_box(&ext) {
+        let Ok(p) = net.position(n) else { continue };
+        let r = (p - a).dot(d) / len2;
+        if !(r > 0.0 && r < best_r) {
+            continue;
+        }
+        let hit = if r <= 1.0 {
+            // Perpendicular distance from the line (Kelly's s-value, in metres).
+            (d.perp_dot(p - a) / len).abs() <= radius
+        } else {
+            p.distance(b) <= radius
+        };
+        if hit && node_ok(net, n, q) {
+            best_r = r;
+            best = Some(SnapEvent::Junction {
+                node: n,
+                point: p,
+                r,
+            });
+        }
+    }
+    // Test 2: road intersections before the best junction event, in order along a–b.
+    for hit in net.edges_crossing(a, b) {
+        if hit.t >= best_r.min(1.0 + f64::EPSILON) {
+            break;
+        }
+        if hit.t * len <= 1e-9 * len.max(1.0) || !edge_ok(net, hit.key, q) {
+            continue;
+        }
+        let point = a + d * hit.t;
+        best = Some(SnapEvent::Cross {
+            edge: hit.key,
+            point,
+            r: hit.t,
+        });
+        break;
+    }
+    if best.is_some() {
+        return best;
+    }
+    // Test 3: proximity of the end b to a road.
+    let around = Aabb2::new(b, b).expanded(radius);
+    let mut near: Option<(f64, EdgeId, DVec2)> = None;
+    for e in net.edges_in_box(&around) {
+        if !edge_ok(net, e, q) {
+            continue;
+        }
+        let Ok((u, v)) = net.segment(e) else { continue };
+        let (c, _) = closest_point_on_segment(b, u, v);
+        let dist = c.distance(b);
+        if dist <= radius && near.is_none_or(|(bd, _, _)| dist < bd) {
+            near = Some((dist, e, c));
+        }
+    }
+    near.map(|(_, edge, point)| SnapEvent::Road { edge, point })
+}

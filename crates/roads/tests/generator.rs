@@ -1,0 +1,291 @@
+//! End-to-end properties of the generator (issue 6).
+
+#![allow(clippy::unwrap_used)]
+
+use std::sync::Arc;
+
+use polis_geom::field::{Constant, FnField, Population, PopulationParams};
+use polis_geom::{DVec2, Field};
+use polis_lsystem::rand_pcg::Pcg64Mcg;
+use polis_roads::legality::Legality;
+use polis_roads::*;
+
+fn flat_inputs(seed: u64) -> RoadInputs {
+    let pop = Population::new(PopulationParams {
+        seed,
+        unit_m: 100.0,
+    })
+    .unwrap();
+    RoadInputs::flat(Arc::new(pop))
+}
+
+fn edge_list(n: &RoadNetwork) -> Vec<(DVec2, DVec2, Road)> {
+    n.edges()
+        .map(|(e, _, _, r)| {
+            let (a, b) = n.segment(e).unwrap();
+            (a, b, *r)
+        })
+        .collect()
+}
+
+#[test]
+fn every_pattern_gives_a_planar_network() {
+    for pattern in [
+        Pattern::Basic,
+        Pattern::NewYork,
+        Pattern::Paris,
+        Pattern::SanFrancisco,
+    ] {
+        let params = RoadParams {
+            pattern,
+            max_segments: 800,
+            ..RoadParams::default()
+        };
+        let city = generate_default(&params).unwrap();
+        city.network.check_invariants().unwrap();
+        assert!(
+            city.report.segments > 100,
+            "{pattern:?}: only {} segments",
+            city.report.segments
+        );
+        assert!(city.report.segments <= 800);
+        let st = network_stats(&city.network);
+        assert!(
+            st.highway_length_m > 0.0 && st.street_length_m > 0.0,
+            "{pattern:?}: {st:?}"
+        );
+    }
+}
+
+#[test]
+fn no_road_in_water_except_short_bridges() {
+    let params = RoadParams {
+        max_segments: 1500,
+        ..RoadParams::default()
+    };
+    let inputs = RoadInputs::procedural(params.seed, &params).unwrap();
+    let legality = Legality::new(&inputs, &params);
+    let city = generate(&params, &inputs).unwrap();
+    city.network.check_invariants().unwrap();
+    let mut water_seen = false;
+    for (a, b, road) in edge_list(&city.network) {
+        let len = a.distance(b);
+        if road.bridge {
+            assert!(
+                len <= params.max_bridge_length_m + 1e-6,
+                "bridge of {len} m"
+            );
+            assert_eq!(road.class, RoadClass::Highway);
+            continue;
+        }
+        // Samples at the legality spacing (what the constraints guarantee).
+        let n = (len / params.legality_step_m).ceil().max(1.0) as usize;
+        for i in 0..=n {
+            let p = a + (b - a) * (i as f64 / n as f64);
+            assert!(!legality.is_water(p), "road {a}–{b} in water at {p}");
+        }
+    }
+    // The map does have water next to the city.
+    for i in 0..200 {
+        let p = DVec2::new(-2000.0 + 20.0 * i as f64, 0.0);
+        water_seen |= legality.is_water(p);
+    }
+    assert!(water_seen);
+}
+
+#[test]
+fn new_york_streets_follow_the_grid() {
+    let grid = 17.0f64;
+    let params = RoadParams {
+        pattern: Pattern::NewYork,
+        grid_angle_deg: grid,
+        max_segments: 1500,
+        ..RoadParams::default()
+    };
+    let city = generate(&params, &flat_inputs(3)).unwrap();
+    city.network.check_invariants().unwrap();
+    let (mut total, mut aligned) = (0.0, 0.0);
+    for (a, b, road) in edge_list(&city.network) {
+        if road.class != RoadClass::Street {
+            continue;
+        }
+        let len = a.distance(b);
+        let ang = (b - a).y.atan2((b - a).x).to_degrees();
+        let off = (ang - grid).rem_euclid(90.0);
+        let off = off.min(90.0 - off);
+        total += len;
+        if off <= 5.0 {
+            aligned += len;
+        }
+    }
+    assert!(total > 10_000.0, "street length {total}");
+    assert!(
+        aligned / total >= 0.8,
+        "only {:.1}% on the grid",
+        100.0 * aligned / total
+    );
+}
+
+#[test]
+fn paris_highways_are_radial_or_concentric() {
+    let centre = DVec2::new(150.0, -100.0);
+    let params = RoadParams {
+        pattern: Pattern::Paris,
+        paris_centre: Some(centre.to_array()),
+        start: Some(centre.to_array()),
+        highway_branch_probability: 0.25,
+        max_segments: 1200,
+        ..RoadParams::default()
+    };
+    let city = generate(&params, &flat_inputs(5)).unwrap();
+    city.network.check_invariants().unwrap();
+    let (mut total, mut ok) = (0.0, 0.0);
+    let (mut radial, mut ring) = (0.0, 0.0);
+    for (a, b, road) in edge_list(&city.network) {
+        if road.class != RoadClass::Highway {
+            continue;
+        }
+        let len = a.distance(b);
+        let mid = (a + b) * 0.5 - centre;
+        let cos = ((b - a).normalize().dot(mid.normalize())).abs();
+        total += len;
+        if cos >= 5f64.to_radians().cos() {
+            ok += len;
+            radial += len;
+        } else if cos <= 5f64.to_radians().sin() {
+            ok += len;
+            ring += len;
+        }
+    }
+    assert!(total > 2000.0, "highway length {total}");
+    assert!(
+        ok / total >= 0.8,
+        "only {:.1}% radial/concentric",
+        100.0 * ok / total
+    );
+    assert!(
+        radial > 0.0 && ring > 0.0,
+        "radial {radial} m, concentric {ring} m"
+    );
+}
+
+#[test]
+fn same_seed_same_network_other_seed_other_network() {
+    let params = RoadParams {
+        max_segments: 600,
+        ..RoadParams::default()
+    };
+    let a = generate_default(&params).unwrap();
+    let b = generate_default(&params).unwrap();
+    assert_eq!(edge_list(&a.network), edge_list(&b.network));
+    assert_eq!(a.report, b.report);
+    let c = generate_default(&RoadParams { seed: 2, ..params }).unwrap();
+    assert_ne!(edge_list(&a.network), edge_list(&c.network));
+}
+
+#[test]
+fn stop_conditions() {
+    let p = RoadParams {
+        max_segments: 50,
+        ..RoadParams::default()
+    };
+    let r = generate_default(&p).unwrap().report;
+    assert_eq!(r.stop, StopReason::SegmentBudget);
+    assert_eq!(r.segments, 50);
+    let p = RoadParams {
+        max_steps: 5,
+        ..RoadParams::default()
+    };
+    let r = generate_default(&p).unwrap().report;
+    assert_eq!(r.stop, StopReason::StepBudget);
+    assert_eq!(r.steps, 5);
+    // Nowhere to branch, nowhere populated: the two highways run out of the map.
+    let p = RoadParams {
+        highway_branch_probability: 0.0,
+        ..RoadParams::default()
+    };
+    let r = generate(&p, &RoadInputs::flat(Arc::new(Constant(0.0)))).unwrap();
+    assert_eq!(r.report.stop, StopReason::NothingLeft);
+    assert!(r.report.segments >= 2);
+    assert_eq!(network_stats(&r.network).street_length_m, 0.0);
+}
+
+/// A custom global goal: highways are pulled toward a landmark; everything else is the
+/// default.
+struct TowardLandmark {
+    inner: DefaultGoals,
+    landmark: DVec2,
+}
+
+impl GlobalGoals for TowardLandmark {
+    fn axiom(&self) -> Vec<(RuleAttr, RoadAttr)> {
+        self.inner.axiom()
+    }
+    fn successors(&self, rule: &RuleAttr, road: &RoadAttr, rng: &mut Pcg64Mcg) -> [Proposal; 3] {
+        let mut out = self.inner.successors(rule, road, rng);
+        if rule.class == RoadClass::Highway {
+            let to = self.landmark - road.end;
+            if to.length() > 1.0 {
+                let a = to.y.atan2(to.x);
+                out[0].road = RoadAttr::new(road.end, a, out[0].road.length, RoadClass::Highway);
+            }
+        }
+        out
+    }
+}
+
+#[test]
+fn custom_goal_replaces_the_default() {
+    let params = RoadParams {
+        start: Some([-1500.0, -1500.0]),
+        highway_branch_probability: 0.0,
+        max_segments: 200,
+        ..RoadParams::default()
+    };
+    let inputs = flat_inputs(9);
+    let landmark = DVec2::new(1200.0, 1300.0);
+    let goals = TowardLandmark {
+        inner: DefaultGoals::new(&params, &inputs).unwrap(),
+        landmark,
+    };
+    let city = RoadGenerator::new(&params, &inputs)
+        .unwrap()
+        .with_goals(Arc::new(goals))
+        .run()
+        .unwrap();
+    city.network.check_invariants().unwrap();
+    let closest = city
+        .network
+        .nodes()
+        .map(|(_, p, _)| p.distance(landmark))
+        .fold(f64::INFINITY, f64::min);
+    assert!(closest <= params.highway_length_m, "closest {closest}");
+}
+
+#[test]
+fn park_and_slope_are_avoided() {
+    let params = RoadParams {
+        max_segments: 800,
+        max_slope: 0.05,
+        ..RoadParams::default()
+    };
+    let park = FnField::new(|p: DVec2| if p.length() < 400.0 { 1.0 } else { 0.0 });
+    let mut inputs = flat_inputs(4);
+    inputs.parks = Arc::new(park);
+    inputs.elevation = Arc::new(FnField::new(|p: DVec2| 0.2 * p.y.max(800.0)));
+    let params = RoadParams {
+        start: Some([700.0, 0.0]),
+        ..params
+    };
+    let legality = Legality::new(&inputs, &params);
+    let city = generate(&params, &inputs).unwrap();
+    city.network.check_invariants().unwrap();
+    for (a, b, road) in edge_list(&city.network) {
+        assert!(!road.bridge);
+        assert!(
+            legality.segment_ok(a, b) || legality.segment_ok(b, a),
+            "{a}–{b}"
+        );
+        let _ = inputs.parks.sample(a);
+    }
+}
