@@ -16,8 +16,7 @@ fn main() {
     divan::main();
 }
 
-/// 100,000 segments of 5–50 m, uniform start and direction, in a 10 km square: about
-/// 23,000 crossings.
+/// 100,000 segments of 5–50 m, uniform start and direction, in a 10 km square.
 fn random_segments() -> Vec<(DVec2, DVec2)> {
     let mut rng = Pcg64Mcg::seed_from_u64(7);
     (0..N)
