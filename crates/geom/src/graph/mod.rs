@@ -46,7 +46,7 @@
 //! # Ok::<(), polis_geom::GeomError>(())
 //! ```
 
-mod insert;
+pub mod insert;
 #[cfg(test)]
 mod insert_tests;
 mod invariants;
