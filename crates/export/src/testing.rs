@@ -196,6 +196,8 @@ pub struct Decoded {
     pub mesh_extras: Vec<Option<serde_json::Value>>,
     pub roots: Vec<usize>,
     pub json: serde_json::Value,
+    /// Primitives with a `TANGENT` attribute.
+    pub tangent_prims: usize,
 }
 
 fn extras(e: &gltf::json::Extras) -> Option<serde_json::Value> {
@@ -243,6 +245,7 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
             .collect()
     };
     let mut prims = Vec::new();
+    let mut tangent_prims = 0;
     for mesh in gltf.meshes() {
         let mut out = Vec::new();
         for p in mesh.primitives() {
@@ -287,6 +290,19 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
             for q in &normals {
                 let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
                 assert!((l - 1.0).abs() < 1e-5, "normal of length {l}");
+            }
+            if let Some(tan) = p.get(&gltf::Semantic::Tangents) {
+                assert_eq!(tan.dimensions(), Dimensions::Vec4);
+                assert_eq!(tan.count(), n);
+                let t = floats(&tan);
+                for (q, nr) in t.chunks_exact(4).zip(&normals) {
+                    let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+                    assert!((l - 1.0).abs() < 1e-5, "tangent of length {l}");
+                    assert!(q[3] == 1.0 || q[3] == -1.0, "handedness {}", q[3]);
+                    let dot = q[0] * nr[0] + q[1] * nr[1] + q[2] * nr[2];
+                    assert!(dot.abs() < 1e-4, "tangent not orthogonal to the normal");
+                }
+                tangent_prims += 1;
             }
             let raw = slice(&idx);
             let (indices, wide): (Vec<u32>, bool) = match idx.data_type() {
@@ -361,6 +377,7 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
         mesh_extras,
         roots,
         json,
+        tangent_prims,
     }
 }
 

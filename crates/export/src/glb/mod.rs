@@ -7,9 +7,12 @@
 //!
 //! * Per geometry (a scene [`Mesh`], or a merged batch): accessors `POSITION` (`VEC3` f32,
 //!   with `min`/`max`), `NORMAL` (`VEC3` f32, renormalised to unit length), `TEXCOORD_0`
-//!   (`VEC2` f32, metres, `v` down as glTF wants) and indices (`u16` when the geometry has at
-//!   most 65,535 vertices, else `u32`), each in its own buffer view with the right
-//!   `target`, offsets aligned to 4 bytes.
+//!   (`VEC2` f32, metres, `v` down as glTF wants), indices (`u16` when the geometry has at
+//!   most 65,535 vertices, else `u32`) and, when the material has a normal texture,
+//!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`), each in its own buffer view with the right
+//!   `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written even for untextured
+//!   materials (so textures can be added in an engine later); the Khronos validator lists
+//!   it as possibly unused (an info, not a warning).
 //! * Materials: glTF metallic-roughness PBR (base colour, metallic, roughness, base colour,
 //!   normal and metallic-roughness textures, double-sidedness); `alphaMode` is `BLEND` when
 //!   the base colour's alpha is below 1, else `OPAQUE`. Meshes without a material use
@@ -49,6 +52,7 @@
 //!   [`Transform::Trs`](polis_geom::Transform::Trs) never hit this.
 
 mod plan;
+mod tangents;
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
@@ -144,7 +148,7 @@ pub fn write_glb<W: Write>(
         .enumerate()
         .map(|(i, img)| png_bytes(i, img))
         .collect::<Result<Vec<_>, _>>()?;
-    let layout = Layout::new(&plan.geometries, &pngs);
+    let layout = Layout::new(scene, &plan.geometries, &pngs);
     let root = document(scene, &plan, &layout)?;
     let json_bytes = json::serialize::to_vec(&root).map_err(ExportError::json("glTF JSON"))?;
 
@@ -214,10 +218,12 @@ struct GeometryLayout {
     wide: bool,
     min: Vec3,
     max: Vec3,
-    /// Byte offsets of positions, normals, uvs, indices.
-    offsets: [u64; 4],
+    /// Whether tangents are written (the material has a normal texture).
+    tangents: bool,
+    /// Byte offsets of positions, normals, uvs, indices, tangents.
+    offsets: [u64; 5],
     /// Byte lengths of the same.
-    lengths: [u64; 4],
+    lengths: [u64; 5],
 }
 
 #[derive(Debug)]
@@ -233,19 +239,24 @@ struct Layout {
 const U16_VERTEX_LIMIT: usize = 65_535;
 
 impl Layout {
-    fn new(geometries: &[Cow<'_, Mesh>], pngs: &[Cow<'_, [u8]>]) -> Layout {
+    fn new(scene: &Scene, geometries: &[Cow<'_, Mesh>], pngs: &[Cow<'_, [u8]>]) -> Layout {
         let mut off = 0u64;
         let mut out = Vec::with_capacity(geometries.len());
         for g in geometries {
             let n = g.vertex_count();
             let wide = n > U16_VERTEX_LIMIT;
+            let tangents = g
+                .material
+                .and_then(|m| scene.materials.get(m.index()))
+                .is_some_and(|m| m.normal_texture.is_some());
             let lengths = [
                 12 * n as u64,
                 12 * n as u64,
                 8 * n as u64,
                 g.indices.len() as u64 * if wide { 4 } else { 2 },
+                if tangents { 16 * n as u64 } else { 0 },
             ];
-            let mut offsets = [0; 4];
+            let mut offsets = [0; 5];
             for (o, len) in offsets.iter_mut().zip(lengths) {
                 *o = off;
                 off = pad4(off + len);
@@ -255,6 +266,7 @@ impl Layout {
                 vertices: n,
                 indices: g.indices.len(),
                 wide,
+                tangents,
                 min: b.min,
                 max: b.max,
                 offsets,
@@ -305,11 +317,13 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 extras: None,
             })
         };
-    // Four accessors per geometry, in order: position, normal, uv, indices.
+    // Four or five accessors per geometry, in order: position, normal, uv, indices,
+    // tangents (for normal-mapped materials).
     let mut accessors = Vec::with_capacity(layout.geometries.len());
     for gl in &layout.geometries {
-        let mut ids = [json::Index::new(0); 4];
-        for (k, id) in ids.iter_mut().enumerate() {
+        let arrays = if gl.tangents { 5 } else { 4 };
+        let mut ids = [json::Index::new(0); 5];
+        for (k, id) in ids.iter_mut().enumerate().take(arrays) {
             let target = if k == 3 {
                 json::buffer::Target::ElementArrayBuffer
             } else {
@@ -325,6 +339,11 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 2 => (
                     gl.vertices,
                     json::accessor::Type::Vec2,
+                    json::accessor::ComponentType::F32,
+                ),
+                4 => (
+                    gl.vertices,
+                    json::accessor::Type::Vec4,
                     json::accessor::ComponentType::F32,
                 ),
                 _ if gl.wide => (
@@ -361,7 +380,7 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 sparse: None,
             });
         }
-        accessors.push(ids);
+        accessors.push((ids, gl.tangents));
     }
     for (i, (img, &(offset, length))) in scene.images.iter().zip(&layout.images).enumerate() {
         let v = view(&mut root, offset, length, None);
@@ -456,12 +475,15 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
             .primitives
             .iter()
             .map(|&(g, material)| {
-                let [pos, nrm, uv, idx] = accessors[g];
-                let attributes = BTreeMap::from([
+                let ([pos, nrm, uv, idx, tan], has_tangents) = accessors[g];
+                let mut attributes = BTreeMap::from([
                     (Checked::Valid(json::mesh::Semantic::Positions), pos),
                     (Checked::Valid(json::mesh::Semantic::Normals), nrm),
                     (Checked::Valid(json::mesh::Semantic::TexCoords(0)), uv),
                 ]);
+                if has_tangents {
+                    attributes.insert(Checked::Valid(json::mesh::Semantic::Tangents), tan);
+                }
                 json::mesh::Primitive {
                     attributes,
                     extensions: None,
@@ -678,7 +700,17 @@ fn write_geometry<W: Write>(
             w.put(&(i as u16).to_le_bytes())?;
         }
     }
-    w.pad4()
+    w.pad4()?;
+    if gl.tangents {
+        for t in tangents::tangents(g) {
+            let mut b = [0u8; 16];
+            for (k, c) in t.to_array().into_iter().enumerate() {
+                b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
+            }
+            w.put(&b)?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

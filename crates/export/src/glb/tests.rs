@@ -48,6 +48,11 @@ fn per_node_reads_back_with_counts_bounds_and_extras() {
         "house 1 and mirror share a mesh"
     );
     assert_eq!(d.node_info[6].1, None, "an empty group has no mesh");
+    // Only the normal-mapped brick geometry (one, shared) has tangents.
+    assert_eq!(
+        d.tangent_prims, 2,
+        "house prism in the two meshes that draw it"
+    );
     // Geometry equals the scene's, bit for bit (normals renormalised).
     let house = &scene.meshes[0];
     let prim = &d.prims[d.node_info[2].1.unwrap()][0];
