@@ -215,3 +215,34 @@ fn deterministic() {
         assert!((x.position - y.position).length() < 1e-12 && (x.time - y.time).abs() < 1e-12);
     }
 }
+
+/// Regression (property test): a 14-gon with 1 µm edges and midpoints moved by 0.1 µm
+/// collapses through a cascade of nearly simultaneous events, where nearly antiparallel
+/// offset lines must not pull vertices to their ill-conditioned crossing.
+#[test]
+fn nearly_regular_with_tiny_edges() {
+    let n = 14;
+    let base = Polygon::new(
+        (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * (i as f64 + 0.8 * 0.43755901151344645) / n as f64;
+                v(5.0 * a.cos(), 5.0 * a.sin())
+            })
+            .collect(),
+    );
+    let kinds = [2, 2, 0, 0, 0, 1, 0, 0, 0, 2, 2, 0, 1, 0];
+    let mut pts = Vec::new();
+    for (i, (a, b)) in base.edges().enumerate() {
+        pts.push(a);
+        match kinds[i] {
+            0 => pts.push(a + (b - a).normalize() * 1e-6),
+            1 => pts.push(
+                (a + b) * 0.5 + (b - a).perp().normalize() * if i == 12 { 1e-8 } else { 1e-7 },
+            ),
+            _ => {}
+        }
+    }
+    let p: PolygonWithHoles = Polygon::new(pts).into();
+    let sk = StraightSkeleton::new(&p).unwrap();
+    check_skeleton(&p, &sk, 1e-7).unwrap();
+}

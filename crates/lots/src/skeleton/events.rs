@@ -37,6 +37,10 @@ pub(crate) const COINCIDENCE_REL: f64 = 1e-9;
 
 const NONE: u32 = u32::MAX;
 
+/// A new vertex is moved onto the exact crossing of its two offset lines when that is
+/// within this many coincidence tolerances of the event point.
+const SNAP_REL: f64 = 1e3;
+
 #[derive(Debug, Clone, Copy)]
 struct Event {
     t: f64,
@@ -314,6 +318,63 @@ impl Engine {
         (va, vb)
     }
 
+    /// Vertex `v` joins a virtual step edge and a parallel input edge `c` that points the
+    /// same way: `c` moves on and sweeps the step's piece, which vanishes. The vertex at the
+    /// piece's far end is replaced by one joining `c` and the edge beyond; returns it (or
+    /// `NONE` if the list collapsed).
+    fn absorb_step(&mut self, v: u32) -> u32 {
+        let t = self.now;
+        let x = *self.vert(v);
+        let n_in = self.input_edges() as u32;
+        if x.out_edge >= n_in {
+            // c → s: the piece of s runs from v to its successor y (s → d).
+            let y = x.next;
+            let vy = *self.vert(y);
+            if y == x.prev {
+                self.vert_mut(v).alive = false;
+                let q = self.pos(y, t);
+                let qn = self.add_node(q, t);
+                self.end_vertex(y, qn);
+                return NONE;
+            }
+            let q = self.pos(y, t);
+            let qn = self.add_node(q, t);
+            self.end_vertex(y, qn);
+            self.arcs.push(SkeletonArc {
+                from: x.node as usize,
+                to: qn as usize,
+                left_edge: x.in_edge as usize,
+                right_edge: x.out_edge as usize,
+                step: false,
+            });
+            self.vert_mut(v).alive = false;
+            self.new_vertex(q, x.in_edge, vy.out_edge, x.prev, vy.next, qn)
+        } else {
+            // s → c: the piece of s runs from the predecessor w (d → s) to v.
+            let w = x.prev;
+            let vw = *self.vert(w);
+            if w == x.next {
+                self.vert_mut(v).alive = false;
+                let q = self.pos(w, t);
+                let qn = self.add_node(q, t);
+                self.end_vertex(w, qn);
+                return NONE;
+            }
+            let q = self.pos(w, t);
+            let qn = self.add_node(q, t);
+            self.end_vertex(w, qn);
+            self.arcs.push(SkeletonArc {
+                from: qn as usize,
+                to: x.node as usize,
+                left_edge: x.out_edge as usize,
+                right_edge: x.in_edge as usize,
+                step: false,
+            });
+            self.vert_mut(v).alive = false;
+            self.new_vertex(q, vw.in_edge, x.out_edge, vw.prev, x.next, qn)
+        }
+    }
+
     /// For a virtual step edge, the input edges before and after it.
     pub fn step_pair(&self, e: usize) -> Option<(u32, u32)> {
         e.checked_sub(self.input_edges())
@@ -345,6 +406,7 @@ impl Engine {
             to: node as usize,
             left_edge: x.in_edge as usize,
             right_edge: x.out_edge as usize,
+            step: false,
         });
         self.vert_mut(v).alive = false;
     }
@@ -365,7 +427,12 @@ impl Engine {
         let m = motion(ea, eb);
         // In exact arithmetic `p` is on both lines; snapping to their crossing keeps the
         // offset distances exact (and places the vertex right after a weighted step).
-        let p = meet(ea, eb, self.now, p).unwrap_or(p);
+        // Nearly antiparallel lines cross far away in an ill-conditioned spot: snap only
+        // when the crossing is where the event put the vertex.
+        let p = match meet(ea, eb, self.now, p) {
+            Some(q) if q.distance(p) <= SNAP_REL * self.eps => q,
+            _ => p,
+        };
         self.verts.push(Vertex {
             p0: p,
             t0: self.now,
@@ -799,11 +866,20 @@ impl Engine {
                     to: qn as usize,
                     left_edge: self.vert(m).out_edge as usize,
                     right_edge: x.out_edge as usize,
+                    step: false,
                 });
                 self.vert_mut(v).alive = false;
                 return;
             }
             if matches!(x.motion, Motion::Step(_)) {
+                let n_in = self.input_edges() as u32;
+                if (x.in_edge >= n_in) != (x.out_edge >= n_in) {
+                    v = self.absorb_step(v);
+                    if v == NONE {
+                        return;
+                    }
+                    continue;
+                }
                 let (va, vb) = self.split_step(v);
                 self.settle(va);
                 self.settle(vb);

@@ -68,6 +68,12 @@ pub struct SkeletonArc {
     pub left_edge: usize,
     /// The input edge whose face lies to the right of `from → to`.
     pub right_edge: usize,
+    /// Whether the arc runs along a weighted step (between parallel neighbours of
+    /// different weights): one of its sides is then the step's zero-area sliver, and
+    /// `left_edge`/`right_edge` name the input edges beyond it. Such an arc lies on the
+    /// offset line of only one of them.
+    #[serde(default)]
+    pub step: bool,
 }
 
 /// Which ring an input edge belongs to, and its index in that ring.
@@ -124,11 +130,15 @@ impl StraightSkeleton {
             .iter()
             .map(|a| {
                 let mut a = *a;
-                if let Some((before, _)) = engine.step_pair(a.left_edge) {
+                // A step may join a step edge and a parallel input edge: map until the
+                // edge is an input edge.
+                while let Some((before, _)) = engine.step_pair(a.left_edge) {
                     a.left_edge = before as usize;
+                    a.step = true;
                 }
-                if let Some((_, after)) = engine.step_pair(a.right_edge) {
+                while let Some((_, after)) = engine.step_pair(a.right_edge) {
                     a.right_edge = after as usize;
+                    a.step = true;
                 }
                 a
             })
@@ -300,6 +310,26 @@ pub(crate) fn prepare(
     Ok(weights)
 }
 
+/// Compares the counter-clockwise angles from `r` to `a` and from `r` to `b` (in
+/// `[0, 2π)`), exactly.
+fn ccw_from(r: DVec2, a: DVec2, b: DVec2) -> std::cmp::Ordering {
+    use polis_geom::predicates::orient2d_value;
+    let half = |d: DVec2| {
+        let o = orient2d_value(DVec2::ZERO, r, d);
+        u8::from(!(o > 0.0 || (o == 0.0 && r.dot(d) > 0.0)))
+    };
+    half(a).cmp(&half(b)).then_with(|| {
+        let o = orient2d_value(DVec2::ZERO, a, b);
+        if o > 0.0 {
+            std::cmp::Ordering::Less
+        } else if o < 0.0 {
+            std::cmp::Ordering::Greater
+        } else {
+            std::cmp::Ordering::Equal
+        }
+    })
+}
+
 /// Builds each face from the arcs that bound it.
 fn assemble_faces(engine: &Engine) -> Vec<Polygon> {
     let n_edges = engine.edges.len();
@@ -320,16 +350,40 @@ fn assemble_faces(engine: &Engine) -> Vec<Polygon> {
             list.sort_unstable();
             let mut used = vec![false; list.len()];
             let mut points = vec![engine.nodes[start].position, engine.nodes[end].position];
+            let mut prev = start;
             let mut cur = end;
             for _ in 0..=list.len() {
                 if cur == start {
                     break;
                 }
+                // Where the face touches itself (weighted faces can wrap around others),
+                // several arcs leave `cur`: take the first clockwise from the way back, which
+                // keeps the face on the left.
                 let from = list.partition_point(|&(f, _)| f < cur);
-                let Some(k) = (from..list.len()).find(|&k| list[k].0 == cur && !used[k]) else {
+                let here = engine.nodes[cur].position;
+                let back = engine.nodes[prev].position - here;
+                let mut best: Option<usize> = None;
+                for k in from..list.len() {
+                    if list[k].0 != cur {
+                        break;
+                    }
+                    if used[k] {
+                        continue;
+                    }
+                    let d = engine.nodes[list[k].1].position - here;
+                    let better = best.is_none_or(|b| {
+                        let db = engine.nodes[list[b].1].position - here;
+                        ccw_from(back, d, db) == std::cmp::Ordering::Greater
+                    });
+                    if better {
+                        best = Some(k);
+                    }
+                }
+                let Some(k) = best else {
                     break;
                 };
                 used[k] = true;
+                prev = cur;
                 cur = list[k].1;
                 if cur != start {
                     points.push(engine.nodes[cur].position);
