@@ -20,8 +20,9 @@
 //! ```
 //!
 //! Key types: [`extract`] / [`extract_with`] (one call) and [`CellExtractor`] (keeps its
-//! buffers between runs), [`CellParams`], [`CellDecomposition`], [`Cell`], [`Ring`],
-//! [`Filament`], [`ExtractionReport`], [`Error`].
+//! buffers between runs), [`extract_planarized`] for graphs that may cross themselves,
+//! [`CellParams`], [`CellDecomposition`], [`Cell`], [`Ring`], [`Filament`],
+//! [`ExtractionReport`], [`Error`].
 //!
 //! ## Example
 //!
@@ -72,15 +73,17 @@
 //!   location. Output order is deterministic (sweep order, then ids).
 //! * `O(n log n)`: one sort of the nodes, then every half-edge is walked once.
 //! * Non-planar input (crossings, overlaps, nodes inside edges) is rejected with
-//!   [`Error::NotPlanar`] naming the edges; coincident nodes are merged (and reported) or
-//!   rejected, see [`CellParams`].
+//!   [`Error::NotPlanar`] naming the edges (or planarised on request with
+//!   [`extract_planarized`]); coincident nodes are merged (and reported) or rejected, see
+//!   [`CellParams`].
 //!
 //! ## Limitations
 //!
 //! * No tolerance: nodes are merged only at exactly equal positions, and nearly touching
 //!   edges count as apart. Snap with the graph's planar insertion first.
-//! * Planarisation is not done here: `PlanarGraph`'s planar insertion (`insert_segment`)
-//!   had not landed when this crate was written; build the graph with it instead.
+//! * [`extract`] rejects non-planar input; [`extract_planarized`] rebuilds it with the
+//!   graph's planar insertion first (snapping moves geometry by up to the snap distance,
+//!   and the cells then refer to the rebuilt graph's ids).
 //! * The planarity check buckets edges in a uniform grid: fast on road graphs, slow for
 //!   nodes of very high degree (thousands of edges at one junction).
 //!
@@ -96,6 +99,7 @@ pub mod error;
 mod output;
 pub mod params;
 mod planarity;
+mod planarize;
 mod topology;
 
 pub use polis_geom as geom;
@@ -107,6 +111,7 @@ pub use output::{
 };
 pub use params::{CellParams, CoincidentNodes};
 pub use planarity::MAX_REPORTED_CONFLICTS;
+pub use planarize::{Planarized, extract_planarized};
 
 use polis_geom::PlanarGraph;
 

@@ -156,6 +156,9 @@ pub enum DropReason {
     },
     /// After merging coincident nodes both its ends are one node.
     ZeroLength,
+    /// During planarisation ([`extract_planarized`](crate::extract_planarized)) its ends
+    /// snapped together.
+    Collapsed,
 }
 
 /// An edge left out of the extraction.

@@ -508,3 +508,50 @@ proptest! {
         }
     }
 }
+
+/// Random segments (on a lattice or not) added raw, so they cross, overlap and touch.
+fn segments(seed: u64, count: usize, lattice: bool) -> G {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut g = G::new();
+    let pt = |rng: &mut Pcg64Mcg| {
+        if lattice {
+            DVec2::new(
+                f64::from(rng.random_range(0..7i32)) * 10.0,
+                f64::from(rng.random_range(0..7i32)) * 10.0,
+            )
+        } else {
+            DVec2::new(rng.random_range(0.0..100.0), rng.random_range(0.0..100.0))
+        }
+    };
+    for _ in 0..count {
+        let (p, q) = (pt(&mut rng), pt(&mut rng));
+        if p != q {
+            let a = g.add_node(p, ()).unwrap();
+            let b = g.add_node(q, ()).unwrap();
+            g.add_edge(a, b, ()).unwrap();
+        }
+    }
+    g
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random segments planarised by polis-geom's planar insertion.
+    #[test]
+    fn random_segments_planarised(seed in any::<u64>(), count in 1usize..25, lattice in any::<bool>()) {
+        let raw = segments(seed, count, lattice);
+        let p = polis_cells::extract_planarized(
+            &raw,
+            &polis_cells::CellParams::default(),
+            &polis_cells::geom::SnapOptions::default(),
+            |_| (),
+        )
+        .unwrap();
+        p.graph.check_invariants().unwrap();
+        check(&p.graph, &p.cells)?;
+        for (e, _, _, _) in raw.edges() {
+            prop_assert!(!p.edge_map[e.index()].is_empty());
+        }
+    }
+}
