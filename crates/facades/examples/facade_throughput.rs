@@ -3,7 +3,7 @@
 //! machine shared with other jobs; wall-clock figures are printed alongside.
 //!
 //! ```text
-//! cargo run --release -p polis-facades --example facade_throughput
+//! cargo run --release -p polis-facades --example facade_throughput [style]
 //! ```
 
 use std::time::Instant;
@@ -34,6 +34,7 @@ fn measure(mut f: impl FnMut() -> usize, min_cpu_s: f64) -> (usize, f64, f64) {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let only = std::env::args().nth(1);
     let opts = RasterOptions::default();
     println!(
         "{:<22} {:>16} {:>16} {:>14} {:>14}",
@@ -41,6 +42,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     for style in builtin_styles() {
         let name = style.name.clone();
+        if only.as_ref().is_some_and(|o| *o != name) {
+            continue;
+        }
         let p = PreparedStyle::new(style)?;
         let f = p.facade(&FacadeSpec::new(20.0, 15.0, 7))?;
         let (texels, cpu, wall) = measure(

@@ -136,6 +136,18 @@ impl Bricks {
     }
 }
 
+/// A corrugated sheet at position `x` across its ridges.
+#[inline]
+fn corrugation(base: &FacadeSample, period_m: f64, depth_m: f32, x: f64) -> FacadeSample {
+    let phase = (x / period_m).fract() as f32;
+    // A triangle-rounded wave: cheaper than sin and smooth enough for normals.
+    let tri = 4.0 * (phase - 0.5).abs() - 1.0;
+    let wave = tri * (1.5 - 0.5 * tri * tri);
+    let mut m = *base;
+    m.height += 0.5 * depth_m * wave;
+    m.shade(0.92 + 0.08 * wave)
+}
+
 /// The colour function of a layer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -226,30 +238,29 @@ impl Col {
                 period_m,
                 depth_m,
                 vertical,
-            } => {
-                let x = if *vertical { ctx.s } else { ctx.t };
-                let phase = (x / period_m).fract() as f32;
-                // A triangle-rounded wave: cheaper than sin and smooth enough for normals.
-                let tri = 4.0 * (phase - 0.5).abs() - 1.0;
-                let wave = tri * (1.5 - 0.5 * tri * tri);
-                let mut m = *base;
-                m.height += 0.5 * depth_m * wave;
-                m.shade(0.92 + 0.08 * wave)
-            }
+            } => corrugation(
+                base,
+                *period_m,
+                *depth_m,
+                if *vertical { ctx.s } else { ctx.t },
+            ),
             Col::Inherit { fallback } => inner.copied().unwrap_or(*fallback),
             Col::Custom(f) => (f.0)(ctx),
         }
     }
 
     /// Evaluates a run of points `(xs[k], t)` that share one cell and context except for
-    /// `s`, adding `depth` to the heights; `ctx_at(s)` builds the full context when needed.
+    /// `s` (the cell box starts at `box_x0`), adding `depth` to the heights; `ctx_at(s)`
+    /// builds the full context when needed.
     /// Equal to calling [`eval`](Self::eval) per point, faster for constant colours and
     /// facade-aligned bricks.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn eval_row(
         &self,
         xs: &[f64],
         t: f64,
+        box_x0: f64,
         depth: f32,
         ctx_at: impl Fn(f64) -> PointCtx,
         out: &mut [FacadeSample],
@@ -261,6 +272,53 @@ impl Col {
                 out.fill(m);
             }
             Col::Bricks(b) if !b.in_cell => b.eval_row(xs, t, depth, out),
+            // Functions of t and the box alone are constant along the run.
+            Col::Gradient { .. }
+            | Col::Inherit { .. }
+            | Col::Corrugated {
+                vertical: false, ..
+            } => {
+                if let Some(&s) = xs.first() {
+                    let mut m = self.eval(&ctx_at(s), None);
+                    m.height += depth;
+                    out.fill(m);
+                }
+            }
+            Col::Frame {
+                inner,
+                edge,
+                width_m,
+            } => {
+                let Some(&s0) = xs.first() else { return };
+                let c = ctx_at(s0);
+                let [w, h] = c.size;
+                let y = c.local[1];
+                let (mut inner, mut edge) = (*inner, *edge);
+                inner.height += depth;
+                edge.height += depth;
+                let band = y < *width_m || h - y <= *width_m;
+                for (o, &s) in out.iter_mut().zip(xs) {
+                    // The same arithmetic as `eval`: local x = s − box origin.
+                    let x = s - box_x0;
+                    *o = if band || x < *width_m || w - x <= *width_m {
+                        edge
+                    } else {
+                        inner
+                    };
+                }
+            }
+            Col::Corrugated {
+                base,
+                period_m,
+                depth_m,
+                vertical: true,
+            } => {
+                for (o, &s) in out.iter_mut().zip(xs) {
+                    let mut m = corrugation(base, *period_m, *depth_m, s);
+                    m.height += depth;
+                    *o = m;
+                }
+            }
             _ => {
                 for (o, &s) in out.iter_mut().zip(xs) {
                     let mut m = self.eval(&ctx_at(s), None);

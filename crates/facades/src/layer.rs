@@ -287,8 +287,8 @@ impl Layer {
         }
         let mut bx = self.unscaled_box(hu, hv)?;
         let (mut x, mut y) = (s, t);
-        if self.cell_scale.is_some() {
-            let [su, sv] = self.scale_of(i, j);
+        let [su, sv] = self.scale_of(i, j);
+        if su != 1.0 || sv != 1.0 {
             if su <= 0.0 || sv <= 0.0 {
                 return None;
             }

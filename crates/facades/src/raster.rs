@@ -253,23 +253,17 @@ pub fn normals_from_heights(
         };
         let mut last_c = f32::NAN;
         let mut last_alpha = 0u8;
-        for (x, px) in orow.chunks_exact_mut(4).enumerate() {
-            let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
-            let (Some(&l), Some(&r), Some(&u), Some(&d), Some(&c)) =
-                (cur.get(x0), cur.get(x1), up.get(x), dn.get(x), cur.get(x))
-            else {
-                continue;
-            };
+        let mut texel = |l: f32, r: f32, u: f32, d: f32, c: f32, k: f32, px: &mut [u8]| {
             if c != last_c {
                 last_c = c;
                 last_alpha = to_u8(c * (0.5 / HEIGHT_RANGE_M) + 0.5);
             }
             if l == r && u == d {
                 px.copy_from_slice(&[128, 128, 255, last_alpha]);
-                continue;
+                return;
             }
             // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
-            let (nx, ny) = (-(r - l) * kx(x1 - x0), -(u - d) * ky);
+            let (nx, ny) = (-(r - l) * k, -(u - d) * ky);
             let inv = 1.0 / (nx * nx + ny * ny + 1.0).sqrt();
             px.copy_from_slice(&[
                 to_u8(nx * inv * 0.5 + 0.5),
@@ -277,6 +271,31 @@ pub fn normals_from_heights(
                 to_u8(inv * 0.5 + 0.5),
                 last_alpha,
             ]);
+        };
+        let (k_in, k_edge) = (kx(2), kx(1));
+        let mut px = orow.chunks_exact_mut(4);
+        // Left border (one-sided), interior (central), right border (one-sided).
+        if let (Some(p), Some(&c), Some(&u), Some(&d)) =
+            (px.next(), cur.first(), up.first(), dn.first())
+        {
+            let r = cur.get(1).copied().unwrap_or(c);
+            texel(c, r, u, d, c, k_edge, p);
+        }
+        if w >= 3 {
+            let inner = cur
+                .windows(3)
+                .zip(up.iter().skip(1))
+                .zip(dn.iter().skip(1))
+                .zip(px.by_ref().take(w - 2));
+            for (((win, &u), &d), p) in inner {
+                texel(win[0], win[2], u, d, win[1], k_in, p);
+            }
+        }
+        if w >= 2
+            && let (Some(p), Some(&c), Some(&l), Some(&u), Some(&d)) =
+                (px.next(), cur.last(), cur.get(w - 2), up.last(), dn.last())
+        {
+            texel(l, c, u, d, c, k_edge, p);
         }
     }
     out

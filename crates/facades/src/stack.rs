@@ -334,7 +334,7 @@ impl LayerStack {
 
     /// As [`border_col_in_row`](Self::border_col_in_row) for non-decreasing `s` along the
     /// row: amortised O(1) with the row state's cursors.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn border_col_advance(
         &self,
         k: usize,
@@ -351,6 +351,39 @@ impl LayerStack {
             }
         }
         None
+    }
+
+    /// For non-decreasing `s` along the row: the border colour at `s` (if any) and, per
+    /// border, where the answer may change next — `(s', inclusive)`: at the first texel
+    /// `≥ s'` (`inclusive`) or `> s'`. Calls `f` with each such boundary.
+    #[inline]
+    pub(crate) fn border_run(
+        &self,
+        k: usize,
+        s: f64,
+        state: &mut RowState,
+        mut f: impl FnMut(f64, bool),
+    ) -> Option<&Col> {
+        let (borders, slot) = (self.borders.get(k)?, state.spans.get_mut(k)?);
+        let mut found = None;
+        for ((_, _, col), (spans, cur)) in borders.iter().zip(slot.iter_mut()) {
+            while spans.get(*cur).is_some_and(|sp| sp.1 < s) {
+                *cur += 1;
+            }
+            match spans.get(*cur) {
+                Some(sp) if sp.0 <= s => {
+                    // Inside: the status changes after the span's end.
+                    f(sp.1, false);
+                    if found.is_none() {
+                        found = Some(col);
+                    }
+                }
+                // Before the next span: the status changes at its start.
+                Some(sp) => f(sp.0, true),
+                None => {}
+            }
+        }
+        found
     }
 
     /// Whether layer `k` is the target of any border influence.

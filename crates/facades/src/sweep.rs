@@ -35,6 +35,32 @@ struct Span {
     box_h: f64,
 }
 
+/// The first of the sorted texel centres `xs` that is `≥ s` (`> s` when `strict` is
+/// false): O(1) from the spacing, corrected against the exact centres so the answer
+/// equals a binary search.
+#[inline]
+fn first_at_or_after(xs: &[f64], s: f64, strict: bool) -> usize {
+    let n = xs.len();
+    let below = |x: f64| if strict { x < s } else { x <= s };
+    let (Some(&first), Some(&second)) = (xs.first(), xs.get(1)) else {
+        return xs.partition_point(|&x| below(x));
+    };
+    let ds = second - first;
+    let guess = ((s - first) / ds).ceil();
+    let mut k = if guess.is_nan() {
+        0
+    } else {
+        guess.clamp(0.0, n as f64) as usize
+    };
+    while k > 0 && xs.get(k - 1).is_some_and(|&x| !below(x)) {
+        k -= 1;
+    }
+    while xs.get(k).is_some_and(|&x| below(x)) {
+        k += 1;
+    }
+    k
+}
+
 /// Reusable buffers of the row sweep for one raster width.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct RowSweep {
@@ -70,6 +96,23 @@ impl RowSweep {
             let j = hv.index;
             let scaled = layer.cell_scale.is_some();
             let v_box = layer.v.get(j).is_some_and(|iv| iv.profile.is_box());
+            // Whole-row rejections (unscaled cells only: scaling moves boxes in t).
+            if layer
+                .v_mask
+                .as_ref()
+                .is_some_and(|m| !m.get(j).copied().unwrap_or(false))
+            {
+                continue;
+            }
+            if !scaled && v_box {
+                let v_on = layer.v.value(j, t) >= 0.5;
+                let in_v_box = layer.v.active(j).is_some_and(|(a, b)| t >= a && t < b);
+                match layer.eval {
+                    Eval::And if !v_on => continue,
+                    Eval::Image(_) | Eval::Nested(_) | Eval::Stack(_) if !in_v_box => continue,
+                    _ => {}
+                }
+            }
             for (i, iv) in layer.u.intervals().iter().enumerate() {
                 if !layer.selected(i, j) {
                     continue;
@@ -82,6 +125,8 @@ impl RowSweep {
                 let Some(bx) = layer.unscaled_box(&hu, &hv) else {
                     continue;
                 };
+                // Cells untouched by influences (scale 1) take the fast paths.
+                let scaled = scaled && layer.scale_of(i, j) != [1.0, 1.0];
                 let definite = !scaled
                     && v_box
                     && iv.profile.is_box()
@@ -131,13 +176,9 @@ impl RowSweep {
                     }
                 };
                 let (sa, sb) = (sa.max(hu.start), sb.min(hu.end));
-                let x0 = xs.partition_point(|&s| s < sa);
+                let x0 = first_at_or_after(xs, sa, true);
                 // The last interval is closed at L.
-                let x1 = if i + 1 == layer.u.len() {
-                    xs.partition_point(|&s| s <= sb)
-                } else {
-                    xs.partition_point(|&s| s < sb)
-                };
+                let x1 = first_at_or_after(xs, sb, i + 1 != layer.u.len());
                 if x0 >= x1 {
                     continue;
                 }
@@ -261,28 +302,20 @@ impl RowSweep {
                                 };
                             }
                         } else {
-                            col.eval_row(xs_sub, t, layer.depth_m, ctx_at, out_sub);
+                            col.eval_row(xs_sub, t, sp.box_x0, layer.depth_m, ctx_at, out_sub);
                         }
                     };
                     if stack.has_borders(sp.layer) {
-                        // Split the run where the border colour starts or stops.
-                        let mut a = 0;
-                        while a < run.len() {
-                            let col_a = stack
-                                .border_col_advance(sp.layer, xs_run[a], &mut self.state)
+                        // Split the run where a border colour starts or stops.
+                        let mut a = x;
+                        while a < e {
+                            let mut b = e;
+                            let col = stack
+                                .border_run(sp.layer, xs[a], &mut self.state, |s, inclusive| {
+                                    b = b.min(first_at_or_after(xs, s, inclusive).max(a + 1));
+                                })
                                 .unwrap_or(&layer.col);
-                            let mut b = a + 1;
-                            while b < run.len()
-                                && std::ptr::eq(
-                                    stack
-                                        .border_col_advance(sp.layer, xs_run[b], &mut self.state)
-                                        .unwrap_or(&layer.col),
-                                    col_a,
-                                )
-                            {
-                                b += 1;
-                            }
-                            shade(col_a, &xs_run[a..b], &mut run[a..b]);
+                            shade(col, &xs[a..b], &mut out[a..b]);
                             a = b;
                         }
                     } else {
