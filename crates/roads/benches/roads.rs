@@ -49,7 +49,7 @@ fn main() {
 
 /// A map big enough for `n` segments (street density of the default city).
 fn setup(n: usize, pattern: Pattern) -> (RoadParams, RoadInputs) {
-    let half = 2000.0 * (n as f64 / 9000.0).sqrt().max(1.0);
+    let half = 2000.0 * (n as f64 / 1500.0).sqrt().max(1.0);
     let params = RoadParams {
         pattern,
         bounds_min: [-half, -half],

@@ -93,10 +93,12 @@ impl DefaultConstraints {
         };
         let p = &self.params;
         // Prune to the last legal sample, refined by bisection toward the violation.
+        // Only the stretch after the last legal sample needs testing (one sample step).
         let (mut lo, mut hi) = (v.t_legal, v.t);
+        let from = a + (b - a) * v.t_legal;
         for _ in 0..10 {
             let mid = 0.5 * (lo + hi);
-            if self.legality.segment_ok(a, a + (b - a) * mid) {
+            if self.legality.segment_ok(from, a + (b - a) * mid) {
                 lo = mid;
             } else {
                 hi = mid;
@@ -256,5 +258,132 @@ impl LocalConstraints for DefaultConstraints {
 
     fn stats(&self) -> ConstraintStats {
         self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::sync::Arc;
+
+    use polis_geom::field::{Constant, FnField};
+
+    use super::*;
+
+    /// Water in the strip 100 ≤ x ≤ 200; land elsewhere.
+    fn strip() -> RoadInputs {
+        let mut i = RoadInputs::flat(Arc::new(Constant(0.5)));
+        i.water = Arc::new(FnField::new(|p: DVec2| {
+            if (100.0..=200.0).contains(&p.x) {
+                1.0
+            } else {
+                0.0
+            }
+        }));
+        i
+    }
+
+    fn propose(
+        c: &mut DefaultConstraints,
+        start: (f64, f64),
+        angle_deg: f64,
+        len: f64,
+        class: RoadClass,
+    ) -> (QueryState, RoadAttr) {
+        let mut r = RoadAttr::new(
+            DVec2::new(start.0, start.1),
+            angle_deg.to_radians(),
+            len,
+            class,
+        );
+        let s = c.adjust(&mut r, &RoadNetwork::new());
+        (s, r)
+    }
+
+    #[test]
+    fn prune_to_the_shore() {
+        let p = RoadParams::default();
+        let mut c = DefaultConstraints::new(&p, &strip());
+        let (s, r) = propose(&mut c, (0.0, 0.0), 0.0, 150.0, RoadClass::Street);
+        assert_eq!(s, QueryState::Succeed);
+        assert!(r.end.x < 100.0 && r.end.x > 99.0, "{:?}", r.end);
+        assert_eq!(c.stats().pruned, 1);
+    }
+
+    #[test]
+    fn highway_bridges_streets_do_not() {
+        let p = RoadParams::default();
+        let mut c = DefaultConstraints::new(&p, &strip());
+        let (s, r) = propose(&mut c, (95.0, 0.0), 0.0, 90.0, RoadClass::Highway);
+        assert_eq!(s, QueryState::Succeed);
+        assert!(r.bridge);
+        assert!(r.end.x > 200.0 && r.length <= p.max_bridge_length_m);
+        let (s, _) = propose(&mut c, (95.0, 0.0), 0.0, 90.0, RoadClass::Street);
+        assert_eq!(s, QueryState::Failed);
+        // Water wider than the limit: no bridge.
+        let p = RoadParams {
+            max_bridge_length_m: 80.0,
+            ..RoadParams::default()
+        };
+        let mut c = DefaultConstraints::new(&p, &strip());
+        let (s, _) = propose(&mut c, (95.0, 0.0), 0.0, 90.0, RoadClass::Highway);
+        assert_eq!(s, QueryState::Failed);
+    }
+
+    #[test]
+    fn rotate_around_a_pond() {
+        let mut i = RoadInputs::flat(Arc::new(Constant(0.5)));
+        i.water = Arc::new(FnField::new(|p: DVec2| {
+            if p.distance(DVec2::new(60.0, -10.0)) < 25.0 {
+                1.0
+            } else {
+                0.0
+            }
+        }));
+        let p = RoadParams::default();
+        let mut c = DefaultConstraints::new(&p, &i);
+        let (s, r) = propose(&mut c, (0.0, 0.0), 0.0, 90.0, RoadClass::Street);
+        assert_eq!(s, QueryState::Succeed);
+        assert!(
+            r.angle > 0.0 && r.angle <= p.max_rotate_deg.to_radians() + 1e-9,
+            "{}",
+            r.angle
+        );
+        assert_eq!(c.stats().rotated, 1);
+        assert!(c.legality().segment_ok(r.start, r.end));
+    }
+
+    #[test]
+    fn outside_the_map_fails() {
+        let p = RoadParams::default();
+        let mut c = DefaultConstraints::new(&p, &RoadInputs::flat(Arc::new(Constant(0.5))));
+        let (s, _) = propose(&mut c, (1990.0, 0.0), 0.0, 200.0, RoadClass::Street);
+        assert_eq!(s, QueryState::Failed);
+    }
+
+    #[test]
+    fn minimum_angle_at_a_junction() {
+        let p = RoadParams::default();
+        let mut c = DefaultConstraints::new(&p, &RoadInputs::flat(Arc::new(Constant(0.5))));
+        let mut n = RoadNetwork::new();
+        let road = crate::network::Road {
+            class: RoadClass::Street,
+            width: 8.0,
+            bridge: false,
+            step: 0,
+        };
+        n.insert_segment(
+            DVec2::ZERO,
+            DVec2::new(100.0, 0.0),
+            road,
+            &Default::default(),
+        )
+        .unwrap();
+        // 10° off the existing road at its end junction: refused.
+        let mut r = RoadAttr::new(DVec2::ZERO, 10f64.to_radians(), 90.0, RoadClass::Street);
+        assert_eq!(c.adjust(&mut r, &n), QueryState::Failed);
+        assert_eq!(c.stats().failed_angle, 1);
+        let mut r = RoadAttr::new(DVec2::ZERO, 90f64.to_radians(), 90.0, RoadClass::Street);
+        assert_eq!(c.adjust(&mut r, &n), QueryState::Succeed);
     }
 }

@@ -25,6 +25,7 @@ pub struct Legality {
     bounds: Aabb2,
     max_slope: f64,
     step: f64,
+    slope_step: f64,
 }
 
 /// The first illegal place along a segment.
@@ -46,6 +47,7 @@ impl Legality {
             bounds: params.bounds(),
             max_slope: params.max_slope,
             step: params.legality_step_m,
+            slope_step: params.slope_step_m,
         }
     }
 
@@ -93,13 +95,18 @@ impl Legality {
     }
 
     /// The first violation along `a–b` (samples every `legality_step_m`, the start
-    /// excluded), or `None` when the whole segment is legal. Slope is tested between
-    /// consecutive samples.
+    /// excluded), or `None` when the whole segment is legal. Slope is tested over runs of
+    /// [`RoadParams::slope_step_m`] (and at the end).
     pub fn segment(&self, a: DVec2, b: DVec2) -> Option<Violation> {
         let len = a.distance(b);
         let n = self.samples(len);
+        self.segment_walk(a, b, len, n)
+    }
+
+    fn segment_walk(&self, a: DVec2, b: DVec2, len: f64, n: usize) -> Option<Violation> {
         let mut prev_t = 0.0;
-        let mut prev_h = self.inputs.elevation.sample(a);
+        // Elevation is compared over runs of at least `slope_step` (grade over a baseline).
+        let (mut h_t, mut h0) = (0.0, f64::NAN);
         for i in 1..=n {
             let t = i as f64 / n as f64;
             let p = a + (b - a) * t;
@@ -110,31 +117,39 @@ impl Legality {
                     what,
                 });
             }
-            let h = self.inputs.elevation.sample(p);
-            let run = len * (t - prev_t);
-            if !h.is_finite() {
-                return Some(Violation {
-                    t,
-                    t_legal: prev_t,
-                    what: Illegal::Outside,
-                });
-            }
-            if run > 0.0 && (h - prev_h).abs() > self.max_slope * run {
-                return Some(Violation {
-                    t,
-                    t_legal: prev_t,
-                    what: Illegal::Slope,
-                });
+            let run = len * (t - h_t);
+            if i == n || run >= self.slope_step {
+                if h0.is_nan() {
+                    h0 = self.inputs.elevation.sample(a);
+                }
+                let h = self.inputs.elevation.sample(p);
+                if !(h.is_finite() && h0.is_finite()) {
+                    return Some(Violation {
+                        t,
+                        t_legal: prev_t,
+                        what: Illegal::Outside,
+                    });
+                }
+                if run > 0.0 && (h - h0).abs() > self.max_slope * run {
+                    return Some(Violation {
+                        t,
+                        t_legal: h_t,
+                        what: Illegal::Slope,
+                    });
+                }
+                h_t = t;
+                h0 = h;
             }
             prev_t = t;
-            prev_h = h;
         }
         None
     }
 
     /// Whether every sample of `a–b` is legal.
     pub fn segment_ok(&self, a: DVec2, b: DVec2) -> bool {
-        self.segment(a, b).is_none()
+        // Most illegal proposals fail at their far end (water ahead, map edge): test the
+        // end point first.
+        self.point(b).is_none() && self.segment(a, b).is_none()
     }
 
     /// Checks that `a–b` only crosses water (no park, slope or map edge) and lands on

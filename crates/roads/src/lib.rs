@@ -48,7 +48,7 @@
 //!
 //! ## Limitations
 //!
-//! * Legality is sampled (every `legality_step_m`, default 4 m): a sliver of water
+//! * Legality is sampled (every `legality_step_m`, default 5 m; slope over `slope_step_m`): a sliver of water
 //!   thinner than that can be missed.
 //! * Streets do not lower the population around them (the open-L-system feedback the
 //!   paper mentions); the population threshold alone stops them.

@@ -258,3 +258,143 @@ pub fn road_rules(goals: Arc<dyn GlobalGoals>) -> Result<TypedRules<'static, Roa
     )?;
     Ok(rules)
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use polis_lsystem::rand_pcg::Pcg64Mcg;
+    use polis_lsystem::{Derivation, DeriveOptions, Environment, TurtleState};
+
+    use super::*;
+
+    /// Goals: the continuation goes on with delay 0 while `age < 2`, then stops; branch 1
+    /// waits 2 steps, branch 2 never grows.
+    struct Stub;
+    impl GlobalGoals for Stub {
+        fn axiom(&self) -> Vec<(RuleAttr, RoadAttr)> {
+            Vec::new()
+        }
+        fn successors(&self, rule: &RuleAttr, road: &RoadAttr, _: &mut Pcg64Mcg) -> [Proposal; 3] {
+            let next = RoadAttr::new(road.end, road.angle, 10.0, rule.class);
+            let r = RuleAttr {
+                age: rule.age + 1,
+                ..*rule
+            };
+            [
+                Proposal {
+                    delay: if rule.age < 2 { 0 } else { -1 },
+                    rule: r,
+                    road: next,
+                },
+                Proposal {
+                    delay: 2,
+                    rule: RuleAttr { age: 10, ..*rule },
+                    road: next,
+                },
+                Proposal {
+                    delay: -1,
+                    rule: r,
+                    road: next,
+                },
+            ]
+        }
+    }
+
+    /// Accepts every query.
+    struct Accept(usize);
+    impl Environment<Vec<RoadModule>> for Accept {
+        fn communicate(&mut self, s: &mut Vec<RoadModule>, i: usize, _: &TurtleState) {
+            if let Some(RoadModule::I { state, .. }) = s.get_mut(i)
+                && *state == QueryState::Unassigned
+            {
+                *state = QueryState::Succeed;
+                self.0 += 1;
+            }
+        }
+    }
+
+    fn syms(s: &[RoadModule]) -> String {
+        s.iter()
+            .map(|m| match m {
+                RoadModule::R { del, .. } => format!("R{del}"),
+                RoadModule::B { del, .. } => format!("B{del}"),
+                RoadModule::I {
+                    state: QueryState::Unassigned,
+                    ..
+                } => "?".into(),
+                RoadModule::I {
+                    state: QueryState::Succeed,
+                    ..
+                } => "S".into(),
+                RoadModule::I {
+                    state: QueryState::Failed,
+                    ..
+                } => "F".into(),
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
+    #[test]
+    fn productions_p1_to_p9() {
+        let rules = road_rules(Arc::new(Stub)).unwrap();
+        let rule = RuleAttr {
+            class: crate::RoadClass::Street,
+            depth: 0,
+            age: 0,
+        };
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, crate::RoadClass::Street);
+        let axiom = vec![
+            RoadModule::R { del: 0, rule },
+            RoadModule::I {
+                road,
+                state: QueryState::Unassigned,
+            },
+        ];
+        let mut d = Derivation::new(rules, axiom, DeriveOptions::default());
+        let mut env = Accept(0);
+        // p8 (environment) answers the axiom, p2 creates B B R ?I, p9 erases the old ?I.
+        d.step_with(&mut env).unwrap();
+        assert_eq!(syms(d.string()), "B2 B-1 R0 S");
+        // p4 decrements, p6 erases the negative branch, p2 again.
+        d.step_with(&mut env).unwrap();
+        assert_eq!(syms(d.string()), "B1 B2 B-1 R0 S");
+        // age 2: the continuation gets del −1 (this stub environment answers its ?I
+        // anyway; the generator's does not).
+        d.step_with(&mut env).unwrap();
+        assert_eq!(syms(d.string()), "B0 B1 B2 B-1 R-1 S");
+        // p5 turns B0 into R ?I; p1 and p7 erase the stopped road.
+        d.step_with(&mut env).unwrap();
+        assert_eq!(syms(d.string()), "R0 S B0 B1");
+        assert_eq!(env.0, 5);
+    }
+
+    #[test]
+    fn failed_query_deletes_the_road() {
+        struct Reject;
+        impl Environment<Vec<RoadModule>> for Reject {
+            fn communicate(&mut self, s: &mut Vec<RoadModule>, i: usize, _: &TurtleState) {
+                if let Some(RoadModule::I { state, .. }) = s.get_mut(i) {
+                    *state = QueryState::Failed;
+                }
+            }
+        }
+        let rules = road_rules(Arc::new(Stub)).unwrap();
+        let rule = RuleAttr {
+            class: crate::RoadClass::Street,
+            depth: 0,
+            age: 0,
+        };
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, crate::RoadClass::Street);
+        let axiom = vec![
+            RoadModule::R { del: 0, rule },
+            RoadModule::I {
+                road,
+                state: QueryState::Unassigned,
+            },
+        ];
+        let mut d = Derivation::new(rules, axiom, DeriveOptions::default());
+        d.step_with(&mut Reject).unwrap();
+        assert!(d.string().is_empty(), "{}", syms(d.string()));
+    }
+}

@@ -101,8 +101,10 @@ pub struct RoadParams {
     pub min_angle_deg: f64,
     /// Shortest segment accepted after pruning or snapping. Default: 12 m.
     pub min_segment_length_m: f64,
-    /// Spacing of legality samples along a segment. Default: 4 m.
+    /// Spacing of legality samples (water, parks, map edge) along a segment. Default: 5 m.
     pub legality_step_m: f64,
+    /// Baseline over which the slope (grade) is measured along a segment. Default: 20 m.
+    pub slope_step_m: f64,
     /// Stop after this many accepted segments. Default: 4000.
     pub max_segments: usize,
     /// Stop after this many derivation steps. Default: 1000.
@@ -150,7 +152,8 @@ impl Default for RoadParams {
             snap_radius_m: 30.0,
             min_angle_deg: 30.0,
             min_segment_length_m: 12.0,
-            legality_step_m: 4.0,
+            legality_step_m: 5.0,
+            slope_step_m: 20.0,
             max_segments: 4000,
             max_steps: 1000,
             smooth_highways: false,
@@ -228,6 +231,7 @@ impl RoadParams {
         pos("sf_connector_length_m", self.sf_connector_length_m)?;
         pos("highway_ray_length_m", self.highway_ray_length_m)?;
         pos("legality_step_m", self.legality_step_m)?;
+        pos("slope_step_m", self.slope_step_m)?;
         pos("rotate_step_deg", self.rotate_step_deg)?;
         let nonneg = |name, v: f64| check(name, v.is_finite() && v >= 0.0, v, "a finite value ≥ 0");
         nonneg("highway_width_m", self.highway_width_m)?;

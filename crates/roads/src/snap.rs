@@ -181,3 +181,94 @@ pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
     }
     near.map(|(_, edge, point)| SnapEvent::Road { edge, point })
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::network::{Junction, Road};
+    use polis_geom::graph::SnapOptions;
+
+    fn road() -> Road {
+        Road {
+            class: RoadClass::Street,
+            width: 8.0,
+            bridge: false,
+            step: 0,
+        }
+    }
+
+    type Seg = ((f64, f64), (f64, f64));
+
+    fn net(segs: &[Seg]) -> RoadNetwork {
+        let mut n = RoadNetwork::new();
+        for &((ax, ay), (bx, by)) in segs {
+            n.insert_segment_with(
+                DVec2::new(ax, ay),
+                DVec2::new(bx, by),
+                road(),
+                &SnapOptions::default(),
+                |_| Junction::default(),
+            )
+            .unwrap();
+        }
+        n
+    }
+
+    fn q(a: (f64, f64), b: (f64, f64), radius: f64) -> SnapQuery {
+        SnapQuery {
+            a: DVec2::new(a.0, a.1),
+            b: DVec2::new(b.0, b.1),
+            radius,
+            start_node: None,
+            only: None,
+        }
+    }
+
+    #[test]
+    fn crossing_becomes_a_junction_point() {
+        let n = net(&[((0.0, 0.0), (100.0, 0.0))]);
+        let ev = snap(&n, &q((40.0, -50.0), (40.0, 50.0), 5.0)).unwrap();
+        assert!(matches!(ev, SnapEvent::Cross { r, .. } if (r - 0.5).abs() < 1e-12));
+        assert_eq!(ev.point(), DVec2::new(40.0, 0.0));
+    }
+
+    #[test]
+    fn end_near_a_road_extends_to_meet_it() {
+        let n = net(&[((0.0, 0.0), (100.0, 0.0))]);
+        let ev = snap(&n, &q((40.0, -50.0), (42.0, -8.0), 10.0)).unwrap();
+        assert!(matches!(ev, SnapEvent::Road { .. }));
+        assert_eq!(ev.point(), DVec2::new(42.0, 0.0));
+        // Out of reach: nothing.
+        assert!(snap(&n, &q((40.0, -50.0), (42.0, -12.0), 10.0)).is_none());
+    }
+
+    #[test]
+    fn end_near_a_junction_extends_to_it_before_a_later_crossing() {
+        // Junction (100, 0) near the end; a road crossing further along is ignored.
+        let n = net(&[((0.0, 0.0), (100.0, 0.0)), ((100.0, 0.0), (100.0, 80.0))]);
+        let ev = snap(&n, &q((96.0, -60.0), (97.0, -6.0), 10.0)).unwrap();
+        assert!(matches!(ev, SnapEvent::Junction { .. }), "{ev:?}");
+        assert_eq!(ev.point(), DVec2::new(100.0, 0.0));
+        // A junction close to the body of the segment wins over a crossing behind it.
+        let n = net(&[((0.0, 20.0), (100.0, 20.0)), ((50.0, 50.0), (50.0, 60.0))]);
+        let ev = snap(&n, &q((48.0, -50.0), (48.0, 30.0), 5.0)).unwrap();
+        assert!(matches!(ev, SnapEvent::Cross { .. }), "{ev:?}");
+        let n = net(&[((0.0, 20.0), (100.0, 20.0)), ((51.0, 0.0), (60.0, -5.0))]);
+        let ev = snap(&n, &q((48.0, -50.0), (48.0, 30.0), 5.0)).unwrap();
+        assert_eq!(ev.point(), DVec2::new(51.0, 0.0), "{ev:?}");
+    }
+
+    #[test]
+    fn roads_at_the_start_junction_are_ignored() {
+        let n = net(&[((0.0, 0.0), (100.0, 0.0))]);
+        let start = n.nearest_node(DVec2::new(100.0, 0.0), 1e-9).map(|x| x.0);
+        let mut query = q((100.0, 0.0), (100.0, 60.0), 10.0);
+        query.start_node = start;
+        assert!(snap(&n, &query).is_none());
+        // Highways ignore streets.
+        let mut query = q((40.0, -50.0), (40.0, 50.0), 5.0);
+        query.only = Some(RoadClass::Highway);
+        assert!(snap(&n, &query).is_none());
+    }
+}
