@@ -480,6 +480,9 @@ proptest! {
     fn planarity_check_agrees_with_the_graph(seed in any::<u64>(), nodes in 2usize..14, edges in 0usize..10) {
         let g = soup(seed, nodes, edges);
         let reference = g.check_invariants();
+        // Without the check, non-planar input gives unspecified cells but never a panic.
+        let unchecked = polis_cells::CellParams { check_planarity: false, ..Default::default() };
+        let _ = polis_cells::extract_with(&g, &unchecked);
         match extract(&g) {
             Ok(d) => {
                 prop_assert!(reference.is_ok(), "missed: {:?}", reference);
