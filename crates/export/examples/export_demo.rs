@@ -10,6 +10,7 @@ use std::fs::File;
 use std::io::BufWriter;
 
 use polis_export::geojson::{GeoJsonOptions, write_geojson};
+use polis_export::geom::field::FnField;
 use polis_export::geom::glam::DVec3;
 use polis_export::geom::mesh::{Facing, flat_polygon, prism};
 use polis_export::geom::scene::{Image, ImageData, Material, Texture, Transform};
@@ -20,6 +21,7 @@ use polis_export::map::{
 };
 use polis_export::obj::{ObjOptions, write_obj};
 use polis_export::sink::DirSink;
+use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_export::svg::{SvgOptions, write_svg};
 
 /// A 64 × 64 brick pattern: 1 texel = 1/64 m… scaled by the material's metre UVs, one
@@ -99,7 +101,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     )?);
     scene.attach_mesh(river_node, river_mesh)?;
 
-    let mut park = Polygon::regular(9, DVec2::new(-40.0, 40.0), 18.0);
+    let mut park = Polygon::regular(9, DVec2::new(90.0, 35.0), 18.0);
     park.make_ccw();
     map.parks.push(park.into());
 
@@ -134,25 +136,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         ),
     ];
     let roads_node = scene.add_node(city, "roads")?;
+    // A gentle slope rising to the north-west; the river valley does not touch the roads
+    // except under the bridge, which spans it.
+    let terrain = FnField::new(|p: DVec2| 0.02 * p.y - 0.01 * p.x);
     for (id, points, class, width_m, bridge) in roads {
-        // Road surface: a ribbon of the road's width along each straight segment.
-        for seg in points.windows(2) {
-            let d = (seg[1] - seg[0]).normalize();
-            let n = DVec2::new(-d.y, d.x) * (width_m / 2.0);
-            let ribbon = Polygon::new(vec![seg[0] - n, seg[1] - n, seg[1] + n, seg[0] + n]);
-            let deck = if bridge { 1.5 } else { 0.05 };
-            let mesh = scene.add_mesh(flat_polygon(
-                &ribbon.into(),
-                deck,
-                Facing::Up,
-                Some(asphalt),
-            )?);
-            let node = scene.add_node(roads_node, format!("road {id}"))?;
-            scene.attach_mesh(node, mesh)?;
-            scene.set_metadata(node, "class", class.as_str())?;
-            scene.set_metadata(node, "width_m", width_m)?;
-            scene.set_metadata(node, "bridge", bridge)?;
-        }
         map.roads.push(MapRoad {
             id,
             points,
@@ -160,6 +147,20 @@ fn main() -> Result<(), Box<dyn Error>> {
             width_m,
             bridge,
         });
+    }
+    for road in &map.roads {
+        let surface = road_surfaces(
+            std::slice::from_ref(road),
+            &terrain,
+            &RoadSurfaceOptions::default(),
+            Some(asphalt),
+        )?;
+        let mesh = scene.add_mesh(surface);
+        let node = scene.add_node(roads_node, format!("road {}", road.id))?;
+        scene.attach_mesh(node, mesh)?;
+        scene.set_metadata(node, "class", road.class.as_str())?;
+        scene.set_metadata(node, "width_m", road.width_m)?;
+        scene.set_metadata(node, "bridge", road.bridge)?;
     }
 
     // Blocks and lots, each building a prism centred on its lot (mesh around a local

@@ -251,6 +251,41 @@ proptest! {
     }
 
     #[test]
+    fn road_surfaces_are_valid_meshes_that_export(map in map(), tilt in -0.2..0.2f64) {
+        let terrain = polis_geom::field::FnField::new(move |p: DVec2| tilt * p.x);
+        let mesh = crate::surfaces::road_surfaces(
+            &map.roads,
+            &terrain,
+            &crate::surfaces::RoadSurfaceOptions::default(),
+            None,
+        )
+        .unwrap();
+        prop_assert!(mesh.validate().is_ok());
+        // Straight roads: the ribbon's area is length × width.
+        for r in map.roads.iter().filter(|r| r.points.len() == 2 && r.width_m > 0.0) {
+            let one = crate::surfaces::road_surfaces(
+                std::slice::from_ref(r),
+                &polis_geom::field::Constant(0.0),
+                &crate::surfaces::RoadSurfaceOptions::default(),
+                None,
+            )
+            .unwrap();
+            let len = (r.points[1] - r.points[0]).length();
+            let want = len * r.width_m;
+            prop_assert!((one.surface_area() - want).abs() <= 1e-3 * want.max(1.0));
+        }
+        let mut scene = Scene::new();
+        let root = scene.add_root("roads");
+        if !mesh.is_empty() {
+            let id = scene.add_mesh(mesh);
+            scene.attach_mesh(root, id).unwrap();
+        }
+        let mut bytes = Vec::new();
+        write_glb(&scene, &GlbOptions::default(), &mut bytes).unwrap();
+        decode_glb(&bytes);
+    }
+
+    #[test]
     fn random_maps_give_well_formed_svg_and_geojson(map in map()) {
         let mut svg = Vec::new();
         crate::svg::write_svg(&map, &crate::svg::SvgOptions::default(), &mut svg).unwrap();
