@@ -14,7 +14,8 @@
 //!                                   │    ├─ boundary: Ring  the minimal cycle, counter-clockwise
 //!                                   │    ├─ holes: Vec<Ring> island outlines, clockwise
 //!                                   │    ├─ filaments        dead ends, connectors inside it
-//!                                   │    └─ parent / children / depth   the containment tree
+//!                                   │    ├─ parent / children / depth   the containment tree
+//!                                   │    └─ road_graph(&g)   its private road graph (payloads cloned)
 //!                                   ├─ outer_filaments, outer_isolated_nodes, outlines
 //!                                   └─ report: merged nodes, dropped edges, counts
 //! ```
@@ -94,6 +95,7 @@
 //! * G. Kelly, *An Interactive System for Procedural City Generation*, 2008, §4.3.1, §4.4.
 
 mod assemble;
+mod cell_graph;
 mod eberly;
 pub mod error;
 mod output;
@@ -104,6 +106,7 @@ mod topology;
 
 pub use polis_geom as geom;
 
+pub use cell_graph::CellGraph;
 pub use error::{Conflict, Error};
 pub use output::{
     Cell, CellDecomposition, CellId, DropReason, DroppedEdge, ExtractionReport, Filament,
