@@ -23,10 +23,11 @@
 //! * Consecutive parallel edges with *different* weights (in the input, or once the edge
 //!   between them has vanished) have no weighted bisector. The wavefront gets a
 //!   perpendicular step there: a virtual edge of weight 0 along the common normal, with one
-//!   vertex on each offset line. Its two arcs run along the same ray and are reported as
-//!   separating the two input edges; the distance guarantee above holds for each arc's own
-//!   line only. Insets stay exact (the step edge has no source, see
-//!   [`inset_shapes`](crate::inset_shapes)).
+//!   vertex on each offset line; once an input edge parallel to the step reaches it, that
+//!   edge sweeps the step away. Arcs along a step are flagged ([`SkeletonArc::step`]) and
+//!   reported as separating the input edges on either side; the distance guarantee above
+//!   holds for one of their two lines only. Insets stay exact (the step edge has no
+//!   source, see [`inset_shapes`](crate::inset_shapes)).
 //! * Points closer than `1e-9` times the polygon's size at the same time are merged into
 //!   one event; nearly simultaneous events are therefore treated as simultaneous.
 //!
