@@ -7,7 +7,10 @@
 
 #![allow(clippy::unwrap_used)]
 
+use std::sync::Arc;
+
 use divan::counter::ItemsCount;
+use polis_geom::field::{Population, PopulationParams};
 use polis_roads::{Pattern, RoadInputs, RoadParams, generate};
 
 /// A field of `/proc/self/status` in KiB (0 where unavailable).
@@ -23,26 +26,49 @@ fn status_kib(key: &str) -> u64 {
         .unwrap_or(0)
 }
 
+/// CPU time of this thread in seconds (`/proc/thread-self/schedstat`, ns on CPU): the
+/// machine is shared, so wall time overstates the cost under load.
+fn cpu_s() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| {
+            s.split_whitespace()
+                .next()
+                .and_then(|v| v.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
 fn main() {
     let base = status_kib("VmRSS:");
-    for &(n, pattern) in &[
-        (15_000, Pattern::Basic),
-        (15_000, Pattern::NewYork),
-        (100_000, Pattern::Basic),
+    for &(n, pattern, flat) in &[
+        (15_000, Pattern::Basic, true),
+        (15_000, Pattern::Basic, false),
+        (15_000, Pattern::NewYork, false),
+        (100_000, Pattern::Basic, false),
     ] {
-        let (params, inputs) = setup(n, pattern);
+        let (params, inputs) = if flat {
+            setup_flat(n)
+        } else {
+            setup(n, pattern)
+        };
         let t = std::time::Instant::now();
+        let c0 = cpu_s();
         let city = generate(&params, &inputs).unwrap();
+        let cpu = cpu_s() - c0;
         let dt = t.elapsed().as_secs_f64();
         let peak = status_kib("VmHWM:").saturating_sub(base);
         println!(
-            "{n:>7} segments {pattern:?}: got {} segments, {} edges, {:.1} ms, {:.0} segments/s, peak RSS +{:.1} MiB",
+            "{n:>7} segments {pattern:?}{}: got {} segments, {} edges, wall {:.1} ms, CPU {:.1} ms, {:.0} segments/CPU-s, peak RSS +{:.1} MiB",
+            if flat { " (population only)" } else { "" },
             city.report.segments,
             city.network.edge_count(),
             dt * 1e3,
-            city.report.segments as f64 / dt,
+            cpu * 1e3,
+            city.report.segments as f64 / cpu,
             peak as f64 / 1024.0
         );
+        println!("        {:?}", city.report.constraints);
     }
     divan::main();
 }
@@ -59,6 +85,26 @@ fn setup(n: usize, pattern: Pattern) -> (RoadParams, RoadInputs) {
     };
     let inputs = RoadInputs::procedural(params.seed, &params).unwrap();
     (params, inputs)
+}
+
+/// Population map only (no water, parks or hills): the generator's own cost without
+/// legality sampling of noise maps.
+fn setup_flat(n: usize) -> (RoadParams, RoadInputs) {
+    let (params, _) = setup(n, Pattern::Basic);
+    let pop = Population::new(PopulationParams {
+        seed: params.seed,
+        unit_m: 100.0,
+    })
+    .unwrap();
+    (params, RoadInputs::flat(Arc::new(pop)))
+}
+
+#[divan::bench(args = [15_000], sample_count = 3, sample_size = 1)]
+fn basic_population_only(bencher: divan::Bencher<'_, '_>, n: usize) {
+    let (params, inputs) = setup_flat(n);
+    bencher
+        .counter(ItemsCount::new(n))
+        .bench(|| generate(&params, &inputs).unwrap());
 }
 
 #[divan::bench(args = [15_000, 100_000], sample_count = 3, sample_size = 1)]
