@@ -71,13 +71,13 @@ impl Cell {
             seen.insert(e, ne);
         }
         for iso in &self.isolated_nodes {
-            if !node_of.contains_key(&iso.node) {
+            if let std::collections::btree_map::Entry::Vacant(slot) = node_of.entry(iso.node) {
                 let m = out.graph.add_node(
                     graph.position(iso.node)?,
                     graph.node_payload(iso.node)?.clone(),
                 )?;
                 out.nodes.push(iso.node);
-                node_of.insert(iso.node, m);
+                slot.insert(m);
             }
         }
         Ok(out)
