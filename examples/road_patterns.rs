@@ -183,7 +183,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         bounds_min: [-3000.0, -3000.0],
         bounds_max: [3000.0, 3000.0],
         start: Some([0.0, 0.0]),
-        highway_branch_probability: 0.1,
+        highway_branch_probability: 0.3,
+        max_rotate_deg: 80.0,
         max_bridge_length_m: 450.0,
         max_segments: 4000,
         ..base

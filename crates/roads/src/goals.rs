@@ -490,3 +490,129 @@ impl GlobalGoals for DefaultGoals {
         [cont, b1, b2]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::sync::Arc;
+
+    use polis_geom::Field;
+    use polis_geom::field::{Constant, FnField};
+    use rand::SeedableRng;
+
+    use super::*;
+
+    fn flat() -> RoadInputs {
+        RoadInputs::flat(Arc::new(FnField::new(|p: DVec2| {
+            (-(p.length() / 800.0).powi(2)).exp()
+        })))
+    }
+
+    #[test]
+    fn highway_rays_climb_toward_population() {
+        let params = RoadParams::default();
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        // The peak is at the origin; from (1000, 0) heading north, the best ray turns west.
+        let a = g.best_ray(DVec2::new(1000.0, 0.0), FRAC_PI_2, 30f64.to_radians());
+        assert!(a > FRAC_PI_2 + 0.1, "{a}");
+        assert!(g.start().length() < 100.0);
+        assert!(g.centre().length() < 100.0);
+    }
+
+    #[test]
+    fn pattern_weights_are_normalised_and_blend() {
+        let params = RoadParams::default();
+        let w: Arc<dyn Field> = Arc::new(Constant(3.0));
+        let inputs =
+            flat().with_pattern_weights(vec![(Pattern::NewYork, w.clone()), (Pattern::Paris, w)]);
+        let g = DefaultGoals::new(&params, &inputs).unwrap();
+        assert_eq!(
+            g.pattern_weights(DVec2::new(5.0, 5.0)),
+            [0.0, 0.5, 0.5, 0.0]
+        );
+        // No weight anywhere: Basic.
+        let inputs = flat().with_pattern_weights(vec![(
+            Pattern::Paris,
+            Arc::new(Constant(0.0)) as Arc<dyn Field>,
+        )]);
+        let g = DefaultGoals::new(&params, &inputs).unwrap();
+        assert_eq!(g.pattern_weights(DVec2::ZERO), [1.0, 0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn new_york_snaps_to_the_grid_with_block_sizes() {
+        let params = RoadParams {
+            pattern: Pattern::NewYork,
+            grid_angle_deg: 10.0,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        let rule = RuleAttr {
+            class: RoadClass::Street,
+            depth: 1,
+            age: 0,
+        };
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 50.0, RoadClass::Street);
+        let [c, b1, b2] = g.successors(&rule, &road, &mut rng);
+        assert!((c.road.angle - 10f64.to_radians()).abs() < 1e-9);
+        assert_eq!(c.road.length, params.block_length_m);
+        assert!((b1.road.angle - 100f64.to_radians()).abs() < 1e-9);
+        assert_eq!(b1.road.length, params.block_width_m);
+        assert!((b2.road.angle + 80f64.to_radians()).abs() < 1e-9);
+        // Branches start where the segment ended.
+        assert_eq!(b1.road.start, road.end);
+    }
+
+    #[test]
+    fn paris_concentric_step_stays_on_the_circle() {
+        let params = RoadParams {
+            pattern: Pattern::Paris,
+            paris_centre: Some([0.0, 0.0]),
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let p = DVec2::new(500.0, 0.0);
+        let aim = g.paris(p, FRAC_PI_2, RoadClass::Street);
+        let q = p + dir(aim.angle) * aim.length;
+        assert!((q.length() - 500.0).abs() < 1e-6);
+        let radial = g.paris(p, 0.1, RoadClass::Street);
+        assert!(radial.angle.abs() < 1e-12);
+    }
+
+    #[test]
+    fn streets_branch_only_above_the_threshold() {
+        let params = RoadParams {
+            street_branch_probability: 1.0,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        let rule = RuleAttr {
+            class: RoadClass::Street,
+            depth: 1,
+            age: 0,
+        };
+        let dense = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, RoadClass::Street);
+        let [_, b1, b2] = g.successors(&rule, &dense, &mut rng);
+        assert!(b1.delay >= 0 && b2.delay >= 0);
+        let empty = RoadAttr::new(DVec2::new(1900.0, 1900.0), 0.0, 10.0, RoadClass::Street);
+        let [c, b1, b2] = g.successors(&rule, &empty, &mut rng);
+        assert!(c.delay < 0 && b1.delay < 0 && b2.delay < 0);
+        // From a highway, street branches wait the extra delay.
+        let hw = RuleAttr {
+            class: RoadClass::Highway,
+            depth: 0,
+            age: 0,
+        };
+        let params = RoadParams {
+            highway_branch_probability: 0.0,
+            ..params
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, RoadClass::Highway);
+        let [_, b1, _] = g.successors(&hw, &road, &mut rng);
+        assert_eq!(b1.delay, params.branch_delay + params.highway_street_delay);
+        assert_eq!(b1.rule.class, RoadClass::Street);
+    }
+}

@@ -94,3 +94,70 @@ pub fn smooth_highways(
     }
     Ok(cut)
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::sync::Arc;
+
+    use polis_geom::field::Constant;
+    use polis_geom::graph::SnapOptions;
+
+    use super::*;
+    use crate::network::Road;
+
+    fn hw() -> Road {
+        Road {
+            class: RoadClass::Highway,
+            width: 16.0,
+            bridge: false,
+            step: 0,
+        }
+    }
+
+    #[test]
+    fn corner_is_cut_and_graph_stays_planar() {
+        let mut n = RoadNetwork::new();
+        let o = SnapOptions::default();
+        n.insert_segment(DVec2::ZERO, DVec2::new(100.0, 0.0), hw(), &o)
+            .unwrap();
+        n.insert_segment(DVec2::new(100.0, 0.0), DVec2::new(100.0, 100.0), hw(), &o)
+            .unwrap();
+        let params = RoadParams {
+            smoothing_rounds: 2,
+            ..RoadParams::default()
+        };
+        let inputs = RoadInputs::flat(Arc::new(Constant(0.5)));
+        let cut = smooth_highways(&mut n, &params, &inputs).unwrap();
+        assert!(cut >= 2, "{cut}");
+        n.check_invariants().unwrap();
+        assert!(n.nearest_node(DVec2::new(100.0, 0.0), 1.0).is_none());
+        let ends = n.node_ids().filter(|&v| n.degree(v).unwrap() == 1).count();
+        assert_eq!(ends, 2);
+    }
+
+    #[test]
+    fn corner_with_a_junction_inside_is_kept() {
+        let mut n = RoadNetwork::new();
+        let o = SnapOptions::default();
+        n.insert_segment(DVec2::ZERO, DVec2::new(100.0, 0.0), hw(), &o)
+            .unwrap();
+        n.insert_segment(DVec2::new(100.0, 0.0), DVec2::new(100.0, 100.0), hw(), &o)
+            .unwrap();
+        // A dead-end street inside the corner's cut triangle.
+        let street = Road {
+            class: RoadClass::Street,
+            ..hw()
+        };
+        n.insert_segment(DVec2::new(90.0, 3.0), DVec2::new(97.0, 6.0), street, &o)
+            .unwrap();
+        let params = RoadParams {
+            smoothing_rounds: 1,
+            ..RoadParams::default()
+        };
+        let inputs = RoadInputs::flat(Arc::new(Constant(0.5)));
+        smooth_highways(&mut n, &params, &inputs).unwrap();
+        n.check_invariants().unwrap();
+        assert!(n.nearest_node(DVec2::new(100.0, 0.0), 1e-9).is_some());
+    }
+}
