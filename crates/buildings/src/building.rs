@@ -1,0 +1,481 @@
+//! The output types and the shape interpreter that turns a derived string into them.
+
+use polis_geom::mesh::to_world;
+use polis_geom::{
+    DVec2, DVec3, Mesh, Polygon, PolygonWithHoles, SegmentIntersection, segment_intersection,
+};
+use polis_lsystem::ParamString;
+use serde::{Deserialize, Serialize};
+
+use crate::BuildingsError;
+use crate::grammar::{BuildingGrammar, Op};
+use crate::params::BuildingKind;
+use crate::roofs::{self, RoofFaces};
+use crate::solid::prism;
+use crate::template::Template;
+
+/// What a part of a building is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum PartRole {
+    /// A mass (`Box`, or a non-terminal drawn as its volume).
+    Mass,
+    /// A roof template.
+    Roof,
+    /// A detail: antenna, spire.
+    Detail,
+    /// A user template.
+    Template,
+}
+
+/// One closed solid of a building.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// The mesh, in metres relative to [`Building::origin`] (glTF axes, Y up).
+    pub mesh: Mesh,
+    /// What it is.
+    pub role: PartRole,
+}
+
+/// The role of a facade face, for the facades stage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum FacadeRole {
+    /// An upper-storey wall.
+    Wall,
+    /// The ground-floor storey of a wall (shop fronts, entrances).
+    GroundFloor,
+    /// A roof plane (its bounding rectangle).
+    Roof,
+}
+
+/// A facade face: a planar rectangle of a building's surface that the facades stage
+/// textures or fills with window geometry.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FacadeFace {
+    /// Corners, counter-clockwise seen from outside: bottom-left, bottom-right, top-right,
+    /// top-left, metres relative to [`Building::origin`] (glTF axes). For roof planes,
+    /// the bounding rectangle of the plane's polygon (`u` horizontal, `v` up the slope).
+    pub quad: [DVec3; 4],
+    /// Width (bottom edge), metres.
+    pub width: f64,
+    /// Height (left edge), metres.
+    pub height: f64,
+    /// Storeys in the face (0 for roofs).
+    pub floors: u32,
+    /// Outward unit normal (orientation).
+    pub normal: DVec3,
+    /// What it is.
+    pub role: FacadeRole,
+    /// Index of the part in [`Building::parts`] it belongs to.
+    pub part: usize,
+}
+
+/// A building: closed solids and facade faces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Building {
+    /// The building's id (its lot's id: one building per lot).
+    pub id: u64,
+    /// The lot it stands on.
+    pub lot_id: u64,
+    /// Its type.
+    pub kind: BuildingKind,
+    /// Total height above the ground, metres (the bounding volume's; parts never rise
+    /// above it).
+    pub height: f64,
+    /// Storeys.
+    pub floors: u32,
+    /// Level of detail: derivation steps drawn.
+    pub lod: usize,
+    /// Layout position of the local origin (the footprint's centroid); every mesh and
+    /// facade coordinate is relative to `to_world(origin, 0)`.
+    pub origin: DVec2,
+    /// The footprint in layout coordinates (absolute), counter-clockwise, starting with
+    /// the primary street edge.
+    pub footprint: Polygon,
+    /// Closed solids.
+    pub parts: Vec<Part>,
+    /// Facade faces.
+    pub facades: Vec<FacadeFace>,
+    /// Templates that could not be built and fell back to a simpler one (a gable on a
+    /// square, a pyramid on a non-star-shaped footprint …).
+    pub fallbacks: u32,
+}
+
+impl Building {
+    /// Triangles in all parts.
+    pub fn triangle_count(&self) -> usize {
+        self.parts.iter().map(|p| p.mesh.triangle_count()).sum()
+    }
+
+    /// The bounding box of all parts (local coordinates).
+    pub fn bbox(&self) -> polis_geom::Aabb3 {
+        self.parts
+            .iter()
+            .fold(polis_geom::Aabb3::default(), |b, p| b.union(&p.mesh.bbox()))
+    }
+}
+
+/// Everything the interpreter needs about one building.
+pub(crate) struct Context<'a> {
+    pub grammar: &'a BuildingGrammar,
+    pub templates: &'a [Template],
+    /// The lot, local coordinates.
+    pub lot: &'a Polygon,
+    /// Unit axis along the primary street edge.
+    pub frame_x: DVec2,
+    /// Height limit, metres.
+    pub top: f64,
+    pub floor_height: f64,
+    pub ground_floor_height: f64,
+    pub slope_default: f64,
+}
+
+#[derive(Clone)]
+struct Shape {
+    ring: Option<Vec<DVec2>>,
+    base: f64,
+    height: f64,
+}
+
+/// Smallest part height drawn, metres.
+const MIN_PART_HEIGHT: f64 = 0.05;
+
+/// Draws a derived string: returns parts, facade faces and the number of fallbacks.
+pub(crate) fn interpret(
+    cx: &Context<'_>,
+    footprint: &[DVec2],
+    height: f64,
+    s: &ParamString,
+) -> Result<(Vec<Part>, Vec<FacadeFace>, u32), BuildingsError> {
+    let mut out = Output {
+        parts: Vec::new(),
+        facades: Vec::new(),
+        fallbacks: 0,
+    };
+    let mut cur = Shape {
+        ring: Some(footprint.to_vec()),
+        base: 0.0,
+        height,
+    };
+    let mut stack: Vec<Shape> = Vec::new();
+    for i in 0..s.len() {
+        let p = s.params(i);
+        let arg = |k: usize, default: f64| {
+            p.get(k)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(default)
+        };
+        match cx.grammar.op(s.symbol(i)) {
+            Op::Ignore => {}
+            Op::Push => stack.push(cur.clone()),
+            Op::Pop => {
+                if let Some(sh) = stack.pop() {
+                    cur = sh;
+                }
+            }
+            Op::Extrude => cur.height = arg(0, cur.height).max(0.0),
+            Op::Up => cur.base += cur.height,
+            Op::Scale => {
+                let (sx, sy, sz) = (arg(0, 1.0), arg(1, 1.0), arg(2, 1.0));
+                cur.height *= sz.max(0.0);
+                cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, sx, sy));
+            }
+            Op::Taper => {
+                let f = arg(0, 1.0);
+                cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, f, f));
+            }
+            Op::Move => {
+                let d = cx.frame_x * arg(0, 0.0) + cx.frame_x.perp() * arg(1, 0.0);
+                cur.base += arg(2, 0.0);
+                if let Some(r) = cur.ring.as_mut() {
+                    r.iter_mut().for_each(|q| *q += d);
+                }
+            }
+            Op::Setback => {
+                let d = arg(0, 0.0);
+                cur.ring = cur.ring.take().and_then(|r| setback(&r, d));
+            }
+            op => {
+                let Some((ring, z0, h)) = clip(cx, &cur) else {
+                    continue;
+                };
+                out.emit(cx, op, &ring, z0, h, p)?;
+            }
+        }
+    }
+    Ok((out.parts, out.facades, out.fallbacks))
+}
+
+struct Output {
+    parts: Vec<Part>,
+    facades: Vec<FacadeFace>,
+    fallbacks: u32,
+}
+
+impl Output {
+    fn emit(
+        &mut self,
+        cx: &Context<'_>,
+        op: Op,
+        ring: &[DVec2],
+        z0: f64,
+        h: f64,
+        p: &[f64],
+    ) -> Result<(), BuildingsError> {
+        let arg = |k: usize, default: f64| {
+            p.get(k)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(default)
+        };
+        let pitch = |k: usize| {
+            let deg = arg(k, cx.slope_default.atan().to_degrees()).clamp(1.0, 85.0);
+            deg.to_radians().tan()
+        };
+        let centre = Polygon::new(ring.to_vec()).centroid();
+        let roof: Result<(Mesh, RoofFaces), BuildingsError> = match op {
+            Op::Box | Op::Volume => {
+                let mesh = prism(ring, z0, z0 + h)?;
+                self.walls(cx, ring, z0, h);
+                self.parts.push(Part {
+                    mesh,
+                    role: PartRole::Mass,
+                });
+                return Ok(());
+            }
+            Op::Flat => roofs::slab(ring, z0, h),
+            Op::Hip => roofs::skeleton_roof(ring, z0, h, pitch(0), false),
+            Op::Gable => roofs::skeleton_roof(ring, z0, h, pitch(0), true),
+            Op::Mansard => roofs::mansard(ring, z0, h, arg(0, 1.5).max(0.01)),
+            Op::Pyramid => roofs::pyramid(ring, z0, h),
+            Op::Spire | Op::Antenna => {
+                let r = arg(0, 1.0).clamp(0.05, 50.0);
+                let sides = if op == Op::Spire { 8 } else { 4 };
+                let small = roofs::regular(centre, r, sides);
+                if !small
+                    .iter()
+                    .all(|&q| Polygon::new(ring.to_vec()).contains(q))
+                {
+                    self.fallbacks += 1;
+                    return Ok(());
+                }
+                let mesh = if op == Op::Spire {
+                    crate::solid::cone(&small, z0, centre, z0 + h)?
+                } else {
+                    prism(&small, z0, z0 + h)?
+                };
+                self.parts.push(Part {
+                    mesh,
+                    role: PartRole::Detail,
+                });
+                return Ok(());
+            }
+            Op::Template => {
+                let i = arg(0, 0.0);
+                let t = (i >= 0.0).then(|| cx.templates.get(i as usize)).flatten();
+                let Some(t) = t else {
+                    self.fallbacks += 1;
+                    return Ok(());
+                };
+                let mesh = t.instance(ring, cx.frame_x, z0, h)?;
+                if roofs::check_solid(&mesh).is_err() {
+                    self.fallbacks += 1;
+                    return Ok(());
+                }
+                self.parts.push(Part {
+                    mesh,
+                    role: PartRole::Template,
+                });
+                return Ok(());
+            }
+            _ => return Ok(()),
+        };
+        let (mesh, faces) = match roof {
+            Ok(r) => r,
+            Err(_) => {
+                self.fallbacks += 1;
+                match roofs::skeleton_roof(ring, z0, h, pitch(0), false) {
+                    Ok(r) if matches!(op, Op::Gable | Op::Pyramid | Op::Mansard) => r,
+                    _ => roofs::slab(ring, z0, h.min(0.5))?,
+                }
+            }
+        };
+        let part = self.parts.len();
+        for f in &faces {
+            if let Some(q) = bounding_quad(f) {
+                self.facades.push(FacadeFace {
+                    role: FacadeRole::Roof,
+                    floors: 0,
+                    part,
+                    ..q
+                });
+            }
+        }
+        self.parts.push(Part {
+            mesh,
+            role: PartRole::Roof,
+        });
+        Ok(())
+    }
+
+    /// Facade faces of a prism's walls: a ground-floor band on the ground, walls above.
+    fn walls(&mut self, cx: &Context<'_>, ring: &[DVec2], z0: f64, h: f64) {
+        let part = self.parts.len();
+        let n = ring.len();
+        let g = cx.ground_floor_height;
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            let mut bands: Vec<(f64, f64, FacadeRole)> = Vec::with_capacity(2);
+            if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
+                bands.push((z0, z0 + g, FacadeRole::GroundFloor));
+                bands.push((z0 + g, z0 + h, FacadeRole::Wall));
+            } else if z0 <= 0.0 {
+                bands.push((z0, z0 + h, FacadeRole::GroundFloor));
+            } else {
+                bands.push((z0, z0 + h, FacadeRole::Wall));
+            }
+            for (lo, hi, role) in bands {
+                let quad = [
+                    to_world(a, lo),
+                    to_world(b, lo),
+                    to_world(b, hi),
+                    to_world(a, hi),
+                ];
+                let fh = if role == FacadeRole::GroundFloor {
+                    g
+                } else {
+                    cx.floor_height
+                };
+                let floors = ((hi - lo) / fh).round().max(1.0) as u32;
+                let d = b - a;
+                self.facades.push(FacadeFace {
+                    quad,
+                    width: d.length(),
+                    height: hi - lo,
+                    floors,
+                    normal: to_world(DVec2::new(d.y, -d.x).normalize_or_zero(), 0.0),
+                    role,
+                    part,
+                });
+            }
+        }
+    }
+}
+
+/// The bounding rectangle of a planar polygon in its plane: `u` horizontal, `v` up.
+fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
+    let n = pts.len();
+    let mut nrm = DVec3::ZERO;
+    for i in 0..n {
+        nrm += pts[i].cross(pts[(i + 1) % n]);
+    }
+    let nrm = nrm.normalize_or_zero();
+    if nrm == DVec3::ZERO {
+        return None;
+    }
+    let t = DVec3::Y.cross(nrm);
+    let t = if t.length() < 1e-9 {
+        DVec3::X
+    } else {
+        t.normalize()
+    };
+    let v = nrm.cross(t);
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in pts {
+        u0 = u0.min(p.dot(t));
+        u1 = u1.max(p.dot(t));
+        v0 = v0.min(p.dot(v));
+        v1 = v1.max(p.dot(v));
+    }
+    let off = nrm * pts[0].dot(nrm);
+    let at = |a: f64, b: f64| off + t * a + v * b;
+    Some(FacadeFace {
+        quad: [at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)],
+        width: u1 - u0,
+        height: v1 - v0,
+        floors: 0,
+        normal: nrm,
+        role: FacadeRole::Roof,
+        part: 0,
+    })
+}
+
+/// The part of the shape to draw: inside the lot, below the top; `None` if nothing is.
+fn clip(cx: &Context<'_>, s: &Shape) -> Option<(Vec<DVec2>, f64, f64)> {
+    let ring = s.ring.as_ref()?;
+    let top = (s.base + s.height).min(cx.top);
+    if !(s.base >= 0.0 && top - s.base >= MIN_PART_HEIGHT) {
+        return None;
+    }
+    inside(cx.lot, ring).then(|| (ring.clone(), s.base, top - s.base))
+}
+
+/// Whether the ring lies inside the lot (vertices inside or on it, no proper crossing).
+pub(crate) fn inside(lot: &Polygon, ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    ring.iter().all(|&p| lot.contains(p))
+        && (0..n).all(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            lot.edges().all(|(c, d)| {
+                !matches!(
+                    segment_intersection(a, b, c, d),
+                    SegmentIntersection::Crossing { .. }
+                )
+            })
+        })
+}
+
+/// The ring scaled about its centroid by `sx` along `x` and `sy` across; `None` if the
+/// result is degenerate.
+fn scaled(r: &[DVec2], x: DVec2, sx: f64, sy: f64) -> Option<Vec<DVec2>> {
+    if !(sx > 0.0 && sy > 0.0) {
+        return None;
+    }
+    let c = Polygon::new(r.to_vec()).centroid();
+    let y = x.perp();
+    let out: Vec<DVec2> = r
+        .iter()
+        .map(|&p| {
+            let d = p - c;
+            c + x * (d.dot(x) * sx) + y * (d.dot(y) * sy)
+        })
+        .collect();
+    let poly = Polygon::new(out);
+    (poly.validate().is_ok() && poly.is_ccw() && poly.len() == r.len()).then(|| poly.into_points())
+}
+
+/// The largest piece of the ring inset by `d`, starting as close as possible to the
+/// original first vertex; `None` when nothing is left.
+fn setback(r: &[DVec2], d: f64) -> Option<Vec<DVec2>> {
+    if !(d.is_finite() && d >= 0.0) {
+        return None;
+    }
+    if d == 0.0 {
+        return Some(r.to_vec());
+    }
+    let poly = PolygonWithHoles::from(Polygon::new(r.to_vec()));
+    let pieces = polis_lots::inset_shapes(&poly, None, d).ok()?;
+    let best = pieces.into_iter().max_by(|a, b| {
+        Polygon::new(a.outer.points.clone())
+            .area()
+            .total_cmp(&Polygon::new(b.outer.points.clone()).area())
+    })?;
+    // Keep the street edge first: rotate so the edge from input edge 0 (or the lowest) leads.
+    let k = best
+        .outer
+        .sources
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.map(|s| (s, i)))
+        .min()
+        .map_or(0, |(_, i)| i);
+    let mut pts = best.outer.points;
+    pts.rotate_left(k);
+    let poly = Polygon::new(pts);
+    (poly.validate().is_ok() && poly.area() > 0.0).then(|| poly.into_points())
+}

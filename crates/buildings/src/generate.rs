@@ -1,0 +1,369 @@
+//! The building generator: footprint → height → grammar derivation → shapes, per LOD.
+
+use polis_geom::{DVec2, Field, Polygon};
+use polis_lots::Lot;
+use polis_lsystem::{Derivation, DeriveOptions, ParamString};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use crate::BuildingsError;
+use crate::building::{Building, Context, interpret};
+use crate::footprint::footprint;
+use crate::grammar::BuildingGrammar;
+use crate::params::{BuildingKind, BuildingParams, HeightDistribution};
+use crate::template::Template;
+
+/// Lowest building drawn, metres: under this the maximum-height map forbids building.
+pub const MIN_BUILDING_HEIGHT: f64 = 2.5;
+
+/// Longest string a building derivation may produce (modules).
+pub const MAX_BUILDING_MODULES: usize = 100_000;
+
+/// A building's footprint and height before any grammar runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// Footprint (layout, absolute), counter-clockwise, primary street edge first.
+    pub footprint: Polygon,
+    /// Height of the bounding volume, metres.
+    pub height: f64,
+    /// Storeys.
+    pub floors: u32,
+    /// Seed of the building's derivation.
+    pub seed: u64,
+}
+
+/// The reusable generator: parameters, one grammar per kind, user templates.
+#[derive(Debug, Clone)]
+pub struct BuildingGenerator {
+    params: BuildingParams,
+    grammars: Vec<BuildingGrammar>,
+    templates: Vec<Template>,
+}
+
+/// A stable 64-bit mix of the city seed and an id (SplitMix64 finaliser).
+pub fn mix_seed(seed: u64, id: u64) -> u64 {
+    let mut z = seed ^ id.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+impl BuildingGenerator {
+    /// A generator with the default grammars of every kind.
+    pub fn new(params: BuildingParams) -> Result<Self, BuildingsError> {
+        params.validate()?;
+        let grammars = BuildingKind::ALL
+            .iter()
+            .map(|&k| BuildingGrammar::default_for(k))
+            .collect::<Result<_, _>>()?;
+        Ok(BuildingGenerator {
+            params,
+            grammars,
+            templates: Vec::new(),
+        })
+    }
+
+    /// Replaces the grammar of `kind` (e.g. one parsed from a user's building file).
+    pub fn set_grammar(&mut self, kind: BuildingKind, grammar: BuildingGrammar) {
+        if let Some(g) = self.grammars.get_mut(kind.index()) {
+            *g = grammar;
+        }
+    }
+
+    /// Adds a user template; `Template(i)` in a grammar names the `i`-th added.
+    pub fn add_template(&mut self, template: Template) -> usize {
+        self.templates.push(template);
+        self.templates.len() - 1
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &BuildingParams {
+        &self.params
+    }
+
+    /// Footprint and height of the building of `kind` on `lot` under the maximum height
+    /// `max_height` (metres, e.g. sampled from the maximum-height map at the lot's
+    /// centroid). `Ok(None)` when the lot cannot carry one (too small after the setbacks,
+    /// or a height limit under [`MIN_BUILDING_HEIGHT`]).
+    pub fn plan(
+        &self,
+        lot: &Lot,
+        lot_id: u64,
+        kind: BuildingKind,
+        max_height: f64,
+    ) -> Result<Option<Plan>, BuildingsError> {
+        if !(max_height.is_finite()) {
+            return Err(BuildingsError::Lot {
+                lot_id,
+                reason: format!("the maximum height {max_height} is not finite"),
+            });
+        }
+        if max_height < MIN_BUILDING_HEIGHT {
+            return Ok(None);
+        }
+        let Some(mut fp) = footprint(
+            lot,
+            lot_id,
+            kind.footprint_strategy(),
+            &self.params.footprint,
+        )?
+        else {
+            return Ok(None);
+        };
+        // Primary street edge first: the longest edge when the lot names none.
+        let n = fp.len();
+        let lead = (0..n)
+            .max_by(|&a, &b| {
+                let (p, q) = (fp.edge(a), fp.edge(b));
+                p.0.distance(p.1)
+                    .total_cmp(&q.0.distance(q.1))
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let lead =
+            if kind.footprint_strategy() == crate::params::FootprintStrategy::SuburbanRectangle {
+                0
+            } else {
+                lead
+            };
+        let mut pts = fp.into_points();
+        pts.rotate_left(lead);
+        fp = Polygon::new(pts);
+        let seed = mix_seed(self.params.seed, lot_id);
+        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x6865_6967_6874);
+        let height = self
+            .draw_height(kind, fp.centroid(), &mut rng)
+            .clamp(MIN_BUILDING_HEIGHT, max_height);
+        let p = &self.params;
+        let floors = if height <= p.ground_floor_height {
+            1
+        } else {
+            1 + ((height - p.ground_floor_height) / p.floor_height).floor() as u32
+        };
+        Ok(Some(Plan {
+            footprint: fp,
+            height,
+            floors,
+            seed,
+        }))
+    }
+
+    /// A height drawn from the configured distribution for `kind` at layout point `at`.
+    pub fn draw_height(&self, kind: BuildingKind, at: DVec2, rng: &mut Pcg64Mcg) -> f64 {
+        let m = self
+            .params
+            .median_height
+            .get(kind.index())
+            .copied()
+            .unwrap_or(10.0);
+        let normal = |rng: &mut Pcg64Mcg| {
+            // Box–Muller with libm-backed trigonometry (platform-independent).
+            let u1: f64 = 1.0 - rng.random::<f64>();
+            let u2: f64 = rng.random::<f64>();
+            (-2.0 * u1.ln()).sqrt() * DVec2::from_angle(std::f64::consts::TAU * u2).x
+        };
+        let h = match self.params.distribution {
+            HeightDistribution::Uniform { deviance } => {
+                m * (1.0 + deviance * (2.0 * rng.random::<f64>() - 1.0))
+            }
+            HeightDistribution::Normal { sigma } => m * (1.0 + sigma * normal(rng)),
+            HeightDistribution::LogNormal {
+                sigma,
+                centre,
+                centre_boost,
+                falloff,
+            } => {
+                let r = at.distance(DVec2::from(centre)) / falloff;
+                let median = m * (1.0 + centre_boost * (-r * r).exp());
+                median * (sigma * normal(rng)).exp()
+            }
+        };
+        if h.is_finite() { h } else { m }
+    }
+
+    /// The building of `kind` on `lot` at level of detail `lod` (derivation steps; capped
+    /// at [`BuildingParams::max_lod`]). `Ok(None)` when the lot carries no building.
+    pub fn build(
+        &self,
+        lot: &Lot,
+        lot_id: u64,
+        kind: BuildingKind,
+        max_height: f64,
+        lod: usize,
+    ) -> Result<Option<Building>, BuildingsError> {
+        let mut all = self.build_lods(
+            lot,
+            lot_id,
+            kind,
+            max_height,
+            lod.min(self.params.max_lod),
+            true,
+        )?;
+        Ok(all.pop())
+    }
+
+    /// Every level of detail `0..=max_lod` of one building (LOD `k + 1` refines LOD `k`).
+    pub fn lods(
+        &self,
+        lot: &Lot,
+        lot_id: u64,
+        kind: BuildingKind,
+        max_height: f64,
+    ) -> Result<Vec<Building>, BuildingsError> {
+        self.build_lods(lot, lot_id, kind, max_height, self.params.max_lod, false)
+    }
+
+    fn build_lods(
+        &self,
+        lot: &Lot,
+        lot_id: u64,
+        kind: BuildingKind,
+        max_height: f64,
+        lod: usize,
+        last_only: bool,
+    ) -> Result<Vec<Building>, BuildingsError> {
+        let Some(plan) = self.plan(lot, lot_id, kind, max_height)? else {
+            return Ok(Vec::new());
+        };
+        let grammar = self
+            .grammars
+            .get(kind.index())
+            .ok_or(BuildingsError::InvalidParameter {
+                name: "kind",
+                reason: "no grammar for this kind".into(),
+            })?;
+        let origin = plan.footprint.centroid();
+        let local: Vec<DVec2> = plan
+            .footprint
+            .points()
+            .iter()
+            .map(|&p| p - origin)
+            .collect();
+        let lot_local = lot.polygon.translated(-origin);
+        let (w, d, frame_x) = extents(&local);
+        let p = &self.params;
+        let cx = Context {
+            grammar,
+            templates: &self.templates,
+            lot: &lot_local,
+            frame_x,
+            top: plan.height,
+            floor_height: p.floor_height,
+            ground_floor_height: p.ground_floor_height,
+            slope_default: p.roof_pitch_deg.to_radians().tan(),
+        };
+        let mut axiom = ParamString::with_capacity(1, 4);
+        axiom
+            .push(
+                grammar.lot_symbol(),
+                &[plan.height, w, d, f64::from(plan.floors)],
+            )
+            .map_err(|source| BuildingsError::Derivation {
+                kind: kind.name().into(),
+                source,
+            })?;
+        let options = DeriveOptions {
+            seed: plan.seed,
+            max_len: MAX_BUILDING_MODULES,
+            ..DeriveOptions::default()
+        };
+        let mut derivation = Derivation::new(grammar.grammar(), axiom, options);
+        let mut out = Vec::new();
+        for k in 0..=lod {
+            if k > 0 {
+                derivation
+                    .step()
+                    .map_err(|source| BuildingsError::Derivation {
+                        kind: kind.name().into(),
+                        source,
+                    })?;
+            }
+            if last_only && k < lod {
+                continue;
+            }
+            let (parts, facades, fallbacks) =
+                interpret(&cx, &local, plan.height, derivation.string())?;
+            out.push(Building {
+                id: lot_id,
+                lot_id,
+                kind,
+                height: plan.height,
+                floors: plan.floors,
+                lod: k,
+                origin,
+                footprint: plan.footprint.clone(),
+                parts,
+                facades,
+                fallbacks,
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// Width along and depth across the first edge, and the first edge's unit direction.
+fn extents(ring: &[DVec2]) -> (f64, f64, DVec2) {
+    let x = match ring {
+        [a, b, ..] => (*b - *a).normalize_or(DVec2::X),
+        _ => DVec2::X,
+    };
+    let y = x.perp();
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in ring {
+        u0 = u0.min(p.dot(x));
+        u1 = u1.max(p.dot(x));
+        v0 = v0.min(p.dot(y));
+        v1 = v1.max(p.dot(y));
+    }
+    (u1 - u0, v1 - v0, x)
+}
+
+/// How zones choose building types.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum ZoneRule {
+    /// The zoning map's value, rounded, indexes [`BuildingKind::ALL`] (0 skyscraper … 5
+    /// industrial; out of range clamps).
+    #[default]
+    Index,
+}
+
+/// The building kind a zoning map assigns to layout point `p` ([`ZoneRule::Index`]).
+pub fn kind_from_zoning(zoning: &dyn Field, p: DVec2) -> BuildingKind {
+    let v = zoning.sample(p);
+    let i = if v.is_finite() {
+        v.round().clamp(0.0, 5.0) as usize
+    } else {
+        3
+    };
+    BuildingKind::ALL
+        .get(i)
+        .copied()
+        .unwrap_or(BuildingKind::House)
+}
+
+/// One-call form: a building (full detail) on every lot, the kind from the zoning map,
+/// the height limit from the maximum-height map, both sampled at the lot's centroid;
+/// lot ids are the slice indices. Lots that carry none are skipped; errors of single lots
+/// are returned, not skipped.
+pub fn generate(
+    lots: &[Lot],
+    params: &BuildingParams,
+    zoning: &dyn Field,
+    max_height: &dyn Field,
+) -> Result<Vec<Building>, BuildingsError> {
+    let g = BuildingGenerator::new(params.clone())?;
+    let mut out = Vec::with_capacity(lots.len());
+    for (i, lot) in lots.iter().enumerate() {
+        let c = lot.polygon.centroid();
+        let kind = kind_from_zoning(zoning, c);
+        if let Some(b) = g.build(lot, i as u64, kind, max_height.sample(c), params.max_lod)? {
+            out.push(b);
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,116 @@
+//! Closed solids from planar faces: the mesh-building primitives every shape module uses.
+//!
+//! Every face is a planar polygon given by its exact world corners; faces of one solid
+//! share corners bit for bit, so [`Mesh::check_closed`] welds them. Texture coordinates
+//! follow `polis_geom::mesh`'s convention (metres, `u` along the horizontal tangent,
+//! `v = −` distance upwards).
+
+use polis_geom::mesh::to_world;
+use polis_geom::{
+    DVec2, DVec3, GeomError, Mesh, Orientation, Polygon, PolygonWithHoles, orient2d, triangulate,
+};
+
+/// Appends the planar polygon `pts` (counter-clockwise seen from its front) as one
+/// flat-shaded face. Convex faces are fanned; others go through the constrained Delaunay
+/// triangulation. Leaves the mesh unchanged on failure.
+pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> {
+    let n = pts.len();
+    if n < 3 {
+        return Err(GeomError::DegenerateTriangle {
+            triangle: mesh.triangle_count(),
+        });
+    }
+    // Newell normal.
+    let mut nrm = DVec3::ZERO;
+    for i in 0..n {
+        let (a, b) = (pts[i], pts[(i + 1) % n]);
+        nrm += DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let nrm = nrm.normalize_or_zero();
+    if nrm == DVec3::ZERO || !nrm.is_finite() {
+        return Err(GeomError::DegenerateTriangle {
+            triangle: mesh.triangle_count(),
+        });
+    }
+    let t = DVec3::Y.cross(nrm);
+    let t = if t.length() < 1e-9 {
+        DVec3::X
+    } else {
+        t.normalize()
+    };
+    let b = nrm.cross(t);
+    let plane: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(t), p.dot(b))).collect();
+    let convex = (0..n).all(|i| {
+        orient2d(plane[i], plane[(i + 1) % n], plane[(i + 2) % n]) == Orientation::CounterClockwise
+    });
+    let base = mesh.positions.len() as u32;
+    let first = mesh.indices.len();
+    let tris: Vec<[u32; 3]> = if convex {
+        (1..n as u32 - 1).map(|i| [0, i, i + 1]).collect()
+    } else {
+        let poly = PolygonWithHoles::from(Polygon::new(plane.clone()));
+        if poly.outer.len() != n || !poly.outer.is_ccw() {
+            return Err(GeomError::DegenerateTriangle {
+                triangle: mesh.triangle_count(),
+            });
+        }
+        triangulate(&poly)?
+    };
+    for tri in &tris {
+        let [p, q, r] = tri.map(|i| pts[i as usize].as_vec3().as_dvec3());
+        if (q - p).cross(r - p) == DVec3::ZERO {
+            mesh.indices.truncate(first);
+            return Err(GeomError::DegenerateTriangle {
+                triangle: first / 3,
+            });
+        }
+        mesh.indices.extend(tri.iter().map(|&i| base + i));
+    }
+    for (p, uv) in pts.iter().zip(&plane) {
+        mesh.add_vertex(*p, nrm, DVec2::new(uv.x, -uv.y));
+    }
+    Ok(())
+}
+
+/// A closed prism over the counter-clockwise ring `ring` from elevation `z0` to `z1`:
+/// walls, a top cap facing up and a bottom cap facing down.
+pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError> {
+    let n = ring.len();
+    let mut m = Mesh::with_capacity(None, 6 * n, 4 * n);
+    let bottom: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z0)).collect();
+    let top: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z1)).collect();
+    for i in 0..n {
+        let j = (i + 1) % n;
+        add_face(&mut m, &[bottom[i], bottom[j], top[j], top[i]])?;
+    }
+    add_face(&mut m, &top)?;
+    let rev: Vec<DVec3> = bottom.iter().rev().copied().collect();
+    add_face(&mut m, &rev)?;
+    Ok(m)
+}
+
+/// A closed pyramid-like solid: the ring at `z0` (bottom cap facing down) joined to the
+/// single `apex` by triangles. The ring must be star-shaped from the apex's plan point.
+pub(crate) fn cone(ring: &[DVec2], z0: f64, apex: DVec2, z1: f64) -> Result<Mesh, GeomError> {
+    let n = ring.len();
+    if !(0..n).all(|i| orient2d(ring[i], ring[(i + 1) % n], apex) == Orientation::CounterClockwise)
+    {
+        return Err(GeomError::InvalidParameter {
+            name: "apex",
+            reason: "the footprint is not star-shaped from the apex".into(),
+        });
+    }
+    let mut m = Mesh::with_capacity(None, 4 * n, 2 * n);
+    let top = to_world(apex, z1);
+    let bottom: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z0)).collect();
+    for i in 0..n {
+        add_face(&mut m, &[bottom[i], bottom[(i + 1) % n], top])?;
+    }
+    let rev: Vec<DVec3> = bottom.iter().rev().copied().collect();
+    add_face(&mut m, &rev)?;
+    Ok(m)
+}

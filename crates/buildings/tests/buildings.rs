@@ -1,0 +1,375 @@
+//! End-to-end tests: closed meshes, footprints in lots, heights, LOD nesting, grammar
+//! errors, determinism, property tests over random lots.
+
+use polis_buildings::building::Building;
+use polis_buildings::{
+    BuildingGenerator, BuildingGrammar, BuildingKind, BuildingParams, BuildingsError, FacadeRole,
+    HeightDistribution, Template,
+};
+use polis_geom::mesh::to_layout;
+use polis_geom::{DVec2, Polygon};
+use polis_lots::Lot;
+use proptest::prelude::*;
+
+fn lot(points: Vec<DVec2>) -> Lot {
+    let polygon = Polygon::new(points);
+    Lot {
+        area: polygon.area(),
+        polygon,
+        street_edges: vec![0],
+        block_id: 0,
+    }
+}
+
+fn shapes() -> Vec<Lot> {
+    vec![
+        lot(Polygon::rect(DVec2::new(100.0, 200.0), DVec2::new(125.0, 240.0)).into_points()),
+        lot(Polygon::rect(DVec2::ZERO, DVec2::new(40.0, 40.0)).into_points()),
+        // L-shape (concave).
+        lot(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(40.0, 0.0),
+            DVec2::new(40.0, 15.0),
+            DVec2::new(18.0, 15.0),
+            DVec2::new(18.0, 35.0),
+            DVec2::new(0.0, 35.0),
+        ]),
+        // Rotated quadrilateral.
+        lot(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(30.0, 10.0),
+            DVec2::new(22.0, 38.0),
+            DVec2::new(-6.0, 25.0),
+        ]),
+        // Pentagon and triangle.
+        lot(Polygon::regular(5, DVec2::new(-500.0, 300.0), 22.0).into_points()),
+        lot(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(45.0, 0.0),
+            DVec2::new(10.0, 40.0),
+        ]),
+    ]
+}
+
+/// Every invariant the issue names for one building.
+fn check(b: &Building, lot: &Lot, max_height: f64) {
+    assert!(
+        b.height <= max_height + 1e-9,
+        "height {} over {max_height}",
+        b.height
+    );
+    for (i, part) in b.parts.iter().enumerate() {
+        let m = &part.mesh;
+        m.validate()
+            .unwrap_or_else(|e| panic!("part {i} of {:?} invalid: {e}", b.kind));
+        m.check_closed().unwrap_or_else(|e| {
+            panic!(
+                "part {i} ({:?}) of {:?} lod {} open: {e}",
+                part.role, b.kind, b.lod
+            )
+        });
+        assert!(
+            m.signed_volume() > 0.0,
+            "part {i} of {:?} has volume {}",
+            b.kind,
+            m.signed_volume()
+        );
+        let bb = m.bbox();
+        assert!(
+            bb.max.y as f64 <= b.height + 1e-3,
+            "part {i} rises to {} above {}",
+            bb.max.y,
+            b.height
+        );
+        assert!(bb.min.y >= -1e-4);
+        for p in &m.positions {
+            let (q, _) = to_layout(p.as_dvec3());
+            let q = q + b.origin;
+            // f32 rounding of local coordinates: allow a millimetre.
+            let ok = lot.polygon.contains(q)
+                || lot.polygon.edges().any(|(a, c)| {
+                    let d = c - a;
+                    let t = ((q - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+                    (a + d * t).distance(q) < 1e-3
+                });
+            assert!(ok, "vertex {q} of {:?} outside its lot", b.kind);
+        }
+    }
+    for p in b.footprint.points() {
+        assert!(
+            lot.polygon.contains(*p),
+            "footprint vertex {p} outside the lot"
+        );
+    }
+    for f in &b.facades {
+        assert!(f.width > 0.0 && f.height > 0.0 && f.part < b.parts.len());
+        assert!((f.normal.length() - 1.0).abs() < 1e-9);
+        if f.role != FacadeRole::Roof {
+            assert!(f.floors >= 1);
+        }
+    }
+}
+
+#[test]
+fn every_kind_on_every_shape_is_closed_inside_and_under_the_limit() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let mut built = 0;
+    for (li, l) in shapes().iter().enumerate() {
+        for kind in BuildingKind::ALL {
+            for seed in 0..6u64 {
+                let id = li as u64 * 100 + seed;
+                let max_h = 200.0;
+                for b in g.lods(l, id, kind, max_h).unwrap() {
+                    check(&b, l, max_h);
+                    assert!(!b.parts.is_empty());
+                    built += 1;
+                }
+            }
+        }
+    }
+    assert!(built > 500);
+}
+
+#[test]
+fn heights_follow_the_max_height_map() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let l = &shapes()[0];
+    for id in 0..30 {
+        let b = g
+            .build(l, id, BuildingKind::Skyscraper, 35.0, 6)
+            .unwrap()
+            .unwrap();
+        assert!(b.height <= 35.0);
+        check(&b, l, 35.0);
+    }
+    assert!(
+        g.build(l, 1, BuildingKind::House, 1.0, 6)
+            .unwrap()
+            .is_none(),
+        "a 1 m limit forbids building"
+    );
+}
+
+#[test]
+fn lod_k_plus_one_lies_in_lod_k_box() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    for l in &shapes() {
+        for kind in BuildingKind::ALL {
+            for id in 0..4 {
+                let lods = g.lods(l, id, kind, 300.0).unwrap();
+                assert_eq!(
+                    lods.first().map(|b| b.parts.len()),
+                    Some(1),
+                    "LOD 0 is the bounding volume"
+                );
+                for w in lods.windows(2) {
+                    let (a, b) = (w[0].bbox(), w[1].bbox());
+                    let eps = polis_geom::glam::Vec3::splat(1e-3);
+                    assert!(
+                        (a.min - eps).cmple(b.min).all() && b.max.cmple(a.max + eps).all(),
+                        "{kind:?} lod {} box {b:?} leaves lod {} box {a:?}",
+                        w[1].lod,
+                        w[0].lod
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn deterministic_per_seed_and_lot() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let l = &shapes()[2];
+    let a = g.build(l, 42, BuildingKind::House, 100.0, 6).unwrap();
+    let b = g.build(l, 42, BuildingKind::House, 100.0, 6).unwrap();
+    assert_eq!(a, b);
+    let heights: Vec<f64> = (0..20)
+        .map(|id| {
+            g.plan(l, id, BuildingKind::Office, 500.0)
+                .unwrap()
+                .unwrap()
+                .height
+        })
+        .collect();
+    assert!(
+        heights.windows(2).any(|w| w[0] != w[1]),
+        "heights vary between lots"
+    );
+    let other = BuildingGenerator::new(BuildingParams {
+        seed: 9,
+        ..BuildingParams::default()
+    })
+    .unwrap();
+    let c: Vec<f64> = (0..20)
+        .map(|id| {
+            other
+                .plan(l, id, BuildingKind::Office, 500.0)
+                .unwrap()
+                .unwrap()
+                .height
+        })
+        .collect();
+    assert_ne!(heights, c);
+}
+
+#[test]
+fn grammar_errors_are_clean() {
+    let e = BuildingGrammar::parse("bad", "p1: Lot(h, w, d, n) -> Extrude(h *) Box\n").unwrap_err();
+    let text = e.to_string();
+    assert!(matches!(e, BuildingsError::Grammar { .. }), "{text}");
+    assert!(text.contains("bad"), "{text}");
+    if let BuildingsError::Grammar {
+        source: polis_lsystem::LsystemError::Parse { line, .. },
+        ..
+    } = e
+    {
+        assert_eq!(line, 1, "line numbers refer to the user's text");
+    }
+    assert!(matches!(
+        BuildingGrammar::parse("x", "p1: A -> B\n"),
+        Err(BuildingsError::GrammarContent { .. })
+    ));
+    assert!(
+        BuildingGrammar::parse("x", "p1: Lot(h,w,d,n) -> Extrude(q) Box\n").is_err(),
+        "unknown name"
+    );
+}
+
+#[test]
+fn user_grammar_and_template() {
+    let mut g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    // A closed tetrahedron as a user template (OBJ).
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nv 0 1 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    let t = Template::from_obj_str("tetra", obj).unwrap();
+    let i = g.add_template(t);
+    let text = format!(
+        "#module Tower\np1: Lot(h,w,d,n) -> Extrude(h/2) Tower Up Template({i})\np2: Tower -> Box\n"
+    );
+    g.set_grammar(
+        BuildingKind::Office,
+        BuildingGrammar::parse("user", &text).unwrap(),
+    );
+    let l = &shapes()[0];
+    let b = g
+        .build(l, 3, BuildingKind::Office, 80.0, 3)
+        .unwrap()
+        .unwrap();
+    check(&b, l, 80.0);
+    assert_eq!(b.parts.len(), 2);
+    assert!(Template::from_obj_str("broken", "v 0 0 0\nf 1 2 3\n").is_err());
+}
+
+#[test]
+fn distributions_stay_finite_and_under_the_limit() {
+    for distribution in [
+        HeightDistribution::Uniform { deviance: 0.5 },
+        HeightDistribution::Normal { sigma: 0.4 },
+        HeightDistribution::LogNormal {
+            sigma: 0.5,
+            centre: [0.0, 0.0],
+            centre_boost: 3.0,
+            falloff: 500.0,
+        },
+    ] {
+        let g = BuildingGenerator::new(BuildingParams {
+            distribution,
+            ..BuildingParams::default()
+        })
+        .unwrap();
+        let l = &shapes()[1];
+        for id in 0..50 {
+            let p = g.plan(l, id, BuildingKind::MidRise, 60.0).unwrap().unwrap();
+            assert!(p.height.is_finite() && p.height <= 60.0 && p.height >= 2.5);
+        }
+    }
+    // Log-normal with a centre boost: taller near the centre on average.
+    let g = BuildingGenerator::new(BuildingParams {
+        distribution: HeightDistribution::LogNormal {
+            sigma: 0.3,
+            centre: [0.0, 0.0],
+            centre_boost: 4.0,
+            falloff: 300.0,
+        },
+        ..BuildingParams::default()
+    })
+    .unwrap();
+    let mean = |c: DVec2| {
+        let l = lot(Polygon::rect(c, c + DVec2::new(20.0, 20.0)).into_points());
+        (0..200)
+            .map(|id| {
+                g.plan(&l, id, BuildingKind::Office, 1e4)
+                    .unwrap()
+                    .unwrap()
+                    .height
+            })
+            .sum::<f64>()
+            / 200.0
+    };
+    assert!(mean(DVec2::ZERO) > 2.0 * mean(DVec2::new(3000.0, 0.0)));
+}
+
+#[test]
+fn house_footprint_is_a_rectangle_set_back_from_the_street() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let l = &shapes()[0];
+    let p = g.plan(l, 1, BuildingKind::House, 50.0).unwrap().unwrap();
+    assert_eq!(p.footprint.len(), 4);
+    // Street edge 0 is y = 200: at least the 5 m street setback away.
+    assert!(
+        p.footprint.points().iter().all(|q| q.y >= 205.0 - 1e-9),
+        "{:?}",
+        p.footprint
+    );
+    let d = g
+        .plan(l, 1, BuildingKind::Skyscraper, 50.0)
+        .unwrap()
+        .unwrap();
+    assert!(
+        (d.footprint.area() - l.polygon.area()).abs() < 1e-9,
+        "downtown fills the lot"
+    );
+    let ind = g
+        .plan(l, 1, BuildingKind::Industrial, 50.0)
+        .unwrap()
+        .unwrap();
+    assert!(
+        (ind.footprint.area() - 19.0 * 34.0).abs() < 1e-6,
+        "industrial insets 3 m"
+    );
+}
+
+/// Random star-shaped lots: convex for few jitters, concave otherwise.
+fn star_lot() -> impl Strategy<Value = Lot> {
+    (
+        3usize..10,
+        prop::collection::vec(0.3f64..1.0, 10),
+        8.0f64..60.0,
+        prop::bool::ANY,
+        -1e4f64..1e4,
+    )
+        .prop_map(|(n, radii, size, convex, off)| {
+            let pts: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / n as f64;
+                    let r = if convex { size } else { size * radii[i] };
+                    DVec2::new(off, -off * 0.5) + DVec2::new(a.cos(), a.sin()) * r
+                })
+                .collect();
+            lot(pts)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #[test]
+    fn random_lots_never_panic_and_stay_valid(l in star_lot(), id in 0u64..1000, kind in 0usize..6, max_h in 0.0f64..250.0) {
+        let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+        let kind = BuildingKind::ALL[kind];
+        if let Ok(lods) = g.lods(&l, id, kind, max_h) {
+            for b in &lods {
+                check(b, &l, max_h);
+            }
+        }
+    }
+}
