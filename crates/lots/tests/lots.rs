@@ -219,6 +219,14 @@ fn bad_input() {
     assert!(subdivide(&nan, 0, &LotParams::default(), &mut rng).is_err());
 }
 
+/// Case count: `default`, or `LOTS_CASES` to stress.
+fn cases(default: u32) -> u32 {
+    std::env::var("LOTS_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(default)
+}
+
 fn blob(n: usize, seeds: &[(f64, f64)]) -> Polygon {
     let pts = (0..n)
         .map(|i| {
@@ -231,7 +239,7 @@ fn blob(n: usize, seeds: &[(f64, f64)]) -> Polygon {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    #![proptest_config(ProptestConfig::with_cases(cases(48)))]
 
     #[test]
     fn partition_and_access(
@@ -260,7 +268,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(32))]
+    #![proptest_config(ProptestConfig::with_cases(cases(32)))]
 
     #[test]
     fn cells_to_blocks_to_lots(
