@@ -6,13 +6,13 @@
 //! classified once with the exact [`segment_intersection`]. No sorting: expected `O(n)` on
 //! road-like graphs, `O(d²)` around a node of degree `d`.
 
-use polis_geom::predicates::{
-    Orientation, SegmentIntersection, orient2d, point_on_segment, segment_intersection,
-};
+use std::cmp::Ordering;
+
+use polis_geom::predicates::{SegmentIntersection, point_on_segment, segment_intersection};
 use polis_geom::{DVec2, EdgeId, NodeId};
 
 use crate::error::{Conflict, Error};
-use crate::topology::Topology;
+use crate::topology::{Start, Topology, ccw_cmp};
 
 /// At most this many conflicts are listed in [`Error::NotPlanar`].
 pub const MAX_REPORTED_CONFLICTS: usize = 16;
@@ -178,6 +178,7 @@ impl PlanarityCheck {
         self.stamp.resize(m + topo.len(), u32::MAX);
         let mut conflicts = Vec::new();
         let mut total = 0;
+        rotation_overlaps(topo, &mut total, &mut conflicts);
         let (start, items, stamp) = (&self.start, &self.items, &mut self.stamp);
         let mut test = |x: u32, c: usize, total: &mut usize, conflicts: &mut Vec<Conflict>| {
             for &y in &items[start[c] as usize..start[c + 1] as usize] {
@@ -212,16 +213,40 @@ impl PlanarityCheck {
     }
 }
 
-/// The shared end and the two other ends of two edges with one common end node.
-fn shared_end(a: [u32; 2], b: [u32; 2]) -> Option<(u32, u32, u32)> {
-    for i in 0..2 {
-        for j in 0..2 {
-            if a[i] == b[j] && a[1 - i] != b[1 - j] {
-                return Some((a[i], a[1 - i], b[1 - j]));
+/// Whether two edges have a common end node.
+fn shares_end(a: [u32; 2], b: [u32; 2]) -> bool {
+    a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]
+}
+
+/// Overlaps of edges sharing an end node: they leave it in exactly the same direction,
+/// so they are neighbours in the node's exact counter-clockwise order.
+fn rotation_overlaps(topo: &Topology, total: &mut usize, conflicts: &mut Vec<Conflict>) {
+    for r in 0..topo.len() {
+        let (s, t) = (topo.adj_start[r], topo.adj_start[r + 1]);
+        if t - s < 2 {
+            continue;
+        }
+        let o = topo.pos[r];
+        // With two edges the wrap-around pair is the same pair.
+        let last = if t - s == 2 { s + 1 } else { t };
+        for k in s..last {
+            let k2 = if k + 1 == t { s } else { k + 1 };
+            let (p, q) = (
+                topo.p(topo.target[k as usize]),
+                topo.p(topo.target[k2 as usize]),
+            );
+            if ccw_cmp(o, p, q, Start::East) == Ordering::Equal {
+                let (e, f) = (topo.edge[k as usize], topo.edge[k2 as usize]);
+                *total += 1;
+                if conflicts.len() < MAX_REPORTED_CONFLICTS {
+                    conflicts.push(Conflict::Overlap {
+                        first: EdgeId::from_raw(e.min(f)),
+                        second: EdgeId::from_raw(e.max(f)),
+                    });
+                }
             }
         }
     }
-    None
 }
 
 /// The conflict between two grid items (edge slot `k` as `k`, isolated node of rank `v`
@@ -247,15 +272,10 @@ fn classify(topo: &Topology, m: u32, x: u32, y: u32) -> Option<Conflict> {
     let (ie, jf) = (topo.edge[e as usize], topo.edge[f as usize]);
     let first = EdgeId::from_raw(ie.min(jf));
     let second = EdgeId::from_raw(ie.max(jf));
-    // Edges sharing an end node meet elsewhere only when they overlap: both leave the
-    // shared node in exactly the same direction.
-    if let Some((o, p, q)) = shared_end(ee, fe) {
-        let (o, p, q) = (topo.p(o), topo.p(p), topo.p(q));
-        let same_side = |a: f64, b: f64, c: f64| (b > a) == (c > a) && (b < a) == (c < a);
-        let overlap = orient2d(o, p, q) == Orientation::Collinear
-            && same_side(o.x, p.x, q.x)
-            && same_side(o.y, p.y, q.y);
-        return overlap.then_some(Conflict::Overlap { first, second });
+    // Edges sharing an end node meet elsewhere only when they overlap, leaving the node
+    // in the same direction: `rotation_overlaps` finds those.
+    if shares_end(ee, fe) {
+        return None;
     }
     match segment_intersection(a0, a1, b0, b1) {
         SegmentIntersection::Disjoint => None,
