@@ -9,8 +9,8 @@
 //!   with `min`/`max`), `NORMAL` (`VEC3` f32, renormalised to unit length), `TEXCOORD_0`
 //!   (`VEC2` f32, metres, `v` down as glTF wants), indices (`u16` when the geometry has at
 //!   most 65,535 vertices, else `u32`) and, when the material has a normal texture,
-//!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`), each in its own buffer view with the right
-//!   `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written even for untextured
+//!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`), each in its own buffer
+//!   view with the right `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written even for untextured
 //!   materials (so textures can be added in an engine later); the Khronos validator lists
 //!   it as possibly unused (an info, not a warning).
 //! * Materials: glTF metallic-roughness PBR (base colour, metallic, roughness, base colour,
@@ -37,11 +37,13 @@
 //! * The scene is validated ([`Scene::validate`]) before anything is written; an invalid
 //!   scene is never written.
 //! * Streaming: the binary chunk is written straight from the scene's meshes through a
-//!   small buffer, never assembled in memory (batched geometry and PNG encodings are the
-//!   only copies).
+//!   small buffer, never assembled in memory (batched geometry, PNG encodings and the
+//!   tangents of one geometry at a time are the only copies).
 //! * Byte-identical output for identical scenes and options.
 //! * The container is exactly what [`gltf::binary::Glb::to_writer`] writes for the same
-//!   chunks (tested), with the 4 GiB limit of the format checked.
+//!   chunks (tested byte for byte). It is written here rather than by `Glb::to_writer`
+//!   because that needs the whole binary chunk as one slice in memory and does not check
+//!   the format's 4 GiB limit, which this writer does before writing anything.
 //!
 //! ## Limitations
 //!
@@ -49,7 +51,7 @@
 //!   [`GlbReport`]): glTF forbids empty accessors.
 //! * A node matrix with shear cannot be a glTF TRS; it is written as `matrix`, which the
 //!   Khronos validator reports as not decomposable. Scenes built with
-//!   [`Transform::Trs`](polis_geom::Transform::Trs) never hit this.
+//!   [`Transform::Trs`] never hit this.
 
 mod plan;
 mod tangents;
