@@ -119,9 +119,18 @@ pub fn encode_png(width: u32, height: u32, color: png::ColorType, data: &[u8]) -
     Ok(out)
 }
 
+/// `[0, 1] → 0..=255`, rounding; clamps out-of-range values and maps NaN to 0.
 #[inline]
 fn to_u8(v: f32) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+    let x = v * 255.0 + 0.5;
+    if x >= 255.0 {
+        255
+    } else if x > 0.0 {
+        // In (0, 255): the truncating cast is exact and cheap.
+        x as i32 as u8
+    } else {
+        0
+    }
 }
 
 /// Rasterises `region` (metres, in the stack's domain) of a stack into `width × height`
@@ -373,6 +382,19 @@ mod tests {
             assert_eq!(tex.albedo[k], to_u8(m.albedo[0]), "({x},{y})");
             assert_eq!(tex.metallic_roughness[k + 1], to_u8(m.roughness));
             assert_eq!(tex.height_m[y * 576 + x], m.height);
+        }
+    }
+
+    #[test]
+    fn to_u8_rounds_and_clamps() {
+        assert_eq!(to_u8(0.0), 0);
+        assert_eq!(to_u8(1.0), 255);
+        assert_eq!(to_u8(0.5), 128);
+        assert_eq!(to_u8(-3.0), 0);
+        assert_eq!(to_u8(7.0), 255);
+        assert_eq!(to_u8(f32::NAN), 0);
+        for k in 0..=255u8 {
+            assert_eq!(to_u8(f32::from(k) / 255.0), k);
         }
     }
 

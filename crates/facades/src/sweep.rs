@@ -69,6 +69,9 @@ pub(crate) struct RowSweep {
     samples: Vec<FacadeSample>,
     spans: Vec<Span>,
     state: RowState,
+    /// Sweeps for nested stacks (reused) and their output row.
+    pool: Vec<RowSweep>,
+    nested_out: Vec<FacadeSample>,
 }
 
 impl RowSweep {
@@ -80,7 +83,18 @@ impl RowSweep {
             samples: vec![FacadeSample::default(); w],
             spans: Vec::new(),
             state: RowState::default(),
+            pool: Vec::new(),
+            nested_out: Vec::new(),
         }
+    }
+
+    /// Re-targets the sweep at arbitrary sorted texel positions.
+    fn set_xs(&mut self, xs: impl Iterator<Item = f64>) {
+        self.xs.clear();
+        self.xs.extend(xs);
+        let n = self.xs.len();
+        self.owner.resize(n, 0);
+        self.samples.resize(n, FacadeSample::default());
     }
 
     /// Evaluates the row at height `t` into `out` (one sample per texel).
@@ -215,7 +229,7 @@ impl RowSweep {
                         let col = stack
                             .border_col_in_row(k, s, &self.state)
                             .unwrap_or(&layer.col);
-                        let mut m = match col {
+                        let m = match col {
                             Col::Inherit { .. } => texel,
                             _ => {
                                 let ctx = PointCtx {
@@ -232,14 +246,69 @@ impl RowSweep {
                                 col.eval(&ctx, Some(&texel))
                             }
                         };
-                        m.height += layer.depth_m;
+                        if let (Some(smp), Some(o)) =
+                            (self.samples.get_mut(x), self.owner.get_mut(x))
+                        {
+                            // Store, then adjust in place (avoids a store-forwarding stall
+                            // on a freshly modified copy).
+                            *smp = m;
+                            smp.height += layer.depth_m;
+                            *o = DONE;
+                        }
+                    }
+                } else if let (Eval::Stack(inner), false) = (&layer.eval, scaled) {
+                    // A nested stack: sweep its row over the texels mapped into its
+                    // domain (the same arithmetic as `Layer::probe_hits`).
+                    let (bw, bh) = (bx[1] - bx[0], bx[3] - bx[2]);
+                    let (iw, ih) = (inner.width(), inner.height());
+                    let nt = (t - bx[2]) / bh * ih;
+                    let mut sub = self.pool.pop().unwrap_or_default();
+                    sub.set_xs(xs[x0..x1].iter().map(|&s| (s - bx[0]) / bw * iw));
+                    let mut buf = std::mem::take(&mut self.nested_out);
+                    buf.resize(x1 - x0, FacadeSample::default());
+                    sub.row(inner, nt, &mut buf);
+                    let has_bg = inner.background().is_some();
+                    for (q, x) in (x0..x1).enumerate() {
+                        if !has_bg && sub.owner.get(q).is_none_or(|&o| o == 0) {
+                            continue;
+                        }
+                        let (Some(&s), Some(&inner_m)) = (xs.get(x), buf.get(q)) else {
+                            break;
+                        };
+                        let col = stack
+                            .border_col_in_row(k, s, &self.state)
+                            .unwrap_or(&layer.col);
+                        let m = match col {
+                            Col::Inherit { .. } => inner_m,
+                            _ => {
+                                let ctx = PointCtx {
+                                    s,
+                                    t,
+                                    i,
+                                    j,
+                                    local: [s - bx[0], t - bx[2]],
+                                    size: [bw, bh],
+                                    pu: layer.u.value(i, s),
+                                    pv: layer.v.value(j, t),
+                                    cell_seed: if matches!(layer.col, Col::Custom(_)) {
+                                        hash2(layer.seed, i as i64, j as i64)
+                                    } else {
+                                        0
+                                    },
+                                };
+                                col.eval(&ctx, Some(&inner_m))
+                            }
+                        };
                         if let (Some(smp), Some(o)) =
                             (self.samples.get_mut(x), self.owner.get_mut(x))
                         {
                             *smp = m;
+                            smp.height += layer.depth_m;
                             *o = DONE;
                         }
                     }
+                    self.nested_out = buf;
+                    self.pool.push(sub);
                 } else {
                     for x in x0..x1 {
                         let Some(&s) = xs.get(x) else { break };
