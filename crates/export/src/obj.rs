@@ -125,7 +125,8 @@ pub fn write_obj<W: Write, S: FileSink>(
         .nodes
         .iter()
         .flat_map(|n| &n.meshes)
-        .any(|m| scene.meshes[m.index()].material.is_none());
+        .map(|m| &scene.meshes[m.index()])
+        .any(|m| m.material.is_none() && !m.is_empty());
     let mut w = Counted::new(&mut obj);
     let io = ExportError::io("obj");
     (|| -> std::io::Result<()> {

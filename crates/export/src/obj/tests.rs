@@ -187,3 +187,39 @@ fn closure_sinks_receive_side_files() {
     );
     assert!(names.iter().all(|(_, len)| *len > 0));
 }
+
+#[test]
+fn default_material_only_when_drawn_and_dir_sink_writes_files() {
+    let mut scene = sample_scene();
+    // Give the plain slab a material, and draw an empty mesh without one: no triangle
+    // needs the default material.
+    scene.meshes[2].material = Some(polis_geom::scene::MaterialId(2));
+    let empty = scene.add_mesh(Mesh::new(None));
+    scene
+        .attach_mesh(polis_geom::scene::NodeId(0), empty)
+        .unwrap();
+    let (obj, files, report) = write(&scene);
+    assert_eq!(report.materials, 3, "no default material for an empty mesh");
+    let (_, mats) = load(&obj, &files);
+    assert!(mats.iter().all(|m| m.name != DEFAULT_MATERIAL));
+
+    let dir = std::env::temp_dir().join(format!("polis-export-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut sink = crate::sink::DirSink::new(&dir);
+    let opts = ObjOptions {
+        stem: "disk".to_string(),
+    };
+    let file = std::fs::File::create(dir.join("disk.obj")).unwrap();
+    write_obj(&scene, &opts, file, &mut sink).unwrap();
+    let obj = std::fs::read(dir.join("disk.obj")).unwrap();
+    let mut from_disk = MemorySink::new();
+    for name in ["disk.mtl", "disk_0_brick.png", "disk_1_normal_map.png"] {
+        from_disk
+            .files
+            .insert(name.to_string(), std::fs::read(dir.join(name)).unwrap());
+    }
+    let (models, mats) = load(&obj, &from_disk);
+    assert_eq!(models.len(), 7);
+    assert_eq!(mats.len(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
