@@ -8,7 +8,8 @@
 //!
 //! [`NodeId`] and [`EdgeId`] are indices into slot vectors with **tombstones**: removing a
 //! node or edge empties its slot, and slots are never reused, so an id names the same
-//! element for the whole life of the graph (and across serde round trips). Iteration is in
+//! element for the whole life of the graph (and across serde round trips; for bit-exact
+//! positions through JSON, serde_json needs its `float_roundtrip` feature). Iteration is in
 //! increasing id order, hence deterministic. [`PlanarGraph::node_bound`] and
 //! [`PlanarGraph::edge_bound`] give the slot counts for id-indexed side tables.
 //!
@@ -26,8 +27,15 @@
 //! [`split_edge`](PlanarGraph::split_edge)) check ids, coordinates, zero length and
 //! duplicates, but not crossings: they are for callers who know their input is planar.
 //! [`insert_segment`](PlanarGraph::insert_segment) keeps the graph planar whatever the
-//! input: it snaps, splits at crossings and merges collinear overlaps.
+//! input: it snaps, splits at crossings and merges collinear overlaps (algorithm,
+//! guarantees and limitations: [`insert`]).
 //! [`check_invariants`](PlanarGraph::check_invariants) verifies everything.
+//!
+//! The graph keeps spatial indexes ([`SegmentIndex`]) of its nodes and edges, updated
+//! on every change: [`nearest_node`](PlanarGraph::nearest_node),
+//! [`nearest_edge`](PlanarGraph::nearest_edge), [`edges_crossing`](PlanarGraph::edges_crossing),
+//! [`nodes_in_box`](PlanarGraph::nodes_in_box) and [`edges_in_box`](PlanarGraph::edges_in_box)
+//! use them.
 //!
 //! # Example
 //!
@@ -42,6 +50,25 @@
 //! let e2 = g.add_edge(o, north, "church lane")?;
 //! assert_eq!(g.edges_at(o)?, &[e1, e2]); // counter-clockwise from east
 //! assert_eq!(g.next_ccw(o, e1)?, e2);
+//! g.check_invariants()?;
+//! # Ok::<(), polis_geom::GeomError>(())
+//! ```
+//!
+//! Planar insertion:
+//!
+//! ```
+//! use polis_geom::{DVec2, graph::{PlanarGraph, SnapOptions}};
+//!
+//! let mut g: PlanarGraph<(), u32> = PlanarGraph::new();
+//! let opts = SnapOptions::default(); // 1 cm snap
+//! g.insert_segment(DVec2::new(0.0, 0.0), DVec2::new(10.0, 10.0), 1, &opts)?;
+//! let r = g.insert_segment(DVec2::new(0.0, 10.0), DVec2::new(10.0, 0.0), 2, &opts)?;
+//! assert_eq!(r.nodes.len(), 3); // through the new crossing node
+//! assert_eq!(g.position(r.nodes[1])?, DVec2::new(5.0, 5.0));
+//! assert_eq!((g.node_count(), g.edge_count()), (5, 4));
+//! // An end 4 mm from the crossing snaps onto it.
+//! let r = g.insert_segment(DVec2::new(5.004, 5.0), DVec2::new(5.0, 20.0), 3, &opts)?;
+//! assert_eq!(g.degree(r.nodes[0])?, 5);
 //! g.check_invariants()?;
 //! # Ok::<(), polis_geom::GeomError>(())
 //! ```
