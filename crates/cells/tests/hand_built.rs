@@ -479,7 +479,8 @@ fn non_planar_input_names_the_edges() {
         check_planarity: false,
         ..CellParams::default()
     };
-    assert!(extract_with(&g, &unchecked).is_ok() || extract_with(&g, &unchecked).is_err());
+    // (the output is unspecified then; this call only has to return).
+    let _ = extract_with(&g, &unchecked);
 }
 
 #[test]
@@ -518,20 +519,15 @@ fn trivial_graphs() {
 
 #[test]
 fn ring_road_inside_a_grid_cell_and_reuse_of_the_extractor() {
-    let mut g = grid(4, 4);
-    for i in 0..3 {
-        // Scale the grid up so islands fit.
-        let _ = i;
+    // A 4 × 4 grid of 100 m blocks.
+    let small = grid(4, 4);
+    let mut g = G::new();
+    for (_, p, _) in small.nodes() {
+        g.add_node(p * 100.0, 0).unwrap();
     }
-    let mut g2 = G::new();
-    for (id, p, _) in g.nodes() {
-        let _ = id;
-        g2.add_node(p * 100.0, 0).unwrap();
+    for (_, a, b, _) in small.edges() {
+        g.add_edge(a, b, 0).unwrap();
     }
-    for (_, a, b, _) in g.edges() {
-        g2.add_edge(a, b, 0).unwrap();
-    }
-    g = g2;
     // A ring road with a cross inside the centre cell (100..200)².
     let c = ring(
         &mut g,
