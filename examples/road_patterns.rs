@@ -96,13 +96,14 @@ fn run(
     city.network.check_invariants()?;
     let st = network_stats(&city.network);
     println!(
-        "{name:<16} {:>6} segments {:>6} edges {:>5} steps  highways {:>7.0} m  streets {:>8.0} m  bridges {:>5.0} m  {:>7.1} ms  ({:?})",
+        "{name:<16} {:>6} segments {:>6} edges {:>5} steps  highways {:>7.0} m  streets {:>8.0} m  bridges {:>5.0} m  dead ends {:>4.1}%  {:>7.1} ms  ({:?})",
         city.report.segments,
         st.edges,
         city.report.steps,
         st.highway_length_m,
         st.street_length_m,
         st.bridge_length_m,
+        100.0 * st.dead_ends as f64 / st.junctions.max(1) as f64,
         dt.as_secs_f64() * 1e3,
         city.report.stop,
     );

@@ -453,7 +453,10 @@ impl GlobalGoals for DefaultGoals {
         for (i, side) in [1.0f64, -1.0].into_iter().enumerate() {
             let r = unit_f64(rng);
             let (bclass, delay) = match class {
-                RoadClass::Highway if r < prm.highway_branch_probability => {
+                // Highways branch into highways only where there is population to connect.
+                RoadClass::Highway
+                    if r < prm.highway_branch_probability && pop > prm.population_threshold =>
+                {
                     (RoadClass::Highway, prm.branch_delay)
                 }
                 RoadClass::Highway => {

@@ -57,7 +57,8 @@ pub struct RoadParams {
     pub highway_ray_length_m: f64,
     /// Population samples per ray (weighted by inverse distance). Default: 6.
     pub highway_ray_samples: u32,
-    /// Probability that a highway branches into another highway at a segment end (each side). Default: 0.06.
+    /// Probability that a highway branches into another highway at a segment end (each
+    /// side), where the population is above [`Self::population_threshold`]. Default: 0.06.
     pub highway_branch_probability: f64,
     /// Probability that a street branch is created on each side of a segment end where
     /// the population exceeds the threshold. Default: 0.9.
