@@ -92,12 +92,14 @@ impl Arena {
             if !filter(i) {
                 continue;
             }
-            let l = pts[i].distance(pts[(i + 1) % n]);
-            if best.is_none_or(|(_, bl)| l > bl) {
-                best = Some((i, l));
+            // Squared lengths compare the same; one square root at the end.
+            let j = if i + 1 == n { 0 } else { i + 1 };
+            let l2 = pts[i].distance_squared(pts[j]);
+            if best.is_none_or(|(_, bl)| l2 > bl) {
+                best = Some((i, l2));
             }
         }
-        best
+        best.map(|(i, l2)| (i, l2.sqrt()))
     }
 
     /// Splits piece `p` by the line perpendicular to `a → b` through the point at fraction
@@ -144,7 +146,8 @@ impl Arena {
         let mut enter = None;
         let mut changes = 0;
         for k in 0..n {
-            let (l0, l1) = (side[k] > 0.0, side[(k + 1) % n] > 0.0);
+            let k1 = if k + 1 == n { 0 } else { k + 1 };
+            let (l0, l1) = (side[k] > 0.0, side[k1] > 0.0);
             if l0 && !l1 {
                 exit = Some(k);
                 changes += 1;
@@ -178,15 +181,15 @@ impl Arena {
         let start = self.pts.len() as u32;
         self.pts.push(y);
         self.street.push(self.street[at(j)]);
-        let mut k = j + 1;
+        let mut k = (j + 1) % n;
         loop {
-            let (pk, sk) = (self.pts[at(k)], self.street[at(k)]);
+            let (pk, sk) = (self.pts[s + k], self.street[s + k]);
             self.pts.push(pk);
             self.street.push(sk);
-            if k % n == i % n {
+            if k == i {
                 break;
             }
-            k += 1;
+            k = if k + 1 == n { 0 } else { k + 1 };
         }
         if x != self.pts[at(i)] {
             self.pts.push(x);
@@ -205,15 +208,15 @@ impl Arena {
             self.pts.push(x);
             self.street.push(self.street[at(i)]);
         }
-        let mut k = i + 1;
+        let mut k = (i + 1) % n;
         loop {
-            let (pk, sk) = (self.pts[at(k)], self.street[at(k)]);
+            let (pk, sk) = (self.pts[s + k], self.street[s + k]);
             self.pts.push(pk);
             self.street.push(sk);
-            if k % n == j % n {
+            if k == j {
                 break;
             }
-            k += 1;
+            k = if k + 1 == n { 0 } else { k + 1 };
         }
         if y != self.pts[at(j)] {
             self.pts.push(y);
