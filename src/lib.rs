@@ -15,3 +15,8 @@ pub use polis_geom as geom;
 pub use polis_lots as lots;
 pub use polis_lsystem as lsystem;
 pub use polis_roads as roads;
+
+// Compile the README's code blocks as doctests so the embedding example stays true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
