@@ -35,10 +35,13 @@ impl TaggedRing {
         ring_signed_area(&self.points)
     }
 
-    /// Edge `i` as (start, end).
-    pub fn edge(&self, i: usize) -> (DVec2, DVec2) {
+    /// Edge `i` (cyclically) as (start, end); `None` for an empty ring.
+    pub fn edge(&self, i: usize) -> Option<(DVec2, DVec2)> {
         let n = self.points.len();
-        (self.points[i % n], self.points[(i + 1) % n])
+        if n == 0 {
+            return None;
+        }
+        Some((self.points[i % n], self.points[(i + 1) % n]))
     }
 }
 

@@ -305,3 +305,23 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases(64)))]
+
+    /// Garbage in (NaN, infinities, repeats, spikes, empty rings): errors out, never panics.
+    #[test]
+    fn never_panics_on_garbage(pts in prop::collection::vec((prop_oneof![
+        Just(f64::NAN), Just(f64::INFINITY), Just(0.0), -5.0f64..5.0, (-3i32..3).prop_map(f64::from)
+    ], (-3i32..3).prop_map(f64::from)), 0..12), flags in prop::collection::vec(any::<bool>(), 0..12)) {
+        let ring = TaggedRing { points: pts.iter().map(|&(x, y)| v(x, y)).collect(), street: flags };
+        let r = Region { outer: ring.clone(), holes: vec![] };
+        let _ = polis_lots::split_by_line(&r, v(0.1, -9.0), v(0.3, 9.0));
+        let _ = subdivide(&r, 0, &LotParams::default(), &mut Pcg64Mcg::seed_from_u64(1));
+        let p: PolygonWithHoles = Polygon::new(ring.points.clone()).into();
+        let _ = polis_lots::StraightSkeleton::new(&p);
+        let _ = polis_lots::inset(&p, 0.5);
+        let cell = Cell { id: 0, polygon: p, road_widths: vec![2.0; ring.points.len()] };
+        let _ = blocks(&cell, &BlockParams::default());
+    }
+}

@@ -380,7 +380,10 @@ fn cut_holes(region: Region, out: &mut Vec<Region>) {
             out.push(r);
             continue;
         };
-        let (a, b) = hole.edge(i);
+        let Some((a, b)) = hole.edge(i) else {
+            out.push(r);
+            continue;
+        };
         let mid = (a + b) * 0.5;
         let pieces = crate::polygon_split::split_by_line(&r, mid, mid + (b - a).perp());
         if pieces.len() == 1 && pieces[0].holes.len() == r.holes.len() {
@@ -395,7 +398,7 @@ fn cut_holes(region: Region, out: &mut Vec<Region>) {
 fn longest_edge(ring: &TaggedRing) -> Option<usize> {
     let n = ring.points.len();
     (0..n)
-        .map(|i| (ring.edge(i), i))
+        .filter_map(|i| ring.edge(i).map(|e| (e, i)))
         .max_by(|((a0, a1), i), ((b0, b1), j)| {
             a0.distance(*a1).total_cmp(&b0.distance(*b1)).then(j.cmp(i))
         })
