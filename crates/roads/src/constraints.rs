@@ -235,6 +235,8 @@ impl LocalConstraints for DefaultConstraints {
             self.stats.failed_short += 1;
             return QueryState::Failed;
         }
+        // A bridge cut short before the water is an ordinary road.
+        let bridge = bridge && !(snapped && self.legality.segment_ok(a, end));
         if snapped {
             let legal = if bridge {
                 len <= p.max_bridge_length_m + 1e-9
