@@ -127,7 +127,12 @@ impl DefaultConstraints {
                 }
             }
         }
-        // Rotate within the maximal angle, nearest first, left before right.
+        // Rotate within the maximal angle, nearest first, left before right (roads follow
+        // coastlines and park edges, not the edge of the map).
+        if v.what == Illegal::Outside {
+            self.stats.failed_illegal += 1;
+            return None;
+        }
         let step = p.rotate_step_deg.to_radians();
         let max = p.max_rotate_deg.to_radians();
         let mut k = 1.0;
