@@ -45,7 +45,7 @@ const SNAP_REL: f64 = 1e3;
 struct Event {
     t: f64,
     /// 0 = edge event (a = start vertex, b = end vertex); 1 = split candidate (a = vertex,
-    /// b = input edge).
+    /// b = edge); 2 = extra split candidate against a step edge created later.
     kind: u8,
     a: u32,
     b: u32,
@@ -315,6 +315,29 @@ impl Engine {
         self.vert_mut(x.prev).next = va;
         self.vert_mut(x.next).prev = vb;
         self.vert_mut(v).alive = false;
+        // Vertices scanned before this edge existed may still run into it.
+        let step_line = self.edges[s as usize];
+        for u in 0..self.verts.len() as u32 {
+            let y = self.verts[u as usize];
+            if !y.alive || u == va || u == vb {
+                continue;
+            }
+            let vel = y.velocity();
+            let slope = step_line.normal.dot(vel);
+            let ahead = step_line.ahead(y.p0, y.t0);
+            if slope >= 0.0 || ahead < -self.eps {
+                continue;
+            }
+            let t = y.t0 - ahead.max(0.0) / slope;
+            if t.is_finite() && t >= self.now && t <= self.horizon {
+                self.queue.push(Reverse(Event {
+                    t,
+                    kind: 2,
+                    a: u,
+                    b: s,
+                }));
+            }
+        }
         (va, vb)
     }
 
@@ -644,7 +667,10 @@ impl Engine {
                                 seeds.into_iter().filter(|&s| s != NONE).collect();
                             self.collapse(p, &seeds, through)?;
                         }
-                        None => self.push_next_candidate(v),
+                        // An extra candidate (kind 2, against a step edge created after the
+                        // vertex's own scan) has no successor in the vertex's batch.
+                        None if ev.kind == 1 => self.push_next_candidate(v),
+                        None => {}
                     }
                 }
             }
