@@ -504,14 +504,17 @@ pub fn classic_stone() -> FacadeStyle {
                 "quoins",
                 CellRole::Pier,
                 EvalStyle::Always,
-                bricks(
-                    stone.shade(1.05),
-                    joint.with_height(-0.03),
-                    [0.9, 0.45],
-                    0.035,
-                    0.35,
-                    0.03,
-                ),
+                // Long and short blocks alternating course by course.
+                Col::Bricks(Bricks {
+                    brick: stone.shade(1.12),
+                    mortar: joint.with_height(-0.03),
+                    size_m: [1.2, 0.45],
+                    joint_m: 0.035,
+                    bond: 0.5,
+                    variation: 0.03,
+                    in_cell: true,
+                    salt: 1,
+                }),
             )
         },
         LayerStyle {
