@@ -1,7 +1,7 @@
 //! Facade styles as data: the serialisable description of a layered grid that adapts to
 //! any facade size ("style textures", Parish & Müller §4.3).
 //!
-//! A [`FacadeStyle`] names the facade's primary grid (an [`AxisStyle`] for the columns and
+//! A [`FacadeStyle`](crate::FacadeStyle) names the facade's primary grid (an [`AxisStyle`] for the columns and
 //! one for the rows) and a [`StackStyle`]: layers (bottom first) over that grid or over
 //! their own axes, each with a selection of rows and columns, an evaluation function and a
 //! colour function, plus influences between layers. [`StackStyle::instantiate`] turns it

@@ -2,7 +2,7 @@
 //!
 //! Parish & Müller texture with "a semi-procedural approach [...] to keep memory usage
 //! small"; Kelly (§4.4.3.3, §5.6) applies *building tiles* with "a best fit algorithm
-//! [that] aims to match the tiles dimensions without splitting or dividing a tile". Here a
+//! \[that\] aims to match the tiles dimensions without splitting or dividing a tile". Here a
 //! style is rasterised once, on a prototype facade of `bays × floors` modules, and cut
 //! along its interval groups into at most nine tiles — the 3 × 3 combinations of the
 //! column parts (start margin, repeated bays, end margin) and the row parts (ground floor
