@@ -166,7 +166,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let water = FnField::new(move |p: DVec2| {
         let inside = island(p) <= 1.0;
         let v = -p.x * s + p.y * c;
-        let mainland = v < -1000.0 || v > 1050.0;
+        let mainland = !(-1000.0..=1050.0).contains(&v);
         if inside || mainland { 0.0 } else { 1.0 }
     });
     let population = FnField::new(move |p: DVec2| (1.0 - island(p)).clamp(0.0, 1.0) * 0.6 + 0.1);
