@@ -48,6 +48,7 @@ pub mod mesh;
 pub mod polygon;
 pub mod predicates;
 pub mod scene;
+mod simplicity;
 pub mod spatial;
 
 pub use bbox::Aabb2;

@@ -483,13 +483,22 @@ fn validate_ring_alone(points: &[DVec2]) -> Result<(), GeomError> {
     Ok(())
 }
 
-/// Below this many edges, all pairs are tested directly; above, through an R-tree.
+/// Below this many edges, all pairs are tested directly; above, by a sweep.
 const BRUTE_FORCE_EDGES: usize = 48;
 
 /// Finds a forbidden intersection between edges of the given rings: any contact between
 /// different rings or non-consecutive edges of one ring, or consecutive edges that fold
 /// back onto each other. Assumes each ring passed [`validate_ring_alone`].
+///
+/// Small inputs test all pairs; larger ones run a Shamos–Hoey sweep (O(n log n), exact).
 fn find_intersection(rings: &[(&[DVec2], Ring)]) -> Option<GeomError> {
+    find_intersection_with(rings, BRUTE_FORCE_EDGES)
+}
+
+fn find_intersection_with(
+    rings: &[(&[DVec2], Ring)],
+    brute_force_edges: usize,
+) -> Option<GeomError> {
     // (ring index, edge index, a, b)
     let edges: Vec<(usize, usize, DVec2, DVec2)> = rings
         .iter()
@@ -501,6 +510,7 @@ fn find_intersection(rings: &[(&[DVec2], Ring)]) -> Option<GeomError> {
         })
         .collect();
     let check = |i: usize, j: usize| -> Option<GeomError> {
+        let (i, j) = (i.min(j), i.max(j));
         let (ri, ei, a0, a1) = edges[i];
         let (rj, ej, b0, b1) = edges[j];
         let hit = segment_intersection(a0, a1, b0, b1);
@@ -525,7 +535,7 @@ fn find_intersection(rings: &[(&[DVec2], Ring)]) -> Option<GeomError> {
             point,
         })
     };
-    if edges.len() <= BRUTE_FORCE_EDGES {
+    if edges.len() <= brute_force_edges {
         for i in 0..edges.len() {
             for j in i + 1..edges.len() {
                 if let Some(e) = check(i, j) {
@@ -535,38 +545,37 @@ fn find_intersection(rings: &[(&[DVec2], Ring)]) -> Option<GeomError> {
         }
         return None;
     }
-    use rstar::primitives::{GeomWithData, Rectangle};
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 2]>, usize>> = edges
-        .iter()
-        .enumerate()
-        .map(|(i, &(_, _, a, b))| {
-            GeomWithData::new(
-                Rectangle::from_corners(a.min(b).to_array(), a.max(b).to_array()),
-                i,
-            )
-        })
-        .collect();
-    let tree = rstar::RTree::bulk_load(boxes);
-    let mut found: Option<(usize, usize, GeomError)> = None;
-    for (i, &(_, _, a, b)) in edges.iter().enumerate() {
-        let env = rstar::AABB::from_corners(a.min(b).to_array(), a.max(b).to_array());
-        for cand in tree.locate_in_envelope_intersecting(env) {
-            let j = cand.data;
-            if j <= i {
-                continue;
+    // The sweep needs every point to be a vertex of at most one ring position; within a
+    // ring that is already checked, across rings it is checked here.
+    if rings.len() > 1 {
+        let mut vertices: Vec<(DVec2, usize, usize)> = rings
+            .iter()
+            .enumerate()
+            .flat_map(|(r, (pts, _))| pts.iter().enumerate().map(move |(v, &p)| (p, r, v)))
+            .collect();
+        vertices.sort_by(|a, b| {
+            crate::simplicity::lex(a.0, b.0)
+                .then(a.1.cmp(&b.1))
+                .then(a.2.cmp(&b.2))
+        });
+        for w in vertices.windows(2) {
+            if w[0].0 == w[1].0 {
+                return Some(GeomError::SelfIntersection {
+                    first_ring: rings[w[0].1].1,
+                    first_edge: w[0].2,
+                    second_ring: rings[w[1].1].1,
+                    second_edge: w[1].2,
+                    point: w[0].0,
+                });
             }
-            if let Some(e) = check(i, j) {
-                // Report the lexicographically first pair, independent of tree order.
-                if found.as_ref().is_none_or(|(fi, fj, _)| (i, j) < (*fi, *fj)) {
-                    found = Some((i, j, e));
-                }
-            }
-        }
-        if found.is_some() {
-            break;
         }
     }
-    found.map(|(_, _, e)| e)
+    let sweep: Vec<crate::simplicity::SweepEdge> = edges
+        .iter()
+        .enumerate()
+        .map(|(i, &(_, _, a, b))| crate::simplicity::SweepEdge::new(a, b, i as u32))
+        .collect();
+    crate::simplicity::find_contact(&sweep, |i, j| check(i as usize, j as usize))
 }
 
 #[cfg(test)]
@@ -756,6 +765,57 @@ mod tests {
             Polygon::new(bad).validate(),
             Err(GeomError::SelfIntersection { .. })
         ));
+    }
+
+    fn ring_strategy() -> impl Strategy<Value = Vec<DVec2>> {
+        // Small integer grids: many collinear edges, T-contacts and touching vertices.
+        prop::collection::vec((-4i32..=4, -4i32..=4), 3..24).prop_map(|v| {
+            v.into_iter()
+                .map(|(x, y)| DVec2::new(x.into(), y.into()))
+                .collect()
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+        #[test]
+        fn sweep_agrees_with_all_pairs(outer in ring_strategy(), hole in ring_strategy()) {
+            for rings in [vec![(outer.as_slice(), Ring::Outer)], vec![(outer.as_slice(), Ring::Outer), (hole.as_slice(), Ring::Hole(0))]] {
+                if rings.iter().any(|(r, _)| validate_ring_alone(r).is_err()) {
+                    continue;
+                }
+                let brute = find_intersection_with(&rings, usize::MAX).is_some();
+                let sweep = find_intersection_with(&rings, 0).is_some();
+                prop_assert_eq!(brute, sweep, "rings {:?}", rings);
+            }
+        }
+
+        #[test]
+        fn sweep_agrees_on_star_like_rings(n in 3usize..60, seed in 0u64..1000, swap in any::<bool>()) {
+            // Random star-shaped rings are simple; swapping two vertices usually breaks them.
+            let mut pts: Vec<DVec2> = (0..n).map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                let r = 2.0 + ((seed.wrapping_mul(6364136223846793005).wrapping_add((i as u64).wrapping_mul(1442695040888963407)) >> 33) % 100) as f64 / 10.0;
+                DVec2::new((r * a.cos() * 8.0).round(), (r * a.sin() * 8.0).round())
+            }).collect();
+            if swap && n > 4 {
+                pts.swap(1, n / 2);
+            }
+            // A hole: a smaller star around the same centre, often touching the outer ring.
+            let m = 3 + (seed as usize % 9);
+            let hole: Vec<DVec2> = (0..m).rev().map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / m as f64;
+                let r = 1.0 + ((seed >> 2).wrapping_add(i as u64 * 7) % 30) as f64 / 10.0;
+                DVec2::new((r * a.cos() * 8.0).round(), (r * a.sin() * 8.0).round())
+            }).collect();
+            for rings in [vec![(pts.as_slice(), Ring::Outer)], vec![(pts.as_slice(), Ring::Outer), (hole.as_slice(), Ring::Hole(0))]] {
+                if rings.iter().all(|(r, _)| validate_ring_alone(r).is_ok()) {
+                    let brute = find_intersection_with(&rings, usize::MAX).is_some();
+                    let sweep = find_intersection_with(&rings, 0).is_some();
+                    prop_assert_eq!(brute, sweep, "rings {:?}", rings);
+                }
+            }
+        }
     }
 
     proptest! {
