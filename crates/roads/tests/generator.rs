@@ -289,3 +289,56 @@ fn park_and_slope_are_avoided() {
         let _ = inputs.parks.sample(a);
     }
 }
+
+#[test]
+fn blended_patterns_follow_their_weight_maps() {
+    // Fig. 7: New York where x < 0, Paris where x > 0 (sharp switch at x = 0).
+    let ny: Arc<dyn Field> = Arc::new(FnField::new(|p: DVec2| if p.x < 0.0 { 1.0 } else { 0.0 }));
+    let paris: Arc<dyn Field> =
+        Arc::new(FnField::new(|p: DVec2| if p.x < 0.0 { 0.0 } else { 1.0 }));
+    let inputs =
+        flat_inputs(3).with_pattern_weights(vec![(Pattern::NewYork, ny), (Pattern::Paris, paris)]);
+    let centre = DVec2::new(1000.0, 0.0);
+    let params = RoadParams {
+        paris_centre: Some(centre.to_array()),
+        max_segments: 2500,
+        ..RoadParams::default()
+    };
+    let city = generate(&params, &inputs).unwrap();
+    city.network.check_invariants().unwrap();
+    let (mut west, mut west_grid, mut east, mut east_paris) = (0.0, 0.0, 0.0, 0.0);
+    for (a, b, road) in edge_list(&city.network) {
+        if road.class != RoadClass::Street {
+            continue;
+        }
+        let (len, mid) = (a.distance(b), (a + b) * 0.5);
+        let d = (b - a) / len;
+        if a.x < -100.0 && b.x < -100.0 {
+            west += len;
+            let off = d.y.atan2(d.x).to_degrees().rem_euclid(90.0);
+            if off.min(90.0 - off) <= 5.0 {
+                west_grid += len;
+            }
+        } else if a.x > 100.0 && b.x > 100.0 {
+            east += len;
+            let cos = d.dot((mid - centre).normalize()).abs();
+            if cos >= 5f64.to_radians().cos() || cos <= 5f64.to_radians().sin() {
+                east_paris += len;
+            }
+        }
+    }
+    assert!(
+        west > 5000.0 && east > 5000.0,
+        "west {west} m, east {east} m"
+    );
+    assert!(
+        west_grid / west >= 0.7,
+        "west on grid {:.2}",
+        west_grid / west
+    );
+    assert!(
+        east_paris / east >= 0.6,
+        "east radial/concentric {:.2}",
+        east_paris / east
+    );
+}
