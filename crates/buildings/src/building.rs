@@ -132,6 +132,9 @@ pub(crate) struct Context<'a> {
 #[derive(Clone)]
 struct Shape {
     ring: Option<Vec<DVec2>>,
+    /// The ring is known to lie inside the lot (the footprint, its setbacks, convex
+    /// shrinks of those): no containment test needed.
+    inside: bool,
     base: f64,
     height: f64,
 }
@@ -153,6 +156,7 @@ pub(crate) fn interpret(
     };
     let mut cur = Shape {
         ring: Some(footprint.to_vec()),
+        inside: true,
         base: 0.0,
         height,
     };
@@ -178,15 +182,18 @@ pub(crate) fn interpret(
             Op::Scale => {
                 let (sx, sy, sz) = (arg(0, 1.0), arg(1, 1.0), arg(2, 1.0));
                 cur.height *= sz.max(0.0);
+                cur.inside &= sx <= 1.0 && sx == sy && is_convex(&cur.ring);
                 cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, sx, sy));
             }
             Op::Taper => {
                 let f = arg(0, 1.0);
+                cur.inside &= f <= 1.0 && is_convex(&cur.ring);
                 cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, f, f));
             }
             Op::Move => {
                 let d = cx.frame_x * arg(0, 0.0) + cx.frame_x.perp() * arg(1, 0.0);
                 cur.base += arg(2, 0.0);
+                cur.inside &= d == DVec2::ZERO;
                 if let Some(r) = cur.ring.as_mut() {
                     r.iter_mut().for_each(|q| *q += d);
                 }
@@ -232,7 +239,6 @@ impl Output {
             let deg = arg(k, cx.slope_default.atan().to_degrees()).clamp(1.0, 85.0);
             deg.to_radians().tan()
         };
-        let centre = Polygon::new(ring.to_vec()).centroid();
         let roof: Result<(Mesh, RoofFaces), BuildingsError> = match op {
             Op::Box | Op::Volume => {
                 let mesh = prism(ring, z0, z0 + h)?;
@@ -250,6 +256,7 @@ impl Output {
             Op::Pyramid => roofs::pyramid(ring, z0, h),
             Op::Spire | Op::Antenna => {
                 let r = arg(0, 1.0).clamp(0.05, 50.0);
+                let centre = Polygon::new(ring.to_vec()).centroid();
                 let sides = if op == Op::Spire { 8 } else { 4 };
                 let small = roofs::regular(centre, r, sides);
                 if !small
@@ -412,7 +419,17 @@ fn clip(cx: &Context<'_>, s: &Shape) -> Option<(Vec<DVec2>, f64, f64)> {
     if !(s.base >= 0.0 && top - s.base >= MIN_PART_HEIGHT) {
         return None;
     }
-    inside(cx.lot, ring).then(|| (ring.clone(), s.base, top - s.base))
+    (s.inside || inside(cx.lot, ring)).then(|| (ring.clone(), s.base, top - s.base))
+}
+
+fn is_convex(r: &Option<Vec<DVec2>>) -> bool {
+    r.as_ref().is_some_and(|r| {
+        let n = r.len();
+        (0..n).all(|i| {
+            polis_geom::orient2d(r[i], r[(i + 1) % n], r[(i + 2) % n])
+                != polis_geom::Orientation::Clockwise
+        })
+    })
 }
 
 /// Whether the ring lies inside the lot (vertices inside or on it, no proper crossing).

@@ -106,15 +106,8 @@ pub fn fit_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     }
     let x = dir / len;
     let y = DVec2::new(-x.y, x.x);
-    let mut c = region.centroid();
-    if !region.contains(c) {
-        // A concave region: try midpoints of diagonals from the first vertex.
-        c = (1..region.len())
-            .map(|i| (region.vertex(0) + region.vertex(i)) * 0.5)
-            .find(|&p| region.contains(p))?;
-    }
     let span = region.bbox().size().length() * 2.0;
-    let hit = |d: DVec2| -> f64 {
+    let hit = |c: DVec2, d: DVec2| -> f64 {
         let far = c + d * span;
         region
             .edges()
@@ -125,11 +118,31 @@ pub fn fit_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
             })
             .fold(f64::INFINITY, f64::min)
     };
-    let mut hw = hit(x).min(hit(-x));
-    let mut hd = hit(y).min(hit(-y));
-    if !(hw.is_finite() && hd.is_finite()) {
-        return None;
+    // Centre: the centroid when it is inside, else the vertex-pair midpoint inside the
+    // region with the roomiest cross (concave regions).
+    let n = region.len();
+    let pairs = if n <= 16 { n } else { 1 };
+    let candidates =
+        std::iter::once(region.centroid())
+            .chain((0..pairs).flat_map(|i| {
+                (i + 2..n).map(move |j| (region.vertex(i) + region.vertex(j)) * 0.5)
+            }));
+    let mut best: Option<(f64, DVec2, f64, f64)> = None;
+    for c in candidates {
+        if region.locate(c) != polis_geom::PointLocation::Inside {
+            continue;
+        }
+        let hw = hit(c, x).min(hit(c, -x));
+        let hd = hit(c, y).min(hit(c, -y));
+        let score = hw * hd;
+        if score.is_finite() && best.is_none_or(|b| score > b.0) {
+            best = Some((score, c, hw, hd));
+        }
+        if best.is_some() && c == region.centroid() {
+            break;
+        }
     }
+    let (_, c, mut hw, mut hd) = best?;
     for _ in 0..40 {
         let corners = [
             c - x * hw - y * hd,
@@ -163,4 +176,109 @@ fn rect_inside(region: &Polygon, q: &[DVec2; 4]) -> bool {
             segment_intersection(q[i], q[(i + 1) % 4], a, b) == SegmentIntersection::Disjoint
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lot(points: Vec<DVec2>, street: Vec<usize>) -> Lot {
+        let polygon = Polygon::new(points);
+        Lot {
+            area: polygon.area(),
+            polygon,
+            street_edges: street,
+            block_id: 0,
+        }
+    }
+
+    #[test]
+    fn downtown_is_the_lot() {
+        let l = lot(
+            Polygon::rect(DVec2::ZERO, DVec2::new(10.0, 20.0)).into_points(),
+            vec![0],
+        );
+        let f = footprint(
+            &l,
+            0,
+            FootprintStrategy::Downtown,
+            &FootprintParams::default(),
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(f.area(), 200.0);
+    }
+
+    #[test]
+    fn suburban_retreats_further_from_the_street() {
+        let l = lot(
+            Polygon::rect(DVec2::ZERO, DVec2::new(20.0, 40.0)).into_points(),
+            vec![0],
+        );
+        let p = FootprintParams::default();
+        let f = footprint(&l, 0, FootprintStrategy::Suburban, &p)
+            .unwrap()
+            .unwrap();
+        let b = f.bbox();
+        assert!(
+            (b.min.y - 5.0).abs() < 1e-9 && (b.max.y - 38.0).abs() < 1e-9,
+            "{b:?}"
+        );
+        assert!((b.min.x - 2.0).abs() < 1e-9 && (b.max.x - 18.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn clockwise_lots_keep_their_street_edge() {
+        let mut pts = Polygon::rect(DVec2::ZERO, DVec2::new(20.0, 40.0)).into_points();
+        pts.reverse(); // edges: 0 = (0,40)→(20,40)? reversed ring: (0,40),(20,40),(20,0),(0,0)
+        let l = lot(pts, vec![2]); // (20,0) → (0,0): the y = 0 street
+        let f = footprint(
+            &l,
+            0,
+            FootprintStrategy::Suburban,
+            &FootprintParams::default(),
+        )
+        .unwrap()
+        .unwrap();
+        assert!((f.bbox().min.y - 5.0).abs() < 1e-9, "{:?}", f.bbox());
+    }
+
+    #[test]
+    fn rectangle_fit_in_a_concave_region() {
+        let region = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(30.0, 0.0),
+            DVec2::new(30.0, 10.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(10.0, 30.0),
+            DVec2::new(0.0, 30.0),
+        ]);
+        let r = fit_rectangle(&region, DVec2::X).unwrap();
+        assert!(r.area() > 10.0);
+        assert!(
+            rect_inside(
+                &region,
+                &[r.vertex(0), r.vertex(1), r.vertex(2), r.vertex(3)]
+            ) || r.points().iter().all(|&p| region.contains(p))
+        );
+    }
+
+    #[test]
+    fn tiny_lots_carry_nothing() {
+        let l = lot(
+            Polygon::rect(DVec2::ZERO, DVec2::new(6.0, 6.0)).into_points(),
+            vec![0],
+        );
+        let p = FootprintParams::default();
+        assert!(
+            footprint(&l, 0, FootprintStrategy::Industrial, &p)
+                .unwrap()
+                .is_none()
+        );
+        let bad = lot(vec![DVec2::ZERO, DVec2::X, DVec2::new(2.0, 0.0)], vec![0]);
+        assert!(matches!(
+            footprint(&bad, 3, FootprintStrategy::Downtown, &p),
+            Err(BuildingsError::Lot { lot_id: 3, .. })
+        ));
+    }
 }

@@ -239,3 +239,111 @@ fn libm_cos(a: f64) -> f64 {
 fn libm_sin(a: f64) -> f64 {
     polis_geom::glam::DVec2::from_angle(a).y
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rect(w: f64, d: f64) -> Vec<DVec2> {
+        Polygon::rect(DVec2::ZERO, DVec2::new(w, d)).into_points()
+    }
+
+    #[test]
+    fn hip_roof_of_a_rectangle_has_the_known_volume() {
+        // 20 × 10 at 45°: ridge 5 m high, volume = w·d²/4 − d³/12 (hip on a rectangle).
+        let (m, faces) = skeleton_roof(&rect(20.0, 10.0), 0.0, 100.0, 1.0, false).unwrap();
+        let expected = 20.0 * 100.0 / 4.0 - 1000.0 / 12.0;
+        assert!(
+            (m.signed_volume() - expected).abs() < 1e-3,
+            "{}",
+            m.signed_volume()
+        );
+        assert_eq!(faces.len(), 4);
+        assert!((m.bbox().max.y - 5.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn hip_roof_is_lowered_to_fit_the_height() {
+        let (m, _) = skeleton_roof(&rect(20.0, 10.0), 3.0, 2.0, 1.0, false).unwrap();
+        assert!((m.bbox().max.y - 5.0).abs() < 1e-5, "ridge at 3 + 2");
+    }
+
+    #[test]
+    fn gable_roof_of_a_rectangle_is_a_prism() {
+        // Gable on 20 × 10 at 45°: a triangular prism, volume = ½·10·5·20.
+        let (m, faces) = skeleton_roof(&rect(20.0, 10.0), 0.0, 100.0, 1.0, true).unwrap();
+        assert!(
+            (m.signed_volume() - 500.0).abs() < 1e-3,
+            "{}",
+            m.signed_volume()
+        );
+        // Two gable walls are vertical.
+        let vertical = faces
+            .iter()
+            .filter(|f| {
+                f.iter().all(|p| (p.x - f[0].x).abs() < 1e-9)
+                    || f.iter().all(|p| (p.z - f[0].z).abs() < 1e-9)
+            })
+            .count();
+        assert_eq!(vertical, 2);
+    }
+
+    #[test]
+    fn gable_on_a_square_has_no_gable_end() {
+        assert!(skeleton_roof(&rect(10.0, 10.0), 0.0, 100.0, 1.0, true).is_err());
+        assert!(skeleton_roof(&rect(10.0, 10.0), 0.0, 100.0, 1.0, false).is_ok());
+    }
+
+    #[test]
+    fn hip_roof_on_an_l_shape_is_closed() {
+        let l = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(30.0, 0.0),
+            DVec2::new(30.0, 10.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(10.0, 25.0),
+            DVec2::new(0.0, 25.0),
+        ];
+        for gable in [false, true] {
+            if let Ok((m, _)) = skeleton_roof(&l, 2.0, 50.0, 0.7, gable) {
+                check_solid(&m).unwrap();
+            } else {
+                assert!(gable, "the hip roof always exists");
+            }
+        }
+    }
+
+    #[test]
+    fn pyramid_and_mansard_volumes() {
+        let (p, _) = pyramid(&rect(10.0, 10.0), 0.0, 6.0).unwrap();
+        assert!((p.signed_volume() - 200.0).abs() < 1e-3);
+        // Mansard 20 × 10, inset 2 over 3 m: frustum volume h/3·(A1 + A2 + √(A1·A2)).
+        let (m, faces) = mansard(&rect(20.0, 10.0), 0.0, 3.0, 2.0).unwrap();
+        let (a1, a2): (f64, f64) = (200.0, 16.0 * 6.0);
+        let v = 3.0 / 3.0 * (a1 + a2 + (a1 * a2).sqrt());
+        // Not similar rectangles, so use the prismatoid formula instead.
+        let am = 18.0 * 8.0;
+        let prismatoid = 3.0 / 6.0 * (a1 + 4.0 * am + a2);
+        assert!(
+            (m.signed_volume() - prismatoid).abs() < 1e-3,
+            "{} vs {prismatoid} (frustum {v})",
+            m.signed_volume()
+        );
+        assert_eq!(faces.len(), 5);
+        // An inset that swallows an edge is refused.
+        assert!(mansard(&rect(20.0, 10.0), 0.0, 3.0, 5.0).is_err());
+    }
+
+    #[test]
+    fn pyramid_needs_a_star_shaped_footprint() {
+        let l = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(30.0, 0.0),
+            DVec2::new(30.0, 2.0),
+            DVec2::new(2.0, 2.0),
+            DVec2::new(2.0, 30.0),
+            DVec2::new(0.0, 30.0),
+        ];
+        assert!(pyramid(&l, 0.0, 5.0).is_err());
+    }
+}

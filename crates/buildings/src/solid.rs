@@ -78,18 +78,75 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
 
 /// A closed prism over the counter-clockwise ring `ring` from elevation `z0` to `z1`:
 /// walls, a top cap facing up and a bottom cap facing down.
+///
+/// Walls are written directly (one quad each, `u` along the ring as in
+/// `Mesh::add_walls`); convex caps are fanned, others triangulated.
 pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError> {
     let n = ring.len();
-    let mut m = Mesh::with_capacity(None, 6 * n, 4 * n);
-    let bottom: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z0)).collect();
-    let top: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z1)).collect();
-    for i in 0..n {
-        let j = (i + 1) % n;
-        add_face(&mut m, &[bottom[i], bottom[j], top[j], top[i]])?;
+    if n < 3 || z1.partial_cmp(&z0) != Some(std::cmp::Ordering::Greater) {
+        return Err(GeomError::DegenerateTriangle { triangle: 0 });
     }
-    add_face(&mut m, &top)?;
-    let rev: Vec<DVec3> = bottom.iter().rev().copied().collect();
-    add_face(&mut m, &rev)?;
+    let mut m = Mesh::with_capacity(None, 6 * n, 4 * n);
+    let mut along = 0.0;
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        let len = a.distance(b);
+        if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || a.as_vec2() == b.as_vec2()
+        {
+            return Err(GeomError::DegenerateTriangle {
+                triangle: m.triangle_count(),
+            });
+        }
+        let d = (b - a) / len;
+        let normal = to_world(DVec2::new(d.y, -d.x), 0.0);
+        let base = m.positions.len() as u32;
+        for (p, h, u) in [
+            (a, z0, along),
+            (b, z0, along + len),
+            (b, z1, along + len),
+            (a, z1, along),
+        ] {
+            m.add_vertex(to_world(p, h), normal, DVec2::new(u, -h));
+        }
+        m.indices
+            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        along += len;
+    }
+    let convex = (0..n).all(|i| {
+        orient2d(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]) == Orientation::CounterClockwise
+    });
+    if convex {
+        for (h, up) in [(z1, true), (z0, false)] {
+            let (normal, sign) = if up {
+                (DVec3::Y, -1.0)
+            } else {
+                (-DVec3::Y, 1.0)
+            };
+            let base = m.positions.len() as u32;
+            for &p in ring {
+                m.add_vertex(to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
+            }
+            for k in 1..n as u32 - 1 {
+                if up {
+                    m.indices.extend_from_slice(&[base, base + k, base + k + 1]);
+                } else {
+                    m.indices.extend_from_slice(&[base, base + k + 1, base + k]);
+                }
+            }
+        }
+        // Fans of exactly convex rings can only collapse when rounded to f32.
+        if m.triangles().any(|[a, b, c]| {
+            let [a, b, c] = [a, b, c].map(|i| m.positions[i as usize].as_dvec3());
+            (b - a).cross(c - a) == DVec3::ZERO
+        }) {
+            return Err(GeomError::DegenerateTriangle { triangle: 0 });
+        }
+    } else {
+        let top: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z1)).collect();
+        add_face(&mut m, &top)?;
+        let rev: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
+        add_face(&mut m, &rev)?;
+    }
     Ok(m)
 }
 
