@@ -187,6 +187,15 @@ pub fn rasterize_stack(
     let dt = region.height() / h as f64;
     let mut sweep = RowSweep::new(region.min.x, ds, w);
     let mut row = vec![FacadeSample::default(); w];
+    // NaN albedo never equals anything: the first row is always converted.
+    let mut prev_row = vec![
+        FacadeSample {
+            albedo: [f32::NAN; 4],
+            ..FacadeSample::default()
+        };
+        w
+    ];
+    let (mut prev_a, mut prev_m) = (vec![0u8; w * 4], vec![0u8; w * 4]);
     let rows = albedo
         .chunks_exact_mut(w * 4)
         .zip(mr.chunks_exact_mut(w * 4))
@@ -194,6 +203,15 @@ pub fn rasterize_stack(
     for (y, ((arow, mrow), hrow)) in rows.enumerate() {
         let t = region.max.y - (y as f64 + 0.5) * dt;
         sweep.row(stack, t, &mut row);
+        // Rows often repeat (inside a course of bricks, a band of cladding): copy them.
+        if prev_row == row {
+            arow.copy_from_slice(&prev_a);
+            mrow.copy_from_slice(&prev_m);
+            for (hh, smp) in hrow.iter_mut().zip(&row) {
+                *hh = smp.height;
+            }
+            continue;
+        }
         // Runs of equal samples are common (walls, mortar, glass): convert once per run.
         let mut prev: Option<(FacadeSample, [u8; 4], [u8; 4])> = None;
         for (((a, m), hh), smp) in arow
@@ -220,6 +238,9 @@ pub fn rasterize_stack(
             m.copy_from_slice(&pm);
             *hh = smp.height;
         }
+        prev_row.copy_from_slice(&row);
+        prev_a.copy_from_slice(arow);
+        prev_m.copy_from_slice(mrow);
     }
     let normal = normals_from_heights(&heights, w, h, ds, dt, normal_strength);
     Ok(FacadeTextures {
@@ -250,16 +271,27 @@ pub fn normals_from_heights(
     }
     // One-sided differences at the borders span one texel, central ones two.
     let kx = |span: usize| strength / (span.max(1) as f64 * ds) as f32;
+    // The last computed row: its (up, centre, down) rows, slope factor and output.
+    let mut last: Option<(usize, usize, usize, f32)> = None;
+    let mut last_out = vec![0u8; w * 4];
+    let row_of = |r: usize| heights.get(r * w..r * w + w);
     for (y, orow) in out.chunks_exact_mut(w * 4).enumerate() {
         let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
         let ky = strength / ((y1 - y0).max(1) as f64 * dt) as f32;
-        let (Some(up), Some(cur), Some(dn)) = (
-            heights.get(y0 * w..y0 * w + w),
-            heights.get(y * w..y * w + w),
-            heights.get(y1 * w..y1 * w + w),
-        ) else {
+        let (Some(up), Some(cur), Some(dn)) = (row_of(y0), row_of(y), row_of(y1)) else {
             continue;
         };
+        // Identical neighbourhoods give identical normals (rows inside a brick course, a
+        // band of corrugated sheet): copy instead of recomputing.
+        if let Some((a, b, c, k)) = last
+            && k == ky
+            && row_of(a) == Some(up)
+            && row_of(b) == Some(cur)
+            && row_of(c) == Some(dn)
+        {
+            orow.copy_from_slice(&last_out);
+            continue;
+        }
         let mut last_c = f32::NAN;
         let mut last_alpha = 0u8;
         let mut texel = |l: f32, r: f32, u: f32, d: f32, c: f32, k: f32, px: &mut [u8]| {
@@ -306,6 +338,8 @@ pub fn normals_from_heights(
         {
             texel(l, c, u, d, c, k_edge, p);
         }
+        last = Some((y0, y, y1, ky));
+        last_out.copy_from_slice(orow);
     }
     out
 }
