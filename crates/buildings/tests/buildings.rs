@@ -361,15 +361,19 @@ fn star_lot() -> impl Strategy<Value = Lot> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
     #[test]
     fn random_lots_never_panic_and_stay_valid(l in star_lot(), id in 0u64..1000, kind in 0usize..6, max_h in 0.0f64..250.0) {
         let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
         let kind = BuildingKind::ALL[kind];
-        if let Ok(lods) = g.lods(&l, id, kind, max_h) {
-            for b in &lods {
-                check(b, &l, max_h);
+        match g.lods(&l, id, kind, max_h) {
+            Ok(lods) => {
+                for b in &lods {
+                    check(b, &l, max_h);
+                }
             }
+            // Star lots are simple polygons: only a numerically failed skeleton may refuse.
+            Err(e) => prop_assert!(matches!(e, BuildingsError::Lots(_)), "{e}"),
         }
     }
 }
