@@ -377,3 +377,88 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn zoning_map_chooses_kinds_and_max_height_map_caps_heights() {
+    use polis_geom::field::{Constant, FnField};
+    // West of x = 0: zone 0 (skyscraper); east: zone 3 (house).
+    let zoning = FnField(|p: DVec2| if p.x < 0.0 { 0.0 } else { 3.0 });
+    let max_height = FnField(|p: DVec2| if p.y < 500.0 { 60.0 } else { 2.0 });
+    let lots = vec![
+        lot(Polygon::rect(DVec2::new(-50.0, 0.0), DVec2::new(-20.0, 40.0)).into_points()),
+        lot(Polygon::rect(DVec2::new(20.0, 0.0), DVec2::new(45.0, 40.0)).into_points()),
+        lot(Polygon::rect(DVec2::new(20.0, 600.0), DVec2::new(45.0, 640.0)).into_points()),
+    ];
+    let out =
+        polis_buildings::generate(&lots, &BuildingParams::default(), &zoning, &max_height).unwrap();
+    assert_eq!(out.len(), 2, "the 2 m limit forbids the third");
+    assert_eq!(out[0].kind, BuildingKind::Skyscraper);
+    assert_eq!(out[1].kind, BuildingKind::House);
+    assert!(out[0].height <= 60.0 && out[0].lot_id == 0 && out[1].lot_id == 1);
+    for (b, l) in out.iter().zip(&lots) {
+        check(b, l, 60.0);
+    }
+    assert_eq!(
+        polis_buildings::kind_from_zoning(&Constant(99.0), DVec2::ZERO),
+        BuildingKind::Industrial
+    );
+    assert_eq!(
+        polis_buildings::kind_from_zoning(&Constant(f64::NAN), DVec2::ZERO),
+        BuildingKind::House
+    );
+}
+
+#[test]
+fn params_round_trip_and_reject_bad_values() {
+    let p = BuildingParams {
+        seed: 5,
+        distribution: HeightDistribution::Normal { sigma: 0.2 },
+        ..BuildingParams::default()
+    };
+    let text = serde_json::to_string(&p).unwrap();
+    assert_eq!(serde_json::from_str::<BuildingParams>(&text).unwrap(), p);
+    for bad in [
+        BuildingParams {
+            floor_height: f64::NAN,
+            ..BuildingParams::default()
+        },
+        BuildingParams {
+            median_height: [0.0; 6],
+            ..BuildingParams::default()
+        },
+        BuildingParams {
+            roof_pitch_deg: 95.0,
+            ..BuildingParams::default()
+        },
+        BuildingParams {
+            distribution: HeightDistribution::Uniform { deviance: 1.5 },
+            ..BuildingParams::default()
+        },
+    ] {
+        assert!(matches!(
+            BuildingGenerator::new(bad),
+            Err(BuildingsError::InvalidParameter { .. })
+        ));
+    }
+}
+
+/// Pins exact values so that changes to the random streams are noticed.
+#[test]
+fn value_stability() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let l = &shapes()[0];
+    let p = g
+        .plan(l, 12345, BuildingKind::Office, 500.0)
+        .unwrap()
+        .unwrap();
+    let b = g
+        .build(l, 12345, BuildingKind::House, 500.0, 6)
+        .unwrap()
+        .unwrap();
+    assert_eq!(polis_buildings::mix_seed(0, 12345), PINNED_SEED);
+    assert_eq!(p.height.to_bits(), PINNED_HEIGHT);
+    assert_eq!(b.triangle_count(), PINNED_TRIANGLES);
+}
+const PINNED_SEED: u64 = 1461705202823340989;
+const PINNED_HEIGHT: u64 = 4631692995821772998; // 46.158124520968656 m
+const PINNED_TRIANGLES: usize = 20;
