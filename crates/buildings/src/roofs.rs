@@ -158,7 +158,7 @@ pub(crate) fn mansard(
         return Err(not_kept());
     };
     let inner = &shape.outer;
-    if inner.points.len() != n || !shape.holes.is_empty() {
+    if inner.points.len() != n || inner.sources.len() != n || !shape.holes.is_empty() {
         return Err(not_kept());
     }
     let k = inner

@@ -171,3 +171,54 @@ pub(crate) fn cone(ring: &[DVec2], z0: f64, apex: DVec2, z1: f64) -> Result<Mesh
     add_face(&mut m, &rev)?;
     Ok(m)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn prism_uvs_are_metres_and_solid_is_closed() {
+        let ring = Polygon::rect(DVec2::ZERO, DVec2::new(12.0, 5.0)).into_points();
+        let m = prism(&ring, 2.0, 9.0).unwrap();
+        m.validate().unwrap();
+        m.check_closed().unwrap();
+        assert!((m.signed_volume() - 12.0 * 5.0 * 7.0).abs() < 1e-3);
+        // The first wall runs 12 m along the ring, from elevation 2 to 9.
+        let us: Vec<f32> = m.uvs[..4].iter().map(|uv| uv.x).collect();
+        let vs: Vec<f32> = m.uvs[..4].iter().map(|uv| uv.y).collect();
+        assert_eq!(us, [0.0, 12.0, 12.0, 0.0]);
+        assert_eq!(vs, [-2.0, -2.0, -9.0, -9.0]);
+    }
+
+    #[test]
+    fn concave_prism_and_faces() {
+        let l = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 4.0),
+            DVec2::new(4.0, 4.0),
+            DVec2::new(4.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
+        let m = prism(&l, 0.0, 3.0).unwrap();
+        m.validate().unwrap();
+        m.check_closed().unwrap();
+        assert!((m.signed_volume() - 64.0 * 3.0).abs() < 1e-3);
+        let mut f = Mesh::new(None);
+        assert!(
+            add_face(&mut f, &[DVec3::ZERO, DVec3::X, DVec3::X * 2.0]).is_err(),
+            "collinear"
+        );
+        assert!(f.is_empty());
+        assert!(prism(&l, 3.0, 3.0).is_err());
+    }
+
+    #[test]
+    fn cone_needs_a_visible_apex() {
+        let sq = Polygon::rect(DVec2::ZERO, DVec2::new(4.0, 4.0)).into_points();
+        let c = cone(&sq, 0.0, DVec2::new(2.0, 2.0), 3.0).unwrap();
+        c.check_closed().unwrap();
+        assert!((c.signed_volume() - 16.0).abs() < 1e-4);
+        assert!(cone(&sq, 0.0, DVec2::new(9.0, 2.0), 3.0).is_err());
+    }
+}
