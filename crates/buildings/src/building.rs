@@ -284,6 +284,29 @@ impl Output {
                     self.fallbacks += 1;
                     return Ok(());
                 };
+                // The template fills the shape's box, which may overhang a non-rectangular
+                // footprint: it must still lie inside the lot.
+                let (x, y) = (cx.frame_x, cx.frame_x.perp());
+                let (mut u0, mut u1, mut v0, mut v1) = (
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                );
+                for q in ring {
+                    (u0, u1) = (u0.min(q.dot(x)), u1.max(q.dot(x)));
+                    (v0, v1) = (v0.min(q.dot(y)), v1.max(q.dot(y)));
+                }
+                let corners = [
+                    x * u0 + y * v0,
+                    x * u1 + y * v0,
+                    x * u1 + y * v1,
+                    x * u0 + y * v1,
+                ];
+                if !inside(cx.lot, &corners) {
+                    self.fallbacks += 1;
+                    return Ok(());
+                }
                 let mesh = t.instance(ring, cx.frame_x, z0, h)?;
                 if roofs::check_solid(&mesh).is_err() {
                     self.fallbacks += 1;

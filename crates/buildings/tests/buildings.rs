@@ -257,6 +257,14 @@ fn user_grammar_and_template() {
         .unwrap();
     check(&b, l, 80.0);
     assert_eq!(b.parts.len(), 2);
+    // On an L-shaped lot the template's box would overhang the lot: it falls back.
+    let l = &shapes()[2];
+    let b = g
+        .build(l, 3, BuildingKind::Office, 80.0, 3)
+        .unwrap()
+        .unwrap();
+    check(&b, l, 80.0);
+    assert_eq!((b.parts.len(), b.fallbacks), (1, 1));
     assert!(Template::from_obj_str("broken", "v 0 0 0\nf 1 2 3\n").is_err());
 }
 
