@@ -12,7 +12,8 @@ use polis_geom::predicates::{SegmentIntersection, point_on_segment, segment_inte
 use polis_geom::{DVec2, EdgeId, NodeId};
 
 use crate::error::{Conflict, Error};
-use crate::topology::{Start, Topology, ccw_cmp};
+use crate::topology::Topology;
+use polis_geom::predicates::{AngleStart, ccw_cmp};
 
 /// At most this many conflicts are listed in [`Error::NotPlanar`].
 pub const MAX_REPORTED_CONFLICTS: usize = 16;
@@ -235,7 +236,7 @@ fn rotation_overlaps(topo: &Topology, total: &mut usize, conflicts: &mut Vec<Con
                 topo.p(topo.target[k as usize]),
                 topo.p(topo.target[k2 as usize]),
             );
-            if ccw_cmp(o, p, q, Start::East) == Ordering::Equal {
+            if ccw_cmp(o, p, q, AngleStart::East) == Ordering::Equal {
                 let (e, f) = (topo.edge[k as usize], topo.edge[k2 as usize]);
                 *total += 1;
                 if conflicts.len() < MAX_REPORTED_CONFLICTS {

@@ -9,9 +9,7 @@
 //! node the live half-edges leaving it form a circular doubly linked list in
 //! counter-clockwise order, copied from the graph's exact rotation system.
 
-use std::cmp::Ordering;
-
-use polis_geom::predicates::{Orientation, orient2d};
+use polis_geom::predicates::{AngleStart, ccw_cmp};
 use polis_geom::{DVec2, EdgeId, NodeId, PlanarGraph};
 
 use crate::error::Error;
@@ -20,35 +18,6 @@ use crate::params::{CellParams, CoincidentNodes};
 
 /// "No index".
 pub(crate) const NONE: u32 = u32::MAX;
-
-/// Which half-plane the direction `o → p` lies in, for an order that starts at `start`.
-#[derive(Clone, Copy)]
-pub(crate) enum Start {
-    /// Counter-clockwise from the positive x axis.
-    East,
-    /// Counter-clockwise from straight down (the negative y axis).
-    Down,
-}
-
-fn half(o: DVec2, p: DVec2, start: Start) -> u8 {
-    let upper = match start {
-        Start::East => p.y > o.y || (p.y == o.y && p.x > o.x),
-        Start::Down => p.x > o.x || (p.x == o.x && p.y < o.y),
-    };
-    if upper { 0 } else { 1 }
-}
-
-/// Exact counter-clockwise order of the directions `o → p` and `o → q`, starting at
-/// `start`. Equal only for identical directions.
-pub(crate) fn ccw_cmp(o: DVec2, p: DVec2, q: DVec2, start: Start) -> Ordering {
-    half(o, p, start)
-        .cmp(&half(o, q, start))
-        .then_with(|| match orient2d(o, p, q) {
-            Orientation::CounterClockwise => Ordering::Less,
-            Orientation::Clockwise => Ordering::Greater,
-            Orientation::Collinear => Ordering::Equal,
-        })
-}
 
 /// The working graph. See the module docs.
 #[derive(Debug, Default)]
@@ -245,7 +214,7 @@ impl Topology {
                 let pos = &self.pos;
                 self.around = list;
                 self.around.sort_unstable_by(|x, y| {
-                    ccw_cmp(o, pos[x.1 as usize], pos[y.1 as usize], Start::East)
+                    ccw_cmp(o, pos[x.1 as usize], pos[y.1 as usize], AngleStart::East)
                         .then(x.0.cmp(&y.0))
                 });
                 self.place(r);
@@ -364,7 +333,7 @@ impl Topology {
                 self.p(self.target[k as usize]),
                 self.p(self.target[best as usize]),
             );
-            if ccw_cmp(o, pk, pb, Start::Down).is_lt() {
+            if ccw_cmp(o, pk, pb, AngleStart::South).is_lt() {
                 best = k;
             }
             k = self.nxt[k as usize];
@@ -421,7 +390,7 @@ mod tests {
         ];
         for i in 0..dirs.len() {
             for j in 0..dirs.len() {
-                assert_eq!(ccw_cmp(o, dirs[i], dirs[j], Start::Down), i.cmp(&j));
+                assert_eq!(ccw_cmp(o, dirs[i], dirs[j], AngleStart::South), i.cmp(&j));
             }
         }
     }

@@ -57,7 +57,9 @@ pub use field::{Field, FieldExt};
 pub use graph::{EdgeId, NodeId, PlanarGraph, SnapOptions};
 pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
-pub use predicates::{Orientation, SegmentIntersection, orient2d, segment_intersection};
+pub use predicates::{
+    AngleStart, Orientation, SegmentIntersection, ccw_cmp, orient2d, segment_intersection,
+};
 pub use scene::{Material, MaterialId, MeshId, MetaValue, Scene, Transform};
 pub use spatial::{SegmentIndex, SpatialIndex};
 

@@ -46,6 +46,47 @@ pub fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> Orientation {
     }
 }
 
+/// Where the counter-clockwise angular order of [`ccw_cmp`] starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum AngleStart {
+    /// At the positive x axis (angle 0), which comes first.
+    #[default]
+    East,
+    /// At the negative y axis (straight down), which comes first.
+    South,
+}
+
+/// Which half of the turn, from `start`, the direction `o → p` lies in: 0 for the first
+/// half-turn (including `start` itself), 1 for the second. Exact; `p != o`.
+#[inline]
+fn half_turn(o: DVec2, p: DVec2, start: AngleStart) -> u8 {
+    let first = match start {
+        AngleStart::East => p.y > o.y || (p.y == o.y && p.x > o.x),
+        AngleStart::South => p.x > o.x || (p.x == o.x && p.y < o.y),
+    };
+    u8::from(!first)
+}
+
+/// Compares the directions `o → p` and `o → q` by their angle measured counter-clockwise
+/// from `start`, exactly: first by half-turn (coordinate comparisons), then by the exact
+/// sign of [`orient2d`]. No angle is ever computed, so the order agrees with every other
+/// predicate. `Equal` only for identical directions. `p` and `q` must differ from `o`.
+///
+/// This is the rotation order of [`PlanarGraph`](crate::PlanarGraph) adjacency lists
+/// (`AngleStart::East`), and what face walks and the minimum cycle basis step along.
+#[inline]
+pub fn ccw_cmp(o: DVec2, p: DVec2, q: DVec2, start: AngleStart) -> std::cmp::Ordering {
+    use std::cmp::Ordering;
+    half_turn(o, p, start)
+        .cmp(&half_turn(o, q, start))
+        .then_with(|| match orient2d(o, p, q) {
+            // q lies counter-clockwise of p (less than π further): p comes first.
+            Orientation::CounterClockwise => Ordering::Less,
+            Orientation::Clockwise => Ordering::Greater,
+            Orientation::Collinear => Ordering::Equal,
+        })
+}
+
 /// Whether `d` lies strictly inside the circle through `a, b, c` (given counter-clockwise).
 /// Exact sign; returns `false` for points on the circle.
 #[inline]
@@ -327,6 +368,51 @@ mod tests {
         assert_eq!(orient2d(a, b, c), Orientation::Collinear);
         let c2 = v(24.0, 24.0 + 1e-14);
         assert_eq!(orient2d(a, b, c2), Orientation::CounterClockwise);
+    }
+
+    #[test]
+    fn ccw_order_of_eight_directions_from_east_and_south() {
+        use std::cmp::Ordering;
+        let o = v(1.0, 1.0);
+        let dirs = [
+            (1.0, 0.0),
+            (1.0, 1.0),
+            (0.0, 1.0),
+            (-1.0, 1.0),
+            (-1.0, 0.0),
+            (-1.0, -1.0),
+            (0.0, -1.0),
+            (1.0, -1.0),
+        ];
+        let pts: Vec<DVec2> = dirs.iter().map(|&(x, y)| o + v(x, y)).collect();
+        for (i, &p) in pts.iter().enumerate() {
+            for (j, &q) in pts.iter().enumerate() {
+                assert_eq!(ccw_cmp(o, p, q, AngleStart::East), i.cmp(&j), "{i} vs {j}");
+                // From the south, straight down (index 6) comes first.
+                let (si, sj) = ((i + 2) % 8, (j + 2) % 8);
+                assert_eq!(
+                    ccw_cmp(o, p, q, AngleStart::South),
+                    si.cmp(&sj),
+                    "{i} vs {j}"
+                );
+            }
+        }
+        assert_eq!(
+            ccw_cmp(o, o + v(2.0, 2.0), o + v(5.0, 5.0), AngleStart::East),
+            Ordering::Equal
+        );
+    }
+
+    #[test]
+    fn ccw_order_tells_nearly_equal_directions_apart() {
+        use std::cmp::Ordering;
+        let o = DVec2::ZERO;
+        let p = v(1.0, 1e-300);
+        let q = v(1.0, 0.0);
+        assert_eq!(ccw_cmp(o, q, p, AngleStart::East), Ordering::Less);
+        let r = v(1.0, -1e-300);
+        assert_eq!(ccw_cmp(o, p, r, AngleStart::East), Ordering::Less);
+        assert_eq!(ccw_cmp(o, r, q, AngleStart::East), Ordering::Greater);
     }
 
     #[test]

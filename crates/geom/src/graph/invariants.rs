@@ -4,8 +4,9 @@ use std::cmp::Ordering;
 
 use glam::DVec2;
 
-use super::{EdgeId, NodeId, PlanarGraph, ccw_cmp};
+use super::{EdgeId, NodeId, PlanarGraph};
 use crate::error::GeomError;
+use crate::predicates::{AngleStart, ccw_cmp};
 use crate::predicates::{SegmentIntersection, point_on_segment, segment_intersection};
 use crate::spatial::{Shape, SpatialIndex};
 
@@ -133,7 +134,7 @@ impl<N, E> PlanarGraph<N, E> {
                 let (Some(p), Some(q)) = (p, q) else {
                     return Err(corrupt(format!("node {n} lists a dead edge")));
                 };
-                match ccw_cmp(o, p, q) {
+                match ccw_cmp(o, p, q, AngleStart::East) {
                     Ordering::Less => {}
                     Ordering::Equal => {
                         let (first, second) = (w[0].min(w[1]), w[0].max(w[1]));

@@ -77,7 +77,6 @@ pub mod insert;
 #[cfg(test)]
 mod insert_tests;
 mod invariants;
-mod order;
 mod serde_impl;
 
 use glam::DVec2;
@@ -85,10 +84,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::bbox::Aabb2;
 use crate::error::{GeomError, validate_point};
+use crate::predicates::{AngleStart, ccw_cmp};
 use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, SpatialIndex};
 
 pub use insert::{Insertion, ROUNDING_TOLERANCE, SnapOptions};
-pub(crate) use order::ccw_cmp;
 
 /// The id of a node of a [`PlanarGraph`]. Stable: never reused after removal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -539,7 +538,7 @@ impl<N, E> PlanarGraph<N, E> {
         let key = |x: EdgeId| self.far_position(x, n);
         let Some(pe) = key(e) else { return };
         let pos = node.adj.partition_point(|&x| match key(x) {
-            Some(px) => ccw_cmp(o, px, pe).then(x.cmp(&e)).is_lt(),
+            Some(px) => ccw_cmp(o, px, pe, AngleStart::East).then(x.cmp(&e)).is_lt(),
             None => true,
         });
         if let Some(Some(node)) = self.nodes.get_mut(n.index()) {

@@ -8,7 +8,7 @@
 
 use std::cmp::Ordering;
 
-use polis_geom::predicates::orient2d;
+use polis_geom::predicates::{AngleStart, ccw_cmp, orient2d};
 use polis_geom::{DVec2, Orientation};
 
 /// Below this sine of the angle between two unit edge directions (the balance between the
@@ -124,24 +124,9 @@ pub(crate) fn is_reflex(din: DVec2, dout: DVec2) -> bool {
     orient2d(DVec2::ZERO, din, dout) == Orientation::Clockwise
 }
 
-/// Which half of the circle a direction lies in: `[0, π)` is 0, `[π, 2π)` is 1.
-fn half(v: DVec2) -> u8 {
-    if v.y > 0.0 || (v.y == 0.0 && v.x > 0.0) {
-        0
-    } else {
-        1
-    }
-}
-
 /// Exact counter-clockwise angular order of two non-zero directions from angle 0.
 pub(crate) fn angle_cmp(a: DVec2, b: DVec2) -> Ordering {
-    half(a)
-        .cmp(&half(b))
-        .then_with(|| match orient2d(DVec2::ZERO, a, b) {
-            Orientation::CounterClockwise => Ordering::Less,
-            Orientation::Clockwise => Ordering::Greater,
-            Orientation::Collinear => Ordering::Equal,
-        })
+    ccw_cmp(DVec2::ZERO, a, b, AngleStart::East)
 }
 
 /// An active vertex of the wavefront.
