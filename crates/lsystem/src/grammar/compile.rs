@@ -11,7 +11,7 @@ use crate::command::{Command, ModuleKind, QueryKind};
 use crate::context::{BranchIndex, ContextItem, ContextView, match_left, match_right};
 use crate::derivation::{Derivation, DeriveOptions, Rules};
 use crate::error::{LsystemError, Result};
-use crate::random::unit_f64;
+use crate::random::pick_weighted;
 use crate::string::ParamString;
 use crate::turtle::TurtleState;
 
@@ -717,16 +717,7 @@ impl Grammar {
             if total <= 0.0 {
                 return false;
             }
-            let target = unit_f64(rng) * total;
-            let mut acc = 0.0;
-            let mut chosen = pi;
-            for &(ci, cw) in &scratch.candidates {
-                chosen = ci;
-                acc += cw;
-                if target < acc {
-                    break;
-                }
-            }
+            let chosen = pick_weighted(&scratch.candidates, total, pi, rng);
             let Some(c) = table.productions.get(chosen as usize) else {
                 return false;
             };
