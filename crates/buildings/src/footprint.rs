@@ -1,6 +1,8 @@
 //! Footprints from lots by building type (Kelly 2008 §4.4.3.1): zero inset downtown, a
-//! weighted inset with a deeper street setback for suburban kinds (and a rectangle fit
-//! for houses), a uniform inset for industrial kinds.
+//! weighted inset with a deeper street setback for suburban kinds (and, for houses, the
+//! largest inscribed rectangle aligned with the street, [`largest_rectangle`]), a uniform
+//! inset for industrial kinds. Kelly's own centre-and-ray rectangle fit stays available
+//! as [`fit_rectangle`].
 //!
 //! # Guarantees
 //! The footprint is a valid counter-clockwise polygon inside the lot (insets lie inside
@@ -74,7 +76,7 @@ pub fn footprint(
     let region = if strategy == FootprintStrategy::SuburbanRectangle {
         let primary = street.first().copied().unwrap_or(0);
         let (a, b) = ring_edge(&lot.polygon, primary, reversed);
-        match fit_rectangle(&region, b - a) {
+        match largest_rectangle(&region, b - a) {
             Some(r) => r,
             None => return Ok(None),
         }
@@ -95,6 +97,203 @@ fn largest(pieces: Vec<PolygonWithHoles>) -> Option<Polygon> {
         .into_iter()
         .map(|p| p.outer)
         .max_by(|a, b| a.area().total_cmp(&b.area()))
+}
+
+/// Uniform steps across the region's extent along the street in the first pass of
+/// [`largest_rectangle`] (besides every vertex coordinate).
+pub const RECTANGLE_GRID_STEPS: usize = 16;
+
+/// Refinement rounds of [`largest_rectangle`] around the best pair of the first pass.
+const RECTANGLE_REFINE_ROUNDS: usize = 3;
+
+/// The largest rectangle with sides parallel and perpendicular to `dir` (the primary
+/// street edge) inside the (possibly concave) simple counter-clockwise `region`.
+///
+/// # Algorithm
+/// In the street frame (`u` along `dir`, `v` across), fix the rectangle's two sides
+/// `u0 < u1`. Every boundary point of the region in the open strip `u0 < u < u1` blocks
+/// its `v`: the edges clipped to the strip project to closed `v` intervals. Between two
+/// blocked intervals the open strip holds no boundary point, so that gap lies entirely
+/// inside or entirely outside the region (one exact point-in-polygon test decides), and
+/// an inside gap `(v0, v1)` is exactly the tallest rectangles over `[u0, u1]` can be. The
+/// height is therefore exact for every pair; the pairs are the vertices' `u` coordinates
+/// (which hold the optimum for orthogonal regions) and a uniform grid of
+/// [`RECTANGLE_GRID_STEPS`] steps, the widest pairs first with an area bound to skip the
+/// rest, then three rounds of a finer grid around the best pair.
+///
+/// # Guarantees
+/// * The result lies inside the region: it is shrunk by a relative `1e-9` margin after
+///   mapping back from the frame and then checked with exact predicates (no corner
+///   outside, no region vertex inside, no edge crossing or touching).
+/// * Bounded error: with `δ` the grid step (the region's `u` extent / 16) and `H` its `v`
+///   extent, the area is at least `A* − 2·δ·H` for the optimum `A*` (the optimum's `u`
+///   range shrunk to the grid keeps its full height); exact when the optimum's sides lie
+///   on vertex coordinates (rectangles, L-shapes, every orthogonal region) or on the
+///   grid; the refinement rounds usually close the rest of the gap.
+/// * Deterministic, no randomness.
+///
+/// `None` when `dir` is zero or not finite, or the region is degenerate.
+///
+/// # References
+/// Kelly 2008 §4.4.3.1 (rectangle footprints for houses); the exact-height strip sweep is
+/// this crate's own; K. Daniels, V. Milenkovic, D. Roth, *Finding the largest area
+/// axis-parallel rectangle in a polygon*, CGTA 7 (1997) for exact algorithms.
+pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
+    let len = dir.length();
+    if !(len > 0.0 && len.is_finite()) || region.len() < 3 {
+        return None;
+    }
+    let x = dir / len;
+    let y = x.perp();
+    let frame: Vec<DVec2> = region
+        .points()
+        .iter()
+        .map(|p| DVec2::new(p.dot(x), p.dot(y)))
+        .collect();
+    if frame.iter().any(|p| !p.is_finite()) {
+        return None;
+    }
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in &frame {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let (w, h) = (hi.x - lo.x, hi.y - lo.y);
+    if !(w > 0.0 && h > 0.0) {
+        return None;
+    }
+    let mut strip = Strip {
+        ring: &frame,
+        vmin: lo.y,
+        vmax: hi.y,
+        blocked: Vec::with_capacity(frame.len()),
+    };
+    // First pass: vertex coordinates and a uniform grid.
+    let mut us: Vec<f64> = frame.iter().map(|p| p.x).collect();
+    let step = w / RECTANGLE_GRID_STEPS as f64;
+    us.extend((1..RECTANGLE_GRID_STEPS).map(|k| lo.x + step * k as f64));
+    us.sort_by(f64::total_cmp);
+    us.dedup();
+    let mut best = Best::default();
+    for (i, &u0) in us.iter().enumerate() {
+        for &u1 in us[i + 1..].iter().rev() {
+            if (u1 - u0) * h <= best.area {
+                break;
+            }
+            strip.consider(u0, u1, &mut best);
+        }
+    }
+    if best.area <= 0.0 {
+        return None;
+    }
+    // Refinement: finer grids around the best sides.
+    let mut r = step;
+    for _ in 0..RECTANGLE_REFINE_ROUNDS {
+        let (b0, b1) = (best.u0, best.u1);
+        let cand = |c: f64| (-4..=4).map(move |k| c + r * 0.25 * f64::from(k));
+        for u0 in cand(b0).filter(|u| *u >= lo.x) {
+            for u1 in cand(b1).filter(|u| *u <= hi.x) {
+                if u1 > u0 && (u1 - u0) * h > best.area {
+                    strip.consider(u0, u1, &mut best);
+                }
+            }
+        }
+        r *= 0.25;
+    }
+    // Back to the layout with a tiny safety margin, checked exactly.
+    let scale = w
+        .max(h)
+        .max(lo.abs().max_element())
+        .max(hi.abs().max_element());
+    let mut margin = 1e-9 * scale;
+    for _ in 0..6 {
+        let (u0, u1) = (best.u0 + margin, best.u1 - margin);
+        let (v0, v1) = (best.v0 + margin, best.v1 - margin);
+        if !(u1 > u0 && v1 > v0) {
+            return None;
+        }
+        let corners = [
+            x * u0 + y * v0,
+            x * u1 + y * v0,
+            x * u1 + y * v1,
+            x * u0 + y * v1,
+        ];
+        if rect_inside(region, &corners) {
+            let r = Polygon::new(corners.to_vec());
+            return (r.area() > 0.0 && r.is_ccw()).then_some(r);
+        }
+        margin *= 16.0;
+    }
+    None
+}
+
+/// The best rectangle so far, in frame coordinates.
+#[derive(Default)]
+struct Best {
+    area: f64,
+    u0: f64,
+    u1: f64,
+    v0: f64,
+    v1: f64,
+}
+
+/// The region in the street frame, with a reusable buffer of blocked intervals.
+struct Strip<'a> {
+    ring: &'a [DVec2],
+    vmin: f64,
+    vmax: f64,
+    blocked: Vec<(f64, f64)>,
+}
+
+impl Strip<'_> {
+    /// The tallest rectangle over `[u0, u1]` inside the region; replaces `best` when larger.
+    fn consider(&mut self, u0: f64, u1: f64, best: &mut Best) {
+        self.blocked.clear();
+        let n = self.ring.len();
+        for i in 0..n {
+            let (a, b) = (self.ring[i], self.ring[(i + 1) % n]);
+            let (p, q) = if a.x <= b.x { (a, b) } else { (b, a) };
+            if q.x <= u0 || p.x >= u1 {
+                continue;
+            }
+            let (va, vb) = if p.x == q.x {
+                (p.y, q.y)
+            } else {
+                let at = |u: f64| p.y + (q.y - p.y) * ((u - p.x) / (q.x - p.x));
+                (
+                    if p.x < u0 { at(u0) } else { p.y },
+                    if q.x > u1 { at(u1) } else { q.y },
+                )
+            };
+            self.blocked.push((va.min(vb), va.max(vb)));
+        }
+        self.blocked.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let width = u1 - u0;
+        let mid = 0.5 * (u0 + u1);
+        let mut cur = self.vmin;
+        let gaps = self
+            .blocked
+            .iter()
+            .map(|&(s, e)| (s, e))
+            .chain(std::iter::once((self.vmax, self.vmax)));
+        for (s, e) in gaps {
+            if s > cur && (s - cur) * width > best.area {
+                let m = DVec2::new(mid, 0.5 * (cur + s));
+                if polis_geom::polygon::locate_in_ring(self.ring, m)
+                    == polis_geom::PointLocation::Inside
+                {
+                    *best = Best {
+                        area: (s - cur) * width,
+                        u0,
+                        u1,
+                        v0: cur,
+                        v1: s,
+                    };
+                }
+            }
+            cur = cur.max(e);
+        }
+    }
 }
 
 /// Kelly's rectangle fit: a rectangle aligned with `dir` (the primary street edge),
@@ -263,6 +462,189 @@ mod tests {
                 &[r.vertex(0), r.vertex(1), r.vertex(2), r.vertex(3)]
             ) || r.points().iter().all(|&p| region.contains(p))
         );
+    }
+
+    fn l_shape() -> Polygon {
+        Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(30.0, 0.0),
+            DVec2::new(30.0, 10.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(10.0, 30.0),
+            DVec2::new(0.0, 30.0),
+        ])
+    }
+
+    fn corners(r: &Polygon) -> [DVec2; 4] {
+        [r.vertex(0), r.vertex(1), r.vertex(2), r.vertex(3)]
+    }
+
+    #[test]
+    fn largest_rectangle_of_a_rectangle_is_itself() {
+        let region = Polygon::rect(DVec2::new(3.0, -2.0), DVec2::new(23.0, 10.0));
+        let r = largest_rectangle(&region, DVec2::X).unwrap();
+        assert!((r.area() - 240.0).abs() < 1e-4, "{}", r.area());
+        assert!(rect_inside(&region, &corners(&r)));
+        // Rotated by 30°, the frame follows the street.
+        let a = DVec2::from_angle(0.5);
+        let rot = region.map_points(|p| DVec2::new(p.x * a.x - p.y * a.y, p.x * a.y + p.y * a.x));
+        let r = largest_rectangle(&rot, a).unwrap();
+        assert!((r.area() - 240.0).abs() < 1e-4, "{}", r.area());
+        // Across the street it is the same rectangle.
+        let r = largest_rectangle(&region, DVec2::Y).unwrap();
+        assert!((r.area() - 240.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn largest_rectangle_of_an_l_shape_is_an_arm() {
+        let r = largest_rectangle(&l_shape(), DVec2::X).unwrap();
+        assert!((r.area() - 300.0).abs() < 1e-4, "{}", r.area());
+        assert!(rect_inside(&l_shape(), &corners(&r)));
+        // A fatter L: the arms are 40 × 12 = 480 and 20 × 40 = 800.
+        let fat = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(40.0, 0.0),
+            DVec2::new(40.0, 12.0),
+            DVec2::new(20.0, 12.0),
+            DVec2::new(20.0, 40.0),
+            DVec2::new(0.0, 40.0),
+        ]);
+        let r = largest_rectangle(&fat, DVec2::X).unwrap();
+        assert!((r.area() - 800.0).abs() < 1e-4, "{}", r.area());
+        // Kelly's centred fit is smaller on the thin L.
+        let k = fit_rectangle(&l_shape(), DVec2::X).unwrap();
+        assert!(k.area() < 300.0 - 1.0, "{}", k.area());
+    }
+
+    #[test]
+    fn largest_rectangle_of_a_right_triangle_is_a_quarter() {
+        // Known result: ab/4, the corner at the right angle, half of each leg.
+        let t = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(16.0, 0.0),
+            DVec2::new(0.0, 10.0),
+        ]);
+        let r = largest_rectangle(&t, DVec2::X).unwrap();
+        assert!((r.area() - 40.0).abs() < 1e-4, "{}", r.area());
+        // A symmetric triangle standing on the street: (base/2)·(height/2).
+        let t = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(20.0, 0.0),
+            DVec2::new(10.0, 12.0),
+        ]);
+        let r = largest_rectangle(&t, DVec2::X).unwrap();
+        assert!((r.area() - 60.0).abs() < 1e-3, "{}", r.area());
+    }
+
+    #[test]
+    fn largest_rectangle_refuses_degenerate_input() {
+        assert!(largest_rectangle(&l_shape(), DVec2::ZERO).is_none());
+        assert!(largest_rectangle(&l_shape(), DVec2::new(f64::NAN, 1.0)).is_none());
+        let flat = Polygon::new(vec![DVec2::ZERO, DVec2::X, DVec2::new(2.0, 0.0)]);
+        assert!(largest_rectangle(&flat, DVec2::X).is_none());
+    }
+
+    /// Random simple regions biased to hard cases: orthogonal (integer) stars, rotated
+    /// rectangles, thin L-shapes, and general stars.
+    fn region() -> impl proptest::strategy::Strategy<Value = (Polygon, DVec2)> {
+        use proptest::prelude::*;
+        (
+            0usize..4,
+            3usize..12,
+            prop::collection::vec(0.2f64..1.0, 12),
+            1.0f64..60.0,
+            -3.2f64..3.2,
+            prop::collection::vec(1i32..8, 4),
+        )
+            .prop_map(|(family, n, radii, size, angle, ints)| {
+                let dir = DVec2::from_angle(angle);
+                let pts: Vec<DVec2> = match family {
+                    0 => (0..n)
+                        .map(|i| {
+                            let a = std::f64::consts::TAU * i as f64 / n as f64;
+                            DVec2::from_angle(a) * size * radii[i]
+                        })
+                        .collect(),
+                    1 => {
+                        let (w, d) = (size, size * radii[0]);
+                        vec![
+                            DVec2::ZERO,
+                            dir * w,
+                            dir * w + dir.perp() * d,
+                            dir.perp() * d,
+                        ]
+                    }
+                    2 => {
+                        let [a, b, c, d] = [ints[0], ints[1], ints[2], ints[3]].map(f64::from);
+                        let (w, h) = (a + c, b + d);
+                        vec![
+                            DVec2::new(0.0, 0.0),
+                            DVec2::new(w, 0.0),
+                            DVec2::new(w, b),
+                            DVec2::new(a, b),
+                            DVec2::new(a, h),
+                            DVec2::new(0.0, h),
+                        ]
+                    }
+                    _ => (0..n)
+                        .map(|i| {
+                            // A staircase star: integer radii on 8 directions.
+                            let a = std::f64::consts::TAU * i as f64 / n as f64;
+                            let r = f64::from(ints[i % 4]);
+                            (DVec2::from_angle(a) * r).round()
+                        })
+                        .collect(),
+                };
+                (Polygon::new(pts), if family == 1 { dir } else { DVec2::X })
+            })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 256, ..Default::default() })]
+        #[test]
+        fn largest_rectangle_is_inside_and_beats_kelly((poly, dir) in region()) {
+            let mut poly = poly;
+            if poly.validate().is_err() || poly.area() < 1e-3 {
+                return Ok(());
+            }
+            poly.make_ccw();
+            let Some(r) = largest_rectangle(&poly, dir) else {
+                // Only a region without interior refuses.
+                proptest::prop_assert!(poly.area() < 1e-6);
+                return Ok(());
+            };
+            proptest::prop_assert!(rect_inside(&poly, &corners(&r)));
+            proptest::prop_assert!(r.is_ccw() && r.validate().is_ok());
+            // Sides along and across the street.
+            let e = r.vertex(1) - r.vertex(0);
+            proptest::prop_assert!(e.perp_dot(dir).abs() <= 1e-9 * e.length() * dir.length());
+            if let Some(k) = fit_rectangle(&poly, dir) {
+                proptest::prop_assert!(
+                    r.area() >= k.area() * (1.0 - 1e-6),
+                    "largest {} < Kelly {}", r.area(), k.area()
+                );
+            }
+            // Bounded error against an independent brute force: no rectangle with sides
+            // on a fine grid of the frame is larger than the bound allows.
+            let x = dir.normalize();
+            let f: Vec<DVec2> = poly.points().iter().map(|p| DVec2::new(p.dot(x), p.dot(x.perp()))).collect();
+            let fp = Polygon::new(f.clone());
+            let bb = fp.bbox();
+            let (w, h) = (bb.max.x - bb.min.x, bb.max.y - bb.min.y);
+            let bound = 2.0 * w / RECTANGLE_GRID_STEPS as f64 * h;
+            let m = 12;
+            let gx = |k: usize| bb.min.x + w * k as f64 / m as f64;
+            let gy = |k: usize| bb.min.y + h * k as f64 / m as f64;
+            let mut brute: f64 = 0.0;
+            for i0 in 0..m { for i1 in i0 + 1..=m { for j0 in 0..m { for j1 in j0 + 1..=m {
+                let area = (gx(i1) - gx(i0)) * (gy(j1) - gy(j0));
+                if area <= brute { continue; }
+                let q = [DVec2::new(gx(i0), gy(j0)), DVec2::new(gx(i1), gy(j0)), DVec2::new(gx(i1), gy(j1)), DVec2::new(gx(i0), gy(j1))];
+                let shrunk = q.map(|c| c + (DVec2::new(gx(i0) + gx(i1), gy(j0) + gy(j1)) * 0.5 - c) * 1e-6);
+                if rect_inside(&fp, &shrunk) { brute = area; }
+            }}}}
+            proptest::prop_assert!(r.area() >= brute * (1.0 - 1e-5) - bound, "largest {} vs grid brute force {brute} (bound {bound})", r.area());
+        }
     }
 
     #[test]

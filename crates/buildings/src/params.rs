@@ -71,8 +71,9 @@ pub enum FootprintStrategy {
     /// Weighted inset: street edges retreat by [`FootprintParams::street_setback`], the
     /// others by [`FootprintParams::side_setback`].
     Suburban,
-    /// [`Suburban`](Self::Suburban) followed by the largest rectangle aligned with the
-    /// primary street edge, centred on the inset region (houses).
+    /// [`Suburban`](Self::Suburban) followed by the largest rectangle inscribed in the
+    /// inset region with sides along and across the primary street edge (houses; see
+    /// [`largest_rectangle`](crate::footprint::largest_rectangle)).
     SuburbanRectangle,
     /// Uniform inset by [`FootprintParams::industrial_setback`].
     Industrial,

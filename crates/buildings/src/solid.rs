@@ -52,13 +52,9 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
     let tris: Vec<[u32; 3]> = if convex {
         (1..n as u32 - 1).map(|i| [0, i, i + 1]).collect()
     } else {
-        let poly = PolygonWithHoles::from(Polygon::new(plane.clone()));
-        if poly.outer.len() != n || !poly.outer.is_ccw() {
-            return Err(GeomError::DegenerateTriangle {
-                triangle: mesh.triangle_count(),
-            });
-        }
-        triangulate(&poly)?
+        triangulate_ring(&plane, false).ok_or(GeomError::DegenerateTriangle {
+            triangle: mesh.triangle_count(),
+        })??
     };
     for tri in &tris {
         let [p, q, r] = tri.map(|i| pts[i as usize].as_vec3().as_dvec3());
@@ -142,12 +138,118 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             return Err(GeomError::DegenerateTriangle { triangle: 0 });
         }
     } else {
-        let top: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z1)).collect();
-        add_face(&mut m, &top)?;
-        let rev: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
-        add_face(&mut m, &rev)?;
+        // One triangulation serves both caps (reversed for the bottom).
+        // The ring is simple: a validated lot, an inset of one, or a checked shrink.
+        let tris =
+            triangulate_ring(ring, true).ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
+        for (h, up) in [(z1, true), (z0, false)] {
+            let (normal, sign) = if up {
+                (DVec3::Y, -1.0)
+            } else {
+                (-DVec3::Y, 1.0)
+            };
+            let base = m.positions.len() as u32;
+            for &p in ring {
+                m.add_vertex(to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
+            }
+            for &[a, b, c] in &tris {
+                if up {
+                    m.indices.extend_from_slice(&[base + a, base + b, base + c]);
+                } else {
+                    m.indices.extend_from_slice(&[base + a, base + c, base + b]);
+                }
+            }
+        }
+        let first_cap = 6 * n;
+        if m.indices[first_cap..].chunks_exact(3).any(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
+            (b - a).cross(c - a) == DVec3::ZERO
+        }) {
+            return Err(GeomError::DegenerateTriangle { triangle: 0 });
+        }
     }
     Ok(m)
+}
+
+/// Largest ring ear clipping handles; longer rings go to the constrained Delaunay
+/// triangulation.
+const EAR_CLIPPING_MAX: usize = 64;
+
+/// Triangles (index triples, counter-clockwise) of the counter-clockwise simple ring
+/// `ring`. Small rings are ear-clipped with exact orientation tests: an ear is a strictly
+/// convex corner whose closed triangle holds no other remaining vertex, so no triangle is
+/// degenerate; when no such ear exists (collinear runs), or for long rings, the
+/// constrained Delaunay triangulation of polis-geom decides. `None` when the ring is not
+/// counter-clockwise. Unless `simple` promises it, the ring is validated first.
+pub(crate) fn triangulate_ring(
+    ring: &[DVec2],
+    simple: bool,
+) -> Option<Result<Vec<[u32; 3]>, GeomError>> {
+    let n = ring.len();
+    if n < 3
+        || polis_geom::polygon::ring_signed_area(ring).partial_cmp(&0.0)
+            != Some(std::cmp::Ordering::Greater)
+    {
+        return None;
+    }
+    if ring.first() == ring.last() {
+        return None;
+    }
+    if n <= EAR_CLIPPING_MAX {
+        if !simple && let Err(e) = Polygon::new(ring.to_vec()).validate() {
+            return Some(Err(e));
+        }
+        if let Some(t) = ear_clip(ring) {
+            return Some(Ok(t));
+        }
+    }
+    Some(triangulate(&PolygonWithHoles::from(Polygon::new(
+        ring.to_vec(),
+    ))))
+}
+
+/// Ear clipping of a counter-clockwise simple ring; `None` when it gets stuck.
+fn ear_clip(ring: &[DVec2]) -> Option<Vec<[u32; 3]>> {
+    let n = ring.len();
+    let mut left: Vec<u32> = (0..n as u32).collect();
+    let mut out = Vec::with_capacity(n - 2);
+    let at = |i: u32| ring[i as usize];
+    let mut i = 0usize;
+    let mut misses = 0usize;
+    while left.len() > 3 {
+        let m = left.len();
+        let (a, b, c) = (left[(i + m - 1) % m], left[i % m], left[(i + 1) % m]);
+        let (pa, pb, pc) = (at(a), at(b), at(c));
+        let ear = orient2d(pa, pb, pc) == Orientation::CounterClockwise
+            && left.iter().all(|&k| {
+                if k == a || k == b || k == c {
+                    return true;
+                }
+                let q = at(k);
+                // Outside the closed triangle: strictly right of one of its edges.
+                orient2d(pa, pb, q) == Orientation::Clockwise
+                    || orient2d(pb, pc, q) == Orientation::Clockwise
+                    || orient2d(pc, pa, q) == Orientation::Clockwise
+            });
+        if ear {
+            out.push([a, b, c]);
+            left.remove(i % m);
+            misses = 0;
+            i %= left.len();
+        } else {
+            misses += 1;
+            if misses > m {
+                return None;
+            }
+            i = (i + 1) % m;
+        }
+    }
+    let [a, b, c] = [left[0], left[1], left[2]];
+    if orient2d(at(a), at(b), at(c)) != Orientation::CounterClockwise {
+        return None;
+    }
+    out.push([a, b, c]);
+    Some(out)
 }
 
 /// A closed pyramid-like solid: the ring at `z0` (bottom cap facing down) joined to the
@@ -211,6 +313,64 @@ mod tests {
         );
         assert!(f.is_empty());
         assert!(prism(&l, 3.0, 3.0).is_err());
+    }
+
+    #[test]
+    fn ear_clipping_covers_concave_rings_without_slivers() {
+        // A comb with collinear runs along its base, and an L with a collinear vertex.
+        let mut comb = vec![DVec2::new(0.0, 0.0)];
+        for k in 0..6 {
+            let x = f64::from(k) * 2.0;
+            comb.push(DVec2::new(x + 1.0, 0.0));
+        }
+        comb.push(DVec2::new(12.0, 0.0));
+        for k in (0..6).rev() {
+            let x = f64::from(k) * 2.0;
+            comb.extend([
+                DVec2::new(x + 2.0, 5.0),
+                DVec2::new(x + 1.5, 5.0),
+                DVec2::new(x + 1.5, 1.0),
+                DVec2::new(x + 0.5, 1.0),
+                DVec2::new(x + 0.5, 5.0),
+            ]);
+        }
+        comb.push(DVec2::new(0.0, 5.0));
+        let comb = Polygon::new(comb);
+        comb.validate().unwrap();
+        let l = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(5.0, 0.0),
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 4.0),
+            DVec2::new(4.0, 4.0),
+            DVec2::new(4.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
+        for ring in [comb.points().to_vec(), l] {
+            let t = triangulate_ring(&ring, false).unwrap().unwrap();
+            assert_eq!(t.len(), ring.len() - 2);
+            let mut area = 0.0;
+            for [a, b, c] in t {
+                let [a, b, c] = [a, b, c].map(|i| ring[i as usize]);
+                assert_eq!(orient2d(a, b, c), Orientation::CounterClockwise);
+                area += 0.5 * (b - a).perp_dot(c - a);
+            }
+            let expected = Polygon::new(ring.clone()).area();
+            assert!((area - expected).abs() < 1e-9, "{area} vs {expected}");
+            assert!(prism(&ring, 0.0, 2.0).unwrap().check_closed().is_ok());
+        }
+        // Clockwise and self-intersecting rings are refused.
+        let mut cw = Polygon::rect(DVec2::ZERO, DVec2::ONE).into_points();
+        cw.reverse();
+        assert!(triangulate_ring(&cw, false).is_none());
+        let bow = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(4.0, 0.0),
+            DVec2::new(0.0, 3.0),
+            DVec2::new(5.0, 3.0),
+            DVec2::new(6.0, -1.0),
+        ];
+        assert!(matches!(triangulate_ring(&bow, false), Some(Err(_)) | None));
     }
 
     #[test]
