@@ -81,10 +81,9 @@
 //!   Felkel–Obdržálek bound, O(n·r) with r reflex vertices), so it grows quadratically on
 //!   polygons with thousands of reflex vertices (see `BENCHMARKS.md`).
 //! * Consecutive parallel edges with different weights meet in a perpendicular step (a
-//!   virtual edge of weight 0), the convention for this case, which has no bisector. Where
-//!   several steps interact (orthogonal polygons with several weights), an arc beside them
-//!   may name input edges whose offset lines it is not on; insets stay exact. Unweighted
-//!   input has no steps.
+//!   virtual edge of weight 0), the convention for this case, which has no bisector. An arc
+//!   along a step lies on the offset line of one of the two input edges it names, not both
+//!   ([`SkeletonArc::step`]). Unweighted input has no steps.
 //!
 //! ## References
 //!

@@ -26,8 +26,11 @@
 //!   vertex on each offset line; once an input edge parallel to the step reaches it, that
 //!   edge sweeps the step away. Arcs along a step are flagged ([`SkeletonArc::step`]) and
 //!   reported as separating the input edges on either side; the distance guarantee above
-//!   holds for one of their two lines only. Insets stay exact (the step edge has no
-//!   source, see [`inset_shapes`](crate::inset_shapes)).
+//!   holds for one of their two lines only (at each end of the arc). A vertex between two
+//!   steps (an input edge ran head-on into a step, or two steps met in line) stands
+//!   still: its arc has no length in the plane and is vertical in the roof, and it names
+//!   an input edge through its start node and one through its end node. Insets stay exact
+//!   (the step edge has no source, see [`inset_shapes`](crate::inset_shapes)).
 //! * Points closer than `1e-9` times the polygon's size at the same time are merged into
 //!   one event; nearly simultaneous events are therefore treated as simultaneous.
 //!
@@ -71,8 +74,10 @@ pub struct SkeletonArc {
     pub right_edge: usize,
     /// Whether the arc runs along a weighted step (between parallel neighbours of
     /// different weights): one of its sides is then the step's zero-area sliver, and
-    /// `left_edge`/`right_edge` name the input edges beyond it. Such an arc lies on the
-    /// offset line of only one of them.
+    /// `left_edge`/`right_edge` name the input edges beyond it. Each end of such an arc
+    /// lies on the offset line of one of them, not necessarily both. An arc between two
+    /// steps stands still (`from` and `to` are at the same place): `left_edge` is then an
+    /// input edge through `from` and `right_edge` one through `to`.
     #[serde(default)]
     pub step: bool,
 }
@@ -125,12 +130,37 @@ impl StraightSkeleton {
             });
         }
         let faces = assemble_faces(&engine);
+        let n_in = engine.input_edges();
+        // An input edge through each node: a raw arc with an input edge on one side lies on
+        // that edge's offset line from end to end, so both its nodes do.
+        let mut through = vec![usize::MAX; engine.nodes.len()];
+        for a in &engine.arcs {
+            for e in [a.left_edge, a.right_edge] {
+                if e < n_in {
+                    through[a.from] = through[a.from].min(e);
+                    through[a.to] = through[a.to].min(e);
+                }
+            }
+        }
         // Arcs along a weighted step separate the two input edges the step joins.
         let arcs = engine
             .arcs
             .iter()
             .map(|a| {
                 let mut a = *a;
+                if a.left_edge >= n_in && a.right_edge >= n_in {
+                    // A vertex between two steps (an input edge ran into a step, or two
+                    // steps met in line) stands still: its arc is vertical in the roof,
+                    // from the face of the event that made it to the face of the event
+                    // that ends it. Neither step's pair describes it.
+                    let (lo, hi) = (through[a.from], through[a.to]);
+                    if lo < n_in && hi < n_in {
+                        a.left_edge = lo;
+                        a.right_edge = hi;
+                        a.step = true;
+                        return a;
+                    }
+                }
                 // A step may join a step edge and a parallel input edge: map until the
                 // edge is an input edge.
                 while let Some((before, _)) = engine.step_pair(a.left_edge) {
