@@ -139,6 +139,9 @@ struct Shape {
     height: f64,
 }
 
+/// Pitch of a mansard's upper roof when `Mansard(d)` gives none, degrees.
+pub const MANSARD_UPPER_PITCH_DEG: f64 = 15.0;
+
 /// Smallest part height drawn, metres.
 const MIN_PART_HEIGHT: f64 = 0.05;
 
@@ -252,7 +255,10 @@ impl Output {
             Op::Flat => roofs::slab(ring, z0, h),
             Op::Hip => roofs::skeleton_roof(ring, z0, h, pitch(0), false),
             Op::Gable => roofs::skeleton_roof(ring, z0, h, pitch(0), true),
-            Op::Mansard => roofs::mansard(ring, z0, h, arg(0, 1.5).max(0.01)),
+            Op::Mansard => {
+                let upper = arg(1, MANSARD_UPPER_PITCH_DEG).clamp(0.0, 60.0);
+                roofs::mansard(ring, z0, h, arg(0, 1.5).max(0.01), upper.to_radians().tan())
+            }
             Op::Pyramid => roofs::pyramid(ring, z0, h),
             Op::Spire | Op::Antenna => {
                 let r = arg(0, 1.0).clamp(0.05, 50.0);

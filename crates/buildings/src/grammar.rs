@@ -20,7 +20,7 @@
 //! | `Box` | emit the shape as a closed prism (a mass with facades) |
 //! | `Flat` | flat roof slab filling the shape |
 //! | `Hip(a)`, `Gable(a)` | hip / gable roof at pitch `a` degrees from the straight skeleton, within the shape's height |
-//! | `Mansard(d)` | mansard roof: sides rise the shape's height while insetting `d` m, flat top |
+//! | `Mansard(d, a)` | mansard roof: a steep lower slope from the straight skeleton cut at the inset by `d` m (any number of pieces), a shallow hip of pitch `a` degrees (default 15; 0 for flat) over every piece left |
 //! | `Pyramid` | pyramid roof to the shape's top |
 //! | `Spire(r)` | octagonal spire of radius `r` m at the centroid |
 //! | `Antenna(r)` | square mast of half-width `r` m at the centroid |

@@ -49,7 +49,8 @@
 //!   largest piece.
 //! * A template that does not fit a footprint falls back (gable → hip → flat slab) and
 //!   is counted in [`Building::fallbacks`].
-//! * Mansard roofs need an inset that keeps every footprint edge; otherwise hip.
+//! * A mansard's break line keeps 1 mm clear of skeleton events (it moves 2 mm past an
+//!   event it would hit), so its top rings are never pinched.
 //!
 //! ## References
 //! Y. Parish, P. Müller, *Procedural Modeling of Cities*, SIGGRAPH 2001, §4.2;
