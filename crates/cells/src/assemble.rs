@@ -2,15 +2,14 @@
 //! polygons, filament chains, the containment of whole components (the one geometric
 //! step), and self-contained cells.
 
-use polis_geom::{DVec2, EdgeId, NodeId, PointLocation, Polygon};
-use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::{AABB, RTree};
+use polis_geom::{DVec2, EdgeId, NodeId, Polygon};
 
 use crate::eberly::{Owner, Span, Sweep};
 use crate::output::{
     Cell, CellDecomposition, CellId, ExtractionReport, Filament, FilamentKind, IsolatedNode, Ring,
 };
-use crate::topology::Topology;
+use crate::sweep_line::SweepLine;
+use crate::topology::{NONE, Topology};
 
 fn ring(topo: &Topology, sweep: &Sweep, span: Span) -> Ring {
     let hs = &sweep.ring_buf[span.start as usize..(span.start + span.len) as usize];
@@ -33,69 +32,27 @@ fn ring(topo: &Topology, sweep: &Sweep, span: Span) -> Ring {
     }
 }
 
-/// Whether ring `inner` lies inside ring `outer`, given that their interiors are either
-/// nested or disjoint. Exact: locates a node of `inner` that is not a node of `outer`
-/// (a nested ring shares at most one node with its container).
-fn ring_inside(inner: &Ring, outer: &Ring, mark: &mut [bool]) -> bool {
-    for n in &outer.nodes {
-        mark[n.index()] = true;
-    }
-    let probe = inner
-        .nodes
-        .iter()
-        .zip(inner.polygon.points())
-        .find(|(n, _)| !mark[n.index()]);
-    let inside = probe.is_some_and(|(_, &p)| outer.polygon.locate(p) == PointLocation::Inside);
-    for n in &outer.nodes {
-        mark[n.index()] = false;
-    }
-    inside
-}
-
 /// For every connected component, the innermost cycle of another component containing it.
-fn component_containers(
-    topo: &Topology,
-    sweep: &Sweep,
-    boundaries: &[Ring],
-    mark: &mut [bool],
-) -> Vec<Option<u32>> {
-    let mut out = vec![None; sweep.components.len()];
-    if sweep.components.len() < 2 || boundaries.is_empty() {
-        return out;
-    }
-    let tree = RTree::bulk_load(
-        boundaries
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                let b = r.polygon.bbox();
-                GeomWithData::new(
-                    Rectangle::from_corners([b.min.x, b.min.y], [b.max.x, b.max.y]),
-                    i as u32,
-                )
-            })
-            .collect(),
-    );
-    let mut found: Vec<u32> = Vec::new();
-    for (k, &v) in sweep.components.iter().enumerate() {
-        let p = topo.p(v);
-        found.clear();
-        found.extend(
-            tree.locate_in_envelope_intersecting(AABB::from_point([p.x, p.y]))
-                .map(|x| x.data)
-                .filter(|&c| boundaries[c as usize].polygon.locate(p) == PointLocation::Inside),
-        );
-        found.sort_unstable();
-        let mut best: Option<u32> = None;
-        for &c in &found {
-            best = Some(match best {
-                Some(b) if !ring_inside(&boundaries[c as usize], &boundaries[b as usize], mark) => {
-                    b
-                }
-                _ => c,
-            });
+///
+/// The face containing a component is the face just above the edge directly below its
+/// leftmost node (from the line sweep): a cell, or the outside of an earlier component,
+/// whose container is then the answer (components are numbered left to right, so that
+/// one is resolved already).
+fn component_containers(topo: &Topology, sweep: &Sweep, line: &SweepLine) -> Vec<Option<u32>> {
+    let mut out: Vec<Option<u32>> = vec![None; sweep.components.len()];
+    for k in 0..out.len() {
+        let v = sweep.components[k] as usize;
+        let Some(&h) = line.below.get(v) else {
+            continue;
+        };
+        if h == NONE || h as usize >= topo.slots() {
+            continue;
         }
-        out[k] = best;
+        out[k] = match sweep.face[h as usize] {
+            Owner::Cell(c) => Some(c),
+            Owner::Outside(j) if (j as usize) < k => out[j as usize],
+            _ => None,
+        };
     }
     out
 }
@@ -177,6 +134,7 @@ fn filament_chains(
 pub(crate) fn assemble(
     topo: &Topology,
     sweep: &Sweep,
+    line: &SweepLine,
     report: ExtractionReport,
 ) -> CellDecomposition {
     let boundaries: Vec<Ring> = sweep
@@ -184,8 +142,7 @@ pub(crate) fn assemble(
         .iter()
         .map(|c| ring(topo, sweep, c.span))
         .collect();
-    let mut mark = vec![false; topo.node_bound];
-    let containers = component_containers(topo, sweep, &boundaries, &mut mark);
+    let containers = component_containers(topo, sweep, line);
     let resolve = |o: Owner| -> Option<u32> {
         match o {
             Owner::Unset => None,

@@ -65,6 +65,8 @@ pub(crate) struct RawLoop {
 pub(crate) struct Sweep {
     /// Half-edge lies on the outside (its left face was walked).
     out: Vec<bool>,
+    /// By half-edge: the face to its left (the walk it was on).
+    pub(crate) face: Vec<Owner>,
     /// For a walked half-edge: the parent of faces entered across it.
     tag: Vec<Owner>,
     on_stack: Vec<u32>,
@@ -103,6 +105,8 @@ impl Sweep {
         self.out.resize(hcount, false);
         self.tag.clear();
         self.tag.resize(hcount, Owner::Unset);
+        self.face.clear();
+        self.face.resize(hcount, Owner::Unset);
         self.on_stack.clear();
         self.on_stack.resize(n, NONE);
         self.cycle_uses.clear();
@@ -210,8 +214,13 @@ impl Sweep {
             self.on_stack[v as usize] = NONE;
         }
 
+        let here = match mode {
+            Mode::Face { cell, .. } => Owner::Cell(cell),
+            Mode::Outside { comp } => Owner::Outside(comp),
+        };
         for &h in &self.walk {
             self.out[h as usize] = true;
+            self.face[h as usize] = here;
         }
         for k in 0..self.walk.len() {
             let h = self.walk[k];

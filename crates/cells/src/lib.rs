@@ -72,7 +72,8 @@
 //! * Every left/right decision uses the exact predicates of `polis-geom` (through the
 //!   graph's exact rotation system); containment of whole components uses exact point
 //!   location. Output order is deterministic (sweep order, then ids).
-//! * `O(n log n)`: one sort of the nodes, then every half-edge is walked once.
+//! * `O(n log n)`: one sort of the nodes, one line sweep (the planarity check, and the
+//!   containment of components), then every half-edge is walked once.
 //! * Non-planar input (crossings, overlaps, nodes inside edges) is rejected with
 //!   [`Error::NotPlanar`] naming the edges (or planarised on request with
 //!   [`extract_planarized`]); coincident nodes are merged (and reported) or rejected, see
@@ -85,8 +86,9 @@
 //! * [`extract`] rejects non-planar input; [`extract_planarized`] rebuilds it with the
 //!   graph's planar insertion first (snapping moves geometry by up to the snap distance,
 //!   and the cells then refer to the rebuilt graph's ids).
-//! * The planarity check buckets edges in a uniform grid: fast on road graphs, slow for
-//!   nodes of very high degree (thousands of edges at one junction).
+//! * Listing the conflicts of a non-planar graph (after the `O(n log n)` sweep has found
+//!   one) buckets edges in a uniform grid: fast on road graphs, slow for nodes of very high
+//!   degree (thousands of edges at one junction).
 //!
 //! ## References
 //!
@@ -102,6 +104,7 @@ mod output;
 pub mod params;
 mod planarity;
 mod planarize;
+mod sweep_line;
 mod topology;
 
 pub use polis_geom as geom;
@@ -145,6 +148,7 @@ pub fn extract_with<N, E>(
 pub struct CellExtractor {
     topo: topology::Topology,
     sweep: eberly::Sweep,
+    line: sweep_line::SweepLine,
     check: planarity::PlanarityCheck,
 }
 
@@ -165,11 +169,26 @@ impl CellExtractor {
     ) -> Result<CellDecomposition, Error> {
         let mut report = ExtractionReport::default();
         self.topo.build(graph, params, &mut report)?;
+        // The line sweep certifies planarity and, on the way, finds the edge below every
+        // node (for the containment of components). Only when it finds a contact does the
+        // slower grid check run, to list every conflict.
+        let mut below_known = false;
         if params.check_planarity {
-            self.check.check(&self.topo)?;
+            below_known = self.line.run(&self.topo, true);
+            if !below_known {
+                self.check.check(&self.topo)?;
+            }
         }
         self.sweep.run(&mut self.topo)?;
-        Ok(assemble::assemble(&self.topo, &self.sweep, report))
+        if !below_known && self.sweep.components.len() > 1 {
+            self.line.run(&self.topo, false);
+        }
+        Ok(assemble::assemble(
+            &self.topo,
+            &self.sweep,
+            &self.line,
+            report,
+        ))
     }
 }
 

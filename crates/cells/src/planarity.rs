@@ -1,5 +1,8 @@
-//! The planarity check: no two edges may share a point other than a common end node, and
-//! no node may lie inside an edge.
+//! Listing the planarity conflicts: no two edges may share a point other than a common end
+//! node, and no node may lie inside an edge.
+//!
+//! The line sweep of [`crate::sweep_line`] decides *whether* the graph is planar; this
+//! check runs only when it is not, to name every conflict.
 //!
 //! Edges are bucketed in a uniform grid (each edge in the cells its segment passes
 //! through, found conservatively column by column); every pair sharing a bucket is
