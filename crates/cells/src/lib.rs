@@ -15,6 +15,7 @@
 //!                                   │    ├─ holes: Vec<Ring> island outlines, clockwise
 //!                                   │    ├─ filaments        dead ends, connectors inside it
 //!                                   │    ├─ parent / children / depth   the containment tree
+//!                                   │    ├─ polygon_with_holes()  its region, valid for polis-lots
 //!                                   │    └─ road_graph(&g)   its private road graph (payloads cloned)
 //!                                   ├─ outer_filaments, outer_isolated_nodes, outlines
 //!                                   └─ report: merged nodes, dropped edges, counts
@@ -23,7 +24,10 @@
 //! Key types: [`extract`] / [`extract_with`] (one call) and [`CellExtractor`] (keeps its
 //! buffers between runs), [`extract_planarized`] for graphs that may cross themselves,
 //! [`CellParams`], [`CellDecomposition`], [`Cell`], [`Ring`], [`Filament`],
-//! [`ExtractionReport`], [`Error`].
+//! [`ExtractionReport`], [`Error`]. For the stages downstream, [`Cell::polygon_with_holes`]
+//! gives every cell's region as a [`geom::PolygonWithHoles`] that passes
+//! `validate` (islands touching the boundary at a node are moved off it by
+//! [`TOUCH_SEPARATION`]).
 //!
 //! ## Example
 //!
@@ -104,6 +108,7 @@ mod output;
 pub mod params;
 mod planarity;
 mod planarize;
+mod region;
 mod sweep_line;
 mod topology;
 
@@ -118,6 +123,7 @@ pub use output::{
 pub use params::{CellParams, CoincidentNodes};
 pub use planarity::MAX_REPORTED_CONFLICTS;
 pub use planarize::{Planarized, extract_planarized};
+pub use region::TOUCH_SEPARATION;
 
 use polis_geom::PlanarGraph;
 

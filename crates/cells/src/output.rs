@@ -136,8 +136,9 @@ impl Cell {
     }
 
     /// The cell's region as a polygon with holes (outer ring counter-clockwise, holes
-    /// clockwise). Holes touching the boundary at a node make it fail
-    /// [`PolygonWithHoles::validate`] although the region is well defined.
+    /// clockwise), exactly as extracted. Holes touching the boundary or each other at a
+    /// node make it fail [`PolygonWithHoles::validate`] although the region is well
+    /// defined: use [`Cell::polygon_with_holes`] for a polygon that always validates.
     pub fn region(&self) -> PolygonWithHoles {
         PolygonWithHoles::new(
             self.boundary.polygon.clone(),

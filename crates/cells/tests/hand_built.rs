@@ -6,7 +6,7 @@
 use polis_cells::geom::{DVec2, EdgeId, NodeId, PlanarGraph};
 use polis_cells::{
     CellDecomposition, CellId, CellParams, CoincidentNodes, Conflict, DropReason, Error,
-    FilamentKind, extract, extract_with,
+    FilamentKind, TOUCH_SEPARATION, extract, extract_with,
 };
 
 type G = PlanarGraph<u32, u32>;
@@ -314,6 +314,133 @@ fn island_touching_the_boundary_at_a_cut_vertex() {
         d.cells[0].area()
     );
     assert!(d.filaments().next().is_none());
+    // As extracted, the touching holes do not validate; the separated polygon does.
+    assert!(d.cells[0].region().validate().is_err());
+    assert_valid_regions(&d);
+}
+
+/// Every cell's `polygon_with_holes` validates, keeps the boundary exactly, keeps the
+/// holes' vertex counts and moves no vertex farther than `TOUCH_SEPARATION`; the area
+/// changes by at most a sliver.
+fn assert_valid_regions(d: &CellDecomposition) {
+    for c in &d.cells {
+        let p = c.polygon_with_holes().unwrap();
+        p.validate().unwrap();
+        assert_eq!(p.outer, c.boundary.polygon);
+        assert_eq!(p.holes.len(), c.holes.len());
+        for (h, ring) in p.holes.iter().zip(&c.holes) {
+            assert_eq!(h.len(), ring.len());
+            assert!(h.signed_area() < 0.0);
+            for (a, b) in h.points().iter().zip(ring.polygon.points()) {
+                assert!((*a - *b).length() <= TOUCH_SEPARATION * 1.000_001);
+            }
+        }
+        let perimeter: f64 = c.holes.iter().map(|h| h.polygon.perimeter()).sum();
+        assert!(
+            (p.area() - c.area()).abs() <= TOUCH_SEPARATION * perimeter,
+            "{} vs {}",
+            p.area(),
+            c.area()
+        );
+    }
+}
+
+#[test]
+fn two_islands_touching_each_other_inside_a_cell() {
+    // Two squares inside a 30 × 30 block, sharing the corner (15, 15); neither touches
+    // the boundary.
+    let mut g = G::new();
+    square(&mut g, 0.0, 0.0, 30.0);
+    let p = nodes(
+        &mut g,
+        &[
+            (1, 10.0, 10.0),
+            (2, 15.0, 10.0),
+            (3, 15.0, 15.0),
+            (4, 10.0, 15.0),
+            (5, 20.0, 15.0),
+            (6, 20.0, 20.0),
+            (7, 15.0, 20.0),
+        ],
+    );
+    for (a, b) in [
+        (1, 2),
+        (2, 3),
+        (3, 4),
+        (4, 1),
+        (3, 5),
+        (5, 6),
+        (6, 7),
+        (7, 3),
+    ] {
+        edge(&mut g, &p, a, b);
+    }
+    let d = extract(&g).unwrap();
+    assert_eq!(d.cells.len(), 3);
+    let outer = &d.cells[0];
+    assert_eq!(outer.holes.len(), 2);
+    assert_eq!(outer.children.len(), 2);
+    assert!((outer.area() - (900.0 - 50.0)).abs() < 1e-9);
+    assert!(outer.region().validate().is_err());
+    let fixed = outer.polygon_with_holes().unwrap();
+    // Both holes' copies of (15, 15) moved, each into its own hole.
+    let shared = DVec2::new(15.0, 15.0);
+    for (h, ring) in fixed.holes.iter().zip(&outer.holes) {
+        let j = ring.nodes.iter().position(|&n| n == p[3]).unwrap();
+        assert_ne!(h.vertex(j), shared);
+        assert!(ring.polygon.contains(h.vertex(j)));
+    }
+    assert_valid_regions(&d);
+}
+
+#[test]
+fn chain_of_islands_from_the_boundary_and_a_reflex_touch() {
+    // An L-shaped island touches the boundary at its corner (0, 0); a triangle island
+    // hangs off the L's reflex corner (10, 10).
+    let mut g = G::new();
+    let b = ring(
+        &mut g,
+        &[(0.0, 0.0), (40.0, 0.0), (40.0, 40.0), (0.0, 40.0)],
+    );
+    let mut l = vec![b[0]];
+    for (x, y) in [
+        (20.0, 1.0),
+        (20.0, 10.0),
+        (10.0, 10.0),
+        (10.0, 20.0),
+        (1.0, 20.0),
+    ] {
+        l.push(g.add_node(DVec2::new(x, y), 0).unwrap());
+    }
+    for i in 0..l.len() {
+        g.add_edge(l[i], l[(i + 1) % l.len()], 0).unwrap();
+    }
+    let reflex = l[3];
+    let t1 = g.add_node(DVec2::new(16.0, 16.0), 0).unwrap();
+    let t2 = g.add_node(DVec2::new(12.0, 18.0), 0).unwrap();
+    g.add_edge(reflex, t1, 0).unwrap();
+    g.add_edge(t1, t2, 0).unwrap();
+    g.add_edge(t2, reflex, 0).unwrap();
+    let d = extract(&g).unwrap();
+    assert_eq!(d.cells.len(), 3);
+    let outer = &d.cells[0];
+    assert_eq!(outer.holes.len(), 2);
+    assert!(outer.region().validate().is_err());
+    // The L's copy of (0, 0), and both copies of the reflex corner, moved.
+    let fixed = outer.polygon_with_holes().unwrap();
+    let mut moved = 0;
+    for (h, ring) in fixed.holes.iter().zip(&outer.holes) {
+        for (j, &n) in ring.nodes.iter().enumerate() {
+            if n == b[0] || n == reflex {
+                assert_ne!(h.vertex(j), ring.polygon.vertex(j));
+                moved += 1;
+            } else {
+                assert_eq!(h.vertex(j), ring.polygon.vertex(j));
+            }
+        }
+    }
+    assert_eq!(moved, 3);
+    assert_valid_regions(&d);
 }
 
 #[test]
