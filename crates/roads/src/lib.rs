@@ -76,6 +76,7 @@ pub mod error;
 pub mod generator;
 pub mod goals;
 pub mod inputs;
+pub mod lattice;
 pub mod legality;
 pub mod modules;
 pub mod network;
@@ -89,7 +90,8 @@ pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };
 pub use goals::{DefaultGoals, GlobalGoals};
-pub use inputs::RoadInputs;
+pub use inputs::{RoadInputs, procedural_lattice_m};
+pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};

@@ -113,6 +113,44 @@ impl Default for SimplexNoise {
     }
 }
 
+/// `⌊x⌋`, bit-identical to [`f64::floor`] (signed zeros and NaN included).
+///
+/// `f64::floor` is a libm call on the baseline x86-64 target (no SSE4.1 `roundsd`), and
+/// it is a good part of a simplex sample; below 2⁵² truncation through `i64` is exact.
+#[inline]
+fn floor(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        let t = (x as i64) as f64;
+        let f = if t > x { t - 1.0 } else { t };
+        // ⌊-0.0⌋ = -0.0 and ⌊0.3⌋ = +0.0, as libm gives them.
+        if f == 0.0 { f.copysign(x) } else { f }
+    } else {
+        x.floor()
+    }
+}
+
+/// The value of one corner with gradient `g` at offset `d` from it: the same operations,
+/// in the same order, as the value part of [`corner`].
+#[inline]
+fn corner_value(g: [f64; 2], dx: f64, dy: f64) -> f64 {
+    let t = 0.5 - dx * dx - dy * dy;
+    if t > 0.0 {
+        let gd = g[0] * dx + g[1] * dy;
+        let t2 = t * t;
+        let t4 = t2 * t2;
+        t4 * gd
+    } else {
+        0.0
+    }
+}
+
+/// The containing simplex of `q`: the offsets from its three corners and their gradients.
+#[derive(Clone, Copy)]
+struct Simplex {
+    d: [[f64; 2]; 3],
+    g: [[f64; 2]; 3],
+}
+
 /// `(value, d value / d d)` of one corner with gradient `g` at offset `d` from the corner.
 #[inline]
 fn corner(g: [f64; 2], dx: f64, dy: f64) -> (f64, f64, f64) {
@@ -159,9 +197,18 @@ impl SimplexNoise {
         usize::from(self.perm[(i + a) & 255]) & 15
     }
 
-    /// The noise value at `q` (noise units), in `[-1, 1]`.
+    /// The noise value at `q` (noise units), in `[-1, 1]`: the value of
+    /// [`value_and_gradient`](Self::value_and_gradient), bit for bit, without the
+    /// gradient's arithmetic.
     pub fn value(&self, q: DVec2) -> f64 {
-        self.value_and_gradient(q).0
+        if !q.is_finite() {
+            return f64::NAN;
+        }
+        let Simplex { d, g } = self.simplex(q);
+        let n0 = corner_value(g[0], d[0][0], d[0][1]);
+        let n1 = corner_value(g[1], d[1][0], d[1][1]);
+        let n2 = corner_value(g[2], d[2][0], d[2][1]);
+        (NORMALISE * (n0 + n1 + n2)).clamp(-1.0, 1.0)
     }
 
     /// The noise value at `q` (noise units) and its exact gradient (per noise unit).
@@ -169,11 +216,23 @@ impl SimplexNoise {
         if !q.is_finite() {
             return (f64::NAN, DVec2::NAN);
         }
+        let Simplex { d, g } = self.simplex(q);
+        let (n0, a0, b0) = corner(g[0], d[0][0], d[0][1]);
+        let (n1, a1, b1) = corner(g[1], d[1][0], d[1][1]);
+        let (n2, a2, b2) = corner(g[2], d[2][0], d[2][1]);
+        let value = (NORMALISE * (n0 + n1 + n2)).clamp(-1.0, 1.0);
+        let gradient = DVec2::new(a0 + a1 + a2, b0 + b1 + b2) * NORMALISE;
+        (value, gradient)
+    }
+
+    /// The simplex containing the finite point `q`.
+    #[inline]
+    fn simplex(&self, q: DVec2) -> Simplex {
         let (x, y) = (q.x, q.y);
         // Skew to find the containing half-square of the simplex grid.
         let s = (x + y) * F2;
-        let i = (x + s).floor();
-        let j = (y + s).floor();
+        let i = floor(x + s);
+        let j = floor(y + s);
         let t = (i + j) * G2;
         // Offset from the first corner, unskewed.
         let x0 = x - (i - t);
@@ -186,15 +245,14 @@ impl SimplexNoise {
         // Lattice coordinates mod 256 (saturating casts: huge or NaN inputs cannot panic).
         let ii = ((i as i64) & 255) as usize;
         let jj = ((j as i64) & 255) as usize;
-        let g0 = GRADIENTS[self.hash(ii, jj)];
-        let g1 = GRADIENTS[self.hash(ii + i1, jj + j1)];
-        let g2 = GRADIENTS[self.hash(ii + 1, jj + 1)];
-        let (n0, a0, b0) = corner(g0, x0, y0);
-        let (n1, a1, b1) = corner(g1, x1, y1);
-        let (n2, a2, b2) = corner(g2, x2, y2);
-        let value = (NORMALISE * (n0 + n1 + n2)).clamp(-1.0, 1.0);
-        let gradient = DVec2::new(a0 + a1 + a2, b0 + b1 + b2) * NORMALISE;
-        (value, gradient)
+        Simplex {
+            d: [[x0, y0], [x1, y1], [x2, y2]],
+            g: [
+                GRADIENTS[self.hash(ii, jj)],
+                GRADIENTS[self.hash(ii + i1, jj + j1)],
+                GRADIENTS[self.hash(ii + 1, jj + 1)],
+            ],
+        }
     }
 }
 
@@ -449,6 +507,72 @@ mod tests {
             }
         }
         assert!(best <= worst + 1e-15, "{best} > {worst}");
+    }
+
+    #[test]
+    fn fast_floor_is_bit_identical_to_libm() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.3,
+            -0.3,
+            1.0,
+            -1.0,
+            0.999_999_999_999_999_9,
+            -0.999_999_999_999_999_9,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            4_503_599_627_370_495.5,
+            -4_503_599_627_370_495.5,
+            4_503_599_627_370_496.0,
+            -4_503_599_627_370_497.0,
+            9.3e18,
+            -9.3e18,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        xs.extend(
+            random_points(31, 50_000, 1e3)
+                .iter()
+                .flat_map(|p| [p.x, p.y]),
+        );
+        xs.extend(
+            random_points(32, 5_000, 1e16)
+                .iter()
+                .flat_map(|p| [p.x, p.y]),
+        );
+        for i in -300..300 {
+            let k = f64::from(i);
+            xs.extend([k, k.next_up(), k.next_down(), k + 0.5]);
+        }
+        for x in xs {
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "floor({x:e})");
+        }
+    }
+
+    #[test]
+    fn value_is_the_value_of_value_and_gradient_bit_for_bit() {
+        let n = SimplexNoise::new(17);
+        let mut pts = random_points(12, 50_000, 300.0);
+        pts.extend(random_points(13, 2_000, 1e12));
+        pts.extend([
+            DVec2::ZERO,
+            DVec2::new(-0.0, 0.0),
+            DVec2::new(1.0 - G2, -G2),
+        ]);
+        for p in pts {
+            assert_eq!(
+                n.value(p).to_bits(),
+                n.value_and_gradient(p).0.to_bits(),
+                "at {p}"
+            );
+        }
+        assert!(n.value(DVec2::new(f64::INFINITY, 0.0)).is_nan());
     }
 
     #[test]

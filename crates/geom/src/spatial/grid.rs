@@ -92,6 +92,137 @@ struct Chunk<K> {
     used: usize,
 }
 
+/// `⌊v⌋` as a cell coordinate, equal to `v.floor() as i64`: below 2⁵² by truncation
+/// (`f64::floor` is a libm call on the baseline x86-64 target, and cell coordinates are
+/// computed several times per query); beyond, by `floor` (the `as` cast saturates).
+#[inline]
+fn cell_floor(v: f64) -> i64 {
+    if v.abs() < 4_503_599_627_370_496.0 {
+        let t = v as i64;
+        if (t as f64) > v { t - 1 } else { t }
+    } else {
+        v.floor() as i64
+    }
+}
+
+/// The grid's cell geometry, copied out of the index so that cell walks need no borrow
+/// of it.
+#[derive(Debug, Clone, Copy)]
+struct Geo {
+    size: f64,
+    inv: f64,
+}
+
+impl Geo {
+    #[inline]
+    fn cell_coord(self, x: f64) -> i64 {
+        // Finite and bounded by MAX_COORDINATE / MIN_CELL_SIZE: fits i64.
+        cell_floor(x * self.inv)
+    }
+
+    /// Calls `f` with the column runs `(i, j0, j1)` (cells `(i, j0..=j1)`) of every cell
+    /// the shape is entered in, columns in increasing order.
+    fn runs_of(self, shape: &Shape, raster: bool, mut f: impl FnMut(i64, i64, i64)) {
+        match *shape {
+            Shape::Segment(a, b) if raster => self.segment_runs(a, b, None, &mut f),
+            _ => {
+                let b = shape.bbox();
+                let (i0, j0) = (self.cell_coord(b.min.x), self.cell_coord(b.min.y));
+                let (i1, j1) = (self.cell_coord(b.max.x), self.cell_coord(b.max.y));
+                for i in i0..=i1 {
+                    f(i, j0, j1);
+                }
+            }
+        }
+    }
+
+    /// Conservative rasterisation of the segment `a–b`: every cell the segment meets is
+    /// reported (and possibly a few neighbours), as one run `(i, j0, j1)` per column in
+    /// increasing column order (a run may be empty, `j0 > j1`). With `clip`, only cells
+    /// inside that range.
+    fn segment_runs(
+        self,
+        a: DVec2,
+        b: DVec2,
+        clip: Option<(Cell, Cell)>,
+        f: &mut impl FnMut(i64, i64, i64),
+    ) {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let (mut i0, mut i1) = (self.cell_coord(lo.x), self.cell_coord(hi.x));
+        let (j_lo, j_hi) = (self.cell_coord(lo.y), self.cell_coord(hi.y));
+        if let Some(((ci0, _), (ci1, _))) = clip {
+            i0 = i0.max(ci0);
+            i1 = i1.min(ci1);
+        }
+        let s = self.size;
+        // Slack for rounding in the column bounds and the line evaluation.
+        let margin = s * 1e-6 + hi.abs().max(lo.abs()).max_element() * 1e-12;
+        let dx = b.x - a.x;
+        for i in i0..=i1 {
+            let (mut j0, mut j1) = if dx == 0.0 || i0 == i1 {
+                (j_lo, j_hi)
+            } else {
+                let x0 = (i as f64 * s - margin).max(lo.x);
+                let x1 = ((i + 1) as f64 * s + margin).min(hi.x);
+                let slope = (b.y - a.y) / dx;
+                let y0 = a.y + (x0 - a.x) * slope;
+                let y1 = a.y + (x1 - a.x) * slope;
+                let ylo = (y0.min(y1) - margin).max(lo.y);
+                let yhi = (y0.max(y1) + margin).min(hi.y);
+                (
+                    self.cell_coord(ylo).max(j_lo),
+                    self.cell_coord(yhi).min(j_hi),
+                )
+            };
+            if let Some(((_, cj0), (_, cj1))) = clip {
+                j0 = j0.max(cj0);
+                j1 = j1.min(cj1);
+            }
+            f(i, j0, j1);
+        }
+    }
+}
+
+/// Column runs of a query walk, kept on the stack for the usual short walks.
+struct Runs {
+    inline: [(i64, i64, i64); 16],
+    len: usize,
+    more: Vec<(i64, i64, i64)>,
+}
+
+impl Runs {
+    fn new() -> Self {
+        Runs {
+            inline: [(0, 0, 0); 16],
+            len: 0,
+            more: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, run: (i64, i64, i64)) {
+        if self.more.is_empty()
+            && let Some(slot) = self.inline.get_mut(self.len)
+        {
+            *slot = run;
+            self.len += 1;
+        } else {
+            if self.more.is_empty() {
+                self.more
+                    .extend_from_slice(self.inline.get(..self.len).unwrap_or(&[]));
+            }
+            self.more.push(run);
+        }
+    }
+
+    fn as_slice(&self) -> &[(i64, i64, i64)] {
+        if self.more.is_empty() {
+            self.inline.get(..self.len).unwrap_or(&[])
+        } else {
+            &self.more
+        }
+    }
+}
+
 #[inline]
 fn chunk_of(c: Cell) -> (Cell, usize) {
     let key = (c.0 >> CHUNK_BITS, c.1 >> CHUNK_BITS);
@@ -172,9 +303,16 @@ impl<K: IndexKey> GridIndex<K> {
     }
 
     #[inline]
+    fn geo(&self) -> Geo {
+        Geo {
+            size: self.options.cell_size,
+            inv: self.inv,
+        }
+    }
+
+    #[inline]
     fn cell_coord(&self, x: f64) -> i64 {
-        // Finite and bounded by MAX_COORDINATE / MIN_CELL_SIZE: fits i64; `as` saturates.
-        (x * self.inv).floor() as i64
+        self.geo().cell_coord(x)
     }
 
     /// The lowest cell of the shape's box, and whether it is rasterised.
@@ -194,70 +332,6 @@ impl<K: IndexKey> GridIndex<K> {
         span > BIG_SPAN
     }
 
-    /// Calls `f` for every cell the shape is entered in.
-    fn cells_of(&self, shape: &Shape, raster: bool, mut f: impl FnMut(Cell)) {
-        match *shape {
-            Shape::Segment(a, b) if raster => self.segment_cells(a, b, None, &mut f),
-            _ => {
-                let b = shape.bbox();
-                let (i0, j0) = (self.cell_coord(b.min.x), self.cell_coord(b.min.y));
-                let (i1, j1) = (self.cell_coord(b.max.x), self.cell_coord(b.max.y));
-                for i in i0..=i1 {
-                    for j in j0..=j1 {
-                        f((i, j));
-                    }
-                }
-            }
-        }
-    }
-
-    /// Conservative rasterisation of the segment `a–b`: every cell the segment meets is
-    /// reported (and possibly a few neighbours), column by column. With `clip`, only
-    /// cells inside that range.
-    fn segment_cells(
-        &self,
-        a: DVec2,
-        b: DVec2,
-        clip: Option<(Cell, Cell)>,
-        f: &mut impl FnMut(Cell),
-    ) {
-        let (lo, hi) = (a.min(b), a.max(b));
-        let (mut i0, mut i1) = (self.cell_coord(lo.x), self.cell_coord(hi.x));
-        let (j_lo, j_hi) = (self.cell_coord(lo.y), self.cell_coord(hi.y));
-        if let Some(((ci0, _), (ci1, _))) = clip {
-            i0 = i0.max(ci0);
-            i1 = i1.min(ci1);
-        }
-        let s = self.options.cell_size;
-        // Slack for rounding in the column bounds and the line evaluation.
-        let margin = s * 1e-6 + hi.abs().max(lo.abs()).max_element() * 1e-12;
-        let dx = b.x - a.x;
-        for i in i0..=i1 {
-            let (mut j0, mut j1) = if dx == 0.0 || i0 == i1 {
-                (j_lo, j_hi)
-            } else {
-                let x0 = (i as f64 * s - margin).max(lo.x);
-                let x1 = ((i + 1) as f64 * s + margin).min(hi.x);
-                let slope = (b.y - a.y) / dx;
-                let y0 = a.y + (x0 - a.x) * slope;
-                let y1 = a.y + (x1 - a.x) * slope;
-                let ylo = (y0.min(y1) - margin).max(lo.y);
-                let yhi = (y0.max(y1) + margin).min(hi.y);
-                (
-                    self.cell_coord(ylo).max(j_lo),
-                    self.cell_coord(yhi).min(j_hi),
-                )
-            };
-            if let Some(((_, cj0), (_, cj1))) = clip {
-                j0 = j0.max(cj0);
-                j1 = j1.min(cj1);
-            }
-            for j in j0..=j1 {
-                f((i, j));
-            }
-        }
-    }
-
     /// The list of one cell, if occupied.
     #[inline]
     fn cell(&self, c: Cell) -> Option<&[Entry<K>]> {
@@ -269,7 +343,7 @@ impl<K: IndexKey> GridIndex<K> {
     }
 
     /// Calls `visit` with every occupied cell of the inclusive range, chunk by chunk.
-    fn walk_range(&self, (i0, j0): Cell, (i1, j1): Cell, visit: &mut dyn FnMut(Cell, &[Entry<K>])) {
+    fn walk_range(&self, (i0, j0): Cell, (i1, j1): Cell, mut visit: impl FnMut(Cell, &[Entry<K>])) {
         for ci in (i0 >> CHUNK_BITS)..=(i1 >> CHUNK_BITS) {
             for cj in (j0 >> CHUNK_BITS)..=(j1 >> CHUNK_BITS) {
                 let Some(ch) = self.chunks.get(&(ci, cj)) else {
@@ -290,33 +364,8 @@ impl<K: IndexKey> GridIndex<K> {
         }
     }
 
-    /// Visits the entries of the cells `walk` presents whose box meets `b`, each once.
-    /// `first_of` gives, for a box-stored entry, the one cell of the walk at which it is
-    /// reported; the others (and all entries when `first_of` is `None`) are
-    /// de-duplicated by sorting on the key.
-    fn visit_cells<F: FnMut(K, &Shape)>(
-        &self,
-        walk: impl FnOnce(&mut dyn FnMut(Cell, &[Entry<K>])),
-        first_of: Option<&dyn Fn(Cell) -> Cell>,
-        b: &Aabb2,
-        mut f: F,
-    ) {
-        let mut found: Vec<Entry<K>> = Vec::new();
-        walk(&mut |c, list| {
-            for e in list {
-                if !e.bbox.intersects(b) {
-                    continue;
-                }
-                match first_of {
-                    Some(first) if !e.raster => {
-                        if first(e.first) == c {
-                            f(e.key, &e.shape);
-                        }
-                    }
-                    _ => found.push(*e),
-                }
-            }
-        });
+    /// Reports the raster entries gathered by a walk, each once, in key order.
+    fn report_raster<F: FnMut(K, &Shape)>(mut found: Vec<Entry<K>>, f: &mut F) {
         found.sort_unstable_by_key(|e| e.key);
         found.dedup_by_key(|e| e.key);
         for e in found {
@@ -371,29 +420,31 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
             self.big.push(entry);
             return Ok(old);
         }
-        let mut touched: Vec<Cell> = Vec::new();
-        self.cells_of(&shape, raster, |c| touched.push(c));
-        for c in touched {
-            let (key, idx) = chunk_of(c);
-            let ch = self.chunks.entry(key).or_insert_with(|| Chunk {
-                cells: vec![Vec::new(); (CHUNK * CHUNK) as usize],
-                used: 0,
-            });
-            if let Some(list) = ch.cells.get_mut(idx) {
-                if list.is_empty() {
-                    ch.used += 1;
-                    self.occupied += 1;
-                }
-                list.push(entry);
+        let geo = self.geo();
+        let (chunks, occupied, extent) = (&mut self.chunks, &mut self.occupied, &mut self.extent);
+        geo.runs_of(&shape, raster, |i, j0, j1| {
+            if j0 > j1 {
+                return;
             }
-            self.extent = Some(match self.extent {
-                None => (c, c),
-                Some((lo, hi)) => (
-                    (lo.0.min(c.0), lo.1.min(c.1)),
-                    (hi.0.max(c.0), hi.1.max(c.1)),
-                ),
+            for j in j0..=j1 {
+                let (key, idx) = chunk_of((i, j));
+                let ch = chunks.entry(key).or_insert_with(|| Chunk {
+                    cells: vec![Vec::new(); (CHUNK * CHUNK) as usize],
+                    used: 0,
+                });
+                if let Some(list) = ch.cells.get_mut(idx) {
+                    if list.is_empty() {
+                        ch.used += 1;
+                        *occupied += 1;
+                    }
+                    list.push(entry);
+                }
+            }
+            *extent = Some(match *extent {
+                None => ((i, j0), (i, j1)),
+                Some((lo, hi)) => ((lo.0.min(i), lo.1.min(j0)), (hi.0.max(i), hi.1.max(j1))),
             });
-        }
+        });
         Ok(old)
     }
 
@@ -404,26 +455,28 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
             return Some(shape);
         }
         let (_, raster) = self.placement(&shape);
-        let mut touched: Vec<Cell> = Vec::new();
-        self.cells_of(&shape, raster, |c| touched.push(c));
-        for c in touched {
-            let (ck, idx) = chunk_of(c);
-            let Some(ch) = self.chunks.get_mut(&ck) else {
-                continue;
-            };
-            if let Some(list) = ch.cells.get_mut(idx)
-                && let Some(i) = list.iter().position(|e| e.key == key)
-            {
-                list.swap_remove(i);
-                if list.is_empty() {
-                    ch.used -= 1;
-                    self.occupied -= 1;
+        let geo = self.geo();
+        let (chunks, occupied) = (&mut self.chunks, &mut self.occupied);
+        geo.runs_of(&shape, raster, |i, j0, j1| {
+            for j in j0..=j1 {
+                let (ck, idx) = chunk_of((i, j));
+                let Some(ch) = chunks.get_mut(&ck) else {
+                    continue;
+                };
+                if let Some(list) = ch.cells.get_mut(idx)
+                    && let Some(i) = list.iter().position(|e| e.key == key)
+                {
+                    list.swap_remove(i);
+                    if list.is_empty() {
+                        ch.used -= 1;
+                        *occupied -= 1;
+                    }
+                }
+                if ch.used == 0 {
+                    chunks.remove(&ck);
                 }
             }
-            if ch.used == 0 {
-                self.chunks.remove(&ck);
-            }
-        }
+        });
         Some(shape)
     }
 
@@ -454,14 +507,22 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         let Some(((i0, j0), (i1, j1))) = range else {
             return;
         };
-        // A box-stored entry is reported at its lowest cell clipped to the range.
-        let first = move |c: Cell| (c.0.max(i0), c.1.max(j0));
-        self.visit_cells(
-            |visit| self.walk_range((i0, j0), (i1, j1), visit),
-            Some(&first),
-            b,
-            f,
-        );
+        // A box-stored entry is reported at its lowest cell clipped to the range; raster
+        // entries are gathered and de-duplicated.
+        let mut raster: Vec<Entry<K>> = Vec::new();
+        self.walk_range((i0, j0), (i1, j1), |c, list| {
+            for e in list {
+                if !e.bbox.intersects(b) {
+                    continue;
+                }
+                if e.raster {
+                    raster.push(*e);
+                } else if (e.first.0.max(i0), e.first.1.max(j0)) == c {
+                    f(e.key, &e.shape);
+                }
+            }
+        });
+        Self::report_raster(raster, &mut f);
     }
 
     fn for_each_candidate_along<F: FnMut(K, &Shape)>(&self, a: DVec2, b: DVec2, mut f: F) {
@@ -469,38 +530,59 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         if bb.is_empty() {
             return;
         }
-        let mut cells = Vec::new();
-        if let Some(range) = self.clipped_range(&bb) {
-            self.segment_cells(a, b, Some(range), &mut |c| cells.push(c));
-            if cells.len() > self.lookup.len() {
-                return self.scan_all(&bb, f);
+        let Some(range) = self.clipped_range(&bb) else {
+            self.visit_big(&bb, &mut f);
+            return;
+        };
+        let geo = self.geo();
+        let mut runs = Runs::new();
+        let mut cells = 0u64;
+        geo.segment_runs(a, b, Some(range), &mut |i, j0, j1| {
+            if j0 <= j1 {
+                runs.push((i, j0, j1));
+                cells += (j1 - j0 + 1) as u64;
             }
+        });
+        if cells > self.lookup.len() as u64 {
+            return self.scan_all(&bb, f);
         }
         self.visit_big(&bb, &mut f);
-        match cells[..] {
-            // One cell: every entry in it is listed once there.
-            [only] => self.visit_cells(
-                |visit| {
-                    if let Some(list) = self.cell(only) {
-                        visit(only, list);
+        let runs = runs.as_slice();
+        // A box-stored entry is in every cell of its box: report it at the first cell of
+        // the walk (columns in increasing order, rows increasing within a column) inside
+        // its box. Raster entries are gathered and de-duplicated.
+        let mut raster: Vec<Entry<K>> = Vec::new();
+        for (r, &(i, j0, j1)) in runs.iter().enumerate() {
+            for j in j0..=j1 {
+                let Some(list) = self.cell((i, j)) else {
+                    continue;
+                };
+                for e in list {
+                    if !e.bbox.intersects(&bb) {
+                        continue;
                     }
-                },
-                Some(&move |_| only),
-                &bb,
-                f,
-            ),
-            _ => self.visit_cells(
-                |visit| {
-                    for &c in &cells {
-                        if let Some(list) = self.cell(c) {
-                            visit(c, list);
-                        }
+                    if e.raster {
+                        raster.push(*e);
+                        continue;
                     }
-                },
-                None,
-                &bb,
-                f,
-            ),
+                    let (ei0, ej0) = e.first;
+                    let ej1 = geo.cell_coord(e.bbox.max.y);
+                    if j != j0.max(ej0) {
+                        continue;
+                    }
+                    let seen_before = runs
+                        .get(..r)
+                        .unwrap_or(&[])
+                        .iter()
+                        .rev()
+                        .take_while(|run| run.0 >= ei0)
+                        .any(|&(_, rj0, rj1)| rj0 <= ej1 && rj1 >= ej0);
+                    if !seen_before {
+                        f(e.key, &e.shape);
+                    }
+                }
+            }
         }
+        Self::report_raster(raster, &mut f);
     }
 }

@@ -194,6 +194,67 @@ proptest! {
     }
 }
 
+/// `for_each_candidate(_along)` report every key at most once, and every shape that
+/// meets the query among them.
+fn check_candidates_once(
+    g: &GridIndex<u32>,
+    brute: &Brute,
+    a: DVec2,
+    b: DVec2,
+) -> Result<(), TestCaseError> {
+    let mut along = Vec::new();
+    g.for_each_candidate_along(a, b, |k, _| along.push(k));
+    let mut boxed = Vec::new();
+    let bx = Aabb2::new(a, b);
+    g.for_each_candidate(&bx, |k, _| boxed.push(k));
+    for (name, mut keys, must) in [
+        (
+            "along",
+            along,
+            brute.crossing(a, b).iter().map(|h| h.0).collect::<Vec<_>>(),
+        ),
+        ("box", boxed, brute.query_box(&bx)),
+    ] {
+        let n = keys.len();
+        keys.sort_unstable();
+        keys.dedup();
+        prop_assert_eq!(keys.len(), n, "{} reported a key twice", name);
+        for k in must {
+            prop_assert!(keys.binary_search(&k).is_ok(), "{} missed {}", name, k);
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn grid_candidates_are_reported_once(
+        ops in ops(),
+        queries in prop::collection::vec((point(), point()), 1..8),
+        cell in prop_oneof![Just(0.5), Just(1.0), Just(3.0), Just(32.0)],
+    ) {
+        let mut g = GridIndex::new(GridOptions { cell_size: cell }).unwrap();
+        let mut brute = Brute::default();
+        for op in &ops {
+            match *op {
+                Op::Insert(k, s) => {
+                    g.insert(k, s).unwrap();
+                    brute.0.insert(k, s);
+                }
+                Op::Remove(k) => {
+                    g.remove(k);
+                    brute.0.remove(&k);
+                }
+            }
+        }
+        for &(a, b) in &queries {
+            check_candidates_once(&g, &brute, a, b)?;
+        }
+    }
+}
+
 #[test]
 fn crossing_order_is_by_parameter_then_key() {
     let mut g = SegmentIndex::<u32>::default();
