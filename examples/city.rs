@@ -1,282 +1,187 @@
 //! The main job: generate a city and write it out.
 //!
 //! ```text
-//! cargo run --release --example city -- [--seed N] [--segments N] [--out DIR]
+//! cargo run --release --example city -- [--preset NAME | --config FILE] [--seed N]
+//!     [--size METRES] [--lod N] [--segments N] [--threads N] [--out DIR]
+//!     [--population PNG] [--water PNG] [--parks PNG] [--elevation PNG METRES]
+//!     [--zoning PNG] [--max-height PNG METRES]
 //! ```
 //!
-//! The one-call pipeline of the `polis` facade (`CityConfig`, `Pipeline`, `generate`) has
-//! not landed yet, so this example chains the stage crates by hand, which is also what the
-//! facade will do:
-//!
-//! 1. **roads** — Parish & Müller's extended L-system on the procedural default maps;
-//! 2. **cells** — Eberly's minimal cycle basis of the road graph;
-//! 3. **blocks** — each cell inset by half of each bounding road's width, with footpaths;
-//! 4. **lots** — Kelly's subdivision with street access;
-//! 5. **buildings** — one building per lot from the default building grammars; the kind
-//!    and the height limit follow the population map (a simple zoning rule written
-//!    here: towers where the population peaks, apartments and mid-rises around them,
-//!    houses at the fringe);
-//! 6. **export** — an SVG map, GeoJSON layers, and a glb/OBJ with the blocks as kerb-high
-//!    plinths and every building's closed meshes.
-//!
-//! Facade textures are not applied yet (the facade stage exists, wiring it into the
-//! scene is the pipeline's job). Everything is deterministic for a seed.
+//! With no arguments it builds the `default` preset and writes `out/city.glb`,
+//! `out/city.obj` (+ `city.mtl` and the facade textures), `out/city.svg` and
+//! `out/city.geojson`, then prints counts and per-stage timings. A grey-scale PNG map
+//! covers the whole city square (top row = north edge); its values in [0, 1] are used as
+//! they are, except elevation and maximum height, which are scaled to the given metres
+//! and zoning, which is scaled to the six building kinds (0 skyscraper … 5 industrial).
 
-use std::fs::File;
-use std::io::BufWriter;
+use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::time::Instant;
 
-use polis::buildings::{BuildingGenerator, BuildingKind, BuildingParams, PartRole};
-use polis::export::map::{
-    BuildingKind as MapKind, MapBlock, MapFootprint, MapLayers, MapLot, MapRoad,
-    RoadClass as MapClass,
-};
-use polis::export::{geojson, glb, obj, sink::DirSink, svg};
-use polis::geom::scene::Material;
-use polis::geom::{Field, PolygonWithHoles, Scene, Transform, mesh::prism, to_world};
-use polis::lots::{BlockParams, Cell as LotCell, LotParams, blocks, subdivide_block};
-use polis::roads::{RoadClass, RoadInputs, RoadParams, generate};
-use rand::SeedableRng;
-use rand_pcg::Pcg64Mcg;
+use polis::geom::Aabb2;
+use polis::geom::field::FieldSpec;
+use polis::{CityConfig, MapSpec, Pipeline, Stage};
 
-/// Height of the block plinths (kerb height), metres.
-const KERB_HEIGHT_M: f64 = 0.15;
+const USAGE: &str = "usage: city [--preset NAME | --config FILE] [--seed N] [--size METRES] \
+    [--lod N] [--segments N] [--threads N] [--out DIR] [--population PNG] [--water PNG] \
+    [--parks PNG] [--elevation PNG METRES] [--zoning PNG] [--max-height PNG METRES]";
 
 struct Args {
-    seed: u64,
-    segments: Option<usize>,
+    config: CityConfig,
     out: PathBuf,
 }
 
-fn parse_args() -> Result<Args, String> {
-    let mut args = Args {
-        seed: RoadParams::default().seed,
-        segments: None,
-        out: PathBuf::from("out"),
-    };
-    let mut it = std::env::args().skip(1);
+fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
+    let raw: Vec<String> = std::env::args().skip(1).collect();
+    // The base configuration first, so the other flags override it.
+    let mut config = CityConfig::preset("default")?;
+    let mut i = 0;
+    while i < raw.len() {
+        match raw[i].as_str() {
+            "--preset" | "--config" if i + 1 >= raw.len() => {
+                return Err(format!("{} needs a value", raw[i]).into());
+            }
+            "--preset" => config = CityConfig::preset(&raw[i + 1])?,
+            "--config" => config = CityConfig::from_path(&raw[i + 1])?,
+            "-h" | "--help" => return Err(USAGE.into()),
+            _ => {}
+        }
+        i += 1;
+    }
+    let mut out = PathBuf::from("out");
+    let mut maps: Vec<(String, PathBuf, f64)> = Vec::new();
+    let mut it = raw.iter();
     while let Some(flag) = it.next() {
-        let mut value = || it.next().ok_or(format!("{flag} needs a value"));
-        match flag.as_str() {
-            "--seed" => args.seed = value()?.parse().map_err(|e| format!("--seed: {e}"))?,
-            "--segments" => {
-                args.segments = Some(value()?.parse().map_err(|e| format!("--segments: {e}"))?)
-            }
-            "--out" => args.out = PathBuf::from(value()?),
-            "-h" | "--help" => {
-                return Err("usage: city [--seed N] [--segments N] [--out DIR]".into());
-            }
-            other => return Err(format!("unknown flag {other}; try --help")),
-        }
-    }
-    Ok(args)
-}
-
-/// The example's zoning rule: building kind and height limit (metres) from the
-/// population density in [0, 1].
-fn zoning(density: f64) -> (BuildingKind, f64) {
-    match density {
-        d if d > 0.55 => (BuildingKind::Skyscraper, 180.0),
-        d if d > 0.45 => (BuildingKind::Office, 90.0),
-        d if d > 0.35 => (BuildingKind::MidRise, 40.0),
-        d if d > 0.25 => (BuildingKind::Apartment, 25.0),
-        d if d > 0.08 => (BuildingKind::House, 12.0),
-        _ => (BuildingKind::Industrial, 15.0),
-    }
-}
-
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse_args()?;
-    std::fs::create_dir_all(&args.out)?;
-    let mut timings: Vec<(&str, f64)> = Vec::new();
-
-    // 1. Roads.
-    let t = Instant::now();
-    let mut params = RoadParams {
-        seed: args.seed,
-        ..RoadParams::default()
-    };
-    if let Some(n) = args.segments {
-        params.max_segments = n;
-    }
-    let inputs = RoadInputs::procedural(params.seed, &params)?;
-    let roads = generate(&params, &inputs)?;
-    let network = &roads.network;
-    timings.push(("roads", t.elapsed().as_secs_f64()));
-
-    // 2. Cells.
-    let t = Instant::now();
-    let cells = polis::cells::extract(network)?;
-    timings.push(("cells", t.elapsed().as_secs_f64()));
-
-    // 3–4. Blocks and lots, cell by cell (seeded per block, so order does not matter).
-    let t = Instant::now();
-    let block_params = BlockParams::default();
-    let lot_params = LotParams::default();
-    let mut map = MapLayers::default();
-    let mut skipped_cells = 0usize;
-    let mut all_blocks = Vec::new();
-    for cell in &cells.cells {
-        let holes: Vec<_> = cell.holes.iter().map(|h| h.polygon.clone()).collect();
-        let mut widths = Vec::new();
-        for ring in std::iter::once(&cell.boundary).chain(cell.holes.iter()) {
-            for &e in &ring.edges {
-                widths.push(network.edge_payload(e)?.width);
-            }
-        }
-        let lot_cell = LotCell {
-            id: cell.id.index() as u64,
-            polygon: PolygonWithHoles::new(cell.boundary.polygon.clone(), holes),
-            road_widths: widths,
+        let mut value = || {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{flag} needs a value; {USAGE}"))
         };
-        // A cell whose islands touch its boundary at a node is not a simple polygon
-        // with holes; such cells are skipped and counted.
-        match blocks(&lot_cell, &block_params) {
-            Ok(bs) => all_blocks.extend(bs),
-            Err(_) => skipped_cells += 1,
+        let num = |v: String| -> Result<f64, String> {
+            v.parse::<f64>().map_err(|e| format!("{flag}: {e}"))
+        };
+        match flag.as_str() {
+            "--preset" | "--config" => {
+                value()?;
+            }
+            "--seed" => config.seed = value()?.parse().map_err(|e| format!("--seed: {e}"))?,
+            "--size" => config.size_m = num(value()?)?,
+            "--lod" => config.lod = Some(value()?.parse().map_err(|e| format!("--lod: {e}"))?),
+            "--segments" => {
+                config.roads.max_segments =
+                    value()?.parse().map_err(|e| format!("--segments: {e}"))?
+            }
+            "--threads" => {
+                config.threads = Some(value()?.parse().map_err(|e| format!("--threads: {e}"))?)
+            }
+            "--out" => out = PathBuf::from(value()?),
+            "--population" | "--water" | "--parks" | "--zoning" => {
+                maps.push((flag.clone(), PathBuf::from(value()?), 1.0))
+            }
+            "--elevation" | "--max-height" => {
+                let path = PathBuf::from(value()?);
+                let scale = num(value()?)?;
+                maps.push((flag.clone(), path, scale));
+            }
+            other => return Err(format!("unknown flag {other}; {USAGE}").into()),
         }
     }
-    let mut lots = Vec::new();
-    for block in &all_blocks {
-        let mut rng = Pcg64Mcg::seed_from_u64(args.seed ^ block.id());
-        let sub = subdivide_block(block, &lot_params, &mut rng)?;
-        for (i, lot) in sub.lots.into_iter().enumerate() {
-            let id = block.id().wrapping_mul(1 << 16).wrapping_add(i as u64);
-            map.lots.push(MapLot {
-                id,
-                block: Some(block.id()),
-                polygon: lot.polygon.clone().into(),
-            });
-            lots.push((id, lot));
+    let h = config.size_m * 0.5;
+    let extent = Aabb2::new(polis::geom::DVec2::new(-h, -h), polis::geom::DVec2::new(h, h));
+    for (flag, path, scale) in maps {
+        let png = MapSpec::png(path, extent);
+        let scaled = |factor: f64| match &png {
+            MapSpec::Field(f) => MapSpec::Field(FieldSpec::Scaled {
+                field: Box::new(f.clone()),
+                factor,
+            }),
+            other => other.clone(),
+        };
+        match flag.as_str() {
+            "--population" => config.maps.population = png,
+            "--water" => config.maps.water = Some(png),
+            "--parks" => config.maps.parks = Some(png),
+            "--zoning" => config.maps.zoning = Some(scaled(5.0)),
+            "--elevation" => config.maps.elevation = Some(scaled(scale)),
+            "--max-height" => config.maps.max_height = Some(scaled(scale)),
+            _ => {}
         }
-        map.blocks.push(MapBlock {
-            id: block.id(),
-            polygon: block.polygon.clone(),
-        });
-        map.parks.extend(sub.green_spaces);
     }
-    timings.push(("blocks + lots", t.elapsed().as_secs_f64()));
+    config.validate()?;
+    Ok(Args { config, out })
+}
 
-    // 5. Buildings: kind and height limit from the population at the lot (a zoning rule
-    // of this example; the pipeline will take zoning and height maps).
-    let t = Instant::now();
-    let generator = BuildingGenerator::new(BuildingParams::default())?;
-    let lod = BuildingParams::default().max_lod;
-    let mut buildings = Vec::new();
-    let mut failed_lots = 0usize;
-    for (id, lot) in &lots {
-        let density = inputs.population.sample(lot.polygon.centroid());
-        let (kind, max_height) = zoning(density);
-        match generator.build(lot, *id, kind, max_height, lod) {
-            Ok(Some(b)) => buildings.push(b),
-            Ok(None) => {}
-            // A degenerate lot is skipped and counted, not fatal.
-            Err(_) => failed_lots += 1,
+/// A one-line progress bar on standard error.
+fn progress_bar() -> impl Fn(Stage, f64) + Send + Sync + 'static {
+    let last = Mutex::new((None::<Stage>, -1i64));
+    move |stage, done| {
+        let Ok(mut last) = last.lock() else { return };
+        let pct = (done * 100.0).round() as i64;
+        if last.0 == Some(stage) && last.1 == pct {
+            return;
         }
-    }
-    timings.push(("buildings", t.elapsed().as_secs_f64()));
-
-    // 6. Export.
-    let t = Instant::now();
-    for (e, _, _, road) in network.edges() {
-        let (a, b) = network.segment(e)?;
-        map.roads.push(MapRoad {
-            id: u64::from(e.raw()),
-            points: vec![a, b],
-            class: match road.class {
-                RoadClass::Highway => MapClass::Highway,
-                RoadClass::Street => MapClass::Street,
-            },
-            width_m: road.width,
-            bridge: road.bridge,
-        });
-    }
-    let mut scene = Scene::new();
-    let kerb = scene.add_material(Material::new("pavement", [0.55, 0.55, 0.52, 1.0]));
-    let root = scene.add_root("city");
-    for block in &all_blocks {
-        let mesh = prism(&block.polygon, 0.0, KERB_HEIGHT_M, Some(kerb))?;
-        let mesh = scene.add_mesh(mesh);
-        let node = scene.add_node(root, format!("block {}", block.id()))?;
-        scene.attach_mesh(node, mesh)?;
-        scene.set_metadata(node, "cell", block.cell_id as f64)?;
-    }
-    let wall = scene.add_material(Material::new("wall", [0.78, 0.74, 0.68, 1.0]));
-    let roof = scene.add_material(Material::new("roof", [0.45, 0.25, 0.2, 1.0]));
-    let detail = scene.add_material(Material::new("detail", [0.3, 0.3, 0.32, 1.0]));
-    let mut triangles = 0usize;
-    for b in &buildings {
-        let node = scene.add_node(root, format!("building {}", b.id))?;
-        scene.node_mut(node)?.transform = Transform::from_translation(to_world(b.origin, 0.0));
-        scene.set_metadata(node, "kind", format!("{:?}", b.kind))?;
-        scene.set_metadata(node, "height", b.height)?;
-        scene.set_metadata(node, "floors", f64::from(b.floors))?;
-        scene.set_metadata(node, "lot", b.lot_id as f64)?;
-        for part in &b.parts {
-            let mut mesh = part.mesh.clone();
-            mesh.material = Some(match part.role {
-                PartRole::Mass => wall,
-                PartRole::Roof => roof,
-                PartRole::Detail | PartRole::Template => detail,
-            });
-            triangles += mesh.triangle_count();
-            let mesh = scene.add_mesh(mesh);
-            scene.attach_mesh(node, mesh)?;
+        *last = (Some(stage), pct);
+        let filled = (done * 30.0).round().clamp(0.0, 30.0) as usize;
+        let mut err = std::io::stderr().lock();
+        let _ = write!(
+            err,
+            "\r{:<10} [{}{}] {:>3} %",
+            stage.name(),
+            "#".repeat(filled),
+            ".".repeat(30 - filled),
+            pct
+        );
+        if done >= 1.0 {
+            let _ = writeln!(err);
         }
-        map.footprints.push(MapFootprint {
-            id: b.id,
-            polygon: b.footprint.clone().into(),
-            kind: match b.kind {
-                BuildingKind::Skyscraper => MapKind::Skyscraper,
-                BuildingKind::Office | BuildingKind::MidRise => MapKind::Commercial,
-                BuildingKind::House | BuildingKind::Apartment => MapKind::Residential,
-                BuildingKind::Industrial => MapKind::Industrial,
-            },
-            height_m: b.height,
-            floors: Some(b.floors),
-            lot: Some(b.lot_id),
-        });
+        let _ = err.flush();
     }
-    svg::write_svg(
-        &map,
-        &svg::SvgOptions::default(),
-        BufWriter::new(File::create(args.out.join("city.svg"))?),
-    )?;
-    geojson::write_geojson(
-        &map,
-        &geojson::GeoJsonOptions::default(),
-        BufWriter::new(File::create(args.out.join("city.geojson"))?),
-    )?;
-    glb::write_glb(
-        &scene,
-        &glb::GlbOptions::default(),
-        BufWriter::new(File::create(args.out.join("city.glb"))?),
-    )?;
-    obj::write_obj(
-        &scene,
-        &obj::ObjOptions::default(),
-        BufWriter::new(File::create(args.out.join("city.obj"))?),
-        &mut DirSink::new(&args.out),
-    )?;
-    timings.push(("export", t.elapsed().as_secs_f64()));
+}
 
-    println!("polis city, seed {}", args.seed);
-    println!("  road segments  {:>8}", network.edge_count());
-    println!("  junctions      {:>8}", network.node_count());
-    println!("  cells          {:>8}", cells.cells.len());
-    println!("  cells skipped  {:>8}", skipped_cells);
-    println!("  blocks         {:>8}", all_blocks.len());
-    println!("  lots           {:>8}", lots.len());
-    println!("  buildings      {:>8}", buildings.len());
-    println!("  lots skipped   {:>8}", failed_lots);
-    println!("  triangles      {:>8}", triangles);
-    for (stage, secs) in &timings {
-        println!("  {stage:<14} {:>8.1} ms", secs * 1e3);
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
     }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let args = parse_args()?;
+    let c = &args.config;
     println!(
-        "wrote {}/city.{{svg,geojson,glb,obj,mtl}}",
-        args.out.display()
+        "polis: {} city, seed {}, {:.1} km × {:.1} km",
+        c.name,
+        c.seed,
+        c.size_m / 1000.0,
+        c.size_m / 1000.0
     );
+    let city = Pipeline::default()
+        .with_progress(progress_bar())
+        .generate(c)?;
+    let t = Instant::now();
+    let written = city.write_all(&args.out)?;
+    let write_time = t.elapsed();
+
+    let s = &city.stats;
+    println!("  road segments   {:>9}", s.road_segments);
+    println!("  junctions       {:>9}", s.junctions);
+    println!("  cells           {:>9}", s.cells);
+    println!("  blocks          {:>9}", s.blocks);
+    println!("  lots            {:>9}", s.lots);
+    println!("  buildings       {:>9}", s.buildings);
+    println!("  dressed         {:>9}", s.dressed_buildings);
+    println!("  facade tiles    {:>9}", s.facade_tiles);
+    println!("  texture memory  {:>7.1} MiB", s.texture_bytes as f64 / 1048576.0);
+    println!("  triangles       {:>9}", s.scene_triangles);
+    println!("  skipped         {:>9}", city.report.skipped.len());
+    for stage in Stage::ALL {
+        println!("  {:<15} {:>7.1} ms", stage.name(), s.time(stage).as_secs_f64() * 1e3);
+    }
+    println!("  {:<15} {:>7.1} ms", "generate total", s.total_time().as_secs_f64() * 1e3);
+    println!("  {:<15} {:>7.1} ms", "write files", write_time.as_secs_f64() * 1e3);
+    for f in &written.files {
+        println!("wrote {}", f.display());
+    }
     Ok(())
 }

@@ -4,8 +4,42 @@
 //! SIGGRAPH 2001) and Kelly (*Citygen*, 2008): road networks, city cells, blocks, lots,
 //! buildings with facades, exported to glTF, OBJ, SVG and GeoJSON.
 //!
-//! This facade re-exports the stage crates. The one-call pipeline (`CityConfig`,
-//! `Pipeline`, `generate`) is not written yet; until then use the stage crates directly.
+//! One call makes a whole city:
+//!
+//! ```no_run
+//! let config = polis::CityConfig::preset("manhattan")?;
+//! let city = polis::generate(&config)?;
+//! println!("{} roads, {} buildings", city.stats.road_segments, city.stats.buildings);
+//! city.write_all("out")?;
+//! # Ok::<(), polis::Error>(())
+//! ```
+//!
+//! ## The pipeline
+//!
+//! [`Pipeline::generate`] runs the stages in order, each a trait with the stage crate as
+//! its default ([`stages`]): maps → roads ([`polis_roads`], the extended L-system) →
+//! cells ([`polis_cells`], the minimal cycle basis) → blocks and lots ([`polis_lots`],
+//! per cell, in parallel) → buildings ([`polis_buildings`], per lot, in parallel) →
+//! facades ([`polis_facades`], shared tile sets, per building in parallel) → the scene.
+//! Replace any stage with `Pipeline::default().with_lots(MyLots)` and friends.
+//!
+//! ## Configuration
+//!
+//! [`CityConfig`] is plain serde data; the built-in presets (`default`, `manhattan`,
+//! `paris`, `san_francisco`, `old_town`, `suburbia`) are JSON files in `presets/`,
+//! compiled in. Every map is procedural and seeded unless a grey-scale PNG replaces it
+//! ([`MapSpec::png`]).
+//!
+//! ## Guarantees
+//!
+//! - **Deterministic**: the same configuration gives the same city and the same output
+//!   bytes, whatever [`CityConfig::threads`] says. Every stage and item draws from its
+//!   own sub-seed ([`seed::sub_seed`]) of the city seed and a stable id, and parallel
+//!   results are gathered in input order.
+//! - **No panics on input**: bad configurations are [`Error::Config`] naming the field;
+//!   degenerate cells and lots are skipped and listed in [`City::report`].
+//!
+//! The stage crates are re-exported as modules ([`roads`], [`cells`], …) for direct use.
 
 pub use polis_buildings as buildings;
 pub use polis_cells as cells;
@@ -15,6 +49,24 @@ pub use polis_geom as geom;
 pub use polis_lots as lots;
 pub use polis_lsystem as lsystem;
 pub use polis_roads as roads;
+
+mod city;
+mod config;
+mod error;
+mod maps;
+mod pipeline;
+mod scene;
+pub mod seed;
+pub mod stages;
+
+pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace_mask};
+pub use config::{
+    CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
+};
+pub use error::{BoxError, Error, Result};
+pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
+pub use pipeline::{Pipeline, Progress, generate};
+pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.
 #[doc = include_str!("../README.md")]

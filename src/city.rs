@@ -1,0 +1,344 @@
+//! [`City`]: every layer of a generated city, its statistics and report, and the writers.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use polis_buildings::Building;
+use polis_cells::CellDecomposition;
+use polis_export::map::{MapBlock, MapFootprint, MapLayers, MapLot};
+use polis_export::sink::DirSink;
+use polis_export::{geojson, glb, obj, svg};
+use polis_facades::TileSet;
+use polis_geom::{DVec2, Field, Polygon, PolygonWithHoles, Scene};
+use polis_lots::{Block, Lot};
+use polis_roads::{GrowthReport, RoadNetwork};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::stages::{Dress, Skip, Stage};
+use crate::{CityConfig, CityMaps};
+
+/// A lot with its stable id and the cell it lies in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CityLot {
+    /// Stable id: `cell id << 24 | index of the lot in its cell`. The building on it has
+    /// the same id.
+    pub id: u64,
+    /// The cell it lies in.
+    pub cell: u64,
+    /// The lot.
+    pub lot: Lot,
+}
+
+/// Time spent in one stage.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct StageTiming {
+    /// The stage.
+    pub stage: Stage,
+    /// Wall-clock time.
+    pub time: Duration,
+}
+
+/// Counts and per-stage timings of a city.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CityStats {
+    /// Road segments (graph edges).
+    pub road_segments: usize,
+    /// Junctions (graph nodes).
+    pub junctions: usize,
+    /// Cells.
+    pub cells: usize,
+    /// Blocks.
+    pub blocks: usize,
+    /// Lots.
+    pub lots: usize,
+    /// Buildings.
+    pub buildings: usize,
+    /// Buildings dressed with facade tiles.
+    pub dressed_buildings: usize,
+    /// Facade tile textures (each with albedo, normal and metallic-roughness images).
+    pub facade_tiles: usize,
+    /// Texture memory of the facade tiles, bytes.
+    pub texture_bytes: usize,
+    /// Triangles of the building meshes.
+    pub building_triangles: usize,
+    /// Triangles of the whole scene (0 when the scene was not built).
+    pub scene_triangles: usize,
+    /// Time per stage, in pipeline order.
+    pub timings: Vec<StageTiming>,
+}
+
+impl CityStats {
+    /// Total time of all stages.
+    pub fn total_time(&self) -> Duration {
+        self.timings.iter().map(|t| t.time).sum()
+    }
+
+    /// Time of one stage (zero if it did not run).
+    pub fn time(&self, stage: Stage) -> Duration {
+        self.timings
+            .iter()
+            .filter(|t| t.stage == stage)
+            .map(|t| t.time)
+            .sum()
+    }
+}
+
+/// Degenerate items skipped on the way, with reasons.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct SkipReport {
+    /// Every skipped item, in pipeline order.
+    pub skipped: Vec<Skip>,
+}
+
+impl SkipReport {
+    /// How many items `stage` skipped.
+    pub fn count(&self, stage: Stage) -> usize {
+        self.skipped.iter().filter(|s| s.stage == stage).count()
+    }
+
+    /// Whether nothing was skipped.
+    pub fn is_empty(&self) -> bool {
+        self.skipped.is_empty()
+    }
+}
+
+/// A generated city: every layer, the scene, statistics and the skip report.
+#[derive(Debug)]
+pub struct City {
+    /// The configuration it was made from.
+    pub config: CityConfig,
+    /// The input maps.
+    pub maps: CityMaps,
+    /// The road network (planar).
+    pub roads: RoadNetwork,
+    /// The road generator's report, when the road stage gives one.
+    pub growth: Option<GrowthReport>,
+    /// Cells of the road graph.
+    pub cells: CellDecomposition,
+    /// Blocks, cell by cell.
+    pub blocks: Vec<Block>,
+    /// Lots, cell by cell.
+    pub lots: Vec<CityLot>,
+    /// Green spaces inside blocks.
+    pub green_spaces: Vec<PolygonWithHoles>,
+    /// Buildings (one per built lot; `id` = the lot's id).
+    pub buildings: Vec<Building>,
+    /// Cell of each building (parallel to `buildings`).
+    pub building_cells: Vec<u64>,
+    /// Shared facade tile sets, one per style in use.
+    pub tile_sets: Vec<TileSet>,
+    /// Facade skin of each building (parallel to `buildings`).
+    pub dresses: Vec<Option<Dress>>,
+    /// The 3-D scene (empty when `scene` was switched off).
+    pub scene: Scene,
+    /// Counts and timings.
+    pub stats: CityStats,
+    /// What was skipped.
+    pub report: SkipReport,
+}
+
+/// Which files [`City::write_all`] wrote.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Written {
+    /// Paths, in the order written.
+    pub files: Vec<PathBuf>,
+}
+
+fn create(path: &Path) -> Result<BufWriter<File>> {
+    File::create(path)
+        .map(BufWriter::new)
+        .map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })
+}
+
+fn finish(mut w: BufWriter<File>, path: &Path) -> Result<()> {
+    w.flush().map_err(|source| Error::Io {
+        path: path.into(),
+        source,
+    })
+}
+
+impl City {
+    /// The 2-D map layers (water, parks, blocks, lots, roads, footprints) for the SVG and
+    /// GeoJSON writers. Water is traced from the water map on a 10 m grid.
+    pub fn map_layers(&self) -> Result<MapLayers> {
+        let mut map = MapLayers::default();
+        if self.maps.has_water {
+            map.water = trace_mask(self.maps.water.as_ref(), self.config.size_m, 10.0);
+        }
+        if self.maps.has_parks {
+            map.parks = trace_mask(self.maps.parks.as_ref(), self.config.size_m, 10.0);
+        }
+        map.parks.extend(self.green_spaces.iter().cloned());
+        map.roads = crate::scene::map_roads(&self.roads)?;
+        map.blocks = self
+            .blocks
+            .iter()
+            .map(|b| MapBlock {
+                id: b.id(),
+                polygon: b.polygon.clone(),
+            })
+            .collect();
+        map.lots = self
+            .lots
+            .iter()
+            .map(|l| MapLot {
+                id: l.id,
+                block: Some(l.lot.block_id),
+                polygon: l.lot.polygon.clone().into(),
+            })
+            .collect();
+        map.footprints = self
+            .buildings
+            .iter()
+            .map(|b| MapFootprint {
+                id: b.id,
+                polygon: b.footprint.clone().into(),
+                kind: crate::scene::map_kind(b.kind),
+                height_m: b.height,
+                floors: Some(b.floors),
+                lot: Some(b.lot_id),
+            })
+            .collect();
+        Ok(map)
+    }
+
+    /// Writes the scene as glb (batching from the configuration).
+    ///
+    /// # Errors
+    /// Export and I/O errors.
+    pub fn write_glb<W: Write>(&self, out: W) -> Result<glb::GlbReport> {
+        let options = glb::GlbOptions {
+            batching: self.config.scene.batching,
+        };
+        Ok(glb::write_glb(&self.scene, &options, out)?)
+    }
+
+    /// Writes `city.glb`, `city.obj` (+ `city.mtl` and textures), `city.svg` and
+    /// `city.geojson` into `dir` (created if missing).
+    ///
+    /// # Errors
+    /// Export and I/O errors, naming the file.
+    pub fn write_all(&self, dir: impl AsRef<Path>) -> Result<Written> {
+        let dir = dir.as_ref();
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            path: dir.into(),
+            source,
+        })?;
+        let mut written = Written::default();
+        let map = self.map_layers()?;
+
+        let path = dir.join("city.svg");
+        let mut w = create(&path)?;
+        svg::write_svg(&map, &svg::SvgOptions::default(), &mut w)?;
+        finish(w, &path)?;
+        written.files.push(path);
+
+        let path = dir.join("city.geojson");
+        let mut w = create(&path)?;
+        geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), &mut w)?;
+        finish(w, &path)?;
+        written.files.push(path);
+
+        let path = dir.join("city.glb");
+        let mut w = create(&path)?;
+        self.write_glb(&mut w)?;
+        finish(w, &path)?;
+        written.files.push(path);
+
+        let path = dir.join("city.obj");
+        let mut w = create(&path)?;
+        obj::write_obj(
+            &self.scene,
+            &obj::ObjOptions::default(),
+            &mut w,
+            &mut DirSink::new(dir),
+        )?;
+        finish(w, &path)?;
+        written.files.push(path);
+        written.files.push(dir.join("city.mtl"));
+        Ok(written)
+    }
+}
+
+/// The area where `mask ≥ 0.5` inside the square map of side `size_m`, as row runs of
+/// `cell_m` squares merged into rectangles (exact on the sampling grid; for drawing).
+pub fn trace_mask(mask: &dyn Field, size_m: f64, cell_m: f64) -> Vec<PolygonWithHoles> {
+    let n = ((size_m / cell_m).ceil() as usize).clamp(1, 4096);
+    let step = size_m / n as f64;
+    let h = size_m * 0.5;
+    let mut out = Vec::new();
+    // Runs of the previous row still open: (start column, end column, start row).
+    let mut open: Vec<(usize, usize, usize)> = Vec::new();
+    let rect = |c0: usize, c1: usize, r0: usize, r1: usize| {
+        let (x0, x1) = (-h + c0 as f64 * step, -h + c1 as f64 * step);
+        let (y0, y1) = (-h + r0 as f64 * step, -h + r1 as f64 * step);
+        Polygon::new(vec![
+            DVec2::new(x0, y0),
+            DVec2::new(x1, y0),
+            DVec2::new(x1, y1),
+            DVec2::new(x0, y1),
+        ])
+        .into()
+    };
+    for r in 0..=n {
+        let mut runs = Vec::new();
+        if r < n {
+            let y = -h + (r as f64 + 0.5) * step;
+            let mut c = 0;
+            while c < n {
+                let inside = |c: usize| mask.sample(DVec2::new(-h + (c as f64 + 0.5) * step, y)) >= 0.5;
+                if inside(c) {
+                    let c0 = c;
+                    while c < n && inside(c) {
+                        c += 1;
+                    }
+                    runs.push((c0, c));
+                } else {
+                    c += 1;
+                }
+            }
+        }
+        // A run continues an open rectangle with exactly the same columns.
+        let mut next = Vec::with_capacity(runs.len());
+        for &(c0, c1) in &runs {
+            match open.iter().position(|&(a, b, _)| a == c0 && b == c1) {
+                Some(i) => next.push(open.swap_remove(i)),
+                None => next.push((c0, c1, r)),
+            }
+        }
+        for (c0, c1, r0) in open.drain(..) {
+            out.push(rect(c0, c1, r0, r));
+        }
+        open = next;
+    }
+    out.sort_by(|a: &PolygonWithHoles, b: &PolygonWithHoles| {
+        let (pa, pb) = (a.outer.points()[0], b.outer.points()[0]);
+        pa.y.total_cmp(&pb.y).then(pa.x.total_cmp(&pb.x))
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polis_geom::field::FnField;
+
+    #[test]
+    fn traced_mask_area_matches_the_sampled_area() {
+        // A disc of radius 300 m: traced area within one cell ring of π r².
+        let disc = FnField::new(|p: DVec2| if p.length() < 300.0 { 1.0 } else { 0.0 });
+        let polys = trace_mask(&disc, 1000.0, 10.0);
+        let area: f64 = polys.iter().map(|p| p.area()).sum();
+        let exact = std::f64::consts::PI * 300.0 * 300.0;
+        assert!((area - exact).abs() < 2.0 * std::f64::consts::PI * 300.0 * 10.0, "{area}");
+        for p in &polys {
+            p.validate().unwrap();
+        }
+    }
+}

@@ -1,0 +1,442 @@
+//! [`CityConfig`]: everything that decides a city, as data (serde), and the built-in
+//! presets.
+
+use std::path::Path;
+
+use polis_buildings::{BuildingKind, BuildingParams};
+use polis_cells::CellParams;
+use polis_export::glb::Batching;
+use polis_facades::FacadeStyle;
+use polis_lots::{BlockParams, LotParams};
+use polis_roads::RoadParams;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::maps::MapsConfig;
+
+/// The whole description of a city. Every field has a default, so a configuration file
+/// names only what differs (`{ "seed": 7, "size_m": 2000 }` is a complete file); unknown
+/// fields are errors, so a typo does not pass silently.
+///
+/// The pipeline owns three things inside the stage parameters: `roads.seed`,
+/// `buildings.seed` (both derived from [`seed`](Self::seed)) and `roads.bounds_*` (the
+/// square of side [`size_m`](Self::size_m) centred on the origin). Values written there
+/// are replaced.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CityConfig {
+    /// A name for reports and output metadata. Default: "polis".
+    pub name: String,
+    /// The city seed; every stage and item derives its own seed from it. Default: 1.
+    pub seed: u64,
+    /// Side of the square city map, metres, centred on the origin. Default: 4000
+    /// (16 km², Citygen's test city).
+    pub size_m: f64,
+    /// Level of detail of the buildings (derivation steps); `None` = the grammars' full
+    /// detail (`buildings.max_lod`). Default: None.
+    pub lod: Option<usize>,
+    /// Worker threads for per-cell and per-lot work; `None` = one per core, `Some(1)` =
+    /// serial. The output is byte-identical for any value. Default: None.
+    pub threads: Option<usize>,
+    /// Input maps.
+    pub maps: MapsConfig,
+    /// Road generator (Parish & Müller §3).
+    pub roads: RoadParams,
+    /// Cell extraction (Eberly's minimal cycle basis).
+    pub cells: CellParams,
+    /// Blocks and footpaths (Kelly §4.4.1).
+    pub blocks: BlockParams,
+    /// Lot subdivision (Kelly §4.4.2, Parish & Müller §4.1).
+    pub lots: LotParams,
+    /// Which building stands where.
+    pub zoning: ZoningConfig,
+    /// Building grammars, footprints and heights (Parish & Müller §4.2, Kelly §4.4.3).
+    pub buildings: BuildingParams,
+    /// Facade textures (Parish & Müller §4.3).
+    pub facades: FacadeConfig,
+    /// How the 3-D scene is assembled.
+    pub scene: SceneConfig,
+}
+
+impl Default for CityConfig {
+    fn default() -> Self {
+        CityConfig {
+            name: "polis".into(),
+            seed: 1,
+            size_m: 4000.0,
+            lod: None,
+            threads: None,
+            maps: MapsConfig::default(),
+            roads: RoadParams::default(),
+            cells: CellParams::default(),
+            blocks: BlockParams::default(),
+            lots: LotParams::default(),
+            zoning: ZoningConfig::default(),
+            buildings: BuildingParams::default(),
+            facades: FacadeConfig::default(),
+            scene: SceneConfig::default(),
+        }
+    }
+}
+
+/// One zoning band: where the population density is at least `min_density`, build
+/// `kind` no taller than `max_height_m`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ZoneBand {
+    /// Lowest density of the band.
+    pub min_density: f64,
+    /// The building kind.
+    pub kind: BuildingKind,
+    /// Height limit, metres.
+    pub max_height_m: f64,
+}
+
+/// How lots get their building kind and height limit: by population density bands
+/// (Parish & Müller §4.2 take the type from zoning maps; without a zoning map the
+/// density is the zoning). A zoning map or a maximum-height map in
+/// [`MapsConfig`] replaces the bands' kind or limit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ZoningConfig {
+    /// Bands, tried from the highest `min_density` down; the first that the density
+    /// reaches applies. Default: skyscrapers above 0.55, offices above 0.45, mid-rises
+    /// above 0.35, apartments above 0.25, houses above 0.08, industry below.
+    pub bands: Vec<ZoneBand>,
+    /// Kind where no band applies. Default: industrial.
+    pub fallback_kind: BuildingKind,
+    /// Height limit where no band applies, metres. Default: 15.
+    pub fallback_max_height_m: f64,
+}
+
+impl Default for ZoningConfig {
+    fn default() -> Self {
+        let band = |min_density, kind, max_height_m| ZoneBand {
+            min_density,
+            kind,
+            max_height_m,
+        };
+        ZoningConfig {
+            bands: vec![
+                band(0.55, BuildingKind::Skyscraper, 180.0),
+                band(0.45, BuildingKind::Office, 90.0),
+                band(0.35, BuildingKind::MidRise, 40.0),
+                band(0.25, BuildingKind::Apartment, 25.0),
+                band(0.08, BuildingKind::House, 12.0),
+            ],
+            fallback_kind: BuildingKind::Industrial,
+            fallback_max_height_m: 15.0,
+        }
+    }
+}
+
+impl ZoningConfig {
+    /// The kind and height limit at `density`.
+    pub fn zone(&self, density: f64) -> (BuildingKind, f64) {
+        self.bands
+            .iter()
+            .filter(|b| density >= b.min_density)
+            .max_by(|a, b| a.min_density.total_cmp(&b.min_density))
+            .map_or((self.fallback_kind, self.fallback_max_height_m), |b| {
+                (b.kind, b.max_height_m)
+            })
+    }
+}
+
+/// How much of a style's tile set a facade shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FacadeDetail {
+    /// One textured quad per facade face: the repeated bay × storey tile (the
+    /// ground-floor tile on ground-floor faces), stretched to whole modules so no window
+    /// is cut. Margins and cornices are left out. City scale: as many triangles as the
+    /// untextured walls.
+    #[default]
+    Compact,
+    /// Every tile of the set: margins, cornice, ground floor and the entrance bay, a few
+    /// quads per face (Kelly's best fit). Close-ups and hero buildings.
+    Full,
+}
+
+/// Which facade style dresses each building kind (names of built-in styles or of
+/// [`FacadeConfig::styles`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct KindStyles {
+    /// Default: office_curtain_wall.
+    pub skyscraper: String,
+    /// Default: office_curtain_wall.
+    pub office: String,
+    /// Default: classic_stone.
+    pub mid_rise: String,
+    /// Default: brick_house.
+    pub house: String,
+    /// Default: brick_house.
+    pub apartment: String,
+    /// Default: industrial.
+    pub industrial: String,
+}
+
+impl Default for KindStyles {
+    fn default() -> Self {
+        KindStyles {
+            skyscraper: "office_curtain_wall".into(),
+            office: "office_curtain_wall".into(),
+            mid_rise: "classic_stone".into(),
+            house: "brick_house".into(),
+            apartment: "brick_house".into(),
+            industrial: "industrial".into(),
+        }
+    }
+}
+
+impl KindStyles {
+    /// The style name for `kind`.
+    pub fn get(&self, kind: BuildingKind) -> &str {
+        match kind {
+            BuildingKind::Skyscraper => &self.skyscraper,
+            BuildingKind::Office => &self.office,
+            BuildingKind::MidRise => &self.mid_rise,
+            BuildingKind::House => &self.house,
+            BuildingKind::Apartment => &self.apartment,
+            BuildingKind::Industrial => &self.industrial,
+        }
+    }
+}
+
+/// Facade textures: shared tile sets per style, applied through UVs in metres.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FacadeConfig {
+    /// Dress buildings with facade textures. Default: true.
+    pub enabled: bool,
+    /// Styles in addition to the built-in ones (a user style may replace a built-in one
+    /// of the same name). Default: none.
+    pub styles: Vec<FacadeStyle>,
+    /// Style per building kind.
+    pub style_of: KindStyles,
+    /// Texels per metre of the tile textures. Default: 32.
+    pub pixels_per_metre: f64,
+    /// Compact (one quad per face) or full tile sets. Default: compact.
+    pub detail: FacadeDetail,
+}
+
+impl Default for FacadeConfig {
+    fn default() -> Self {
+        FacadeConfig {
+            enabled: true,
+            styles: Vec::new(),
+            style_of: KindStyles::default(),
+            pixels_per_metre: 32.0,
+            detail: FacadeDetail::Compact,
+        }
+    }
+}
+
+/// How the glTF/OBJ scene is assembled from the layers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SceneConfig {
+    /// Height of the block plinths (kerbs), metres. Default: 0.15.
+    pub kerb_height_m: f64,
+    /// Road surfaces as meshes draped on the elevation. Default: true.
+    pub road_surfaces: bool,
+    /// Node structure of the glb: per building, or batched per cell and material.
+    /// Default: batched (few draw calls, as Citygen).
+    pub batching: Batching,
+}
+
+impl Default for SceneConfig {
+    fn default() -> Self {
+        SceneConfig {
+            kerb_height_m: 0.15,
+            road_surfaces: true,
+            batching: Batching::PerParentAndMaterial,
+        }
+    }
+}
+
+/// The built-in presets: name and file text (`presets/<name>.json`).
+const PRESETS: &[(&str, &str)] = &[
+    ("default", include_str!("../presets/default.json")),
+    ("manhattan", include_str!("../presets/manhattan.json")),
+    ("paris", include_str!("../presets/paris.json")),
+    ("san_francisco", include_str!("../presets/san_francisco.json")),
+    ("old_town", include_str!("../presets/old_town.json")),
+    ("suburbia", include_str!("../presets/suburbia.json")),
+];
+
+impl CityConfig {
+    /// Names of the built-in presets.
+    pub fn preset_names() -> impl Iterator<Item = &'static str> {
+        PRESETS.iter().map(|(n, _)| *n)
+    }
+
+    /// A built-in preset by name (see [`preset_names`](Self::preset_names)).
+    ///
+    /// # Errors
+    /// [`Error::UnknownPreset`] listing the names that exist.
+    pub fn preset(name: &str) -> Result<CityConfig> {
+        let text = PRESETS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, t)| *t)
+            .ok_or_else(|| Error::UnknownPreset {
+                name: name.into(),
+                known: Self::preset_names().collect::<Vec<_>>().join(", "),
+            })?;
+        Self::from_json(text, &format!("preset {name}"))
+    }
+
+    /// Parses a configuration from JSON text; `source_name` names it in errors.
+    ///
+    /// # Errors
+    /// [`Error::Parse`] with the line and column, or [`Error::Config`] from
+    /// [`validate`](Self::validate).
+    pub fn from_json(text: &str, source_name: &str) -> Result<CityConfig> {
+        let config: CityConfig = serde_json::from_str(text).map_err(|e| Error::Parse {
+            source_name: source_name.into(),
+            message: e.to_string(),
+        })?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Reads a JSON configuration file.
+    ///
+    /// # Errors
+    /// [`Error::Io`], [`Error::Parse`] or [`Error::Config`].
+    pub fn from_path(path: impl AsRef<Path>) -> Result<CityConfig> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.into(),
+            source,
+        })?;
+        Self::from_json(&text, &path.display().to_string())
+    }
+
+    /// The configuration as pretty JSON (every field, defaults included).
+    pub fn to_json(&self) -> String {
+        // Serialising plain data with string keys cannot fail; fall back to an empty
+        // object rather than panic.
+        serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".into())
+    }
+
+    /// The road parameters the pipeline runs: `roads` with the city's seed and bounds.
+    pub fn effective_road_params(&self) -> RoadParams {
+        let h = self.size_m * 0.5;
+        RoadParams {
+            seed: crate::seed::sub_seed(self.seed, crate::Stage::Roads, 0),
+            bounds_min: [-h, -h],
+            bounds_max: [h, h],
+            ..self.roads.clone()
+        }
+    }
+
+    /// The building parameters the pipeline runs: `buildings` with the city's seed.
+    pub fn effective_building_params(&self) -> BuildingParams {
+        BuildingParams {
+            seed: crate::seed::sub_seed(self.seed, crate::Stage::Buildings, 0),
+            ..self.buildings.clone()
+        }
+    }
+
+    /// The level of detail the buildings are drawn at.
+    pub fn effective_lod(&self) -> usize {
+        self.lod
+            .unwrap_or(self.buildings.max_lod)
+            .min(self.buildings.max_lod)
+    }
+
+    /// Checks what the stage crates do not: the city's own fields, the zoning bands and
+    /// the facade options; then the road and building parameters as the pipeline will
+    /// run them.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming the field, or the stage crate's parameter error.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.size_m.is_finite() && (10.0..=1.0e6).contains(&self.size_m)) {
+            return Err(Error::config(
+                "size_m",
+                format!("{} m; give a map side in [10, 1000000] m", self.size_m),
+            ));
+        }
+        if self.threads == Some(0) {
+            return Err(Error::config(
+                "threads",
+                "0 threads; give at least 1, or leave it out for one per core",
+            ));
+        }
+        for (i, b) in self.zoning.bands.iter().enumerate() {
+            if !(b.min_density.is_finite() && b.max_height_m.is_finite() && b.max_height_m > 0.0)
+            {
+                return Err(Error::config(
+                    format!("zoning.bands[{i}]"),
+                    "min_density must be finite and max_height_m finite and > 0",
+                ));
+            }
+        }
+        if !(self.zoning.fallback_max_height_m.is_finite()
+            && self.zoning.fallback_max_height_m > 0.0)
+        {
+            return Err(Error::config(
+                "zoning.fallback_max_height_m",
+                "must be finite and > 0",
+            ));
+        }
+        let ppm = self.facades.pixels_per_metre;
+        if !(ppm.is_finite() && (1.0..=512.0).contains(&ppm)) {
+            return Err(Error::config(
+                "facades.pixels_per_metre",
+                format!("{ppm}; give 1 to 512 texels per metre"),
+            ));
+        }
+        if !(self.scene.kerb_height_m.is_finite() && (0.0..=5.0).contains(&self.scene.kerb_height_m))
+        {
+            return Err(Error::config(
+                "scene.kerb_height_m",
+                "give a kerb height in [0, 5] m",
+            ));
+        }
+        self.effective_road_params().validate()?;
+        self.effective_building_params().validate()?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_parses_and_validates() {
+        for name in CityConfig::preset_names() {
+            let c = CityConfig::preset(name).unwrap();
+            c.validate().unwrap();
+            // A preset survives a round trip through its full JSON form.
+            let back = CityConfig::from_json(&c.to_json(), name).unwrap();
+            assert_eq!(back, c, "{name}");
+        }
+    }
+
+    #[test]
+    fn unknown_preset_and_unknown_fields_are_errors() {
+        let err = CityConfig::preset("atlantis").unwrap_err();
+        assert!(err.to_string().contains("manhattan"), "{err}");
+        let err = CityConfig::from_json(r#"{ "sede": 3 }"#, "test").unwrap_err();
+        assert!(err.to_string().contains("sede"), "{err}");
+        let err = CityConfig::from_json(r#"{ "size_m": -4 }"#, "test").unwrap_err();
+        assert!(err.to_string().contains("size_m"), "{err}");
+        let err = CityConfig::from_json("{ not json", "test").unwrap_err();
+        assert!(matches!(err, Error::Parse { .. }), "{err}");
+    }
+
+    #[test]
+    fn zoning_bands_pick_the_highest_band_reached() {
+        let z = ZoningConfig::default();
+        assert_eq!(z.zone(0.9).0, BuildingKind::Skyscraper);
+        assert_eq!(z.zone(0.3).0, BuildingKind::Apartment);
+        assert_eq!(z.zone(0.0).0, BuildingKind::Industrial);
+        assert_eq!(z.zone(f64::NAN).0, BuildingKind::Industrial);
+    }
+}

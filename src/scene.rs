@@ -1,0 +1,321 @@
+//! Assembling the 3-D [`Scene`] of a city: block plinths, road surfaces, buildings with
+//! their facade skins, and the shared facade textures as materials.
+//!
+//! The node tree is `city → roads`, `city → cell <id> → block <id> | building <id>`;
+//! building nodes carry `kind`, `height`, `floors` and `lot` metadata, block nodes
+//! `cell`. With [`Batching::PerParentAndMaterial`](polis_export::glb::Batching) the glb
+//! writer merges each cell's leaves into one primitive per material.
+
+use polis_buildings::{Building, BuildingKind, PartRole};
+use polis_export::map::{MapRoad, RoadClass as MapClass};
+use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
+use polis_facades::TileSet;
+use polis_geom::scene::{Image, ImageData, Texture};
+use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
+use polis_lots::Block;
+use polis_roads::{RoadClass, RoadNetwork};
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::stages::Dress;
+use crate::{CityConfig, CityMaps};
+
+/// Plain materials of the scene, by role.
+struct Palette {
+    pavement: MaterialId,
+    road: MaterialId,
+    walls: [MaterialId; 6],
+    roof: MaterialId,
+    detail: MaterialId,
+    /// Per style, per tile.
+    tiles: Vec<Vec<MaterialId>>,
+}
+
+fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
+    let mut m = |name: &str, rgb: [f32; 3]| {
+        scene.add_material(Material::new(name, [rgb[0], rgb[1], rgb[2], 1.0]))
+    };
+    let pavement = m("pavement", [0.55, 0.55, 0.52]);
+    let road = m("asphalt", [0.18, 0.18, 0.19]);
+    let walls = [
+        m("wall skyscraper", [0.55, 0.62, 0.70]),
+        m("wall office", [0.62, 0.66, 0.70]),
+        m("wall mid-rise", [0.80, 0.76, 0.68]),
+        m("wall house", [0.82, 0.72, 0.60]),
+        m("wall apartment", [0.76, 0.66, 0.58]),
+        m("wall industrial", [0.60, 0.60, 0.58]),
+    ];
+    let roof = m("roof", [0.45, 0.25, 0.20]);
+    let detail = m("detail", [0.30, 0.30, 0.32]);
+    let mut tiles = Vec::with_capacity(sets.len());
+    for set in sets {
+        let mut ids = Vec::with_capacity(set.tiles.len());
+        for (k, tile) in set.tiles.iter().enumerate() {
+            let t = &tile.textures;
+            let name = format!("{} tile {k}", set.style);
+            let mut texture = |suffix: &str, pixels: &[u8]| -> Result<_> {
+                let image = scene.add_image(Image {
+                    name: format!("{} {suffix}", name),
+                    data: ImageData::Rgba8 {
+                        width: t.width,
+                        height: t.height,
+                        pixels: pixels.to_vec(),
+                    },
+                });
+                Ok(scene.add_texture(Texture {
+                    name: format!("{name} {suffix}"),
+                    image,
+                    ..Texture::default()
+                })?)
+            };
+            let albedo = texture("albedo", &t.albedo)?;
+            let normal = texture("normal", &t.normal)?;
+            let mr = texture("metallic-roughness", &t.metallic_roughness)?;
+            ids.push(scene.add_material(Material {
+                name,
+                base_color_texture: Some(albedo),
+                normal_texture: Some(normal),
+                metallic_roughness_texture: Some(mr),
+                metallic: 1.0,
+                roughness: 1.0,
+                ..Material::default()
+            }));
+        }
+        tiles.push(ids);
+    }
+    Ok(Palette {
+        pavement,
+        road,
+        walls,
+        roof,
+        detail,
+        tiles,
+    })
+}
+
+/// The road network as map polylines (one per edge).
+pub(crate) fn map_roads(network: &RoadNetwork) -> Result<Vec<MapRoad>> {
+    let mut roads = Vec::with_capacity(network.edge_count());
+    for (e, _, _, road) in network.edges() {
+        let (a, b) = network.segment(e)?;
+        roads.push(MapRoad {
+            id: u64::from(e.raw()),
+            points: vec![a, b],
+            class: match road.class {
+                RoadClass::Highway => MapClass::Highway,
+                RoadClass::Street => MapClass::Street,
+            },
+            width_m: road.width,
+            bridge: road.bridge,
+        });
+    }
+    Ok(roads)
+}
+
+/// Lowest ground under a ring of layout points.
+fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
+    let e = pts
+        .iter()
+        .map(|&p| elevation.sample(p))
+        .filter(|e| e.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    if e.is_finite() { e } else { 0.0 }
+}
+
+/// The meshes of one building: parts with their materials, walls covered by the skin left
+/// out, and one skin mesh per tile.
+fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
+    let wall = pal.walls[b.kind.index().min(5)];
+    let mut out = Vec::with_capacity(b.parts.len() + 2);
+    for (pi, part) in b.parts.iter().enumerate() {
+        let material = Some(match part.role {
+            PartRole::Mass => wall,
+            PartRole::Roof => pal.roof,
+            PartRole::Detail | PartRole::Template => pal.detail,
+        });
+        let faces: Vec<usize> = dress
+            .map(|d| {
+                let mut f: Vec<usize> = d.quads.iter().map(|q| q.face).collect();
+                f.dedup();
+                f.retain(|&k| b.facades.get(k).is_some_and(|f| f.part == pi));
+                f
+            })
+            .unwrap_or_default();
+        if faces.is_empty() {
+            let mut mesh = part.mesh.clone();
+            mesh.material = material;
+            out.push(mesh);
+            continue;
+        }
+        // Keep the triangles no dressed face covers.
+        let mut mesh = Mesh::with_capacity(
+            material,
+            part.mesh.vertex_count(),
+            part.mesh.triangle_count(),
+        );
+        mesh.positions.clone_from(&part.mesh.positions);
+        mesh.normals.clone_from(&part.mesh.normals);
+        mesh.uvs.clone_from(&part.mesh.uvs);
+        for t in part.mesh.triangles() {
+            let p = t.map(|i| {
+                part.mesh
+                    .positions
+                    .get(i as usize)
+                    .map_or(DVec3::NAN, |v| v.as_dvec3())
+            });
+            let covered = faces.iter().filter_map(|&k| b.facades.get(k)).any(|f| {
+                let n = f.normal;
+                let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+                if tn.dot(n) < 0.99 {
+                    return false;
+                }
+                let tol = 1e-3;
+                if p.iter().any(|v| (*v - f.quad[0]).dot(n).abs() > tol) {
+                    return false;
+                }
+                let c = (p[0] + p[1] + p[2]) / 3.0 - f.quad[0];
+                let (u, v) = (
+                    (f.quad[1] - f.quad[0]).normalize_or_zero(),
+                    (f.quad[3] - f.quad[0]).normalize_or_zero(),
+                );
+                let (s, h) = (c.dot(u), c.dot(v));
+                s > -tol && s < f.width + tol && h > -tol && h < f.height + tol
+            });
+            if !covered {
+                mesh.indices.extend_from_slice(&t);
+            }
+        }
+        out.push(mesh);
+    }
+    if let Some(d) = dress {
+        let Some(materials) = pal.tiles.get(d.style) else {
+            return Ok(out);
+        };
+        let mut skins: Vec<Mesh> = materials.iter().map(|&m| Mesh::new(Some(m))).collect();
+        for q in &d.quads {
+            if let Some(mesh) = skins.get_mut(q.tile) {
+                mesh.add_quad(q.corners, q.uvs)?;
+            }
+        }
+        out.extend(skins.into_iter().filter(|m| !m.is_empty()));
+    }
+    Ok(out)
+}
+
+/// Everything the scene is built from.
+pub(crate) struct SceneInputs<'a> {
+    pub config: &'a CityConfig,
+    pub maps: &'a CityMaps,
+    pub network: &'a RoadNetwork,
+    pub blocks: &'a [Block],
+    pub buildings: &'a [Building],
+    /// Cell id of each building.
+    pub building_cells: &'a [u64],
+    pub dresses: &'a [Option<Dress>],
+    pub tile_sets: &'a [TileSet],
+}
+
+/// Builds the scene.
+pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
+    let mut scene = Scene::new();
+    let pal = palette(&mut scene, inp.tile_sets)?;
+    let elevation = inp.maps.elevation.as_ref();
+    let root = scene.add_root(inp.config.name.clone());
+    scene.set_metadata(root, "seed", inp.config.seed as f64)?;
+
+    if inp.config.scene.road_surfaces && inp.network.edge_count() > 0 {
+        let roads = map_roads(inp.network)?;
+        let mesh = road_surfaces(
+            &roads,
+            elevation,
+            &RoadSurfaceOptions::default(),
+            Some(pal.road),
+        )?;
+        let node = scene.add_node(root, "roads")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
+
+    // Cells in id order: the parent of their blocks and buildings.
+    let mut cell_ids: Vec<u64> = inp
+        .blocks
+        .iter()
+        .map(|b| b.cell_id)
+        .chain(inp.building_cells.iter().copied())
+        .collect();
+    cell_ids.sort_unstable();
+    cell_ids.dedup();
+    let mut cell_nodes = Vec::with_capacity(cell_ids.len());
+    for &c in &cell_ids {
+        let node = scene.add_node(root, format!("cell {c}"))?;
+        scene.set_metadata(node, "cell", c as f64)?;
+        cell_nodes.push(node);
+    }
+    let cell_node = |c: u64| {
+        cell_ids
+            .binary_search(&c)
+            .ok()
+            .and_then(|i| cell_nodes.get(i).copied())
+    };
+
+    let kerb = inp.config.scene.kerb_height_m;
+    let plinths: Vec<Result<Option<Mesh>>> = inp
+        .blocks
+        .par_iter()
+        .map(|block| {
+            if kerb <= 0.0 {
+                return Ok(None);
+            }
+            let base = ground(elevation, block.polygon.outer.points());
+            Ok(Some(polis_geom::mesh::prism(
+                &block.polygon,
+                base,
+                base + kerb,
+                Some(pal.pavement),
+            )?))
+        })
+        .collect();
+    for (block, mesh) in inp.blocks.iter().zip(plinths) {
+        let (Some(mesh), Some(parent)) = (mesh?, cell_node(block.cell_id)) else {
+            continue;
+        };
+        let node = scene.add_node(parent, format!("block {}", block.id()))?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
+
+    let meshes: Vec<Result<Vec<Mesh>>> = inp
+        .buildings
+        .par_iter()
+        .enumerate()
+        .map(|(i, b)| building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal))
+        .collect();
+    for ((b, meshes), &cell) in inp.buildings.iter().zip(meshes).zip(inp.building_cells) {
+        let Some(parent) = cell_node(cell) else {
+            continue;
+        };
+        let node = scene.add_node(parent, format!("building {}", b.id))?;
+        let base = ground(elevation, b.footprint.points());
+        scene.node_mut(node)?.transform = Transform::from_translation(to_world(b.origin, base));
+        scene.set_metadata(node, "kind", b.kind.name())?;
+        scene.set_metadata(node, "height", b.height)?;
+        scene.set_metadata(node, "floors", f64::from(b.floors))?;
+        scene.set_metadata(node, "lot", b.lot_id as f64)?;
+        for mesh in meshes? {
+            let mesh = scene.add_mesh(mesh);
+            scene.attach_mesh(node, mesh)?;
+        }
+    }
+    Ok(scene)
+}
+
+/// The SVG/GeoJSON kind of a building kind.
+pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
+    use polis_export::map::BuildingKind as K;
+    match kind {
+        BuildingKind::Skyscraper => K::Skyscraper,
+        BuildingKind::Office | BuildingKind::MidRise => K::Commercial,
+        BuildingKind::House | BuildingKind::Apartment => K::Residential,
+        BuildingKind::Industrial => K::Industrial,
+    }
+}

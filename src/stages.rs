@@ -1,0 +1,510 @@
+//! The swappable stages of the pipeline and their default implementations.
+//!
+//! | stage | trait | default | granularity |
+//! |---|---|---|---|
+//! | roads | [`RoadStage`] | [`ParishMullerRoads`] | the whole map |
+//! | cells | [`CellStage`] | [`EberlyCells`] | the whole road graph |
+//! | blocks and lots | [`LotStage`] | [`KellyLots`] | one cell (run in parallel) |
+//! | buildings | [`BuildingStage`] | [`GrammarBuildings`] | one lot (run in parallel) |
+//! | facades | [`FacadeStage`] | [`TiledFacades`] | one building (run in parallel) |
+//!
+//! Per-item stages receive their item's own seed (derived from the city seed and the
+//! item's stable id), so they need no shared random generator and the parallel run
+//! equals the serial one.
+
+use std::sync::Arc;
+
+use polis_buildings::{Building, BuildingGenerator, BuildingKind, FacadeRole};
+use polis_cells::{Cell, CellDecomposition};
+use polis_facades::{FaceRole, FacadeSpec, PreparedStyle, RasterOptions, TileSet};
+use polis_geom::{DVec2, DVec3, PolygonWithHoles};
+use polis_lots::{Block, Lot};
+use polis_roads::{GlobalGoals, GrowthReport, RoadGenerator, RoadNetwork};
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
+
+use crate::config::{CityConfig, FacadeDetail};
+use crate::error::{Error, Result};
+use crate::maps::CityMaps;
+
+/// The stages, in pipeline order (also the keys of timings and skip counts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// Building the input maps.
+    Maps,
+    /// The road network.
+    Roads,
+    /// Cells: the minimal cycle basis of the road graph.
+    Cells,
+    /// Blocks, footpaths and lots.
+    Lots,
+    /// Buildings.
+    Buildings,
+    /// Facade textures and skins.
+    Facades,
+    /// Assembling the 3-D scene.
+    Scene,
+}
+
+impl Stage {
+    /// Every stage in order.
+    pub const ALL: [Stage; 7] = [
+        Stage::Maps,
+        Stage::Roads,
+        Stage::Cells,
+        Stage::Lots,
+        Stage::Buildings,
+        Stage::Facades,
+        Stage::Scene,
+    ];
+
+    /// A lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Maps => "maps",
+            Stage::Roads => "roads",
+            Stage::Cells => "cells",
+            Stage::Lots => "lots",
+            Stage::Buildings => "buildings",
+            Stage::Facades => "facades",
+            Stage::Scene => "scene",
+        }
+    }
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What every stage sees: the configuration and the built maps.
+#[derive(Debug, Clone, Copy)]
+pub struct StageContext<'a> {
+    /// The city configuration.
+    pub config: &'a CityConfig,
+    /// The input maps.
+    pub maps: &'a CityMaps,
+}
+
+impl StageContext<'_> {
+    /// The seed of `stage` for the item with stable id `id`.
+    pub fn seed(&self, stage: Stage, id: u64) -> u64 {
+        crate::seed::sub_seed(self.config.seed, stage, id)
+    }
+}
+
+/// A degenerate item that was skipped, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Skip {
+    /// The stage that skipped it.
+    pub stage: Stage,
+    /// The item's id (cell id, lot id, building id).
+    pub id: u64,
+    /// Why.
+    pub reason: String,
+}
+
+// ---------------------------------------------------------------------------------------
+// Roads.
+
+/// The road network and what the generator reports about it.
+#[derive(Debug, Clone)]
+pub struct RoadsOutput {
+    /// A planar road graph.
+    pub network: RoadNetwork,
+    /// The growth report of an L-system generator, if there is one.
+    pub growth: Option<GrowthReport>,
+}
+
+/// Makes the road network of the whole map.
+pub trait RoadStage: Send + Sync {
+    /// The road network; it must be planar (every crossing a node).
+    ///
+    /// # Errors
+    /// Any failure; a user stage wraps its own error in [`Error::Stage`].
+    fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput>;
+}
+
+/// Parish & Müller's extended L-system (polis-roads), with optional custom goals.
+#[derive(Clone, Default)]
+pub struct ParishMullerRoads {
+    /// Global goals replacing the defaults (a custom road pattern). Default: none.
+    pub goals: Option<Arc<dyn GlobalGoals>>,
+}
+
+impl std::fmt::Debug for ParishMullerRoads {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ParishMullerRoads")
+            .field("custom_goals", &self.goals.is_some())
+            .finish()
+    }
+}
+
+impl RoadStage for ParishMullerRoads {
+    fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput> {
+        let params = cx.config.effective_road_params();
+        let mut generator = RoadGenerator::new(&params, &cx.maps.road_inputs())?;
+        if let Some(goals) = &self.goals {
+            generator = generator.with_goals(Arc::clone(goals));
+        }
+        let generated = generator.run()?;
+        Ok(RoadsOutput {
+            network: generated.network,
+            growth: Some(generated.report),
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Cells.
+
+/// Finds the cells (enclosed regions) of the road graph.
+pub trait CellStage: Send + Sync {
+    /// The cells of `network`.
+    ///
+    /// # Errors
+    /// Any failure (a non-planar graph for the default stage).
+    fn cells(&self, network: &RoadNetwork, cx: &StageContext<'_>) -> Result<CellDecomposition>;
+}
+
+/// Eberly's minimal cycle basis (polis-cells) with the configuration's `cells` options.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EberlyCells;
+
+impl CellStage for EberlyCells {
+    fn cells(&self, network: &RoadNetwork, cx: &StageContext<'_>) -> Result<CellDecomposition> {
+        Ok(polis_cells::extract_with(network, &cx.config.cells)?)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Blocks and lots.
+
+/// One cell as the lot stage receives it.
+#[derive(Debug, Clone)]
+pub struct CellInput<'a> {
+    /// The cell (boundary and island rings with their road-graph ids, filaments).
+    pub cell: &'a Cell,
+    /// The cell's region with the width of the road along every ring edge (boundary
+    /// edges first, then each hole's), as polis-lots takes it.
+    pub region: polis_lots::Cell,
+    /// This cell's seed.
+    pub seed: u64,
+}
+
+/// What the lot stage makes of one cell.
+#[derive(Debug, Clone, Default)]
+pub struct CellLots {
+    /// Blocks (the cell inset by the roads' half widths, with footpaths).
+    pub blocks: Vec<Block>,
+    /// Lots, each inside one of the blocks.
+    pub lots: Vec<Lot>,
+    /// Green spaces (parks inside blocks).
+    pub green_spaces: Vec<PolygonWithHoles>,
+    /// Degenerate pieces skipped (counted in the city's report).
+    pub skipped: Vec<Skip>,
+}
+
+/// Turns one cell into blocks and lots. Called for every cell, possibly in parallel.
+pub trait LotStage: Send + Sync {
+    /// The blocks and lots of one cell.
+    ///
+    /// # Errors
+    /// Failures that should stop the city; a degenerate cell should rather be reported in
+    /// [`CellLots::skipped`].
+    fn lots(&self, cell: &CellInput<'_>, cx: &StageContext<'_>) -> Result<CellLots>;
+}
+
+/// Kelly's blocks (straight-skeleton inset, footpaths) and lot subdivision (polis-lots).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct KellyLots;
+
+impl LotStage for KellyLots {
+    fn lots(&self, input: &CellInput<'_>, cx: &StageContext<'_>) -> Result<CellLots> {
+        let mut out = CellLots::default();
+        let id = input.region.id;
+        let blocks = match polis_lots::blocks(&input.region, &cx.config.blocks) {
+            Ok(b) => b,
+            Err(e) => {
+                out.skipped.push(Skip {
+                    stage: Stage::Lots,
+                    id,
+                    reason: format!("cell {id}: no blocks: {e}"),
+                });
+                return Ok(out);
+            }
+        };
+        let mut rng = Pcg64Mcg::seed_from_u64(input.seed);
+        for block in blocks {
+            match polis_lots::subdivide_block(&block, &cx.config.lots, &mut rng) {
+                Ok(sub) => {
+                    out.lots.extend(sub.lots);
+                    out.green_spaces.extend(sub.green_spaces);
+                    out.blocks.push(block);
+                }
+                Err(e) => out.skipped.push(Skip {
+                    stage: Stage::Lots,
+                    id: block.id(),
+                    reason: format!("block {} of cell {id}: {e}", block.piece),
+                }),
+            }
+        }
+        Ok(out)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Buildings.
+
+/// One lot as the building stage receives it.
+#[derive(Debug, Clone, Copy)]
+pub struct LotInput<'a> {
+    /// The lot's stable id (also the building's).
+    pub id: u64,
+    /// The lot.
+    pub lot: &'a Lot,
+    /// The kind the zoning chose.
+    pub kind: BuildingKind,
+    /// The height limit, metres.
+    pub max_height_m: f64,
+    /// The level of detail asked for.
+    pub lod: usize,
+}
+
+/// Builds the building of one lot; made once per city by [`BuildingStage::prepare`].
+pub trait BuildLot: Send + Sync {
+    /// The building on `lot`, or `None` for an empty lot.
+    ///
+    /// # Errors
+    /// Failures of this lot: the pipeline skips the lot and reports the error.
+    fn build(&self, lot: &LotInput<'_>) -> Result<Option<Building>>;
+}
+
+/// The building stage: prepares (grammars, templates) once per city, then builds lots,
+/// possibly in parallel.
+pub trait BuildingStage: Send + Sync {
+    /// The per-lot builder for this city.
+    ///
+    /// # Errors
+    /// Bad parameters or grammars.
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn BuildLot + 'a>>;
+}
+
+/// The stochastic parametric building grammars of polis-buildings.
+#[derive(Debug, Clone, Default)]
+pub struct GrammarBuildings {
+    /// Grammars replacing the defaults of some kinds (written in the text grammar).
+    pub grammars: Vec<(BuildingKind, polis_buildings::BuildingGrammar)>,
+}
+
+impl BuildingStage for GrammarBuildings {
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn BuildLot + 'a>> {
+        let mut generator = BuildingGenerator::new(cx.config.effective_building_params())?;
+        for (kind, grammar) in &self.grammars {
+            generator.set_grammar(*kind, grammar.clone());
+        }
+        Ok(Box::new(generator))
+    }
+}
+
+impl BuildLot for BuildingGenerator {
+    fn build(&self, lot: &LotInput<'_>) -> Result<Option<Building>> {
+        Ok(BuildingGenerator::build(
+            self,
+            lot.lot,
+            lot.id,
+            lot.kind,
+            lot.max_height_m,
+            lot.lod,
+        )?)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Facades.
+
+/// A textured quad of a building's skin (relative to the building's origin, glTF axes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkinQuad {
+    /// Corners: bottom-left, bottom-right, top-right, top-left seen from outside.
+    pub corners: [DVec3; 4],
+    /// Texture coordinates of the corners (glTF convention, repeating sampler).
+    pub uvs: [DVec2; 4],
+    /// The tile of the style's tile set.
+    pub tile: usize,
+    /// The facade face (index into [`Building::facades`]) it covers.
+    pub face: usize,
+}
+
+/// A building's facade skin: quads textured with one style's tiles. The quads replace the
+/// wall triangles they cover in the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dress {
+    /// Index of the style in [`City::tile_sets`](crate::City::tile_sets).
+    pub style: usize,
+    /// The quads.
+    pub quads: Vec<SkinQuad>,
+}
+
+/// Dresses buildings; made once per city by [`FacadeStage::prepare`].
+pub trait DressBuilding: Send + Sync {
+    /// The shared tile sets (one per style), indexed by [`Dress::style`].
+    fn tile_sets(&self) -> &[TileSet];
+    /// The skin of one building, or `None` to leave it plain.
+    ///
+    /// # Errors
+    /// Failures of this building: the pipeline skips its skin and reports the error.
+    fn dress(&self, building: &Building, seed: u64) -> Result<Option<Dress>>;
+}
+
+/// The facade stage: textures (once per city), then skins per building.
+pub trait FacadeStage: Send + Sync {
+    /// The dresser for this city.
+    ///
+    /// # Errors
+    /// Bad styles or rasterisation options.
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn DressBuilding + 'a>>;
+}
+
+/// Parish & Müller's layered-grid facades (polis-facades), applied as Kelly's shared
+/// building tiles: each style is rasterised once into a tile set; every wall face is
+/// covered by quads whose UVs repeat the tiles a whole number of modules.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TiledFacades;
+
+struct Tiler {
+    styles: Vec<PreparedStyle>,
+    sets: Vec<TileSet>,
+    style_of: [Option<usize>; 6],
+    detail: FacadeDetail,
+}
+
+impl FacadeStage for TiledFacades {
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn DressBuilding + 'a>> {
+        let fc = &cx.config.facades;
+        let opts = RasterOptions {
+            pixels_per_metre: fc.pixels_per_metre,
+            ..RasterOptions::default()
+        };
+        let mut styles: Vec<PreparedStyle> = Vec::new();
+        let mut sets = Vec::new();
+        let mut style_of = [None; 6];
+        if fc.enabled {
+            for kind in BuildingKind::ALL {
+                let name = fc.style_of.get(kind);
+                if let Some(i) = styles.iter().position(|s| s.style().name == name) {
+                    style_of[kind.index()] = Some(i);
+                    continue;
+                }
+                let style = fc
+                    .styles
+                    .iter()
+                    .find(|s| s.name == name)
+                    .cloned()
+                    .or_else(|| polis_facades::builtin::builtin_style(name))
+                    .ok_or_else(|| {
+                        Error::config(
+                            format!("facades.style_of.{}", kind.name()),
+                            format!(
+                                "no style named {name:?}: neither built in (brick_house, \
+                                 office_curtain_wall, classic_stone, industrial) nor in \
+                                 facades.styles"
+                            ),
+                        )
+                    })?;
+                let prepared = PreparedStyle::new(style)?;
+                sets.push(TileSet::build(&prepared, &opts)?);
+                style_of[kind.index()] = Some(styles.len());
+                styles.push(prepared);
+            }
+        }
+        Ok(Box::new(Tiler {
+            styles,
+            sets,
+            style_of,
+            detail: fc.detail,
+        }))
+    }
+}
+
+impl DressBuilding for Tiler {
+    fn tile_sets(&self) -> &[TileSet] {
+        &self.sets
+    }
+
+    fn dress(&self, b: &Building, seed: u64) -> Result<Option<Dress>> {
+        let Some(style) = self.style_of.get(b.kind.index()).copied().flatten() else {
+            return Ok(None);
+        };
+        let (Some(prepared), Some(set)) = (self.styles.get(style), self.sets.get(style)) else {
+            return Ok(None);
+        };
+        let mut quads = Vec::new();
+        for (k, face) in b.facades.iter().enumerate() {
+            let role = match face.role {
+                FacadeRole::Wall => FaceRole::UpperFloors,
+                FacadeRole::GroundFloor => FaceRole::GroundFloor,
+                FacadeRole::Roof => continue,
+            };
+            if !(face.width > 0.5 && face.height > 0.5) {
+                continue;
+            }
+            let spec = FacadeSpec {
+                width_m: face.width,
+                height_m: face.height,
+                floors: Some(face.floors),
+                role,
+                seed: crate::seed::mix(seed, k as u64),
+            };
+            let facade = prepared.facade(&spec)?;
+            let [bl, br, _tr, tl] = face.quad;
+            let (du, dv) = (br - bl, tl - bl);
+            let at = |s: f64, t: f64| bl + du * (s / face.width) + dv * (t / face.height);
+            let tiles = facade.tile_quads(set);
+            let chosen: Vec<_> = match self.detail {
+                FacadeDetail::Full => tiles,
+                // The repeated tile of the face's main rows, stretched over the whole face.
+                FacadeDetail::Compact => tiles
+                    .iter()
+                    .filter(|q| {
+                        set.tiles.get(q.tile).is_some_and(|t| {
+                            t.cols == polis_facades::Part::Repeat && !t.entrance
+                        })
+                    })
+                    .max_by(|a, b| {
+                        (a.rect.width() * a.rect.height())
+                            .total_cmp(&(b.rect.width() * b.rect.height()))
+                    })
+                    .map(|q| {
+                        let mut q = *q;
+                        q.rect = polis_geom::Aabb2::new(
+                            DVec2::ZERO,
+                            DVec2::new(face.width, face.height),
+                        );
+                        vec![q]
+                    })
+                    .unwrap_or_default(),
+            };
+            // A face is dressed only if its quads cover it (a tile missing from the set
+            // would leave a hole where the wall triangles are replaced).
+            let covered: f64 = chosen.iter().map(|q| q.rect.width() * q.rect.height()).sum();
+            if (covered - face.width * face.height).abs() > 1e-6 * face.width * face.height {
+                continue;
+            }
+            for q in chosen {
+                let (x0, y0, x1, y1) = (q.rect.min.x, q.rect.min.y, q.rect.max.x, q.rect.max.y);
+                let uv = |s: f64, t: f64| DVec2::from(q.uv_at(s, t));
+                quads.push(SkinQuad {
+                    corners: [at(x0, y0), at(x1, y0), at(x1, y1), at(x0, y1)],
+                    uvs: [uv(x0, y0), uv(x1, y0), uv(x1, y1), uv(x0, y1)],
+                    tile: q.tile,
+                    face: k,
+                });
+            }
+        }
+        Ok((!quads.is_empty()).then_some(Dress { style, quads }))
+    }
+}

@@ -1,0 +1,243 @@
+//! Integration tests of the one-call pipeline: every preset on a small city.
+
+use std::collections::HashMap;
+
+use polis::geom::{DVec2, PointLocation, Polygon, PolygonWithHoles, SegmentIntersection};
+use polis::stages::{CellInput, CellLots, LotStage, StageContext};
+use polis::{City, CityConfig, Pipeline, Stage};
+
+/// A preset shrunk to a small city that still has every layer.
+fn small(name: &str) -> CityConfig {
+    let mut c = CityConfig::preset(name).unwrap();
+    c.size_m = c.size_m.min(1600.0);
+    c.roads.max_segments = 260;
+    c.facades.pixels_per_metre = 6.0;
+    c
+}
+
+fn glb_bytes(city: &City) -> Vec<u8> {
+    let mut out = Vec::new();
+    city.write_glb(&mut out).unwrap();
+    out
+}
+
+fn map_bytes(city: &City) -> (Vec<u8>, Vec<u8>) {
+    let map = city.map_layers().unwrap();
+    let mut svg = Vec::new();
+    polis::export::svg::write_svg(&map, &Default::default(), &mut svg).unwrap();
+    let mut json = Vec::new();
+    polis::export::geojson::write_geojson(&map, &Default::default(), &mut json).unwrap();
+    (svg, json)
+}
+
+fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + d * t)
+}
+
+/// `p` lies in `region` or within `tol` metres of its boundary.
+fn inside(region: &PolygonWithHoles, p: DVec2, tol: f64) -> bool {
+    region.locate(p) != PointLocation::Outside
+        || region
+            .rings()
+            .flat_map(|(_, ring)| ring.edges())
+            .any(|(a, b)| distance_to_segment(p, a, b) <= tol)
+}
+
+fn polygon_inside(inner: &Polygon, outer: &PolygonWithHoles, tol: f64) -> bool {
+    inner.points().iter().all(|&p| inside(outer, p, tol))
+}
+
+fn check_city(name: &str, city: &City) {
+    // The road graph is planar: graph invariants, and no two edges cross (brute force on
+    // a small city).
+    city.roads.check_invariants().unwrap();
+    let segs: Vec<_> = city
+        .roads
+        .edges()
+        .map(|(e, a, b, _)| (city.roads.segment(e).unwrap(), a, b))
+        .collect();
+    for (i, ((p0, p1), a0, b0)) in segs.iter().enumerate() {
+        for ((q0, q1), a1, b1) in &segs[i + 1..] {
+            let shared = [a0, b0].iter().filter(|n| **n == a1 || **n == b1).count();
+            match polis::geom::segment_intersection(*p0, *p1, *q0, *q1) {
+                SegmentIntersection::Disjoint => {}
+                SegmentIntersection::Touching { .. } if shared > 0 => {}
+                other => panic!("{name}: roads cross or touch: {other:?}"),
+            }
+        }
+    }
+    assert!(city.stats.road_segments > 50, "{name}: {:?}", city.stats);
+    assert!(city.stats.buildings > 20, "{name}: {:?}", city.stats);
+
+    // Every lot inside its block, every footprint inside its lot.
+    let blocks: HashMap<u64, &PolygonWithHoles> =
+        city.blocks.iter().map(|b| (b.id(), &b.polygon)).collect();
+    for l in &city.lots {
+        let block = blocks.get(&l.lot.block_id).expect("the lot's block exists");
+        assert!(
+            polygon_inside(&l.lot.polygon, block, 1e-6),
+            "{name}: lot {} leaves block {}",
+            l.id,
+            l.lot.block_id
+        );
+    }
+    let lots: HashMap<u64, &Polygon> = city.lots.iter().map(|l| (l.id, &l.lot.polygon)).collect();
+    for b in &city.buildings {
+        let lot = PolygonWithHoles::from((*lots.get(&b.lot_id).expect("lot exists")).clone());
+        assert!(
+            polygon_inside(&b.footprint, &lot, 1e-6),
+            "{name}: building {} leaves its lot",
+            b.id
+        );
+        // Every building mesh is a closed 2-manifold.
+        for (k, part) in b.parts.iter().enumerate() {
+            part.mesh
+                .check_closed()
+                .unwrap_or_else(|e| panic!("{name}: building {} part {k}: {e}", b.id));
+        }
+        assert!(b.height.is_finite() && b.height > 0.0);
+    }
+
+    // No NaN anywhere in the scene (validate checks every value and index).
+    city.scene.validate().unwrap();
+    for mesh in &city.scene.meshes {
+        assert!(mesh.positions.iter().all(|p| p.is_finite()));
+        assert!(mesh.normals.iter().all(|n| n.is_finite()));
+        assert!(mesh.uvs.iter().all(|t| t.is_finite()));
+    }
+    for l in &city.lots {
+        assert!(l.lot.polygon.points().iter().all(|p| p.is_finite()));
+    }
+
+    // The glb reads back with the gltf crate: as many materials and images as the scene,
+    // indices in range.
+    let bytes = glb_bytes(city);
+    let doc = polis::export::gltf::Gltf::from_slice(&bytes).unwrap();
+    assert_eq!(doc.materials().count(), city.scene.materials.len(), "{name}");
+    assert_eq!(doc.images().count(), city.scene.images.len(), "{name}");
+    assert!(doc.meshes().count() > 0);
+    let stats_tris = city.stats.scene_triangles;
+    assert!(stats_tris > 0);
+    assert_eq!(city.scene.triangle_count(), stats_tris);
+}
+
+#[test]
+fn every_preset_makes_a_valid_city() {
+    for name in CityConfig::preset_names() {
+        let config = small(name);
+        let city = polis::generate(&config).unwrap();
+        check_city(name, &city);
+        assert!(city.stats.dressed_buildings > 0, "{name}: no facades");
+        assert_eq!(city.stats.timings.len(), Stage::ALL.len());
+    }
+}
+
+#[test]
+fn two_runs_and_any_thread_count_give_identical_bytes() {
+    for name in ["default", "paris"] {
+        let mut config = small(name);
+        config.threads = Some(1);
+        let a = polis::generate(&config).unwrap();
+        let b = polis::generate(&config).unwrap();
+        config.threads = Some(3);
+        let c = polis::generate(&config).unwrap();
+        let (ga, gb, gc) = (glb_bytes(&a), glb_bytes(&b), glb_bytes(&c));
+        assert!(ga == gb, "{name}: two serial runs differ");
+        assert!(ga == gc, "{name}: serial and parallel runs differ");
+        assert_eq!(map_bytes(&a), map_bytes(&c), "{name}: maps differ");
+        // And the other seed gives another city.
+        config.seed += 1;
+        let d = polis::generate(&config).unwrap();
+        assert!(glb_bytes(&d) != ga);
+    }
+}
+
+/// A deliberately trivial lot stage: each block's parcels become lots as they are.
+struct WholeParcels;
+
+impl LotStage for WholeParcels {
+    fn lots(&self, input: &CellInput<'_>, cx: &StageContext<'_>) -> polis::Result<CellLots> {
+        let mut out = CellLots::default();
+        let Ok(blocks) = polis::lots::blocks(&input.region, &cx.config.blocks) else {
+            return Ok(out);
+        };
+        for block in blocks {
+            for parcel in &block.parcels {
+                let polygon = Polygon::new(parcel.outer.points.clone());
+                let area = polygon.area();
+                out.lots.push(polis::lots::Lot {
+                    street_edges: (0..polygon.len())
+                        .filter(|&i| parcel.outer.street.get(i).copied().unwrap_or(false))
+                        .collect(),
+                    polygon,
+                    block_id: block.id(),
+                    area,
+                });
+            }
+            out.blocks.push(block);
+        }
+        Ok(out)
+    }
+}
+
+#[test]
+fn a_replaced_lot_stage_is_used() {
+    let config = small("default");
+    let default = polis::generate(&config).unwrap();
+    let custom = Pipeline::default()
+        .with_lots(WholeParcels)
+        .generate(&config)
+        .unwrap();
+    // One lot per parcel: far fewer lots than Kelly's subdivision, each a whole parcel.
+    assert!(custom.lots.len() < default.lots.len() / 2);
+    let parcels: usize = custom.blocks.iter().map(|b| b.parcels.len()).sum();
+    assert_eq!(custom.lots.len(), parcels);
+    check_city("custom lots", &custom);
+}
+
+#[test]
+fn progress_reaches_every_stage_and_ends_at_one() {
+    use std::sync::{Arc, Mutex};
+    let seen: Arc<Mutex<Vec<(Stage, f64)>>> = Arc::default();
+    let log = Arc::clone(&seen);
+    let config = small("old_town");
+    Pipeline::default()
+        .with_progress(move |s, f| log.lock().unwrap().push((s, f)))
+        .generate(&config)
+        .unwrap();
+    let seen = seen.lock().unwrap();
+    for stage in Stage::ALL {
+        let fractions: Vec<f64> = seen.iter().filter(|(s, _)| *s == stage).map(|(_, f)| *f).collect();
+        assert_eq!(fractions.last(), Some(&1.0), "{stage}");
+        assert!(fractions.iter().all(|f| (0.0..=1.0).contains(f)));
+    }
+}
+
+#[test]
+fn bad_configurations_are_errors_not_panics() {
+    let mut c = small("default");
+    c.size_m = f64::NAN;
+    assert!(matches!(polis::generate(&c), Err(polis::Error::Config { .. })));
+    let mut c = small("default");
+    c.threads = Some(0);
+    assert!(polis::generate(&c).is_err());
+    let mut c = small("default");
+    c.facades.style_of.house = "no such style".into();
+    let err = polis::generate(&c).unwrap_err();
+    assert!(err.to_string().contains("no such style"), "{err}");
+    let mut c = small("default");
+    c.roads.street_length_m = -1.0;
+    assert!(polis::generate(&c).is_err());
+    let mut c = small("default");
+    c.maps.water = Some(polis::MapSpec::png(
+        "/no/such/file.png",
+        polis::geom::Aabb2::new(DVec2::ZERO, DVec2::ONE),
+    ));
+    assert!(polis::generate(&c).is_err());
+}
