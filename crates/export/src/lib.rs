@@ -8,7 +8,7 @@
 //! | [`obj::write_obj`] | [`Scene`](geom::Scene) | Wavefront OBJ (one group per object, world space, triangles) + MTL + texture PNGs through a [`FileSink`](sink::FileSink) |
 //! | [`svg::write_svg`] | [`MapLayers`](map::MapLayers) | SVG plan: water, parks, blocks, lots, roads by class and width, footprints by kind; north up |
 //! | [`geojson::write_geojson`] | [`MapLayers`](map::MapLayers) | RFC 7946 FeatureCollection in a documented local metric coordinate system |
-//! | [`surfaces::road_surfaces`] | [`MapRoad`](map::MapRoad)s + an elevation [`Field`](geom::Field) | a [`Mesh`](geom::Mesh) of road ribbons (mitred, draped, bridges spanning) to put in a scene |
+//! | [`surfaces::road_surfaces`] | [`MapRoad`](map::MapRoad)s + an elevation [`Field`](geom::Field) | a [`Mesh`](geom::Mesh) of road ribbons joined by junction polygons, dead-end caps (draped, bridges spanning) to put in a scene |
 //!
 //! The 3-D input is `polis-geom`'s [`Scene`](geom::Scene) (what the building and facade
 //! stages produce); the 2-D input is this crate's plain [`map`] model, which anyone can
@@ -57,9 +57,8 @@
 //!
 //! ## Limitations
 //!
-//! * Road surfaces ([`surfaces`]) are ribbons that overlap at crossings (larger classes
-//!   lifted on top), not junction polygons; footpath rings around blocks are not built
-//!   here (they need the straight-skeleton inset of `polis-lots`).
+//! * Road surfaces ([`surfaces`]) join roads only where they share a point (a planar
+//!   graph); roads that cross without one overlap (larger classes lifted on top).
 //! * glTF: no KTX2/JPEG textures, no animations or cameras; a sheared node matrix is
 //!   written as `matrix` (not a TRS). OBJ: no metallic-roughness texture map.
 //! * GeoJSON positions are local metres, not WGS 84 (stated in the file; see [`geojson`]).

@@ -263,10 +263,14 @@ proptest! {
         prop_assert!(mesh.validate().is_ok());
         // Straight roads: the ribbon's area is length × width.
         for r in map.roads.iter().filter(|r| r.points.len() == 2 && r.width_m > 0.0) {
+            let flat = crate::surfaces::RoadSurfaceOptions {
+                end_cap: crate::surfaces::EndCap::Flat,
+                ..Default::default()
+            };
             let one = crate::surfaces::road_surfaces(
                 std::slice::from_ref(r),
                 &polis_geom::field::Constant(0.0),
-                &crate::surfaces::RoadSurfaceOptions::default(),
+                &flat,
                 None,
             )
             .unwrap();

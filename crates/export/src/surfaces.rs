@@ -1,30 +1,63 @@
-//! Road surface meshes: ribbons of each road's width along its centre line, draped on an
-//! elevation field, for the glTF and OBJ writers.
+//! Road surface meshes: ribbons of each road's width joined by junction polygons, draped
+//! on an elevation field, for the glTF and OBJ writers.
 //!
 //! [`road_surfaces`] turns the [`MapRoad`]s of a map into one [`Mesh`] (one material):
 //!
-//! * Each road is a ribbon of its width. At interior vertices the two sides are joined with
-//!   a **miter** (the offset point on the bisector), so a polyline's ribbon has exactly the
-//!   area `length × width` and no gaps; the miter length is limited to
-//!   [`MITER_LIMIT`] half-widths (sharper turns are clamped and slightly narrowed).
-//! * Segments longer than [`RoadSurfaceOptions::max_segment_m`] are subdivided and every
-//!   station is lifted to the elevation field sampled at its centre point, plus
-//!   [`RoadSurfaceOptions::lift_m`]; bridges instead run straight between the elevations at
-//!   their two ends (a deck over water or a valley).
-//! * Crossings: ribbons of different roads overlap where they cross; each class is lifted
-//!   by [`RoadSurfaceOptions::class_lift_m`] per rank (footpath < other < street < major <
-//!   highway) so the larger road is drawn on top without depth fighting.
-//! * Quads are flat shaded (Newell normals), counter-clockwise from above; texture
-//!   coordinates are metres with `u` along the road (from its start) and `v` across it
-//!   (`0` on the right edge to `−width` on the left), so a lane-marking texture runs along
-//!   the road.
+//! * **The network.** Every centre-line point is a node; roads that share a point (exactly)
+//!   meet there. Each segment between two nodes becomes a ribbon of its road's width.
+//!   Duplicate segments (the same two nodes twice) keep the wider road.
+//! * **Junctions.** At every node of degree ≥ 2 the incident segments are sorted
+//!   counter-clockwise ([`ccw_cmp`](polis_geom::predicates::ccw_cmp)). Where two
+//!   consecutive roads enclose less than a half-turn, the left border of one meets the
+//!   right border of the next; each ribbon is cut square at the farthest such corner along
+//!   it, and the junction polygon runs cut, corner, cut, … around the node. A gap of more
+//!   than a half-turn (the outside of a bend) gets a miter up to [`MITER_LIMIT`]
+//!   half-widths, else a bevel; a gap of exactly a half-turn a step between the borders.
+//!   A node where one road continues straight (two segments, exactly opposite) needs no
+//!   polygon. The polygon is star-shaped around the node (checked exactly) and
+//!   triangulated with [`triangulate`](polis_geom::mesh::triangulate).
+//! * **Dead ends** (degree 1) get an [`EndCap`]: round by default.
+//! * **Short segments.** When the two junctions of a segment want more than its length,
+//!   both cuts are shortened in proportion (the ribbon vanishes) and a corner that then
+//!   lies beyond a cut is joined by a chord; if the polygon is then no longer star-shaped
+//!   (near-parallel roads on short segments, overlapping segments) the junction is the
+//!   convex hull of its corners. [`RoadSurfaceReport`] counts these cases.
+//! * **Draping.** Every vertex is lifted to the elevation field at its own layout point
+//!   plus [`RoadSurfaceOptions::lift_m`]; segments longer than
+//!   [`RoadSurfaceOptions::max_segment_m`] are subdivided. Bridges instead run straight
+//!   between their cut ends, and a node all of whose roads are bridges is a flat deck at
+//!   the bridge's height (interpolated along the road between its two end points).
+//! * **Classes.** Each class is lifted by [`RoadSurfaceOptions::class_lift_m`] per rank
+//!   (footpath < other < street < major < highway); a junction takes the highest rank of
+//!   its roads, and a ribbon's cut ends take their junction's height, so ribbon and
+//!   junction share their edge exactly. Roads that cross without a shared point (a bridge
+//!   over a street, or input that is not planar) overlap, the larger class on top.
+//! * **Texture coordinates** are metres: on ribbons `u` along the road (from its start)
+//!   and `v` across it (`0` on the right edge to `−width` on the left), so a lane-marking
+//!   texture runs along the road; on junctions and caps the layout position `(x, −y)`.
+//!   Ribbons are flat shaded per quad; each junction has one normal (the area-weighted
+//!   mean of its triangles').
+//!
+//! ## Guarantees
+//!
+//! On a planar network (roads meet only at shared points, as a
+//! [`PlanarGraph`](polis_geom::PlanarGraph) gives them) whose segments are long enough for
+//! their junctions (no segment clamped) and whose roads keep their width apart elsewhere,
+//! ribbons and junction polygons do not overlap: the property tests check pairwise-disjoint
+//! interiors on random planar graphs. The mesh always passes
+//! [`Mesh::validate`](polis_geom::Mesh::validate) (no NaN, no zero-area triangle).
 //!
 //! ## Limitations
 //!
-//! * No junction polygons: overlapping ribbons stand in for intersections, and turns
-//!   sharper than the miter limit are clamped rather than bevelled.
-//! * The terrain is sampled at the ribbon's stations only; a ribbon may float above or dip
-//!   below terrain that bends across its width.
+//! * Roads crossing without a shared point are not split: their ribbons overlap.
+//! * The terrain is sampled at the vertices only; a wide junction may float above or dip
+//!   below terrain that bends inside it.
+//! * Clamped junctions (near-parallel roads on very short segments) may overlap their
+//!   neighbours; the report counts them.
+//!
+//! ## Footpaths
+//!
+//! The footpath strips around blocks are meshed by [`crate::footpaths`].
 
 use polis_geom::field::Field;
 use polis_geom::glam::DVec3;
@@ -36,8 +69,34 @@ use serde::{Deserialize, Serialize};
 use crate::ExportError;
 use crate::map::{MapLayers, MapRoad};
 
+mod junctions;
+
+pub use junctions::MIN_TRIM_HALF_WIDTHS;
+
 /// The longest miter, in half-widths (2 = turns up to 120° are exact).
 pub const MITER_LIMIT: f64 = 2.0;
+
+/// How a road ends at a dead end (a node with one road).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum EndCap {
+    /// The ribbon stops square at the node.
+    Flat,
+    /// The ribbon goes on half its width past the node.
+    Square,
+    /// A half-disc of the road's width past the node, as a polygon of `segments` edges
+    /// (at least 2).
+    Round {
+        /// Edges of the half-disc's arc.
+        segments: u32,
+    },
+}
+
+impl Default for EndCap {
+    fn default() -> Self {
+        EndCap::Round { segments: 8 }
+    }
+}
 
 /// Options of [`road_surfaces`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,8 +107,10 @@ pub struct RoadSurfaceOptions {
     pub max_segment_m: f64,
     /// Height of the surface above the terrain, metres (finite). Default: 0.05.
     pub lift_m: f64,
-    /// Extra height per class rank at crossings, metres (finite, ≥ 0). Default: 0.02.
+    /// Extra height per class rank, metres (finite, ≥ 0). Default: 0.02.
     pub class_lift_m: f64,
+    /// The cap at dead ends. Default: `EndCap::Round { segments: 8 }`.
+    pub end_cap: EndCap,
 }
 
 impl Default for RoadSurfaceOptions {
@@ -58,25 +119,51 @@ impl Default for RoadSurfaceOptions {
             max_segment_m: 10.0,
             lift_m: 0.05,
             class_lift_m: 0.02,
+            end_cap: EndCap::default(),
         }
     }
 }
 
-/// Builds the surface ribbons of `roads` as one mesh with `material`, draped on
-/// `elevation` (metres above the layout plane at each layout point).
+/// What [`road_surfaces_with_report`] built and which hard cases it met.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct RoadSurfaceReport {
+    /// Junction polygons and dead-end caps in the mesh.
+    pub junctions: usize,
+    /// Segments dropped because another segment joins the same two points (the wider
+    /// one is kept).
+    pub duplicate_segments: usize,
+    /// Segments too short for the cuts both junctions wanted (cuts shortened).
+    pub clamped_segments: usize,
+    /// Corners between two roads joined by a chord because a cut was shortened.
+    pub clamped_corners: usize,
+    /// Junctions replaced by the convex hull of their corners (near-parallel roads on
+    /// short segments, overlapping segments).
+    pub approximated_junctions: usize,
+    /// Junctions left out because their polygon was degenerate.
+    pub skipped_junctions: usize,
+}
+
+/// Builds the road surfaces of `roads` (ribbons, junctions, dead-end caps) as one mesh
+/// with `material`, draped on `elevation` (metres above the layout plane at each layout
+/// point). See the [module docs](self) for the construction.
 ///
 /// Roads are checked as [`MapLayers::validate`] checks them; zero-width roads and
 /// zero-length segments are skipped. Fails with [`ExportError::InvalidMap`] when the
-/// elevation field returns a non-finite value.
+/// elevation field returns a non-finite value, [`ExportError::InvalidOption`] on options
+/// out of range.
 ///
 /// ```
 /// use polis_export::map::{MapRoad, RoadClass};
-/// use polis_export::surfaces::{road_surfaces, RoadSurfaceOptions};
+/// use polis_export::surfaces::{road_surfaces, EndCap, RoadSurfaceOptions};
 /// use polis_export::geom::{DVec2, field::Constant};
-/// let road = MapRoad::new(vec![DVec2::ZERO, DVec2::new(100.0, 0.0)], RoadClass::Street, 8.0);
-/// let mesh = road_surfaces(&[road], &Constant(0.0), &RoadSurfaceOptions::default(), None)?;
+/// // A crossing of two 100 m streets, 8 m wide: 2 × 800 m² less the shared 64 m².
+/// let a = MapRoad::new(vec![DVec2::new(-50.0, 0.0), DVec2::ZERO, DVec2::new(50.0, 0.0)], RoadClass::Street, 8.0);
+/// let b = MapRoad::new(vec![DVec2::new(0.0, -50.0), DVec2::ZERO, DVec2::new(0.0, 50.0)], RoadClass::Street, 8.0);
+/// let options = RoadSurfaceOptions { end_cap: EndCap::Flat, ..Default::default() };
+/// let mesh = road_surfaces(&[a, b], &Constant(0.0), &options, None)?;
 /// mesh.validate()?;
-/// assert!((mesh.surface_area() - 800.0).abs() < 1e-3);
+/// assert!((mesh.surface_area() - (1600.0 - 64.0)).abs() < 1e-2);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn road_surfaces(
@@ -85,7 +172,43 @@ pub fn road_surfaces(
     options: &RoadSurfaceOptions,
     material: Option<MaterialId>,
 ) -> Result<Mesh, ExportError> {
-    let o = options;
+    road_surfaces_with_report(roads, elevation, options, material).map(|(mesh, _)| mesh)
+}
+
+/// [`road_surfaces`] with the [`RoadSurfaceReport`] of the hard cases met.
+pub fn road_surfaces_with_report(
+    roads: &[MapRoad],
+    elevation: &dyn Field,
+    options: &RoadSurfaceOptions,
+    material: Option<MaterialId>,
+) -> Result<(Mesh, RoadSurfaceReport), ExportError> {
+    check_options(options)?;
+    MapLayers {
+        roads: roads.to_vec(),
+        ..MapLayers::default()
+    }
+    .validate()?;
+    let plan = junctions::plan(roads, options);
+    let drape = Drape::new(roads, &plan, elevation, options)?;
+    let mut mesh = Mesh::with_capacity(
+        material,
+        4 * plan.edges.len() + 8 * plan.junctions.len(),
+        2 * plan.edges.len() + 6 * plan.junctions.len(),
+    );
+    for e in plan.edges.iter().filter(|e| !e.dropped) {
+        add_ribbon(&mut mesh, roads, e, &drape, options)?;
+    }
+    let mut report = plan.report.clone();
+    for j in &plan.junctions {
+        if !add_junction(&mut mesh, j, &drape)? {
+            report.skipped_junctions += 1;
+            report.junctions -= 1;
+        }
+    }
+    Ok((mesh, report))
+}
+
+fn check_options(o: &RoadSurfaceOptions) -> Result<(), ExportError> {
     if !(o.max_segment_m.is_finite() && o.max_segment_m > 0.0) {
         return Err(ExportError::InvalidOption {
             name: "max_segment_m",
@@ -98,257 +221,198 @@ pub fn road_surfaces(
             reason: "lift_m must be finite and class_lift_m finite and ≥ 0".to_string(),
         });
     }
-    MapLayers {
-        roads: roads.to_vec(),
-        ..MapLayers::default()
-    }
-    .validate()?;
-    let mut mesh = Mesh::new(material);
-    for (i, road) in roads.iter().enumerate() {
-        add_ribbon(&mut mesh, i, road, elevation, o)?;
-    }
-    Ok(mesh)
+    Ok(())
 }
 
-/// The left unit normal of the direction `d`.
-fn left(d: DVec2) -> DVec2 {
-    DVec2::new(-d.y, d.x)
+/// Heights of the plan's vertices.
+struct Drape<'a> {
+    elevation: &'a dyn Field,
+    /// Lift of each node (its highest class).
+    node_lift: Vec<f64>,
+    /// Deck height of each node all of whose roads are bridges.
+    deck: Vec<Option<f64>>,
+}
+
+impl<'a> Drape<'a> {
+    fn new(
+        roads: &[MapRoad],
+        plan: &junctions::Plan,
+        elevation: &'a dyn Field,
+        o: &RoadSurfaceOptions,
+    ) -> Result<Self, ExportError> {
+        let lift = |r: usize| o.lift_m + o.class_lift_m * f64::from(roads[r].class.rank());
+        let mut node_lift = vec![o.lift_m; plan.nodes.len()];
+        let mut deck = vec![None; plan.nodes.len()];
+        for (v, n) in plan.nodes.iter().enumerate() {
+            let mut sum = 0.0;
+            let mut all_bridges = !n.ends.is_empty();
+            for (k, &(e, starts)) in n.ends.iter().enumerate() {
+                let edge = &plan.edges[e];
+                let l = lift(edge.road);
+                if k == 0 || l > node_lift[v] {
+                    node_lift[v] = l;
+                }
+                let road = &roads[edge.road];
+                if !road.bridge {
+                    all_bridges = false;
+                } else if all_bridges {
+                    let s = edge.s_a + if starts { 0.0 } else { edge.len };
+                    sum += bridge_height(road, edge.road, s, elevation)?;
+                }
+            }
+            if all_bridges {
+                deck[v] = Some(sum / n.ends.len() as f64);
+            }
+        }
+        Ok(Drape {
+            elevation,
+            node_lift,
+            deck,
+        })
+    }
+
+    /// The terrain under `p`, checked.
+    fn ground(&self, p: DVec2) -> Result<f64, ExportError> {
+        sample(self.elevation, p)
+    }
+
+    /// The surface height at `p`, a vertex of node `v`'s junction or ribbon cuts.
+    fn at_node(&self, v: usize, p: DVec2) -> Result<f64, ExportError> {
+        let base = match self.deck[v] {
+            Some(h) => h,
+            None => self.ground(p)?,
+        };
+        Ok(base + self.node_lift[v])
+    }
+}
+
+fn sample(elevation: &dyn Field, p: DVec2) -> Result<f64, ExportError> {
+    let h = elevation.sample(p);
+    if h.is_finite() {
+        Ok(h)
+    } else {
+        Err(ExportError::map(
+            format!("road surface at {p}"),
+            format!("the elevation field is {h} there; it must be finite"),
+        ))
+    }
+}
+
+/// The deck height of bridge `road` at `s` metres along its centre line: straight between
+/// the terrain at its two end points.
+fn bridge_height(
+    road: &MapRoad,
+    index: usize,
+    s: f64,
+    elevation: &dyn Field,
+) -> Result<f64, ExportError> {
+    let (Some(&first), Some(&last)) = (road.points.first(), road.points.last()) else {
+        return Err(ExportError::map(
+            format!("road {index} (id {})", road.id),
+            "a bridge needs at least two points",
+        ));
+    };
+    let total: f64 = road.points.windows(2).map(|w| (w[1] - w[0]).length()).sum();
+    let (h0, h1) = (sample(elevation, first)?, sample(elevation, last)?);
+    let f = if total > 0.0 {
+        (s / total).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    Ok(h0 + (h1 - h0) * f)
 }
 
 fn add_ribbon(
     mesh: &mut Mesh,
-    index: usize,
-    road: &MapRoad,
-    elevation: &dyn Field,
+    roads: &[MapRoad],
+    e: &junctions::PlanEdge,
+    drape: &Drape<'_>,
     o: &RoadSurfaceOptions,
 ) -> Result<(), ExportError> {
-    let half = road.width_m / 2.0;
-    if half <= 0.0 {
+    let road = &roads[e.road];
+    let inner = e.len - e.trim[0] - e.trim[1];
+    if inner <= e.len * 1e-12 {
         return Ok(());
     }
-    // Drop repeated points: they have no direction.
-    let mut pts: Vec<DVec2> = Vec::with_capacity(road.points.len());
-    for &p in &road.points {
-        if pts.last() != Some(&p) {
-            pts.push(p);
-        }
-    }
-    if pts.len() < 2 {
-        return Ok(());
-    }
-    let dirs: Vec<DVec2> = pts.windows(2).map(|w| (w[1] - w[0]).normalize()).collect();
-    // Offset (from centre to the left edge) at every vertex: miter at interior vertices.
-    let offsets: Vec<DVec2> = (0..pts.len())
-        .map(|k| {
-            let before = dirs.get(k.wrapping_sub(1)).copied();
-            let after = dirs.get(k).copied();
-            match (before, after) {
-                (Some(a), Some(b)) => {
-                    let (na, nb) = (left(a), left(b));
-                    let bis = (na + nb).normalize_or_zero();
-                    let cos = bis.dot(na);
-                    if bis == DVec2::ZERO || cos <= 0.0 {
-                        na * half
-                    } else {
-                        bis * (half / cos.max(1.0 / MITER_LIMIT))
-                    }
-                }
-                (Some(a), None) | (None, Some(a)) => left(a) * half,
-                (None, None) => DVec2::ZERO,
-            }
-        })
-        .collect();
     let lift = o.lift_m + o.class_lift_m * f64::from(road.class.rank());
-    let height = |p: DVec2| -> Result<f64, ExportError> {
-        let h = elevation.sample(p);
-        if h.is_finite() {
-            Ok(h)
+    let [ra, la] = e.cut_a;
+    let [rb, lb] = e.cut_b;
+    let ends = [
+        [drape.at_node(e.a, ra)?, drape.at_node(e.a, la)?],
+        [drape.at_node(e.b, rb)?, drape.at_node(e.b, lb)?],
+    ];
+    let pieces = (inner / o.max_segment_m).ceil().max(1.0) as usize;
+    let station = |j: usize| -> Result<(DVec3, DVec3, f64), ExportError> {
+        let t = j as f64 / pieces as f64;
+        let (r, l) = (ra.lerp(rb, t), la.lerp(lb, t));
+        let (hr, hl) = if j == 0 {
+            (ends[0][0], ends[0][1])
+        } else if j == pieces {
+            (ends[1][0], ends[1][1])
+        } else if road.bridge {
+            (
+                ends[0][0] + (ends[1][0] - ends[0][0]) * t,
+                ends[0][1] + (ends[1][1] - ends[0][1]) * t,
+            )
         } else {
-            Err(ExportError::map(
-                format!("road {index} (id {})", road.id),
-                format!("the elevation field is {h} at {p}; it must be finite"),
-            ))
-        }
-    };
-    let (h_start, h_end) = if road.bridge {
-        (height(pts[0])?, height(pts[pts.len() - 1])?)
-    } else {
-        (0.0, 0.0)
-    };
-    let total: f64 = pts.windows(2).map(|w| (w[1] - w[0]).length()).sum();
-    let mut along = 0.0;
-    for (k, w) in pts.windows(2).enumerate() {
-        let (a, b) = (w[0], w[1]);
-        let len = (b - a).length();
-        let pieces = (len / o.max_segment_m).ceil().max(1.0) as usize;
-        let station = |j: usize| -> Result<(DVec3, DVec3, f64), ExportError> {
-            let t = j as f64 / pieces as f64;
-            let c = a.lerp(b, t);
-            let off = offsets[k].lerp(offsets[k + 1], t);
-            let s = along + len * t;
-            let h = if road.bridge {
-                let f = if total > 0.0 { s / total } else { 0.0 };
-                h_start + (h_end - h_start) * f
-            } else {
-                height(c)?
-            } + lift;
-            Ok((to_world(c + off, h), to_world(c - off, h), s))
+            (drape.ground(r)? + lift, drape.ground(l)? + lift)
         };
-        let mut prev = station(0)?;
-        for j in 1..=pieces {
-            let next = station(j)?;
-            let (l0, r0, s0) = prev;
-            let (l1, r1, s1) = next;
-            let uv = [
-                DVec2::new(s0, 0.0),
-                DVec2::new(s1, 0.0),
-                DVec2::new(s1, -road.width_m),
-                DVec2::new(s0, -road.width_m),
-            ];
-            // Counter-clockwise from above: right edge forwards, left edge backwards.
-            // A quad collapsed by a clamped miter is skipped (the mesh stays valid).
-            let _ = mesh.add_quad([r0, r1, l1, l0], uv);
-            prev = next;
-        }
-        along += len;
+        let s = e.s_a + e.trim[0] + inner * t;
+        Ok((to_world(l, hl), to_world(r, hr), s))
+    };
+    let mut prev = station(0)?;
+    for j in 1..=pieces {
+        let next = station(j)?;
+        let (l0, r0, s0) = prev;
+        let (l1, r1, s1) = next;
+        let uv = [
+            DVec2::new(s0, 0.0),
+            DVec2::new(s1, 0.0),
+            DVec2::new(s1, -road.width_m),
+            DVec2::new(s0, -road.width_m),
+        ];
+        // Counter-clockwise from above: right edge forwards, left edge backwards.
+        // A quad collapsed to nothing by rounding is skipped (the mesh stays valid).
+        let _ = mesh.add_quad([r0, r1, l1, l0], uv);
+        prev = next;
     }
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::map::RoadClass;
-    use polis_geom::field::{Constant, FnField};
-    use polis_geom::glam::Vec3;
-
-    fn road(points: &[(f64, f64)], class: RoadClass, w: f64) -> MapRoad {
-        MapRoad::new(
-            points.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
-            class,
-            w,
-        )
+/// Adds a junction polygon; `false` if it has no usable triangle after rounding to `f32`.
+fn add_junction(
+    mesh: &mut Mesh,
+    j: &junctions::Junction,
+    drape: &Drape<'_>,
+) -> Result<bool, ExportError> {
+    let mut world = Vec::with_capacity(j.ring.len());
+    for &p in &j.ring {
+        world.push(to_world(p, drape.at_node(j.node, p)?));
     }
-
-    #[test]
-    fn straight_and_mitred_ribbons_have_exact_area() {
-        let o = RoadSurfaceOptions::default();
-        let straight = road(&[(0.0, 0.0), (100.0, 0.0)], RoadClass::Street, 8.0);
-        let m = road_surfaces(&[straight], &Constant(0.0), &o, None).unwrap();
-        m.validate().unwrap();
-        assert_eq!(m.triangle_count(), 2 * 10, "subdivided every 10 m");
-        assert!((m.surface_area() - 800.0).abs() < 1e-3);
-        assert!(
-            m.normals.iter().all(|n| (*n - Vec3::Y).length() < 1e-6),
-            "faces up"
-        );
-        // An L turn (90°) and a 120° turn: miters keep area = length × width.
-        for (pts, len) in [
-            (vec![(0.0, 0.0), (50.0, 0.0), (50.0, 40.0)], 90.0),
-            (
-                vec![(0.0, 0.0), (30.0, 0.0), (15.0, 25.980762113533157)],
-                60.0,
-            ),
-        ] {
-            let r = road(&pts, RoadClass::Major, 6.0);
-            let m = road_surfaces(&[r], &Constant(2.0), &o, None).unwrap();
-            m.validate().unwrap();
-            assert!(
-                (m.surface_area() - len * 6.0).abs() < 1e-2,
-                "{} vs {}",
-                m.surface_area(),
-                len * 6.0
-            );
-            let lift = 2.0 + o.lift_m + o.class_lift_m * 3.0;
-            assert!(
-                m.positions
-                    .iter()
-                    .all(|p| (f64::from(p.y) - lift).abs() < 1e-5)
-            );
+    let rounded: Vec<DVec3> = world.iter().map(|w| w.as_vec3().as_dvec3()).collect();
+    let mut normal = DVec3::ZERO;
+    let mut keep = Vec::with_capacity(j.triangles.len());
+    for t in &j.triangles {
+        let [a, b, c] = t.map(|i| rounded[i as usize]);
+        let n = (b - a).cross(c - a);
+        if n != DVec3::ZERO {
+            normal += n;
+            keep.push(*t);
         }
     }
-
-    #[test]
-    fn drapes_on_terrain_and_bridges_span() {
-        let o = RoadSurfaceOptions {
-            max_segment_m: 5.0,
-            lift_m: 0.0,
-            class_lift_m: 0.0,
-        };
-        let slope = FnField::new(|p: DVec2| 0.1 * p.x);
-        let r = road(&[(0.0, 0.0), (40.0, 0.0)], RoadClass::Street, 4.0);
-        let m = road_surfaces(std::slice::from_ref(&r), &slope, &o, None).unwrap();
-        m.validate().unwrap();
-        for p in &m.positions {
-            assert!((p.y - 0.1 * p.x).abs() < 1e-5, "{p}");
-        }
-        // A valley 10 m deep between x = 10 and 30: the road dips, the bridge does not.
-        let valley = FnField::new(|p: DVec2| {
-            if (10.0..=30.0).contains(&p.x) {
-                -10.0
-            } else {
-                0.0
-            }
-        });
-        let m = road_surfaces(std::slice::from_ref(&r), &valley, &o, None).unwrap();
-        assert!(m.positions.iter().any(|p| p.y == -10.0));
-        let bridge = MapRoad { bridge: true, ..r };
-        let m = road_surfaces(&[bridge], &valley, &o, None).unwrap();
-        assert!(m.positions.iter().all(|p| p.y == 0.0));
+    let normal = normal.normalize_or_zero();
+    if keep.is_empty() || !normal.is_finite() || normal.y <= 0.0 {
+        return Ok(false);
     }
-
-    #[test]
-    fn larger_classes_lie_on_top_at_crossings() {
-        let o = RoadSurfaceOptions::default();
-        let a = road(&[(-20.0, 0.0), (20.0, 0.0)], RoadClass::Highway, 10.0);
-        let b = road(&[(0.0, -20.0), (0.0, 20.0)], RoadClass::Footpath, 2.0);
-        let ha = road_surfaces(&[a], &Constant(0.0), &o, None)
-            .unwrap()
-            .positions[0]
-            .y;
-        let hb = road_surfaces(&[b], &Constant(0.0), &o, None)
-            .unwrap()
-            .positions[0]
-            .y;
-        assert!(ha > hb);
+    let base = mesh.vertex_count() as u32;
+    for (&p, &w) in j.ring.iter().zip(&world) {
+        mesh.add_vertex(w, normal, DVec2::new(p.x, -p.y));
     }
-
-    #[test]
-    fn degenerate_and_bad_input() {
-        let o = RoadSurfaceOptions::default();
-        // Zero width, repeated points, a U-turn: no panic, valid mesh.
-        let roads = [
-            road(&[(0.0, 0.0), (10.0, 0.0)], RoadClass::Street, 0.0),
-            road(
-                &[(0.0, 0.0), (0.0, 0.0), (10.0, 0.0), (10.0, 0.0)],
-                RoadClass::Street,
-                3.0,
-            ),
-            road(
-                &[(0.0, 0.0), (10.0, 0.0), (0.0, 0.0)],
-                RoadClass::Street,
-                3.0,
-            ),
-            road(
-                &[(0.0, 0.0), (10.0, 0.0), (0.0, 0.5)],
-                RoadClass::Street,
-                3.0,
-            ),
-        ];
-        let m = road_surfaces(&roads, &Constant(0.0), &o, None).unwrap();
-        m.validate().unwrap();
-        assert!(m.triangle_count() > 0);
-        let nan = FnField::new(|_p: DVec2| f64::NAN);
-        assert!(matches!(
-            road_surfaces(&roads[1..2], &nan, &o, None),
-            Err(ExportError::InvalidMap { .. })
-        ));
-        let bad = RoadSurfaceOptions {
-            max_segment_m: 0.0,
-            ..o.clone()
-        };
-        assert!(road_surfaces(&roads, &Constant(0.0), &bad, None).is_err());
-        let nan_road = road(&[(0.0, f64::NAN), (1.0, 0.0)], RoadClass::Street, 3.0);
-        assert!(road_surfaces(&[nan_road], &Constant(0.0), &o, None).is_err());
+    for [a, b, c] in keep {
+        mesh.push_triangle(base + a, base + b, base + c)?;
     }
+    Ok(true)
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,576 @@
+//! The 2-D plan of a road network's surface: the graph of road segments, the cut of every
+//! ribbon end, and one polygon per junction, all in layout coordinates (f64).
+//!
+//! At every node the incident segments are sorted counter-clockwise
+//! ([`ccw_cmp`](polis_geom::predicates::ccw_cmp)); between two consecutive roads `i` and
+//! `j` lies a *gap*. In a gap narrower than a half-turn the left border of `i` meets the
+//! right border of `j` at a corner `P`; each ribbon is cut square at the farthest corner
+//! along it, and the junction polygon runs cut, corner, cut, … around the node. Gaps wider
+//! than a half-turn get a miter (or a bevel beyond [`MITER_LIMIT`]), a straight gap a step
+//! between the two borders, a dead end a cap.
+
+use std::collections::BTreeMap;
+
+use polis_geom::mesh::triangulate;
+use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
+use polis_geom::{DVec2, Polygon, PolygonWithHoles};
+
+use super::{EndCap, MITER_LIMIT, RoadSurfaceOptions, RoadSurfaceReport};
+use crate::map::MapRoad;
+
+/// The shortest cut of a ribbon end at a junction, in half-widths: keeps the node strictly
+/// inside its junction polygon.
+pub const MIN_TRIM_HALF_WIDTHS: f64 = 0.05;
+
+/// Relative slack on the miter limit, so a turn exactly at the limit (120° for
+/// [`MITER_LIMIT`] = 2) keeps its miter despite rounding.
+const MITER_SLACK: f64 = 1e-9;
+
+/// Relative distance under which a cut and a corner count as the same point (the corner
+/// then is the cut's vertex, so the polygon has no sliver edge).
+const SNAP: f64 = 1e-9;
+
+/// Relative sine under which two vertices of a junction seen from its node lie on one ray.
+const COLLINEAR: f64 = 1e-9;
+
+/// A road segment of the plan: one piece of a road's centre line between two nodes.
+#[derive(Debug, Clone)]
+pub(crate) struct PlanEdge {
+    /// The road (index into the input) it belongs to.
+    pub road: usize,
+    /// Its nodes.
+    pub a: usize,
+    pub b: usize,
+    /// Length of the road's centre line before `a`, metres.
+    pub s_a: f64,
+    /// Length of the segment, metres.
+    pub len: f64,
+    /// Half the road's width, metres.
+    pub half: f64,
+    /// The ribbon's cut at `a`: its right and left corner (seen going from `a` to `b`).
+    pub cut_a: [DVec2; 2],
+    /// The ribbon's cut at `b`: its right and left corner (seen going from `a` to `b`).
+    pub cut_b: [DVec2; 2],
+    /// Trim at each end, metres from the node along the segment.
+    pub trim: [f64; 2],
+    /// Dropped as a duplicate of another segment between the same nodes.
+    pub dropped: bool,
+}
+
+/// A node of the plan.
+#[derive(Debug, Clone)]
+pub(crate) struct PlanNode {
+    /// Its position.
+    pub pos: DVec2,
+    /// Incident kept segments: (edge, whether the edge starts here), counter-clockwise.
+    pub ends: Vec<(usize, bool)>,
+}
+
+/// A junction polygon (or dead-end cap), counter-clockwise, and its triangles.
+#[derive(Debug, Clone)]
+pub(crate) struct Junction {
+    /// The node.
+    pub node: usize,
+    /// The ring.
+    pub ring: Vec<DVec2>,
+    /// Triangles as indices into `ring`, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The whole plan.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Plan {
+    pub nodes: Vec<PlanNode>,
+    pub edges: Vec<PlanEdge>,
+    pub junctions: Vec<Junction>,
+    pub report: RoadSurfaceReport,
+}
+
+/// The left unit normal of the direction `d`.
+pub(crate) fn left(d: DVec2) -> DVec2 {
+    DVec2::new(-d.y, d.x)
+}
+
+/// An exact key for a point (−0 and +0 are the same point).
+fn key(p: DVec2) -> (u64, u64) {
+    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+}
+
+/// One incident segment seen from its node.
+#[derive(Debug, Clone, Copy)]
+struct End {
+    edge: usize,
+    starts: bool,
+    /// The other end's position.
+    far: DVec2,
+    /// Unit direction away from the node.
+    d: DVec2,
+    /// Half-width.
+    w: f64,
+}
+
+impl End {
+    fn n(&self) -> DVec2 {
+        left(self.d)
+    }
+}
+
+/// The kind of the gap between two consecutive roads at a node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Gap {
+    /// Narrower than a half-turn: the borders meet at `c + t·dᵢ + wᵢ·nᵢ` (`s` along `dⱼ`),
+    /// both ahead of the node.
+    Convex { t: f64, s: f64 },
+    /// Narrower than a half-turn, but `i` is so much wider that the borders would meet
+    /// behind the node on `i`'s side (`i_wide`), or the reverse: the narrow road's border
+    /// meets the wide road's end line (through the node) at `s0` along the narrow road.
+    Wide { i_wide: bool, s0: f64 },
+    /// Exactly a half-turn.
+    Straight,
+    /// Wider than a half-turn; the borders' crossing if they are not parallel.
+    Reflex { ts: Option<(f64, f64)> },
+    /// The two roads leave in the same direction (overlapping segments).
+    Same,
+}
+
+/// Where the left border of `i` (offset `wᵢ`) meets the right border of `j` (offset `wⱼ`):
+/// distances along `dᵢ` and `dⱼ`. `None` when parallel.
+///
+/// `wⱼ + wᵢ·cos θ` is evaluated as `wⱼ·(1 + cos θ) + (wᵢ − wⱼ)·cos θ` with
+/// `1 + cos θ = |dᵢ + dⱼ|² / 2`, which stays accurate for nearly opposite roads (a road
+/// that bends a little), where `1 + cos θ` alone would cancel.
+fn border_crossing(i: &End, j: &End) -> Option<(f64, f64)> {
+    let sin = i.d.perp_dot(j.d);
+    if sin == 0.0 {
+        return None;
+    }
+    let cos = i.d.dot(j.d);
+    let one_plus_cos = (i.d + j.d).length_squared() / 2.0;
+    let t = (j.w * one_plus_cos + (i.w - j.w) * cos) / sin;
+    let s = (i.w * one_plus_cos + (j.w - i.w) * cos) / sin;
+    (t.is_finite() && s.is_finite()).then_some((t, s))
+}
+
+fn classify(c: DVec2, i: &End, j: &End) -> Gap {
+    match orient2d(c, i.far, j.far) {
+        // Exactly a left turn, but parallel (or turned back) in floating point: straight.
+        Orientation::CounterClockwise if i.d.perp_dot(j.d) <= 0.0 => Gap::Straight,
+        Orientation::CounterClockwise => match border_crossing(i, j) {
+            Some((t, s)) if t >= 0.0 && s >= 0.0 => Gap::Convex { t, s },
+            Some((t, _)) => {
+                // cos θ < 0 here (t or s negative needs an obtuse gap): the narrow road's
+                // border crosses the wide one's end line at w·sin θ / (−cos θ).
+                let (sin, cos) = (i.d.perp_dot(j.d), i.d.dot(j.d));
+                let i_wide = t < 0.0;
+                let w = if i_wide { j.w } else { i.w };
+                let s0 = (w * sin / -cos).max(0.0);
+                if s0.is_finite() {
+                    Gap::Wide { i_wide, s0 }
+                } else {
+                    Gap::Same
+                }
+            }
+            None => Gap::Same,
+        },
+        Orientation::Clockwise => Gap::Reflex {
+            ts: border_crossing(i, j),
+        },
+        Orientation::Collinear => {
+            if (i.far - c).dot(j.far - c) < 0.0 {
+                Gap::Straight
+            } else {
+                Gap::Same
+            }
+        }
+    }
+}
+
+/// Builds the plan: segments, trims, cuts and junction polygons.
+pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
+    let mut p = Plan::default();
+    let mut index: BTreeMap<(u64, u64), usize> = BTreeMap::new();
+    let mut node = |nodes: &mut Vec<PlanNode>, q: DVec2| -> usize {
+        *index.entry(key(q)).or_insert_with(|| {
+            nodes.push(PlanNode {
+                pos: q,
+                ends: Vec::new(),
+            });
+            nodes.len() - 1
+        })
+    };
+    let mut pair: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    for (r, road) in roads.iter().enumerate() {
+        let half = road.width_m / 2.0;
+        if half.is_nan() || half <= 0.0 {
+            continue;
+        }
+        let mut s = 0.0;
+        let mut prev: Option<DVec2> = None;
+        for &q in &road.points {
+            let Some(a) = prev.filter(|&a| a != q) else {
+                prev = Some(q);
+                continue;
+            };
+            let len = (q - a).length();
+            let (na, nb) = (node(&mut p.nodes, a), node(&mut p.nodes, q));
+            let e = p.edges.len();
+            p.edges.push(PlanEdge {
+                road: r,
+                a: na,
+                b: nb,
+                s_a: s,
+                len,
+                half,
+                cut_a: [a; 2],
+                cut_b: [q; 2],
+                trim: [0.0; 2],
+                dropped: false,
+            });
+            // Two segments between the same nodes: keep the wider one.
+            let k = (na.min(nb), na.max(nb));
+            match pair.get(&k) {
+                Some(&other) if p.edges[other].half >= half => p.edges[e].dropped = true,
+                Some(&other) => {
+                    p.edges[other].dropped = true;
+                    pair.insert(k, e);
+                }
+                None => {
+                    pair.insert(k, e);
+                }
+            }
+            s += len;
+            prev = Some(q);
+        }
+    }
+    p.report.duplicate_segments = p.edges.iter().filter(|e| e.dropped).count();
+    for (e, edge) in p.edges.iter().enumerate() {
+        if !edge.dropped {
+            p.nodes[edge.a].ends.push((e, true));
+            p.nodes[edge.b].ends.push((e, false));
+        }
+    }
+    let ends: Vec<Vec<End>> = p
+        .nodes
+        .iter_mut()
+        .map(|n| sorted_ends(n, &p.edges))
+        .collect();
+    // Pass 1: the trim each junction wants.
+    let mut gaps: Vec<Vec<Gap>> = Vec::with_capacity(ends.len());
+    for (v, es) in ends.iter().enumerate() {
+        let c = p.nodes[v].pos;
+        let k = es.len();
+        let g: Vec<Gap> = if k >= 2 {
+            (0..k)
+                .map(|i| classify(c, &es[i], &es[(i + 1) % k]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        if !is_straight(&g) {
+            for (i, gap) in g.iter().enumerate() {
+                let j = (i + 1) % k;
+                match *gap {
+                    Gap::Convex { t, s } => {
+                        want_trim(&mut p.edges, &es[i], t);
+                        want_trim(&mut p.edges, &es[j], s);
+                    }
+                    Gap::Wide { i_wide: true, s0 } => want_trim(&mut p.edges, &es[j], s0),
+                    Gap::Wide { i_wide: false, s0 } => want_trim(&mut p.edges, &es[i], s0),
+                    _ => {}
+                }
+            }
+            if k >= 2 {
+                for end in es {
+                    want_trim(&mut p.edges, end, MIN_TRIM_HALF_WIDTHS * end.w);
+                }
+            }
+        }
+        gaps.push(g);
+    }
+    // Pass 2: a segment too short for both trims is shared in proportion.
+    for e in p.edges.iter_mut().filter(|e| !e.dropped) {
+        let sum = e.trim[0] + e.trim[1];
+        if sum > e.len {
+            let f = e.len / sum;
+            e.trim = [e.trim[0] * f, e.trim[1] * f];
+            p.report.clamped_segments += 1;
+        }
+    }
+    // Pass 3: cuts and polygons.
+    for (v, es) in ends.iter().enumerate() {
+        let c = p.nodes[v].pos;
+        let ring = match es.len() {
+            0 => continue,
+            1 => dead_end(c, &es[0], &mut p.edges, o.end_cap),
+            _ if is_straight(&gaps[v]) => {
+                for end in es {
+                    set_cut(&mut p.edges, end, cut(c, end, 0.0));
+                }
+                continue;
+            }
+            _ => junction(c, es, &gaps[v], &mut p.edges, &mut p.report),
+        };
+        let Some(ring) = ring else { continue };
+        match triangulate(&PolygonWithHoles::new(
+            Polygon::new(ring.clone()),
+            Vec::new(),
+        )) {
+            Ok(triangles) if !triangles.is_empty() => p.junctions.push(Junction {
+                node: v,
+                ring,
+                triangles,
+            }),
+            _ => p.report.skipped_junctions += 1,
+        }
+    }
+    p.report.junctions = p.junctions.len();
+    p
+}
+
+/// Whether the gaps are those of a node where one road simply continues (two roads,
+/// exactly opposite): no junction polygon, the ribbons meet at a square cut.
+fn is_straight(gaps: &[Gap]) -> bool {
+    gaps.len() == 2 && gaps.iter().all(|g| *g == Gap::Straight)
+}
+
+fn sorted_ends(n: &mut PlanNode, edges: &[PlanEdge]) -> Vec<End> {
+    let c = n.pos;
+    let mut es: Vec<End> = n
+        .ends
+        .iter()
+        .map(|&(edge, starts)| {
+            let e = &edges[edge];
+            let far = if starts { e.cut_b[0] } else { e.cut_a[0] };
+            End {
+                edge,
+                starts,
+                far,
+                d: (far - c) / e.len,
+                w: e.half,
+            }
+        })
+        .collect();
+    // Stable: equal directions (overlapping segments) keep the input order.
+    es.sort_by(|x, y| ccw_cmp(c, x.far, y.far, AngleStart::East));
+    n.ends = es.iter().map(|e| (e.edge, e.starts)).collect();
+    es
+}
+
+fn slot(end: &End) -> usize {
+    usize::from(!end.starts)
+}
+
+fn want_trim(edges: &mut [PlanEdge], end: &End, t: f64) {
+    let tr = &mut edges[end.edge].trim[slot(end)];
+    if t > *tr {
+        *tr = t;
+    }
+}
+
+fn trim_of(edges: &[PlanEdge], end: &End) -> f64 {
+    edges[end.edge].trim[slot(end)]
+}
+
+/// The cut of `end` at distance `t`: its right and left corner seen from the node.
+fn cut(c: DVec2, end: &End, t: f64) -> [DVec2; 2] {
+    let m = c + end.d * t;
+    let n = end.n() * end.w;
+    [m - n, m + n]
+}
+
+/// Stores a cut given as seen from the node: the ribbon's corners seen from `a` to `b` are
+/// the same at `a` and swapped at `b`.
+fn set_cut(edges: &mut [PlanEdge], end: &End, [r, l]: [DVec2; 2]) {
+    let e = &mut edges[end.edge];
+    if end.starts {
+        e.cut_a = [r, l];
+    } else {
+        e.cut_b = [l, r];
+    }
+}
+
+fn dead_end(c: DVec2, end: &End, edges: &mut [PlanEdge], cap: EndCap) -> Option<Vec<DVec2>> {
+    let [r, l] = cut(c, end, 0.0);
+    set_cut(edges, end, [r, l]);
+    let (n, back) = (end.n() * end.w, -end.d * end.w);
+    let mut ring = vec![r, l];
+    match cap {
+        EndCap::Flat => return None,
+        EndCap::Square => ring.extend([l + back, r + back]),
+        EndCap::Round { segments } => {
+            let m = segments.max(2);
+            for k in 1..m {
+                let phi = std::f64::consts::PI * f64::from(k) / f64::from(m);
+                ring.push(c + n * phi.cos() + back * phi.sin());
+            }
+        }
+    }
+    Some(ring)
+}
+
+fn junction(
+    c: DVec2,
+    es: &[End],
+    gaps: &[Gap],
+    edges: &mut [PlanEdge],
+    report: &mut RoadSurfaceReport,
+) -> Option<Vec<DVec2>> {
+    let k = es.len();
+    let trims: Vec<f64> = es.iter().map(|e| trim_of(edges, e)).collect();
+    let mut cuts: Vec<[DVec2; 2]> = es.iter().zip(&trims).map(|(e, &t)| cut(c, e, t)).collect();
+    let mut extra: Vec<Vec<DVec2>> = vec![Vec::new(); k];
+    let mut clean = true;
+    for i in 0..k {
+        let j = (i + 1) % k;
+        let (ei, ej) = (&es[i], &es[j]);
+        let bevel = || vec![c + ei.n() * ei.w, c - ej.n() * ej.w];
+        match gaps[i] {
+            Gap::Convex { t, s } => {
+                let tol = SNAP * (ei.w + ej.w + t + s);
+                if t <= trims[i] + tol && s <= trims[j] + tol {
+                    let corner = c + ei.d * t + ei.n() * ei.w;
+                    match (trims[i] - t <= tol, trims[j] - s <= tol) {
+                        (true, true) => cuts[j][0] = cuts[i][1],
+                        (true, false) => {}
+                        (false, true) => cuts[j][0] = corner,
+                        (false, false) => extra[i].push(corner),
+                    }
+                } else {
+                    // Trims clamped by a short segment: the corner lies beyond a cut.
+                    report.clamped_corners += 1;
+                }
+            }
+            Gap::Wide { i_wide, s0 } => {
+                // Along the wide road's end line to the narrow road's border, then out.
+                let (wide, narrow, tn) = if i_wide {
+                    (ei, ej, trims[j])
+                } else {
+                    (ej, ei, trims[i])
+                };
+                let end = if i_wide {
+                    c + ei.n() * ei.w
+                } else {
+                    c - ej.n() * ej.w
+                };
+                let side = if i_wide { -1.0 } else { 1.0 };
+                let meet = c + narrow.d * s0 + narrow.n() * (side * narrow.w);
+                let tol = SNAP * (wide.w + narrow.w + s0);
+                if s0 > tn + tol {
+                    report.clamped_corners += 1;
+                    extra[i].push(end);
+                } else if i_wide {
+                    extra[i].push(end);
+                    if tn - s0 <= tol {
+                        cuts[j][0] = meet;
+                    } else {
+                        extra[i].push(meet);
+                    }
+                } else {
+                    if tn - s0 <= tol {
+                        cuts[i][1] = meet;
+                    } else {
+                        extra[i].push(meet);
+                    }
+                    extra[i].push(end);
+                }
+            }
+            Gap::Straight => extra[i] = bevel(),
+            Gap::Reflex { ts } => {
+                let miter = ts.and_then(|(t, s)| {
+                    let q = c + ei.d * t + ei.n() * ei.w;
+                    let limit = MITER_LIMIT * ei.w.max(ej.w) * (1.0 + MITER_SLACK);
+                    (t <= trims[i] && s <= trims[j] && (q - c).length() <= limit).then_some(q)
+                });
+                extra[i] = match miter {
+                    Some(q) => vec![q],
+                    None => bevel(),
+                };
+            }
+            Gap::Same => clean = false,
+        }
+    }
+    let mut ring: Vec<DVec2> = Vec::with_capacity(4 * k);
+    for i in 0..k {
+        ring.extend(cuts[i]);
+        ring.extend(&extra[i]);
+    }
+    dedup_ring(&mut ring);
+    for (e, cut) in es.iter().zip(&cuts) {
+        set_cut(edges, e, *cut);
+    }
+    if clean && star_shaped(c, &ring) {
+        return Some(ring);
+    }
+    // Overlapping or clamped roads: the convex hull of every corner covers the junction.
+    report.approximated_junctions += 1;
+    let hull = convex_hull(ring);
+    (hull.len() >= 3).then_some(hull)
+}
+
+/// Drops consecutive repeated points (and a closing repeat).
+fn dedup_ring(ring: &mut Vec<DVec2>) {
+    ring.dedup();
+    while ring.len() > 1 && ring.first() == ring.last() {
+        ring.pop();
+    }
+}
+
+/// Whether every vertex sees the next counter-clockwise from `c` (turning less than a
+/// half-turn; decided exactly) and the ring winds once around `c`: then the ring is simple
+/// and star-shaped from `c`.
+pub(crate) fn star_shaped(c: DVec2, ring: &[DVec2]) -> bool {
+    if ring.len() < 3 {
+        return false;
+    }
+    // Each step turns by less than a half-turn, so the sum of the turns (within rounding)
+    // tells one winding from none or two.
+    let mut turned = 0.0;
+    for (k, &a) in ring.iter().enumerate() {
+        let b = ring[(k + 1) % ring.len()];
+        if a == c || b == c {
+            return false;
+        }
+        let (da, db) = (a - c, b - c);
+        if orient2d(c, a, b) != Orientation::CounterClockwise {
+            // Two points on one ray from `c` (a step along a road's end line, computed
+            // points off the ray by rounding) are allowed; anything turning back is not.
+            let along = da.dot(db) > 0.0
+                && orient2d_value(c, a, b).abs() <= COLLINEAR * da.length() * db.length();
+            if !along {
+                return false;
+            }
+        }
+        turned += da.perp_dot(db).atan2(da.dot(db));
+    }
+    (turned - std::f64::consts::TAU).abs() < 1e-6
+}
+
+/// The convex hull, counter-clockwise, without collinear points (Andrew's monotone chain
+/// on exact orientations).
+pub(crate) fn convex_hull(mut pts: Vec<DVec2>) -> Vec<DVec2> {
+    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    let mut hull: Vec<DVec2> = Vec::with_capacity(pts.len() + 1);
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 {
+            Box::new(pts.iter())
+        } else {
+            Box::new(pts.iter().rev())
+        };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && orient2d(hull[hull.len() - 2], hull[hull.len() - 1], q)
+                    != Orientation::CounterClockwise
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
