@@ -27,6 +27,7 @@ use std::collections::BinaryHeap;
 
 use polis_geom::DVec2;
 
+use super::candidates::{Bounds, Candidate, CandidateBatch, Query, SplitLines};
 use super::wavefront::{EdgeLine, Motion, Vertex, angle_cmp, is_reflex, meet, motion};
 use super::{SkeletonArc, SkeletonNode};
 use crate::LotsError;
@@ -72,38 +73,6 @@ impl Ord for Event {
     }
 }
 
-/// A potential split: the time a vertex reaches the supporting line of an input edge.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Candidate {
-    t: f64,
-    edge: u32,
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Candidate {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.t.total_cmp(&other.t).then(self.edge.cmp(&other.edge))
-    }
-}
-
-/// How many split candidates of one vertex are kept at a time; the next batch is computed
-/// only if all of these turn out not to be real hits.
-const CANDIDATE_BATCH: usize = 12;
-
-/// The next few split candidates of one vertex, sorted.
-#[derive(Debug, Clone, Copy, Default)]
-struct CandidateBatch {
-    items: [Candidate; CANDIDATE_BATCH],
-    len: u8,
-    next: u8,
-    /// Whether these are all the candidates there are.
-    complete: bool,
-}
-
 /// One incoming or outgoing wavefront edge at a collapse point.
 #[derive(Debug, Clone, Copy)]
 struct Ray {
@@ -126,15 +95,10 @@ pub(crate) struct Engine {
     pub arcs: Vec<SkeletonArc>,
     queue: BinaryHeap<Reverse<Event>>,
     candidates: Vec<CandidateBatch>,
-    /// Per input edge, structure of arrays: unit normal x, y, offset `n · a`, weight.
-    line_nx: Vec<f64>,
-    line_ny: Vec<f64>,
-    line_c: Vec<f64>,
-    line_w: Vec<f64>,
+    /// The supporting lines of all edges, for split candidates.
+    pub(crate) lines: SplitLines,
     /// For each virtual step edge (after the input edges): the input edges it joins.
     step_pairs: Vec<(u32, u32)>,
-    /// Scratch: hit time of the vertex being scanned on every edge line.
-    hit_times: Vec<f64>,
     /// For each input edge, vertices that started a wavefront piece of it.
     pieces: Vec<Vec<u32>>,
     mark: Vec<u32>,
@@ -165,10 +129,7 @@ impl Engine {
         self.queue.clear();
         self.candidates.clear();
         self.step_pairs.clear();
-        self.line_nx.clear();
-        self.line_ny.clear();
-        self.line_c.clear();
-        self.line_w.clear();
+        self.lines.clear();
         self.pieces.clear();
         self.mark.clear();
         self.stamp = 0;
@@ -229,11 +190,10 @@ impl Engine {
         self.candidates
             .resize(self.verts.len(), CandidateBatch::default());
         for e in &self.edges {
-            self.line_nx.push(e.normal.x);
-            self.line_ny.push(e.normal.y);
-            self.line_c.push(e.normal.dot(e.a));
-            self.line_w.push(e.weight);
+            self.lines.push(e);
         }
+        let bounds = self.bounds();
+        self.lines.build_index(&self.edges, &bounds);
         self.mark.resize(self.verts.len(), 0);
         for v in 0..self.verts.len() as u32 {
             let ein = &self.edges[self.verts[v as usize].in_edge as usize];
@@ -277,10 +237,7 @@ impl Engine {
         let p = x.p0;
         let step = EdgeLine::new(p, p + dir, 0.0);
         self.edges.push(step);
-        self.line_nx.push(step.normal.x);
-        self.line_ny.push(step.normal.y);
-        self.line_c.push(step.normal.dot(step.a));
-        self.line_w.push(0.0);
+        self.lines.push(&step);
         self.pieces.push(Vec::new());
         self.step_pairs.push((x.in_edge, x.out_edge));
         let s = (self.edges.len() - 1) as u32;
@@ -530,84 +487,28 @@ impl Engine {
         self.push_next_candidate(v);
     }
 
-    /// The `CANDIDATE_BATCH` earliest hits of vertex `x` on input edge lines after `after`
-    /// (in the order time, then edge).
+    /// The `CANDIDATE_BATCH` earliest hits of vertex `x` on edge lines after `after` (in
+    /// the order time, then edge).
     fn scan_candidates(&mut self, x: &Vertex, after: Option<Candidate>) -> CandidateBatch {
-        let mut batch = CandidateBatch::default();
-        let vel = x.velocity();
-        let (px, py) = (x.p0.x, x.p0.y);
-        // First pass, branch-free so that it vectorises: the time the vertex reaches each
-        // edge line (infinite if it never does, or if it is already behind the line).
-        let mut times = std::mem::take(&mut self.hit_times);
-        let m = self.line_nx.len();
-        times.clear();
-        times.resize(m, f64::INFINITY);
-        let (nxs, nys, cs, ws) = (
-            &self.line_nx[..m],
-            &self.line_ny[..m],
-            &self.line_c[..m],
-            &self.line_w[..m],
-        );
-        let (t0, eps) = (x.t0, self.eps);
-        for (i, slot) in times.iter_mut().enumerate() {
-            let slope = nxs[i] * vel.x + nys[i] * vel.y - ws[i];
-            let ahead = nxs[i] * px + nys[i] * py - cs[i] - ws[i] * t0;
-            let t = t0 - ahead.max(0.0) / slope;
-            *slot = if slope < 0.0 && ahead >= -eps {
-                t
-            } else {
-                f64::INFINITY
-            };
+        let q = Query {
+            p0: x.p0,
+            t0: x.t0,
+            vel: x.velocity(),
+            in_edge: x.in_edge,
+            out_edge: x.out_edge,
+            after,
+        };
+        let bounds = self.bounds();
+        self.lines.batch(&q, &bounds)
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            horizon: self.horizon,
+            eps: self.eps,
+            bbox_min: self.bbox_min,
+            bbox_max: self.bbox_max,
         }
-        // Second pass: the few that can enter the batch. Candidates later than `limit`
-        // (the horizon, then the batch's last entry once it is full) cannot.
-        let mut limit = self.horizon;
-        for (i, &t) in times.iter().enumerate() {
-            if t.is_nan() || t > limit {
-                continue;
-            }
-            let i = i as u32;
-            if i == x.in_edge || i == x.out_edge {
-                continue;
-            }
-            let cand = Candidate { t, edge: i };
-            if after.is_some_and(|a| cand <= a) {
-                continue;
-            }
-            let full = batch.len as usize == CANDIDATE_BATCH;
-            if full && cand >= batch.items[CANDIDATE_BATCH - 1] {
-                continue;
-            }
-            let p = x.p0 + vel * (t - x.t0);
-            if p.x < self.bbox_min.x
-                || p.y < self.bbox_min.y
-                || p.x > self.bbox_max.x
-                || p.y > self.bbox_max.y
-            {
-                continue;
-            }
-            // Insertion into the sorted batch, dropping the largest when full.
-            let mut k = if full {
-                CANDIDATE_BATCH - 1
-            } else {
-                batch.len as usize
-            };
-            while k > 0 && batch.items[k - 1] > cand {
-                batch.items[k] = batch.items[k - 1];
-                k -= 1;
-            }
-            batch.items[k] = cand;
-            if !full {
-                batch.len += 1;
-            }
-            if batch.len as usize == CANDIDATE_BATCH {
-                limit = batch.items[CANDIDATE_BATCH - 1].t;
-            }
-        }
-        // A batch that is not full holds every candidate there is.
-        batch.complete = (batch.len as usize) < CANDIDATE_BATCH;
-        self.hit_times = times;
-        batch
     }
 
     fn push_next_candidate(&mut self, v: u32) {

@@ -15,8 +15,10 @@
 //!   input edge `e` whose face it bounds (up to rounding).
 //! * The faces tile the polygon: their areas add up to the polygon's area (up to rounding),
 //!   and face `e` is a counter-clockwise polygon that starts with input edge `e`.
-//! * Split events are never skipped: a reflex vertex is tested against every input edge,
-//!   and a hit is confirmed against the wavefront as it is at the moment of the hit.
+//! * Split events are never skipped: every edge line a reflex vertex can reach is a
+//!   candidate (found by a scan or an index that give the same candidates, see
+//!   `candidates`), and a hit is confirmed against the wavefront as it is at the moment
+//!   of the hit.
 //!
 //! # Limitations
 //!
@@ -41,6 +43,7 @@
 //! Eppstein, Erickson, *Raising Roofs, Crashing Cycles, and Playing Pool* (DCG 1999) for
 //! weighted skeletons; Kelly 2008 §4.4.1.1 and §4.4.3.1.
 
+mod candidates;
 pub(crate) mod events;
 pub(crate) mod wavefront;
 
