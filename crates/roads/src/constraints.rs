@@ -180,7 +180,59 @@ impl DefaultConstraints {
     }
 }
 
+impl DefaultConstraints {
+    /// Kelly's snap of `a → end` for a road of `class` leaving `start_node`: `Ok(None)`
+    /// when nothing is near, `Ok(Some(event))` for an event meeting the minimum angle,
+    /// `Err(())` for one below it.
+    fn snap_event(
+        &self,
+        net: &RoadNetwork,
+        start_node: Option<NodeId>,
+        a: DVec2,
+        end: DVec2,
+        class: RoadClass,
+    ) -> Result<Option<SnapEvent>, ()> {
+        let q = SnapQuery {
+            a,
+            b: end,
+            radius: self.params.snap_radius_m,
+            start_node,
+            only: match class {
+                RoadClass::Highway => Some(RoadClass::Highway),
+                RoadClass::Street => None,
+            },
+        };
+        let Some(ev) = snap(net, &q) else {
+            return Ok(None);
+        };
+        let ok = match ev {
+            SnapEvent::Junction { node, .. } => self.angle_ok_at(net, node, a),
+            SnapEvent::Cross { edge, .. } | SnapEvent::Road { edge, .. } => {
+                self.angle_ok_edge(net, edge, a, ev.point())
+            }
+        };
+        if ok { Ok(Some(ev)) } else { Err(()) }
+    }
+
+    fn count_snap(&mut self, ev: &SnapEvent) {
+        match ev {
+            SnapEvent::Junction { .. } => self.stats.junction_snaps += 1,
+            SnapEvent::Cross { .. } => self.stats.crossings += 1,
+            SnapEvent::Road { .. } => self.stats.road_snaps += 1,
+        }
+    }
+}
+
 impl LocalConstraints for DefaultConstraints {
+    /// §3.3's two steps. Step 1 makes the proposal legal (prune, bridge, rotate), step 2
+    /// applies the self-sensitive rules (snap to a crossing, junction or road, minimum
+    /// angles), and a snapped road is checked for legality again.
+    ///
+    /// When the proposal as given, snapped, is already a legal road, the result of the two
+    /// steps is that road, and it is taken straight away: one legality walk instead of
+    /// two. (If the proposal itself was illegal, step 1 would have pruned or rotated it
+    /// first; taking the legal snapped road instead connects to the network where the
+    /// two-step order would stop short of it.)
     fn adjust(&mut self, road: &mut RoadAttr, net: &RoadNetwork) -> QueryState {
         self.stats.proposals += 1;
         let a = road.start;
@@ -192,59 +244,67 @@ impl LocalConstraints for DefaultConstraints {
             self.stats.failed_illegal += 1;
             return QueryState::Failed;
         }
-        let p = self.params.clone();
+        let min_len = self.params.min_segment_length_m.max(1e-3);
+        let start_node = net.nearest_node(a, SAME_POINT_M).map(|(n, _)| n);
+        let proposed = a + dir(road.angle) * road.length;
+        // The proposal as given, snapped: taken when that road is legal.
+        let first = self.snap_event(net, start_node, a, proposed, road.class);
+        if let Ok(Some(ev)) = first {
+            let end = ev.point();
+            let len = a.distance(end);
+            let start_ok = start_node.is_none_or(|s| self.angle_ok_at(net, s, proposed));
+            if start_ok && len >= min_len && self.legality.segment_ok(a, end) {
+                self.count_snap(&ev);
+                road.end = end;
+                road.angle = angle_of(end - a);
+                road.length = len;
+                road.bridge = false;
+                road.snapped = true;
+                return QueryState::Succeed;
+            }
+        }
+        // Step 1: legality.
         let Some((mut end, angle, bridge)) =
             self.make_legal(a, road.angle, road.length, road.class)
         else {
             return QueryState::Failed;
         };
-        let start_node = net.nearest_node(a, SAME_POINT_M).map(|(n, _)| n);
         if let Some(s) = start_node
             && !self.angle_ok_at(net, s, end)
         {
             self.stats.failed_angle += 1;
             return QueryState::Failed;
         }
-        let q = SnapQuery {
-            a,
-            b: end,
-            radius: p.snap_radius_m,
-            start_node,
-            only: match road.class {
-                RoadClass::Highway => Some(RoadClass::Highway),
-                RoadClass::Street => None,
-            },
+        // Step 2: self-sensitivity (the snap of the unchanged proposal is known already).
+        let event = if end == proposed {
+            first
+        } else {
+            self.snap_event(net, start_node, a, end, road.class)
         };
         let mut snapped = false;
-        if let Some(ev) = snap(net, &q) {
-            let ok = match ev {
-                SnapEvent::Junction { node, .. } => self.angle_ok_at(net, node, a),
-                SnapEvent::Cross { edge, .. } | SnapEvent::Road { edge, .. } => {
-                    self.angle_ok_edge(net, edge, a, ev.point())
-                }
-            };
-            if !ok {
+        match event {
+            Err(()) => {
                 self.stats.failed_angle += 1;
                 return QueryState::Failed;
             }
-            match ev {
-                SnapEvent::Junction { .. } => self.stats.junction_snaps += 1,
-                SnapEvent::Cross { .. } => self.stats.crossings += 1,
-                SnapEvent::Road { .. } => self.stats.road_snaps += 1,
+            Ok(Some(ev)) => {
+                self.count_snap(&ev);
+                end = ev.point();
+                snapped = true;
             }
-            end = ev.point();
-            snapped = true;
+            Ok(None) => {}
         }
         let len = a.distance(end);
-        if len.is_nan() || len < p.min_segment_length_m.max(1e-3) {
+        if len.is_nan() || len < min_len {
             self.stats.failed_short += 1;
             return QueryState::Failed;
         }
+        let max_bridge = self.params.max_bridge_length_m;
         // A bridge cut short before the water is an ordinary road.
         let bridge = bridge && !(snapped && self.legality.segment_ok(a, end));
         if snapped {
             let legal = if bridge {
-                len <= p.max_bridge_length_m + 1e-9
+                len <= max_bridge + 1e-9
                     && (self.legality.bridgeable(a, end)
                         || self.legality.point(end) == Some(Illegal::Water))
             } else {

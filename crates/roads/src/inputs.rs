@@ -13,15 +13,16 @@ use crate::params::{Pattern, RoadParams};
 const COAST_THRESHOLD: f64 = 0.72;
 
 /// The lattice spacing of [`RoadInputs::procedural`]'s coastline and hills for `params`'
-/// map: 20 m, or coarser for maps over 40 km across so that each lattice's cache stays
+/// map: 40 m (the finest noise octave, 190–225 m across, gets five lattice points per
+/// wavelength), or coarser for maps over 80 km across so that each lattice's cache stays
 /// within about 2,000 × 2,000 points (16 MiB).
 pub fn procedural_lattice_m(params: &RoadParams) -> f64 {
     let b = params.bounds();
     let widest = b.width().max(b.height());
     if widest.is_finite() {
-        (widest / 2000.0).max(20.0)
+        (widest / 2000.0).max(40.0)
     } else {
-        20.0
+        40.0
     }
 }
 
@@ -81,12 +82,13 @@ impl RoadInputs {
     /// hills up to ~60 m, no parks. All noise is seeded from `seed`.
     ///
     /// The coastline and the hills are [`LazyLattice`] maps with
-    /// [`procedural_lattice_m`] spacing (20 m up to 40 km wide maps): the fBm is
+    /// [`procedural_lattice_m`] spacing (40 m up to 80 km wide maps): the fBm is
     /// evaluated once per lattice point, where roads are tested, and interpolated
     /// bilinearly between (water is where the interpolated coast value exceeds the
-    /// threshold). The network is grown and tested on exactly these maps; the finest noise
-    /// octave is ~190 m across, so against the raw fBm the lattice moves the coast by at
-    /// most about 1.5 m and the hills by about 0.3 m (tested). [`RoadInputs::procedural_with_lattice`] with
+    /// threshold). The network is grown and tested on exactly these maps. The finest noise
+    /// octave is 190–225 m across (five lattice points per wavelength), so against the raw
+    /// fBm the lattice moves the coastline by at most about 9 m and the hills by about
+    /// 1 m (tested) — detail far below the 90–240 m road segments. [`RoadInputs::procedural_with_lattice`] with
     /// `None` gives the raw fBm maps.
     ///
     /// # Errors
@@ -194,7 +196,7 @@ mod tests {
     fn the_lattice_maps_stay_close_to_the_raw_fbm_maps() {
         let params = RoadParams::default();
         let s = procedural_lattice_m(&params);
-        assert_eq!(s, 20.0);
+        assert_eq!(s, 40.0);
         let lat = RoadInputs::procedural(params.seed, &params).unwrap();
         let raw = RoadInputs::procedural_with_lattice(params.seed, &params, None).unwrap();
         let b = params.bounds();
@@ -207,16 +209,16 @@ mod tests {
                 water += usize::from(w == 1.0);
                 if w != raw.water.sample(p) {
                     differ += 1;
-                    // Wherever they disagree, the raw coastline is within 2 m (1.45 m
-                    // measured for this seed).
-                    let d = distance_to_shore(raw.water.as_ref(), p, 5.0);
+                    // Wherever they disagree, the raw coastline is near: within 12 m
+                    // (8.6 m measured for this seed, against 40 m lattice cells).
+                    let d = distance_to_shore(raw.water.as_ref(), p, 50.0);
                     worst = worst.max(d);
-                    assert!(d <= 2.0, "{p}: {d} m from the fBm coast");
+                    assert!(d <= 12.0, "{p}: {d} m from the fBm coast");
                 }
-                // Elevation (0–60 m): within half a metre (0.26 m measured).
+                // Elevation (0–60 m): within 1.5 m (1.09 m measured).
                 let (he, hr) = (lat.elevation.sample(p), raw.elevation.sample(p));
                 worst_h = worst_h.max((he - hr).abs());
-                assert!((he - hr).abs() < 0.5, "{p}: {he} vs {hr}");
+                assert!((he - hr).abs() < 1.5, "{p}: {he} vs {hr}");
             }
         }
         assert!(

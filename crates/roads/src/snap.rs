@@ -12,6 +12,7 @@
 //!   have the lowest priority, runs only when the first two found nothing.
 
 use polis_geom::predicates::closest_point_on_segment;
+use polis_geom::spatial::{Shape, SpatialIndex};
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
 
 use crate::network::{RoadClass, RoadNetwork};
@@ -123,13 +124,19 @@ pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
     let mut best: Option<SnapEvent> = None;
     // Above this r nothing can win any more (Kelly's benchmark).
     let mut best_r = 1.0 + radius / len;
-    // Test 1: junction proximity inside the extended bounding box.
+    // Test 1: junction proximity inside the extended bounding box. The index's
+    // candidates come in no particular order: ties in r go to the smaller node id.
     let ext = Aabb2::new(a, b).expanded(radius);
-    for n in net.nodes_in_box(&ext) {
-        let Ok(p) = net.position(n) else { continue };
+    net.node_index().for_each_candidate(&ext, |n, shape| {
+        let Shape::Point(p) = *shape else { return };
+        if !ext.contains(p) {
+            return;
+        }
         let r = (p - a).dot(d) / len2;
-        if !(r > 0.0 && r < best_r) {
-            continue;
+        let better = r < best_r
+            || (r == best_r && matches!(best, Some(SnapEvent::Junction { node, .. }) if n < node));
+        if !(r > 0.0 && better) {
+            return;
         }
         let hit = if r <= 1.0 {
             // Perpendicular distance from the line (Kelly's s-value, in metres).
@@ -145,7 +152,7 @@ pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
                 r,
             });
         }
-    }
+    });
     // Test 2: road intersections before the best junction event, in order along a–b.
     for hit in net.edges_crossing(a, b) {
         if hit.t >= best_r.min(1.0 + f64::EPSILON) {
@@ -165,20 +172,21 @@ pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
     if best.is_some() {
         return best;
     }
-    // Test 3: proximity of the end b to a road.
+    // Test 3: proximity of the end b to a road (every road within the radius meets the
+    // box around b; ties in distance go to the smaller edge id).
     let around = Aabb2::new(b, b).expanded(radius);
     let mut near: Option<(f64, EdgeId, DVec2)> = None;
-    for e in net.edges_in_box(&around) {
-        if !edge_ok(net, e, q) {
-            continue;
-        }
-        let Ok((u, v)) = net.segment(e) else { continue };
+    net.edge_index().for_each_candidate(&around, |e, shape| {
+        let Shape::Segment(u, v) = *shape else { return };
         let (c, _) = closest_point_on_segment(b, u, v);
         let dist = c.distance(b);
-        if dist <= radius && near.is_none_or(|(bd, _, _)| dist < bd) {
+        if dist <= radius
+            && near.is_none_or(|(bd, be, _)| (dist, e) < (bd, be))
+            && edge_ok(net, e, q)
+        {
             near = Some((dist, e, c));
         }
-    }
+    });
     near.map(|(_, edge, point)| SnapEvent::Road { edge, point })
 }
 

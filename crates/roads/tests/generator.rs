@@ -342,3 +342,61 @@ fn blended_patterns_follow_their_weight_maps() {
         east_paris / east
     );
 }
+
+/// The lattice-cached procedural maps (issue 6's speed work): for several seeds, every
+/// non-bridge road is legal at every legality sample on the maps it was grown on (no
+/// water, park, map edge), bridges are highways within the length limit that only cross
+/// water, and against the raw (uncached) fBm maps a sample can be "in water" only within
+/// the lattice's displacement of the raw coastline.
+#[test]
+fn lattice_maps_keep_every_legality_property() {
+    for seed in 1..=3u64 {
+        let params = RoadParams {
+            seed,
+            max_segments: 1200,
+            ..RoadParams::default()
+        };
+        let inputs = RoadInputs::procedural(seed, &params).unwrap();
+        let raw = RoadInputs::procedural_with_lattice(seed, &params, None).unwrap();
+        let legality = Legality::new(&inputs, &params);
+        let raw_legality = Legality::new(&raw, &params);
+        let city = generate(&params, &inputs).unwrap();
+        city.network.check_invariants().unwrap();
+        let (mut samples, mut raw_wet) = (0usize, 0usize);
+        for (a, b, road) in edge_list(&city.network) {
+            let len = a.distance(b);
+            if road.bridge {
+                assert_eq!(road.class, RoadClass::Highway);
+                assert!(
+                    len <= params.max_bridge_length_m + 1e-6,
+                    "bridge of {len} m"
+                );
+                assert!(
+                    legality.bridgeable(a, b) || legality.bridgeable(b, a),
+                    "bridge {a}–{b} crosses more than water"
+                );
+                continue;
+            }
+            let n = (len / params.legality_step_m).ceil().max(1.0) as usize;
+            for i in 0..=n {
+                let p = a + (b - a) * (i as f64 / n as f64);
+                samples += 1;
+                assert_eq!(legality.point(p), None, "seed {seed}: road {a}–{b} at {p}");
+                if raw_legality.is_water(p) {
+                    raw_wet += 1;
+                    // Raw land within 12 m (the lattice moves the coast by ≤ ~9 m).
+                    let near_land = (0..16).any(|k| {
+                        let d = DVec2::from_angle(f64::from(k) * std::f64::consts::PI / 8.0);
+                        (1..=24).any(|s| !raw_legality.is_water(p + d * (0.5 * f64::from(s))))
+                    });
+                    assert!(near_land, "seed {seed}: {p} is deep in the raw fBm sea");
+                }
+            }
+        }
+        assert!(samples > 10_000, "{samples}");
+        assert!(
+            raw_wet * 100 <= samples,
+            "{raw_wet} of {samples} samples in raw water"
+        );
+    }
+}
