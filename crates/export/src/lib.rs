@@ -9,6 +9,7 @@
 //! | [`svg::write_svg`] | [`MapLayers`](map::MapLayers) | SVG plan: water, parks, blocks, lots, roads by class and width, footprints by kind; north up |
 //! | [`geojson::write_geojson`] | [`MapLayers`](map::MapLayers) | RFC 7946 FeatureCollection in a documented local metric coordinate system |
 //! | [`surfaces::road_surfaces`] | [`MapRoad`](map::MapRoad)s + an elevation [`Field`](geom::Field) | a [`Mesh`](geom::Mesh) of road ribbons joined by junction polygons, dead-end caps (draped, bridges spanning) to put in a scene |
+//! | [`footpaths::footpath_mesh`] | a block's footpath strip ([`PolygonWithHoles`](geom::PolygonWithHoles)) + an elevation [`Field`](geom::Field) | a kerb-high, draped, closed [`Mesh`](geom::Mesh) of the footpath |
 //!
 //! The 3-D input is `polis-geom`'s [`Scene`](geom::Scene) (what the building and facade
 //! stages produce); the 2-D input is this crate's plain [`map`] model, which anyone can
@@ -75,6 +76,7 @@ pub use gltf;
 pub use polis_geom as geom;
 
 mod error;
+pub mod footpaths;
 pub mod geojson;
 pub mod glb;
 mod images;
