@@ -192,6 +192,34 @@ pub struct FacadeReport {
     pub floors: usize,
 }
 
+/// The primary grid of a style fitted to one face (see [`PreparedStyle::layout`]).
+#[derive(Debug, Clone)]
+pub struct FacadeLayout {
+    pub(crate) spec: FacadeSpec,
+    pub(crate) columns: IntervalGroup,
+    pub(crate) rows: IntervalGroup,
+    pub(crate) report: FacadeReport,
+}
+
+impl FacadeLayout {
+    /// The spec it was fitted to.
+    pub fn spec(&self) -> &FacadeSpec {
+        &self.spec
+    }
+    /// The fitted columns.
+    pub fn columns(&self) -> &IntervalGroup {
+        &self.columns
+    }
+    /// The fitted rows.
+    pub fn rows(&self) -> &IntervalGroup {
+        &self.rows
+    }
+    /// What had to be simplified (no skipped layers: the stack is not instantiated).
+    pub fn report(&self) -> &FacadeReport {
+        &self.report
+    }
+}
+
 /// A style fitted to one face: evaluate it, rasterise it, or extract its cells.
 #[derive(Debug, Clone)]
 pub struct Facade {
@@ -240,6 +268,49 @@ impl PreparedStyle {
     /// # Errors
     /// [`FacadeError::InvalidNumber`] for a bad spec; style errors from nested layers.
     pub fn facade(&self, spec: &FacadeSpec) -> Result<Facade> {
+        let FacadeLayout {
+            spec: _,
+            columns,
+            rows,
+            mut report,
+        } = self.layout(spec)?;
+        let st = &self.style;
+        let mut rng = Pcg64Mcg::seed_from_u64(mix64(spec.seed ^ self.salt));
+        let tint = {
+            use rand::Rng;
+            1.0 + st.tint_jitter * (2.0 * unit(rng.next_u64()) - 1.0)
+        };
+        let mut ctx = BuildContext {
+            grid_u: Some(&columns),
+            grid_v: Some(&rows),
+            width: spec.width_m,
+            height: spec.height_m,
+            street: spec.role == FaceRole::Street,
+            openings: spec.role != FaceRole::Blank,
+            rng: &mut rng,
+            depth: 0,
+            images: Some(&self.images),
+            path: String::new(),
+        };
+        let (stack, rep) = st.stack.instantiate(&mut ctx)?;
+        report.skipped_layers = rep.skipped_layers;
+        Ok(Facade {
+            spec: *spec,
+            columns,
+            rows,
+            stack,
+            tint,
+            report,
+        })
+    }
+
+    /// Fits only the primary grid (columns and rows) of the style to a face: what
+    /// [`Facade::tile_quads`] needs, without instantiating the layer stack. Much cheaper
+    /// than [`facade`](Self::facade) when a city is textured with shared tile sets.
+    ///
+    /// # Errors
+    /// [`FacadeError::InvalidNumber`] for a bad spec.
+    pub fn layout(&self, spec: &FacadeSpec) -> Result<FacadeLayout> {
         spec.validate()?;
         let st = &self.style;
         let rows_style = match spec.role {
@@ -277,31 +348,10 @@ impl PreparedStyle {
         let columns = fit(&st.columns, spec.width_m, None, &mut report.blank_columns)?;
         let rows = fit(&rows_style, spec.height_m, wanted, &mut report.blank_rows)?;
         report.floors = rows.floor_count();
-        let mut rng = Pcg64Mcg::seed_from_u64(mix64(spec.seed ^ self.salt));
-        let tint = {
-            use rand::Rng;
-            1.0 + st.tint_jitter * (2.0 * unit(rng.next_u64()) - 1.0)
-        };
-        let mut ctx = BuildContext {
-            grid_u: Some(&columns),
-            grid_v: Some(&rows),
-            width: spec.width_m,
-            height: spec.height_m,
-            street: spec.role == FaceRole::Street,
-            openings: spec.role != FaceRole::Blank,
-            rng: &mut rng,
-            depth: 0,
-            images: Some(&self.images),
-            path: String::new(),
-        };
-        let (stack, rep) = st.stack.instantiate(&mut ctx)?;
-        report.skipped_layers = rep.skipped_layers;
-        Ok(Facade {
+        Ok(FacadeLayout {
             spec: *spec,
             columns,
             rows,
-            stack,
-            tint,
             report,
         })
     }

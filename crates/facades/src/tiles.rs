@@ -21,7 +21,7 @@ use polis_geom::{Aabb2, DVec2};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{FacadeError, Result};
-use crate::facade::{Facade, FacadeSpec, FaceRole, PreparedStyle};
+use crate::facade::{Facade, FacadeLayout, FacadeReport, FacadeSpec, FaceRole, PreparedStyle};
 use crate::interval::{IntervalGroup, Part};
 use crate::raster::{FacadeTextures, RasterOptions};
 
@@ -199,12 +199,29 @@ impl Facade {
     /// entrance bay. Regions whose tile is missing (a facade with margins the prototype
     /// lacked) are skipped; blank faces get no quads.
     pub fn tile_quads(&self, set: &TileSet) -> Vec<TileQuad> {
+        tile_quads(self.spec(), self.columns(), self.rows(), self.report(), set)
+    }
+}
+
+impl FacadeLayout {
+    /// The same quads as [`Facade::tile_quads`] of the facade with this layout.
+    pub fn tile_quads(&self, set: &TileSet) -> Vec<TileQuad> {
+        tile_quads(&self.spec, &self.columns, &self.rows, &self.report, set)
+    }
+}
+
+fn tile_quads(
+    spec: &FacadeSpec,
+    cols: &IntervalGroup,
+    rows: &IntervalGroup,
+    report: &FacadeReport,
+    set: &TileSet,
+) -> Vec<TileQuad> {
+    {
         let mut out = Vec::new();
-        if self.report().blank_columns || self.report().blank_rows {
+        if report.blank_columns || report.blank_rows {
             return out;
         }
-        let cols = self.columns();
-        let rows = self.rows();
         let tile_mod = |k: usize| {
             set.tiles
                 .get(k)
@@ -212,8 +229,8 @@ impl Facade {
         };
         let n_cols = cols.repeat_count();
         let n_rows = rows.repeat_count();
-        let has_entrance = self.spec().role == FaceRole::Street
-            && set.find(Part::Repeat, Part::Start, true).is_some();
+        let has_entrance =
+            spec.role == FaceRole::Street && set.find(Part::Repeat, Part::Start, true).is_some();
         for &(rp, y0, y1) in &parts(rows) {
             for &(cp, x0, x1) in &parts(cols) {
                 let Some(k) = set.find(cp, rp, false) else {
@@ -272,6 +289,43 @@ impl Facade {
 mod tests {
     use super::*;
     use crate::builtin;
+
+    #[test]
+    fn the_layout_alone_gives_the_facades_quads() {
+        for style in builtin::builtin_styles() {
+            let p = PreparedStyle::new(style).unwrap();
+            let set = TileSet::build(
+                &p,
+                &RasterOptions {
+                    pixels_per_metre: 8.0,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            for role in [
+                FaceRole::Street,
+                FaceRole::Side,
+                FaceRole::GroundFloor,
+                FaceRole::UpperFloors,
+            ] {
+                for (w, h, floors) in [(9.0, 8.0, None), (23.5, 14.2, Some(4)), (2.0, 1.0, None)] {
+                    let spec = FacadeSpec {
+                        floors,
+                        role,
+                        ..FacadeSpec::new(w, h, 11)
+                    };
+                    let full = p.facade(&spec).unwrap().tile_quads(&set);
+                    let layout = p.layout(&spec).unwrap();
+                    assert_eq!(
+                        layout.tile_quads(&set),
+                        full,
+                        "{} {role:?} {w}x{h}",
+                        set.style
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn quads_cover_the_facade_once_with_whole_modules() {
