@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{FacadeError, Result};
 use crate::sample::{FacadeSample, hash2, unit};
+use crate::sweep::RowSink;
 
 /// Where a point lies, handed to colour and evaluation functions.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,40 +100,113 @@ impl Bricks {
         self.brick.shade(1.0 + self.variation * (2.0 * r - 1.0))
     }
 
-    /// `eval(x, y)` for every `x` of a row, plus `depth` on the height: the course is
-    /// found once per row and each brick's shade once per brick (same results as `eval`).
-    fn eval_row(&self, xs: &[f64], y: f64, depth: f32, out: &mut [FacadeSample]) {
+    /// The course of row `y` when the row is not inside a bed joint (then every texel of
+    /// the row depends on its course and `x` alone), else `None`.
+    pub(crate) fn course(&self, y: f64) -> Option<f64> {
+        let h = self.size_m[1];
+        let course = (y / h).floor();
+        (y - course * h >= self.joint_m).then_some(course)
+    }
+
+    /// `eval(x, y)` for the texels `first..first + xs.len()` of a row, plus `depth` on
+    /// the height, as runs into `sink`: the course is found once per row and each brick's
+    /// shade once per brick (same results as `eval`). `x` is `xs[k] − x_origin` (0 for
+    /// facade-aligned bricks, the box origin for bricks laid in the cell).
+    pub(crate) fn eval_row<S: RowSink>(
+        &self,
+        xs: &[f64],
+        first: usize,
+        x_origin: Option<f64>,
+        y: f64,
+        depth: f32,
+        sink: &mut S,
+    ) {
         let [w, h] = self.size_m;
         let course = (y / h).floor();
         let ly = y - course * h;
         let mut mortar = self.mortar;
         mortar.height += depth;
+        let end = first + xs.len();
         if ly < self.joint_m {
-            out.fill(mortar);
+            sink.fill(first, end, mortar);
             return;
         }
         let off = course * self.bond * w;
-        let mut last = f64::NAN;
-        let mut brick = self.brick;
-        for (o, &x) in out.iter_mut().zip(xs) {
-            let xo = x + off;
-            let col = (xo / w).floor();
-            if xo - col * w < self.joint_m {
-                *o = mortar;
-                continue;
+        let shade = |col: f64| {
+            let mut b = if self.variation == 0.0 {
+                self.brick
+            } else {
+                let r = unit(hash2(self.salt, col as i64, course as i64));
+                self.brick.shade(1.0 + self.variation * (2.0 * r - 1.0))
+            };
+            b.height += depth;
+            b
+        };
+        // The brick column of texel k and whether it is mortar: the same arithmetic as
+        // `eval`.
+        let xo_at = |k: usize| {
+            let s = xs.get(k).copied().unwrap_or(f64::NAN);
+            let x = match x_origin {
+                Some(o) => s - o,
+                None => s,
+            };
+            x + off
+        };
+        let state = |k: usize| {
+            let xo = xo_at(k);
+            let col = floor_fast(xo / w);
+            (col, xo - col * w < self.joint_m)
+        };
+        let n = xs.len();
+        let spacing = match (xs.first(), xs.get(1)) {
+            (Some(&a), Some(&b)) => b - a,
+            _ => 0.0,
+        };
+        // Walk run by run: within a column the joint is a prefix, so "same column and
+        // same kind" holds on a prefix of the texels that follow; guess its end from the
+        // spacing and correct the guess against the exact per-texel test.
+        let mut k = 0;
+        while k < n {
+            let (col, mortar_run) = state(k);
+            let boundary = if mortar_run {
+                col * w + self.joint_m
+            } else {
+                (col + 1.0) * w
+            };
+            let g = ((boundary - xo_at(k)) / spacing).ceil();
+            let step = if g.is_finite() && g >= 1.0 {
+                g.min(n as f64) as usize
+            } else {
+                1
+            };
+            let same = |q: usize| {
+                let (c, m) = state(q);
+                c == col && m == mortar_run
+            };
+            let mut e = (k + step).clamp(k + 1, n);
+            while e > k + 1 && !same(e - 1) {
+                e -= 1;
             }
-            if col != last {
-                last = col;
-                brick = if self.variation == 0.0 {
-                    self.brick
-                } else {
-                    let r = unit(hash2(self.salt, col as i64, course as i64));
-                    self.brick.shade(1.0 + self.variation * (2.0 * r - 1.0))
-                };
-                brick.height += depth;
+            while e < n && same(e) {
+                e += 1;
             }
-            *o = brick;
+            let m = if mortar_run { mortar } else { shade(col) };
+            sink.fill(first + k, first + e, m);
+            k = e;
         }
+    }
+}
+
+/// `x.floor()` without a library call on targets without SSE4.1 (truncation, corrected
+/// for negative non-integers); the result may differ from `floor` only in the sign of a
+/// zero, which no caller can observe (it is multiplied and compared).
+#[inline]
+fn floor_fast(x: f64) -> f64 {
+    if x.abs() < 4.0e15 {
+        let t = x as i64 as f64;
+        if t > x { t - 1.0 } else { t }
+    } else {
+        x.floor()
     }
 }
 
@@ -146,6 +220,20 @@ fn corrugation(base: &FacadeSample, period_m: f64, depth_m: f32, x: f64) -> Faca
     let mut m = *base;
     m.height += 0.5 * depth_m * wave;
     m.shade(0.92 + 0.08 * wave)
+}
+
+/// A vertical corrugation at `s` with `depth` added to the height.
+#[inline]
+fn corrugated_at(
+    base: &FacadeSample,
+    period_m: f64,
+    depth_m: f32,
+    s: f64,
+    depth: f32,
+) -> FacadeSample {
+    let mut m = corrugation(base, period_m, depth_m, s);
+    m.height += depth;
+    m
 }
 
 /// The colour function of a layer.
@@ -249,29 +337,38 @@ impl Col {
         }
     }
 
-    /// Evaluates a run of points `(xs[k], t)` that share one cell and context except for
-    /// `s` (the cell box starts at `box_x0`), adding `depth` to the heights; `ctx_at(s)`
-    /// builds the full context when needed.
-    /// Equal to calling [`eval`](Self::eval) per point, faster for constant colours and
-    /// facade-aligned bricks.
+    /// Evaluates the texels `first..first + xs.len()` of a row (texel centres `xs`, at
+    /// height `t`) that share one cell and context except for `s` (the cell box starts at
+    /// `box_x0`), adding `depth` to the heights, as runs into `sink`; `ctx_at(s)` builds the
+    /// full context when needed. Equal to calling [`eval`](Self::eval) per point, faster
+    /// for colours that are constant along runs (solid, frames, bricks).
     #[inline]
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn eval_row(
+    pub(crate) fn eval_row<S: RowSink>(
         &self,
         xs: &[f64],
+        first: usize,
         t: f64,
         box_x0: f64,
         depth: f32,
         ctx_at: impl Fn(f64) -> PointCtx,
-        out: &mut [FacadeSample],
+        sink: &mut S,
     ) {
+        let end = first + xs.len();
         match self {
             Col::Solid(m) => {
                 let mut m = *m;
                 m.height += depth;
-                out.fill(m);
+                sink.fill(first, end, m);
             }
-            Col::Bricks(b) if !b.in_cell => b.eval_row(xs, t, depth, out),
+            Col::Bricks(b) if !b.in_cell => b.eval_row(xs, first, None, t, depth, sink),
+            Col::Bricks(b) => {
+                if let Some(&s) = xs.first() {
+                    // `eval` lays in-cell bricks at ctx.local = (s − box x0, t − box y0).
+                    let y = ctx_at(s).local[1];
+                    b.eval_row(xs, first, Some(box_x0), y, depth, sink);
+                }
+            }
             // Functions of t and the box alone are constant along the run.
             Col::Gradient { .. }
             | Col::Inherit { .. }
@@ -281,7 +378,7 @@ impl Col {
                 if let Some(&s) = xs.first() {
                     let mut m = self.eval(&ctx_at(s), None);
                     m.height += depth;
-                    out.fill(m);
+                    sink.fill(first, end, m);
                 }
             }
             Col::Frame {
@@ -297,15 +394,25 @@ impl Col {
                 inner.height += depth;
                 edge.height += depth;
                 let band = y < *width_m || h - y <= *width_m;
-                for (o, &s) in out.iter_mut().zip(xs) {
+                if band {
+                    sink.fill(first, end, edge);
+                    return;
+                }
+                let mut run_start = first;
+                let mut run_edge = false;
+                for (k, &s) in xs.iter().enumerate() {
                     // The same arithmetic as `eval`: local x = s − box origin.
                     let x = s - box_x0;
-                    *o = if band || x < *width_m || w - x <= *width_m {
-                        edge
-                    } else {
-                        inner
-                    };
+                    let is_edge = x < *width_m || w - x <= *width_m;
+                    if k == 0 {
+                        run_edge = is_edge;
+                    } else if is_edge != run_edge {
+                        sink.fill(run_start, first + k, if run_edge { edge } else { inner });
+                        run_start = first + k;
+                        run_edge = is_edge;
+                    }
                 }
+                sink.fill(run_start, end, if run_edge { edge } else { inner });
             }
             Col::Corrugated {
                 base,
@@ -313,19 +420,38 @@ impl Col {
                 depth_m,
                 vertical: true,
             } => {
-                for (o, &s) in out.iter_mut().zip(xs) {
-                    let mut m = corrugation(base, *period_m, *depth_m, s);
-                    m.height += depth;
-                    *o = m;
+                for (k, &s) in xs.iter().enumerate() {
+                    sink.put(
+                        first + k,
+                        corrugated_at(base, *period_m, *depth_m, s, depth),
+                    );
                 }
             }
             _ => {
-                for (o, &s) in out.iter_mut().zip(xs) {
+                for (k, &s) in xs.iter().enumerate() {
                     let mut m = self.eval(&ctx_at(s), None);
                     m.height += depth;
-                    *o = m;
+                    sink.put(first + k, m);
                 }
             }
+        }
+    }
+
+    /// For a vertically corrugated colour: the sample at every `s` of `xs` with `depth`
+    /// added (a function of `s` alone, so a raster computes it once per column).
+    pub(crate) fn vertical_strip(&self, xs: &[f64], depth: f32) -> Option<Vec<FacadeSample>> {
+        match self {
+            Col::Corrugated {
+                base,
+                period_m,
+                depth_m,
+                vertical: true,
+            } => Some(
+                xs.iter()
+                    .map(|&s| corrugated_at(base, *period_m, *depth_m, s, depth))
+                    .collect(),
+            ),
+            _ => None,
         }
     }
 

@@ -5,8 +5,12 @@
 //! stacks (glazing bars, panes) are mapped into the facade and reported with their nesting
 //! level.
 
+use std::fmt;
+use std::ops::Deref;
+use std::sync::Arc;
+
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::facade::Facade;
 use crate::layer::{CellRole, Eval, Layer};
@@ -21,8 +25,9 @@ pub struct FacadeCell {
     pub role: CellRole,
     /// Index of its layer in its stack (bottom = 0); higher layers cover lower ones.
     pub layer: usize,
-    /// Name of its layer.
-    pub layer_name: String,
+    /// Name of its layer (shared by every cell of the layer: cloning it is a reference
+    /// count, not an allocation).
+    pub layer_name: LayerName,
     /// Offset from the wall plane, metres (negative: recessed), summed over nesting.
     pub depth_m: f32,
     /// The image variant shown (e.g. 0 closed, 1 half open, 2 open), for image layers.
@@ -33,6 +38,89 @@ pub struct FacadeCell {
     pub row: usize,
     /// 0 for facade layers, 1 for cells of a nested stack inside a level-0 cell, …
     pub level: u32,
+}
+
+/// The name of a layer as carried by every [`FacadeCell`]: a shared, immutable string.
+///
+/// It dereferences to `str` and compares equal to `str`, `&str` and `String`, so code
+/// written against the former `String` field (`cell.layer_name == "windows"`,
+/// `cell.layer_name.starts_with(..)`, `format!("{}", cell.layer_name)`) keeps working;
+/// it serialises as a plain string.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct LayerName(Arc<str>);
+
+impl LayerName {
+    /// The name as a string slice.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl Deref for LayerName {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.0
+    }
+}
+
+impl AsRef<str> for LayerName {
+    fn as_ref(&self) -> &str {
+        &self.0
+    }
+}
+
+impl fmt::Display for LayerName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl From<&str> for LayerName {
+    fn from(s: &str) -> Self {
+        LayerName(Arc::from(s))
+    }
+}
+
+impl From<String> for LayerName {
+    fn from(s: String) -> Self {
+        LayerName(Arc::from(s))
+    }
+}
+
+impl From<LayerName> for String {
+    fn from(n: LayerName) -> Self {
+        n.0.to_string()
+    }
+}
+
+impl PartialEq<str> for LayerName {
+    fn eq(&self, other: &str) -> bool {
+        &*self.0 == other
+    }
+}
+
+impl PartialEq<&str> for LayerName {
+    fn eq(&self, other: &&str) -> bool {
+        &*self.0 == *other
+    }
+}
+
+impl PartialEq<String> for LayerName {
+    fn eq(&self, other: &String) -> bool {
+        *self.0 == **other
+    }
+}
+
+impl Serialize for LayerName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for LayerName {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        String::deserialize(d).map(LayerName::from)
+    }
 }
 
 /// An affine map from a nested domain into the facade: `p ↦ offset + p · scale`.
@@ -66,6 +154,8 @@ fn collect_layer(
     out: &mut Vec<FacadeCell>,
 ) {
     let depth_m = depth + layer.depth_m;
+    // One shared name per layer and call: every cell holds a reference to it.
+    let name = LayerName::from(layer.name.as_str());
     for j in 0..layer.v.len() {
         for i in 0..layer.u.len() {
             layer.cell_rects(i, j, |r| {
@@ -73,7 +163,7 @@ fn collect_layer(
                     rect: map.rect(&r),
                     role: layer.role,
                     layer: index,
-                    layer_name: layer.name.clone(),
+                    layer_name: name.clone(),
                     depth_m,
                     variant: layer.variant(i, j),
                     col: i,

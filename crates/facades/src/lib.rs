@@ -107,7 +107,7 @@ pub use axis::{AxisStyle, Segment};
 pub use color::{Bricks, Col, ColFn, PointCtx};
 pub use error::{FacadeError, Result};
 pub use facade::{Facade, FacadeReport, FacadeSpec, FacadeStyle, FaceRole, PreparedStyle};
-pub use geometry::FacadeCell;
+pub use geometry::{FacadeCell, LayerName};
 pub use image::{ImageSet, ImageStyle, MaterialImage};
 pub use interval::{Hit, Interval, IntervalGroup, Part};
 pub use layer::{CellRole, Eval, EvalFn, Layer, Probe};

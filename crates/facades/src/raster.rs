@@ -20,7 +20,7 @@ use crate::error::{FacadeError, Result, check_range};
 use crate::facade::Facade;
 use crate::sample::FacadeSample;
 use crate::stack::LayerStack;
-use crate::sweep::RowSweep;
+use crate::sweep::{RowRuns, RowSweep, RunKind};
 
 /// Heights in `[−HEIGHT_RANGE_M, +HEIGHT_RANGE_M]` metres map to the normal map's alpha.
 pub const HEIGHT_RANGE_M: f32 = 0.5;
@@ -183,66 +183,51 @@ pub fn rasterize_stack(
     let mut albedo = vec![0u8; n * 4];
     let mut mr = vec![0u8; n * 4];
     let mut heights = vec![0f32; n];
+    let mut normal = vec![0u8; n * 4];
     let ds = region.width() / w as f64;
     let dt = region.height() / h as f64;
     let mut sweep = RowSweep::new(region.min.x, ds, w);
-    let mut row = vec![FacadeSample::default(); w];
-    // NaN albedo never equals anything: the first row is always converted.
-    let mut prev_row = vec![
-        FacadeSample {
-            albedo: [f32::NAN; 4],
-            ..FacadeSample::default()
-        };
-        w
-    ];
-    let (mut prev_a, mut prev_m) = (vec![0u8; w * 4], vec![0u8; w * 4]);
-    let rows = albedo
-        .chunks_exact_mut(w * 4)
-        .zip(mr.chunks_exact_mut(w * 4))
-        .zip(heights.chunks_exact_mut(w));
-    for (y, ((arow, mrow), hrow)) in rows.enumerate() {
+    // The last three rows as runs and as height segments (row y lives in slot y % 3).
+    let mut runs: [RowRuns; 3] = Default::default();
+    let mut hsegs: [Vec<HSeg>; 3] = Default::default();
+    let mut conv = Converter::new(tint);
+    let mut normals = NormalRows::new(w, h, ds, dt, normal_strength);
+    for y in 0..h {
         let t = region.max.y - (y as f64 + 0.5) * dt;
-        sweep.row(stack, t, &mut row);
-        // Rows often repeat (inside a course of bricks, a band of cladding): copy them.
-        if prev_row == row {
-            arow.copy_from_slice(&prev_a);
-            mrow.copy_from_slice(&prev_m);
-            for (hh, smp) in hrow.iter_mut().zip(&row) {
-                *hh = smp.height;
-            }
-            continue;
-        }
-        // Runs of equal samples are common (walls, mortar, glass): convert once per run.
-        let mut prev: Option<(FacadeSample, [u8; 4], [u8; 4])> = None;
-        for (((a, m), hh), smp) in arow
-            .chunks_exact_mut(4)
-            .zip(mrow.chunks_exact_mut(4))
-            .zip(hrow.iter_mut())
-            .zip(&row)
-        {
-            let (pa, pm) = match prev {
-                Some((p, pa, pm)) if p == *smp => (pa, pm),
-                _ => {
-                    let pa = [
-                        to_u8(smp.albedo[0] * tint),
-                        to_u8(smp.albedo[1] * tint),
-                        to_u8(smp.albedo[2] * tint),
-                        to_u8(smp.albedo[3]),
-                    ];
-                    let pm = [255, to_u8(smp.roughness), to_u8(smp.metallic), 255];
-                    prev = Some((*smp, pa, pm));
-                    (pa, pm)
-                }
+        let slot = y % 3;
+        let prev = (y + 2) % 3;
+        sweep.row_runs(stack, t, &mut runs[slot]);
+        let (row4, row1) = (y * w * 4..(y + 1) * w * 4, y * w..(y + 1) * w);
+        if y > 0 && runs[slot] == runs[prev] {
+            // Rows often repeat (inside a course of bricks, a band of cladding): copy.
+            let (p4, p1) = (row4.start - w * 4, row1.start - w);
+            albedo.copy_within(p4..row4.start, row4.start);
+            mr.copy_within(p4..row4.start, row4.start);
+            heights.copy_within(p1..row1.start, row1.start);
+            let [a, b, c] = &mut hsegs;
+            let (dst, src) = match slot {
+                0 => (a, &*c),
+                1 => (b, &*a),
+                _ => (c, &*b),
             };
-            a.copy_from_slice(&pa);
-            m.copy_from_slice(&pm);
-            *hh = smp.height;
+            dst.clone_from(src);
+        } else {
+            let (Some(arow), Some(mrow), Some(hrow)) = (
+                albedo.get_mut(row4.clone()),
+                mr.get_mut(row4),
+                heights.get_mut(row1),
+            ) else {
+                continue;
+            };
+            conv.row(&runs[slot], &sweep, arow, mrow, hrow);
+            height_segments(&runs[slot], &mut hsegs[slot]);
         }
-        prev_row.copy_from_slice(&row);
-        prev_a.copy_from_slice(arow);
-        prev_m.copy_from_slice(mrow);
+        // Row y − 1 now has both neighbours: derive its normals.
+        if y > 0 {
+            normals.row(y - 1, &hsegs, &heights, &mut normal);
+        }
     }
-    let normal = normals_from_heights(&heights, w, h, ds, dt, normal_strength);
+    normals.row(h - 1, &hsegs, &heights, &mut normal);
     Ok(FacadeTextures {
         width,
         height,
@@ -252,6 +237,299 @@ pub fn rasterize_stack(
         metallic_roughness: mr,
         height_m: heights,
     })
+}
+
+/// Converts runs of samples into RGBA8 texels, once per run.
+struct Converter {
+    tint: f32,
+    /// The last converted constant sample and its albedo and metallic-roughness texels.
+    last: Option<(FacadeSample, [u8; 4], [u8; 4])>,
+    /// Converted column strips, by strip id: (albedo, metallic-roughness) of every texel.
+    strips: Vec<Option<(Vec<u8>, Vec<u8>)>>,
+}
+
+impl Converter {
+    fn new(tint: f32) -> Self {
+        Converter {
+            tint,
+            last: None,
+            strips: Vec::new(),
+        }
+    }
+
+    #[inline]
+    fn texels(&self, m: &FacadeSample) -> ([u8; 4], [u8; 4]) {
+        let tint = self.tint;
+        (
+            [
+                to_u8(m.albedo[0] * tint),
+                to_u8(m.albedo[1] * tint),
+                to_u8(m.albedo[2] * tint),
+                to_u8(m.albedo[3]),
+            ],
+            [255, to_u8(m.roughness), to_u8(m.metallic), 255],
+        )
+    }
+
+    /// Writes one row of albedo, metallic-roughness and height from its runs.
+    fn row(
+        &mut self,
+        runs: &RowRuns,
+        sweep: &RowSweep,
+        arow: &mut [u8],
+        mrow: &mut [u8],
+        hrow: &mut [f32],
+    ) {
+        let mut a = 0usize;
+        for run in &runs.runs {
+            let b = (run.end as usize).min(hrow.len());
+            if b <= a {
+                continue;
+            }
+            match run.kind {
+                RunKind::Const(m) => {
+                    let (pa, pm) = match self.last {
+                        Some((p, pa, pm)) if p == m => (pa, pm),
+                        _ => {
+                            let (pa, pm) = self.texels(&m);
+                            self.last = Some((m, pa, pm));
+                            (pa, pm)
+                        }
+                    };
+                    fill4(arow.get_mut(a * 4..b * 4).unwrap_or_default(), pa);
+                    fill4(mrow.get_mut(a * 4..b * 4).unwrap_or_default(), pm);
+                    if let Some(hh) = hrow.get_mut(a..b) {
+                        hh.fill(m.height);
+                    }
+                }
+                RunKind::Strip(id) => {
+                    let samples = sweep.strip_samples(id);
+                    let k = id as usize;
+                    if self.strips.len() <= k {
+                        self.strips.resize(k + 1, None);
+                    }
+                    if self.strips.get(k).is_some_and(Option::is_none) {
+                        let mut sa = Vec::with_capacity(samples.len() * 4);
+                        let mut sm = Vec::with_capacity(samples.len() * 4);
+                        for m in samples {
+                            let (pa, pm) = self.texels(m);
+                            sa.extend_from_slice(&pa);
+                            sm.extend_from_slice(&pm);
+                        }
+                        if let Some(slot) = self.strips.get_mut(k) {
+                            *slot = Some((sa, sm));
+                        }
+                    }
+                    if let Some(Some((sa, sm))) = self.strips.get(k)
+                        && let (Some(src_a), Some(src_m), Some(src_h)) = (
+                            sa.get(a * 4..b * 4),
+                            sm.get(a * 4..b * 4),
+                            samples.get(a..b),
+                        )
+                    {
+                        arow.get_mut(a * 4..b * 4)
+                            .unwrap_or_default()
+                            .copy_from_slice(src_a);
+                        mrow.get_mut(a * 4..b * 4)
+                            .unwrap_or_default()
+                            .copy_from_slice(src_m);
+                        for (hh, m) in hrow.get_mut(a..b).unwrap_or_default().iter_mut().zip(src_h)
+                        {
+                            *hh = m.height;
+                        }
+                    }
+                }
+            }
+            a = b;
+        }
+    }
+}
+
+/// Writes the texel `p` into every 4-byte texel of `dst`.
+#[inline]
+fn fill4(dst: &mut [u8], p: [u8; 4]) {
+    for px in dst.chunks_exact_mut(4) {
+        px.copy_from_slice(&p);
+    }
+}
+
+/// A run of a row's height field: constant (bit pattern) or a column strip's heights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum HKind {
+    Const(u32),
+    Strip(u32),
+}
+
+/// A segment of a row's height field ending (exclusive) at `end`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct HSeg {
+    end: u32,
+    kind: HKind,
+}
+
+/// The maximal segments of equal height (or of one strip) of a row.
+fn height_segments(runs: &RowRuns, out: &mut Vec<HSeg>) {
+    out.clear();
+    for run in &runs.runs {
+        let kind = match run.kind {
+            RunKind::Const(m) => HKind::Const(m.height.to_bits()),
+            RunKind::Strip(id) => HKind::Strip(id),
+        };
+        match out.last_mut() {
+            Some(last) if last.kind == kind => last.end = run.end,
+            _ => out.push(HSeg { end: run.end, kind }),
+        }
+    }
+}
+
+/// The normal-map texel for heights left, right, up, down and centre with slope factors
+/// `k` (along the row) and `ky` (across rows); the height itself goes to alpha.
+#[inline]
+fn normal_texel(l: f32, r: f32, u: f32, d: f32, c: f32, k: f32, ky: f32) -> [u8; 4] {
+    let alpha = to_u8(c * (0.5 / HEIGHT_RANGE_M) + 0.5);
+    if l == r && u == d {
+        return [128, 128, 255, alpha];
+    }
+    // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
+    let (nx, ny) = (-(r - l) * k, -(u - d) * ky);
+    let inv = 1.0 / (nx * nx + ny * ny + 1.0).sqrt();
+    [
+        to_u8(nx * inv * 0.5 + 0.5),
+        to_u8(ny * inv * 0.5 + 0.5),
+        to_u8(inv * 0.5 + 0.5),
+        alpha,
+    ]
+}
+
+/// The normal-map derivation fused into the row loop: row `y` is derived as soon as row
+/// `y + 1` exists, segment by segment of constant heights (only texels next to a height
+/// change are computed one by one), and copied when its neighbourhood repeats the last
+/// one. Equal, texel for texel, to [`normals_from_heights`].
+struct NormalRows {
+    w: usize,
+    h: usize,
+    dt: f64,
+    strength: f32,
+    k_in: f32,
+    k_edge: f32,
+    /// The last derived row, its slope factor across rows and its neighbourhood.
+    last: Option<(usize, u32)>,
+    last_segs: [Vec<HSeg>; 3],
+}
+
+impl NormalRows {
+    fn new(w: usize, h: usize, ds: f64, dt: f64, strength: f32) -> Self {
+        // One-sided differences at the borders span one texel, central ones two.
+        let kx = |span: usize| strength / (span.max(1) as f64 * ds) as f32;
+        NormalRows {
+            w,
+            h,
+            dt,
+            strength,
+            k_in: kx(2),
+            k_edge: kx(1),
+            last: None,
+            last_segs: Default::default(),
+        }
+    }
+
+    /// Derives row `y` (its rows `y − 1`, `y`, `y + 1`, clamped, are in `heights` and in
+    /// `segs[row % 3]`).
+    fn row(&mut self, y: usize, segs: &[Vec<HSeg>; 3], heights: &[f32], out: &mut [u8]) {
+        let (w, h) = (self.w, self.h);
+        if y >= h || w == 0 {
+            return;
+        }
+        let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+        let ky = self.strength / ((y1 - y0).max(1) as f64 * self.dt) as f32;
+        let (Some(su), Some(sc), Some(sd)) = (segs.get(y0 % 3), segs.get(y % 3), segs.get(y1 % 3))
+        else {
+            return;
+        };
+        let row4 = y * w * 4..(y + 1) * w * 4;
+        if let Some((ly, lk)) = self.last
+            && lk == ky.to_bits()
+            && self.last_segs[0] == *su
+            && self.last_segs[1] == *sc
+            && self.last_segs[2] == *sd
+        {
+            out.copy_within(ly * w * 4..(ly + 1) * w * 4, row4.start);
+            return;
+        }
+        let row_of = |r: usize| heights.get(r * w..r * w + w).unwrap_or_default();
+        let (up, cur, dn) = (row_of(y0), row_of(y), row_of(y1));
+        let Some(orow) = out.get_mut(row4) else {
+            return;
+        };
+        let (k_in, k_edge) = (self.k_in, self.k_edge);
+        let at = |x: usize| -> [u8; 4] {
+            let (Some(&c), Some(&u), Some(&d)) = (cur.get(x), up.get(x), dn.get(x)) else {
+                return [0; 4];
+            };
+            if x == 0 {
+                let r = cur.get(1).copied().unwrap_or(c);
+                normal_texel(c, r, u, d, c, k_edge, ky)
+            } else if x + 1 == w {
+                let l = cur.get(x - 1).copied().unwrap_or(c);
+                normal_texel(l, c, u, d, c, k_edge, ky)
+            } else {
+                let l = cur.get(x - 1).copied().unwrap_or(c);
+                let r = cur.get(x + 1).copied().unwrap_or(c);
+                normal_texel(l, r, u, d, c, k_in, ky)
+            }
+        };
+        let put = |orow: &mut [u8], x: usize, p: [u8; 4]| {
+            if let Some(px) = orow.get_mut(x * 4..x * 4 + 4) {
+                px.copy_from_slice(&p);
+            }
+        };
+        let (mut iu, mut ic, mut id) = (0usize, 0usize, 0usize);
+        let mut a = 0usize;
+        while a < w {
+            let (Some(gu), Some(gc), Some(gd)) = (su.get(iu), sc.get(ic), sd.get(id)) else {
+                // Malformed segments (never produced): derive the rest texel by texel.
+                for x in a..w {
+                    put(orow, x, at(x));
+                }
+                break;
+            };
+            let b = (gu.end.min(gc.end).min(gd.end) as usize).min(w);
+            if b <= a {
+                for x in a..w {
+                    put(orow, x, at(x));
+                }
+                break;
+            }
+            match (gu.kind, gc.kind, gd.kind) {
+                (HKind::Const(hu), HKind::Const(hc), HKind::Const(hd)) if b - a >= 3 => {
+                    put(orow, a, at(a));
+                    let (hu, hc, hd) = (f32::from_bits(hu), f32::from_bits(hc), f32::from_bits(hd));
+                    // Inside the segment every texel sees the same neighbourhood.
+                    let p = normal_texel(hc, hc, hu, hd, hc, k_in, ky);
+                    fill4(
+                        orow.get_mut((a + 1) * 4..(b - 1) * 4).unwrap_or_default(),
+                        p,
+                    );
+                    put(orow, b - 1, at(b - 1));
+                }
+                _ => {
+                    for x in a..b {
+                        put(orow, x, at(x));
+                    }
+                }
+            }
+            for (seg, i) in [(su, &mut iu), (sc, &mut ic), (sd, &mut id)] {
+                if seg.get(*i).is_some_and(|g| g.end as usize <= b) {
+                    *i += 1;
+                }
+            }
+            a = b;
+        }
+        self.last = Some((y, ky.to_bits()));
+        self.last_segs[0].clone_from(su);
+        self.last_segs[1].clone_from(sc);
+        self.last_segs[2].clone_from(sd);
+    }
 }
 
 /// A tangent-space normal map (RGBA8, height in alpha) from a height field (rows
@@ -292,26 +570,8 @@ pub fn normals_from_heights(
             orow.copy_from_slice(&last_out);
             continue;
         }
-        let mut last_c = f32::NAN;
-        let mut last_alpha = 0u8;
-        let mut texel = |l: f32, r: f32, u: f32, d: f32, c: f32, k: f32, px: &mut [u8]| {
-            if c != last_c {
-                last_c = c;
-                last_alpha = to_u8(c * (0.5 / HEIGHT_RANGE_M) + 0.5);
-            }
-            if l == r && u == d {
-                px.copy_from_slice(&[128, 128, 255, last_alpha]);
-                return;
-            }
-            // Row y0 is higher up the wall than y1: dh/dt = (h(y0) − h(y1)) / Δt.
-            let (nx, ny) = (-(r - l) * k, -(u - d) * ky);
-            let inv = 1.0 / (nx * nx + ny * ny + 1.0).sqrt();
-            px.copy_from_slice(&[
-                to_u8(nx * inv * 0.5 + 0.5),
-                to_u8(ny * inv * 0.5 + 0.5),
-                to_u8(inv * 0.5 + 0.5),
-                last_alpha,
-            ]);
+        let texel = |l: f32, r: f32, u: f32, d: f32, c: f32, k: f32, px: &mut [u8]| {
+            px.copy_from_slice(&normal_texel(l, r, u, d, c, k, ky));
         };
         let (k_in, k_edge) = (kx(2), kx(1));
         let mut px = orow.chunks_exact_mut(4);
@@ -398,7 +658,177 @@ impl Facade {
 mod tests {
     use super::*;
     use crate::builtin;
-    use crate::facade::{FacadeSpec, PreparedStyle};
+    use crate::color::Col;
+    use crate::facade::{FacadeSpec, FaceRole, PreparedStyle};
+    use crate::interval::IntervalGroup;
+    use crate::layer::{Eval, Layer};
+    use crate::profile::Profile;
+
+    /// The rasteriser as it was before runs, column strips and fused normals: every texel
+    /// sampled by the row sweep and converted on its own, normals derived afterwards from
+    /// the whole height field. The run rasteriser must give the same bytes.
+    fn reference(
+        stack: &LayerStack,
+        region: &Aabb2,
+        w: usize,
+        h: usize,
+        tint: f32,
+        strength: f32,
+    ) -> FacadeTextures {
+        let ds = region.width() / w as f64;
+        let dt = region.height() / h as f64;
+        let mut sweep = RowSweep::new(region.min.x, ds, w);
+        let mut row = vec![FacadeSample::default(); w];
+        let (mut albedo, mut mr, mut heights) = (vec![], vec![], vec![]);
+        for y in 0..h {
+            let t = region.max.y - (y as f64 + 0.5) * dt;
+            sweep.row(stack, t, &mut row);
+            for m in &row {
+                albedo.extend([
+                    to_u8(m.albedo[0] * tint),
+                    to_u8(m.albedo[1] * tint),
+                    to_u8(m.albedo[2] * tint),
+                    to_u8(m.albedo[3]),
+                ]);
+                mr.extend([255, to_u8(m.roughness), to_u8(m.metallic), 255]);
+                heights.push(m.height);
+            }
+        }
+        FacadeTextures {
+            width: w as u32,
+            height: h as u32,
+            size_m: [region.width(), region.height()],
+            normal: normals_from_heights(&heights, w, h, ds, dt, strength),
+            albedo,
+            metallic_roughness: mr,
+            height_m: heights,
+        }
+    }
+
+    fn same_as_reference(stack: &LayerStack, region: &Aabb2, w: u32, h: u32, tint: f32) {
+        for strength in [1.0, 3.5] {
+            let got = rasterize_stack(stack, region, w, h, tint, strength).unwrap();
+            let want = reference(stack, region, w as usize, h as usize, tint, strength);
+            assert!(got.albedo == want.albedo, "albedo differs");
+            assert!(
+                got.metallic_roughness == want.metallic_roughness,
+                "mr differs"
+            );
+            assert!(got.height_m == want.height_m, "heights differ");
+            if let Some(k) = (0..got.normal.len()).find(|&k| got.normal[k] != want.normal[k]) {
+                panic!("normal byte {k} (texel {}) differs", k / 4);
+            }
+            assert_eq!(got, want);
+        }
+    }
+
+    #[test]
+    fn runs_give_the_bytes_of_texel_by_texel_rasterisation() {
+        for style in builtin::builtin_styles() {
+            let p = PreparedStyle::new(style).unwrap();
+            for (w, h, role, ppm) in [
+                (20.0, 15.0, FaceRole::Street, 24.0),
+                (7.3, 9.1, FaceRole::Street, 37.0),
+                (13.0, 30.0, FaceRole::Side, 9.5),
+                (2.0, 2.0, FaceRole::Blank, 16.0),
+            ] {
+                let f = p
+                    .facade(&FacadeSpec {
+                        role,
+                        ..FacadeSpec::new(w, h, 23)
+                    })
+                    .unwrap();
+                let (tw, th) = ((w * ppm).round() as u32, (h * ppm).round() as u32);
+                let full = Aabb2::new(DVec2::ZERO, DVec2::new(w, h));
+                same_as_reference(f.stack(), &full, tw, th, f.tint());
+                // An off-origin region, and degenerate 1-texel-wide and -high rasters.
+                let part = Aabb2::new(DVec2::new(0.37 * w, 0.21 * h), DVec2::new(w, 0.9 * h));
+                same_as_reference(f.stack(), &part, tw / 2 + 1, th / 3 + 1, 1.0);
+                same_as_reference(f.stack(), &full, 1, th, 1.0);
+                same_as_reference(f.stack(), &full, tw, 1, 1.0);
+                same_as_reference(f.stack(), &full, 2, 2, 1.0);
+            }
+        }
+    }
+
+    #[test]
+    fn runs_match_the_reference_on_strips_and_closures() {
+        // Corrugation (a column strip) under a closure colour and bricks in the cell.
+        let u = IntervalGroup::from_lengths([
+            (1.0, "a", Profile::Off),
+            (2.0, "b", Profile::Centered { size_m: 1.3 }),
+            (1.5, "a", Profile::Off),
+        ])
+        .unwrap();
+        let v = IntervalGroup::from_lengths([
+            (1.2, "a", Profile::Off),
+            (
+                2.5,
+                "b",
+                Profile::Inset {
+                    start_m: 0.3,
+                    end_m: 0.2,
+                },
+            ),
+        ])
+        .unwrap();
+        let whole = |l: f64| IntervalGroup::single(l, "w", Profile::Full).unwrap();
+        let sheet = Layer::new(
+            whole(4.5),
+            whole(3.7),
+            Eval::Always,
+            Col::Corrugated {
+                base: FacadeSample::rgb(0.4, 0.5, 0.6),
+                period_m: 0.17,
+                depth_m: 0.03,
+                vertical: true,
+            },
+        )
+        .with_depth(0.01);
+        let blocks = Layer::new(
+            u.clone(),
+            v.clone(),
+            Eval::And,
+            Col::Bricks(crate::color::Bricks {
+                brick: FacadeSample::rgb(0.7, 0.6, 0.5),
+                mortar: FacadeSample::rgb(0.3, 0.3, 0.3).with_height(-0.02),
+                size_m: [0.31, 0.13],
+                joint_m: 0.02,
+                bond: 0.5,
+                variation: 0.2,
+                in_cell: true,
+                salt: 4,
+            }),
+        );
+        let dots = Layer::new(
+            u,
+            v,
+            Eval::Or,
+            Col::custom(|c| {
+                FacadeSample::rgb((c.s / 5.0) as f32, 0.2, 0.3).with_height((c.t * 0.01) as f32)
+            }),
+        )
+        .with_masks(Some(vec![false, false, true]), None);
+        let stack = LayerStack::new(
+            vec![sheet, blocks, dots],
+            vec![crate::stack::Influence::Border {
+                source: 1,
+                target: 0,
+                margin_m: 0.12,
+                col: Col::Corrugated {
+                    base: FacadeSample::rgb(0.9, 0.8, 0.1),
+                    period_m: 0.05,
+                    depth_m: 0.01,
+                    vertical: true,
+                },
+            }],
+            None,
+        )
+        .unwrap();
+        let full = Aabb2::new(DVec2::ZERO, DVec2::new(4.5, 3.7));
+        same_as_reference(&stack, &full, 171, 133, 0.93);
+        same_as_reference(&stack, &full, 45, 37, 1.0);
+    }
 
     #[test]
     fn raster_matches_point_evaluation() {

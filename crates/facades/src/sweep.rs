@@ -17,12 +17,120 @@
 
 use crate::color::{Col, PointCtx};
 use crate::interval::Hit;
-use crate::layer::Eval;
+use crate::layer::{Eval, Layer};
 use crate::sample::{FacadeSample, hash2};
 use crate::stack::{LayerStack, RowState};
 
 /// Owner flag: the texel's sample was computed while probing.
 const DONE: u32 = u32::MAX;
+
+/// Where a row sweep writes its samples: texels `0..w` are written once each, in
+/// increasing order, as runs.
+pub(crate) trait RowSink {
+    /// Texels `a..b` take `m`.
+    fn fill(&mut self, a: usize, b: usize, m: FacadeSample);
+    /// Texel `x` takes `m`.
+    #[inline]
+    fn put(&mut self, x: usize, m: FacadeSample) {
+        self.fill(x, x + 1, m);
+    }
+    /// Whether the sink keeps column strips by reference ([`RowSink::strip`]).
+    fn wants_strips(&self) -> bool {
+        false
+    }
+    /// Texels `a..b` take `samples` (one each), which are `a..b` of the sweep's strip `id`.
+    fn strip(&mut self, a: usize, b: usize, id: u32, samples: &[FacadeSample]) {
+        let _ = id;
+        for (k, m) in samples.iter().enumerate().take(b.saturating_sub(a)) {
+            self.put(a + k, *m);
+        }
+    }
+}
+
+/// A sink that stores one sample per texel.
+pub(crate) struct Texels<'a>(pub(crate) &'a mut [FacadeSample]);
+
+impl RowSink for Texels<'_> {
+    #[inline]
+    fn fill(&mut self, a: usize, b: usize, m: FacadeSample) {
+        if let Some(run) = self.0.get_mut(a..b) {
+            run.fill(m);
+        }
+    }
+
+    #[inline]
+    fn put(&mut self, x: usize, m: FacadeSample) {
+        if let Some(o) = self.0.get_mut(x) {
+            *o = m;
+        }
+    }
+}
+
+/// What a run of a row holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum RunKind {
+    /// One sample over the whole run.
+    Const(FacadeSample),
+    /// The same texels of a column strip of the sweep (a colour that depends on `s` only).
+    Strip(u32),
+}
+
+/// A run of texels ending (exclusive) at `end`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Run {
+    /// One past the last texel.
+    pub(crate) end: u32,
+    /// Its content.
+    pub(crate) kind: RunKind,
+}
+
+/// A row as maximal runs (adjacent equal constant runs are merged).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct RowRuns {
+    pub(crate) runs: Vec<Run>,
+}
+
+impl RowSink for RowRuns {
+    #[inline]
+    fn fill(&mut self, a: usize, b: usize, m: FacadeSample) {
+        if b <= a {
+            return;
+        }
+        let end = b as u32;
+        if let Some(last) = self.runs.last_mut()
+            && last.kind == RunKind::Const(m)
+        {
+            last.end = end;
+            return;
+        }
+        self.runs.push(Run {
+            end,
+            kind: RunKind::Const(m),
+        });
+    }
+
+    fn wants_strips(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn strip(&mut self, a: usize, b: usize, id: u32, _samples: &[FacadeSample]) {
+        if b <= a {
+            return;
+        }
+        let end = b as u32;
+        if let Some(last) = self.runs.last_mut()
+            && last.kind == RunKind::Strip(id)
+        {
+            last.end = end;
+            return;
+        }
+        self.runs.push(Run {
+            end,
+            kind: RunKind::Strip(id),
+        });
+    }
+}
 
 #[derive(Debug, Clone, Copy)]
 struct Span {
@@ -33,6 +141,8 @@ struct Span {
     box_y0: f64,
     box_w: f64,
     box_h: f64,
+    /// For an image cell: the chosen image and the cell seed.
+    image: Option<(usize, u64)>,
 }
 
 /// The first of the sorted texel centres `xs` that is `≥ s` (`> s` when `strict` is
@@ -72,7 +182,18 @@ pub(crate) struct RowSweep {
     /// Sweeps for nested stacks (reused) and their output row.
     pool: Vec<RowSweep>,
     nested_out: Vec<FacadeSample>,
+    /// Column strips of colours that depend on `s` alone, keyed by the colour's address
+    /// (valid for the stack being swept): one sample per texel.
+    strips: Vec<(usize, Vec<FacadeSample>)>,
+    /// Whole rows of facade-aligned brick patterns, keyed by (colour address, course,
+    /// depth): every row of a course between its joints is the same.
+    brick_rows: Vec<((usize, u64, u32), RowRuns)>,
+    /// Next entry of `brick_rows` to replace when full.
+    brick_next: usize,
 }
+
+/// Most cached brick rows (several brick colours may alternate along a row).
+const BRICK_ROWS: usize = 16;
 
 impl RowSweep {
     /// A sweep over `w` texels whose centres are `s0 + (x + ½)·ds`.
@@ -85,7 +206,85 @@ impl RowSweep {
             state: RowState::default(),
             pool: Vec::new(),
             nested_out: Vec::new(),
+            strips: Vec::new(),
+            brick_rows: Vec::new(),
+            brick_next: 0,
         }
+    }
+
+    /// Emits texels `a..b` of a facade-aligned brick colour from the row cache of its
+    /// course (computed over the whole row on first use). `None` if the colour is not such
+    /// a pattern.
+    fn cached_bricks<S: RowSink>(
+        &mut self,
+        col: &Col,
+        t: f64,
+        depth: f32,
+        a: usize,
+        b: usize,
+        sink: &mut S,
+    ) -> Option<()> {
+        let Col::Bricks(bricks) = col else {
+            return None;
+        };
+        if bricks.in_cell {
+            return None;
+        }
+        let course = bricks.course(t)?;
+        let key = (
+            col as *const Col as usize,
+            course.to_bits(),
+            depth.to_bits(),
+        );
+        let slot = match self.brick_rows.iter().position(|(k, _)| *k == key) {
+            Some(p) => p,
+            None => {
+                let mut runs = RowRuns::default();
+                bricks.eval_row(&self.xs, 0, None, t, depth, &mut runs);
+                if self.brick_rows.len() < BRICK_ROWS {
+                    self.brick_rows.push((key, runs));
+                    self.brick_rows.len() - 1
+                } else {
+                    let p = self.brick_next % BRICK_ROWS;
+                    self.brick_next = p + 1;
+                    if let Some(e) = self.brick_rows.get_mut(p) {
+                        *e = (key, runs);
+                    }
+                    p
+                }
+            }
+        };
+        let runs = &self.brick_rows.get(slot)?.1.runs;
+        let mut start = runs.partition_point(|r| (r.end as usize) <= a);
+        let mut from = a;
+        while from < b {
+            let Some(r) = runs.get(start) else { break };
+            let to = (r.end as usize).min(b);
+            if let RunKind::Const(m) = r.kind {
+                sink.fill(from, to, m);
+            }
+            from = to;
+            start += 1;
+        }
+        Some(())
+    }
+
+    /// The samples of column strip `id` (one per texel), as referenced by
+    /// [`RunKind::Strip`].
+    pub(crate) fn strip_samples(&self, id: u32) -> &[FacadeSample] {
+        self.strips.get(id as usize).map_or(&[], |s| s.1.as_slice())
+    }
+
+    /// The strip id of `col` (with `depth`) if it depends on `s` alone, computing it on
+    /// first use.
+    fn strip_id(&mut self, col: &Col, depth: f32) -> Option<u32> {
+        let key = col as *const Col as usize;
+        if let Some(k) = self.strips.iter().position(|(c, _)| *c == key) {
+            return Some(k as u32);
+        }
+        let samples = col.vertical_strip(&self.xs, depth)?;
+        self.strips.push((key, samples));
+        Some(self.strips.len() as u32 - 1)
     }
 
     /// Re-targets the sweep at arbitrary sorted texel positions.
@@ -99,6 +298,19 @@ impl RowSweep {
 
     /// Evaluates the row at height `t` into `out` (one sample per texel).
     pub(crate) fn row(&mut self, stack: &LayerStack, t: f64, out: &mut [FacadeSample]) {
+        let w = out.len().min(self.xs.len());
+        let out = out.get_mut(..w).unwrap_or_default();
+        self.row_into(stack, t, &mut Texels(out));
+    }
+
+    /// Evaluates the row at height `t` as runs (cleared first).
+    pub(crate) fn row_runs(&mut self, stack: &LayerStack, t: f64, out: &mut RowRuns) {
+        out.runs.clear();
+        self.row_into(stack, t, out);
+    }
+
+    /// Evaluates the row at height `t` into a sink, texels `0..w` in order.
+    fn row_into<S: RowSink>(&mut self, stack: &LayerStack, t: f64, sink: &mut S) {
         stack.begin_row(t, &mut self.state);
         self.owner.fill(0);
         self.spans.clear();
@@ -205,6 +417,7 @@ impl RowSweep {
                     box_y0: bx[2],
                     box_w: bx[1] - bx[0],
                     box_h: bx[3] - bx[2],
+                    image: None,
                 });
                 if definite {
                     if let Some(o) = self.owner.get_mut(x0..x1) {
@@ -213,47 +426,24 @@ impl RowSweep {
                 } else if let (Eval::Image(set), false) = (&layer.eval, scaled) {
                     // One image per cell: choose it once, then sample texels directly
                     // (the same arithmetic as `Layer::probe_hits`).
+                    // The texels where the image is opaque become the span's; they
+                    // are coloured with the runs.
                     let seed = hash2(layer.seed, i as i64, j as i64);
-                    let Some(img) = set.get(set.choose(seed)) else {
+                    let chosen = set.choose(seed);
+                    let Some(img) = set.get(chosen) else {
                         continue;
                     };
+                    if let Some(sp) = self.spans.last_mut() {
+                        sp.image = Some((chosen, seed));
+                    }
                     let (bw, bh) = (bx[1] - bx[0], bx[3] - bx[2]);
-                    let ly = t - bx[2];
-                    for x in x0..x1 {
-                        let Some(&s) = xs.get(x) else { break };
-                        let local = [s - bx[0], ly];
-                        let texel = img.sample(local[0] / bw, local[1] / bh);
-                        if texel.albedo[3] < 0.5 {
-                            continue;
-                        }
-                        let col = stack
-                            .border_col_in_row(k, s, &self.state)
-                            .unwrap_or(&layer.col);
-                        let m = match col {
-                            Col::Inherit { .. } => texel,
-                            _ => {
-                                let ctx = PointCtx {
-                                    s,
-                                    t,
-                                    i,
-                                    j,
-                                    local,
-                                    size: [bw, bh],
-                                    pu: layer.u.value(i, s),
-                                    pv: layer.v.value(j, t),
-                                    cell_seed: seed,
-                                };
-                                col.eval(&ctx, Some(&texel))
-                            }
-                        };
-                        if let (Some(smp), Some(o)) =
-                            (self.samples.get_mut(x), self.owner.get_mut(x))
-                        {
-                            // Store, then adjust in place (avoids a store-forwarding stall
-                            // on a freshly modified copy).
-                            *smp = m;
-                            smp.height += layer.depth_m;
-                            *o = DONE;
+                    let v = (t - bx[2]) / bh;
+                    let (Some(xr), Some(or)) = (xs.get(x0..x1), self.owner.get_mut(x0..x1)) else {
+                        continue;
+                    };
+                    for (&s, o) in xr.iter().zip(or) {
+                        if img.sample((s - bx[0]) / bw, v).albedo[3] >= 0.5 {
+                            *o = id;
                         }
                     }
                 } else if let (Eval::Stack(inner), false) = (&layer.eval, scaled) {
@@ -329,7 +519,7 @@ impl RowSweep {
         }
         let background = stack.background().unwrap_or_default();
         let layers = stack.layers();
-        let w = out.len().min(self.owner.len());
+        let w = self.owner.len();
         let mut x = 0;
         while x < w {
             let o = self.owner[x];
@@ -337,63 +527,138 @@ impl RowSweep {
             while e < w && self.owner[e] == o {
                 e += 1;
             }
-            let run = &mut out[x..e];
             match o {
-                0 => run.fill(background),
-                DONE => run.copy_from_slice(&self.samples[x..e]),
+                0 => sink.fill(x, e, background),
+                DONE => {
+                    for (q, m) in self.samples[x..e].iter().enumerate() {
+                        sink.put(x + q, *m);
+                    }
+                }
                 id => {
                     let sp = self.spans.get(id as usize - 1).copied();
-
                     let layer = sp.and_then(|sp| layers.get(sp.layer));
                     let (Some(sp), Some(layer)) = (sp, layer) else {
-                        run.fill(background);
+                        sink.fill(x, e, background);
                         x = e;
                         continue;
-                    };
-                    let ctx_at = |s: f64| PointCtx {
-                        s,
-                        t,
-                        i: sp.hu.index,
-                        j: sp.hv.index,
-                        local: [s - sp.box_x0, t - sp.box_y0],
-                        size: [sp.box_w, sp.box_h],
-                        pu: layer.u.value(sp.hu.index, s),
-                        pv: layer.v.value(sp.hv.index, t),
-                        cell_seed: 0,
-                    };
-                    let xs_run = &xs[x..e];
-                    let shade = |col: &Col, xs_sub: &[f64], out_sub: &mut [FacadeSample]| {
-                        if let Col::Custom(_) = col {
-                            for (o, &s) in out_sub.iter_mut().zip(xs_sub) {
-                                *o = match layer.probe_hits(s, t, &sp.hu, &sp.hv) {
-                                    Some(p) => layer.shade(&p, col),
-                                    None => background,
-                                };
-                            }
-                        } else {
-                            col.eval_row(xs_sub, t, sp.box_x0, layer.depth_m, ctx_at, out_sub);
-                        }
                     };
                     if stack.has_borders(sp.layer) {
                         // Split the run where a border colour starts or stops.
                         let mut a = x;
                         while a < e {
                             let mut b = e;
+                            let xs = &self.xs;
                             let col = stack
                                 .border_run(sp.layer, xs[a], &mut self.state, |s, inclusive| {
                                     b = b.min(first_at_or_after(xs, s, inclusive).max(a + 1));
                                 })
                                 .unwrap_or(&layer.col);
-                            shade(col, &xs[a..b], &mut out[a..b]);
+                            self.shade_run(layer, &sp, col, t, background, a, b, sink);
                             a = b;
                         }
                     } else {
-                        shade(&layer.col, xs_run, run);
+                        self.shade_run(layer, &sp, &layer.col, t, background, x, e, sink);
                     }
                 }
             }
             x = e;
         }
+    }
+
+    /// Colours texels `a..b` of a definite span with `col`.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn shade_run<S: RowSink>(
+        &mut self,
+        layer: &Layer,
+        sp: &Span,
+        col: &Col,
+        t: f64,
+        background: FacadeSample,
+        a: usize,
+        b: usize,
+        sink: &mut S,
+    ) {
+        if sink.wants_strips()
+            && let Some(id) = self.strip_id(col, layer.depth_m)
+        {
+            let samples = self.strip_samples(id);
+            sink.strip(a, b, id, samples.get(a..b).unwrap_or_default());
+            return;
+        }
+        if sink.wants_strips()
+            && self
+                .cached_bricks(col, t, layer.depth_m, a, b, sink)
+                .is_some()
+        {
+            return;
+        }
+        let xs = &self.xs[a..b];
+        if let (Some((chosen, seed)), Eval::Image(set)) = (sp.image, &layer.eval) {
+            let Some(img) = set.get(chosen) else {
+                sink.fill(a, b, background);
+                return;
+            };
+            // The same arithmetic as `Layer::probe_hits`; one colour per image texel.
+            let ly = t - sp.box_y0;
+            let v = ly / sp.box_h;
+            let mut run: Option<(usize, FacadeSample, FacadeSample)> = None;
+            for (k, &s) in xs.iter().enumerate() {
+                let local = [s - sp.box_x0, ly];
+                let texel = img.sample(local[0] / sp.box_w, v);
+                if let Some((start, last, m)) = run {
+                    if last == texel && matches!(col, Col::Inherit { .. }) {
+                        continue;
+                    }
+                    sink.fill(start, a + k, m);
+                }
+                let mut m = match col {
+                    Col::Inherit { .. } => texel,
+                    _ => {
+                        let ctx = PointCtx {
+                            s,
+                            t,
+                            i: sp.hu.index,
+                            j: sp.hv.index,
+                            local,
+                            size: [sp.box_w, sp.box_h],
+                            pu: layer.u.value(sp.hu.index, s),
+                            pv: layer.v.value(sp.hv.index, t),
+                            cell_seed: seed,
+                        };
+                        col.eval(&ctx, Some(&texel))
+                    }
+                };
+                m.height += layer.depth_m;
+                run = Some((a + k, texel, m));
+            }
+            if let Some((start, _, m)) = run {
+                sink.fill(start, b, m);
+            }
+            return;
+        }
+        if let Col::Custom(_) = col {
+            for (k, &s) in xs.iter().enumerate() {
+                let m = match layer.probe_hits(s, t, &sp.hu, &sp.hv) {
+                    Some(p) => layer.shade(&p, col),
+                    None => background,
+                };
+                sink.put(a + k, m);
+            }
+            return;
+        }
+        let ctx_at = |s: f64| PointCtx {
+            s,
+            t,
+            i: sp.hu.index,
+            j: sp.hv.index,
+            local: [s - sp.box_x0, t - sp.box_y0],
+            size: [sp.box_w, sp.box_h],
+            pu: layer.u.value(sp.hu.index, s),
+            pv: layer.v.value(sp.hv.index, t),
+            cell_seed: 0,
+        };
+        col.eval_row(xs, a, t, sp.box_x0, layer.depth_m, ctx_at, sink);
     }
 }
 
@@ -415,12 +680,36 @@ mod tests {
         let (ds, dt) = (w / nx as f64, h / ny as f64);
         let mut sweep = RowSweep::new(0.0, ds, nx);
         let mut row = vec![FacadeSample::default(); nx];
+        // The run sweep (column strips, brick-row cache) expanded back to texels.
+        let mut run_sweep = RowSweep::new(0.0, ds, nx);
+        let mut runs = RowRuns::default();
+        let mut expanded = vec![FacadeSample::default(); nx];
         for y in 0..ny {
             let t = h - (y as f64 + 0.5) * dt;
             sweep.row(stack, t, &mut row);
-            for (x, got) in row.iter().enumerate() {
+            run_sweep.row_runs(stack, t, &mut runs);
+            let mut a = 0;
+            for r in &runs.runs {
+                let b = r.end as usize;
+                assert!(b > a, "empty or unordered run");
+                match r.kind {
+                    RunKind::Const(m) => expanded[a..b].fill(m),
+                    RunKind::Strip(id) => {
+                        expanded[a..b].copy_from_slice(&run_sweep.strip_samples(id)[a..b]);
+                    }
+                }
+                a = b;
+            }
+            assert_eq!(a, nx, "runs cover the row");
+            // Runs are maximal: no two adjacent constant runs are equal.
+            for pair in runs.runs.windows(2) {
+                assert_ne!(pair[0].kind, pair[1].kind, "unmerged runs");
+            }
+            for (x, (got, from_runs)) in row.iter().zip(&expanded).enumerate() {
                 let s = (x as f64 + 0.5) * ds;
-                assert_eq!(*got, stack.sample(s, t), "texel ({x}, {y}) at ({s}, {t})");
+                let want = stack.sample(s, t);
+                assert_eq!(*got, want, "texel ({x}, {y}) at ({s}, {t})");
+                assert_eq!(*from_runs, want, "run texel ({x}, {y}) at ({s}, {t})");
             }
         }
     }
