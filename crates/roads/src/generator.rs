@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use polis_geom::GeomError;
 use polis_geom::graph::SnapOptions;
+use polis_geom::spatial::GridOptions;
 use polis_lsystem::{Derivation, DeriveOptions, Environment, TurtleState, TypedRules};
 use serde::{Deserialize, Serialize};
 
@@ -20,6 +21,11 @@ use crate::smooth::smooth_highways;
 /// Snap distance of the planar insertion itself: only rounding-level coincidences (the
 /// meaningful snapping is done by the local constraints with the snap radius).
 pub const INSERT_SNAP_M: f64 = 1e-3;
+
+/// Cell size of the network's spatial indexes: about a street segment, less than a
+/// highway one (with 64 m cells, 15,000 segments ran ~6 % more instructions; 96 m and
+/// 128 m measured alike). A speed knob only: answers do not depend on it.
+pub const INDEX_CELL_M: f64 = 96.0;
 
 /// Why the growth stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -226,7 +232,9 @@ impl RoadGenerator {
                 ..DeriveOptions::default()
             },
         );
-        let mut graph = RoadNetwork::new();
+        let mut graph = RoadNetwork::with_index_options(GridOptions {
+            cell_size: INDEX_CELL_M,
+        })?;
         let mut report = GrowthReport::default();
         let mut env = RoadEnv {
             graph: &mut graph,

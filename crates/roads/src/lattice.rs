@@ -153,6 +153,19 @@ impl LazyLattice {
         if v.is_nan() { f32::NAN } else { v }
     }
 
+    /// The four corner values of cell `(i, j)`, computing the missing ones (the slow
+    /// path, kept out of line so that the cached path stays small).
+    #[cold]
+    #[inline(never)]
+    fn corners(&self, i: i64, j: i64) -> [f64; 4] {
+        [
+            self.value(i, j),
+            self.value(i + 1, j),
+            self.value(i, j + 1),
+            self.value(i + 1, j + 1),
+        ]
+    }
+
     /// The lattice value at `(i, j)`, from the cache when the point is in the window.
     #[inline]
     fn value(&self, i: i64, j: i64) -> f64 {
@@ -218,12 +231,7 @@ impl Field for LazyLattice {
         let (i, j) = (x0 as i64, y0 as i64);
         let [v00, v10, v01, v11] = match self.cached_corners(i, j) {
             Some(c) => c,
-            None => [
-                self.value(i, j),
-                self.value(i + 1, j),
-                self.value(i, j + 1),
-                self.value(i + 1, j + 1),
-            ],
+            None => self.corners(i, j),
         };
         let bottom = v00 + (v10 - v00) * fx;
         let top = v01 + (v11 - v01) * fx;
