@@ -26,7 +26,7 @@ use polis_geom::field::Field;
 use polis_geom::glam::DVec3;
 use polis_geom::mesh::{to_world, triangulate};
 use polis_geom::scene::MaterialId;
-use polis_geom::{DVec2, Mesh, Polygon, PolygonWithHoles};
+use polis_geom::{DVec2, MAX_COORDINATE, Mesh, Polygon, PolygonWithHoles};
 use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
@@ -151,7 +151,19 @@ fn add_footpath(
             format!("{e}; give a simple outer ring (the kerb) with simple holes inside"),
         )
     };
-    strip.validate().map_err(invalid)?;
+    // Coordinates first (they bound the subdivision); `triangulate` validates the rest.
+    for (_, ring) in strip.rings() {
+        if let Some(p) = ring
+            .points()
+            .iter()
+            .find(|p| !(p.is_finite() && p.abs().max_element() <= MAX_COORDINATE))
+        {
+            return Err(ExportError::map(
+                "footpath strip",
+                format!("the point {p} is not finite or beyond ±{MAX_COORDINATE} m"),
+            ));
+        }
+    }
     let mut strip = strip.clone();
     strip.normalize();
     let split = PolygonWithHoles::new(

@@ -244,6 +244,29 @@ impl LayerSet {
     };
 }
 
+/// Checks roads as [`MapLayers::validate`] does.
+pub(crate) fn check_roads(roads: &[MapRoad]) -> Result<(), ExportError> {
+    for (i, r) in roads.iter().enumerate() {
+        let who = || format!("road {i} (id {})", r.id);
+        if r.points.len() < 2 {
+            return Err(ExportError::map(
+                who(),
+                format!("{} points; a road needs at least 2", r.points.len()),
+            ));
+        }
+        for (k, &p) in r.points.iter().enumerate() {
+            check_point(p, k, who)?;
+        }
+        if !(r.width_m.is_finite() && r.width_m >= 0.0) {
+            return Err(ExportError::map(
+                who(),
+                format!("width {} m must be finite and ≥ 0", r.width_m),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl MapLayers {
     /// Checks every feature: coordinates finite and within ±[`MAX_COORDINATE`] m, rings of
     /// at least three points, roads of at least two points, widths and heights finite and
@@ -264,24 +287,7 @@ impl MapLayers {
         for (i, l) in self.lots.iter().enumerate() {
             check_polygon(&l.polygon, || format!("lot {i} (id {})", l.id))?;
         }
-        for (i, r) in self.roads.iter().enumerate() {
-            let who = || format!("road {i} (id {})", r.id);
-            if r.points.len() < 2 {
-                return Err(ExportError::map(
-                    who(),
-                    format!("{} points; a road needs at least 2", r.points.len()),
-                ));
-            }
-            for (k, &p) in r.points.iter().enumerate() {
-                check_point(p, k, who)?;
-            }
-            if !(r.width_m.is_finite() && r.width_m >= 0.0) {
-                return Err(ExportError::map(
-                    who(),
-                    format!("width {} m must be finite and ≥ 0", r.width_m),
-                ));
-            }
-        }
+        check_roads(&self.roads)?;
         for (i, f) in self.footprints.iter().enumerate() {
             let who = || format!("footprint {i} (id {})", f.id);
             check_polygon(&f.polygon, who)?;

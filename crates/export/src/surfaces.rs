@@ -67,7 +67,7 @@ use polis_geom::{DVec2, Mesh};
 use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
-use crate::map::{MapLayers, MapRoad};
+use crate::map::{MapRoad, check_roads};
 
 mod junctions;
 
@@ -148,7 +148,8 @@ pub struct RoadSurfaceReport {
 /// with `material`, draped on `elevation` (metres above the layout plane at each layout
 /// point). See the [module docs](self) for the construction.
 ///
-/// Roads are checked as [`MapLayers::validate`] checks them; zero-width roads and
+/// Roads are checked as [`MapLayers::validate`](crate::map::MapLayers::validate) checks
+/// them; zero-width roads and
 /// zero-length segments are skipped. Fails with [`ExportError::InvalidMap`] when the
 /// elevation field returns a non-finite value, [`ExportError::InvalidOption`] on options
 /// out of range.
@@ -183,11 +184,7 @@ pub fn road_surfaces_with_report(
     material: Option<MaterialId>,
 ) -> Result<(Mesh, RoadSurfaceReport), ExportError> {
     check_options(options)?;
-    MapLayers {
-        roads: roads.to_vec(),
-        ..MapLayers::default()
-    }
-    .validate()?;
+    check_roads(roads)?;
     let plan = junctions::plan(roads, options);
     let drape = Drape::new(roads, &plan, elevation, options)?;
     let mut mesh = Mesh::with_capacity(
