@@ -393,6 +393,56 @@ mod tests {
         m.check_closed().unwrap();
     }
 
+    #[test]
+    fn roads_and_footpaths_export_to_glb_and_obj() {
+        use crate::map::{MapRoad, RoadClass};
+        use crate::surfaces::{RoadSurfaceOptions, road_surfaces};
+        use polis_geom::scene::{Material, Scene};
+        // A block between four streets, its footpath, on a slope.
+        let slope = FnField::new(|p: DVec2| 0.05 * p.x);
+        let c = [(0.0, 0.0), (50.0, 0.0), (50.0, 40.0), (0.0, 40.0)].map(|(x, y)| DVec2::new(x, y));
+        let roads: Vec<MapRoad> = (0..4)
+            .map(|k| MapRoad::new(vec![c[k], c[(k + 1) % 4]], RoadClass::Street, 8.0))
+            .collect();
+        let strip =
+            PolygonWithHoles::new(rect(4.0, 4.0, 46.0, 36.0), vec![rect(6.5, 6.5, 43.5, 33.5)]);
+        let mut scene = Scene::new();
+        let asphalt = scene.add_material(Material::new("asphalt", [0.2, 0.2, 0.2, 1.0]));
+        let paving = scene.add_material(Material::new("paving", [0.7, 0.7, 0.65, 1.0]));
+        let road = road_surfaces(
+            &roads,
+            &slope,
+            &RoadSurfaceOptions::default(),
+            Some(asphalt),
+        )
+        .unwrap();
+        let path =
+            footpath_mesh(&strip, &slope, &FootpathOptions::default(), Some(paving)).unwrap();
+        let (rt, pt) = (road.triangle_count(), path.triangle_count());
+        let root = scene.add_root("city");
+        for (name, mesh) in [("roads", road), ("footpaths", path)] {
+            let node = scene.add_node(root, name).unwrap();
+            let id = scene.add_mesh(mesh);
+            scene.attach_mesh(node, id).unwrap();
+        }
+        let mut glb = Vec::new();
+        crate::glb::write_glb(&scene, &Default::default(), &mut glb).unwrap();
+        let doc = crate::testing::decode_glb(&glb);
+        assert_eq!((doc.meshes, doc.materials), (2, 2));
+        let tris: Vec<usize> = doc
+            .prims
+            .iter()
+            .flatten()
+            .map(|p| p.indices.len() / 3)
+            .collect();
+        assert_eq!(tris, vec![rt, pt]);
+        let (mut obj, mut files) = (Vec::new(), crate::sink::MemorySink::new());
+        crate::obj::write_obj(&scene, &Default::default(), &mut obj, &mut files).unwrap();
+        let (models, _) = crate::obj::tests::load(&obj, &files);
+        let faces: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+        assert_eq!(faces, rt + pt);
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
