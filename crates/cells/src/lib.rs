@@ -178,8 +178,9 @@ impl CellExtractor {
         // The line sweep certifies planarity and, on the way, finds the edge below every
         // node (for the containment of components). Only when it finds a contact does the
         // slower grid check run, to list every conflict.
+        // A graph built only by planar insertion vouches for itself.
         let mut below_known = false;
-        if params.check_planarity {
+        if params.check_planarity && !graph.is_planar_by_construction() {
             below_known = self.line.run(&self.topo, true);
             if !below_known {
                 self.check.check(&self.topo)?;

@@ -27,8 +27,11 @@ pub struct CellParams {
     /// Verify that no two edges cross or overlap and that no node lies inside an edge
     /// before extracting, and fail with [`Error::NotPlanar`](crate::Error::NotPlanar)
     /// naming the offending edges. An exact `O(n log n)` line sweep (Shamos–Hoey), about a
-    /// quarter of the extraction's time; switch it off only for graphs known to be planar
-    /// (e.g. built with planar insertion).
+    /// quarter of the extraction's time. Skipped, whatever this says, for graphs that are
+    /// planar by construction
+    /// ([`PlanarGraph::is_planar_by_construction`](polis_geom::PlanarGraph::is_planar_by_construction):
+    /// built only with planar insertion and removals); switch it off only for other graphs
+    /// known to be planar.
     /// On a non-planar graph without the check the output is unspecified (but no panic).
     /// Default: `true`.
     pub check_planarity: bool,

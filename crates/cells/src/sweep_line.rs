@@ -48,9 +48,11 @@ struct Seg {
 /// Buffers and results of the sweep.
 #[derive(Debug, Default)]
 pub(crate) struct SweepLine {
-    /// Every edge once started, in the order the sweep met their left ends (the status
-    /// refers into it: its entries stay close in memory, unlike the nodes' positions).
+    /// The active edges' geometry, referred to by the status. Entries of edges that ended
+    /// are reused (`free`), so this stays as small as the status and in cache, unlike the
+    /// nodes' positions.
     segs: Vec<Seg>,
+    free: Vec<u32>,
     /// Active edges bottom to top, as indices into `segs`.
     status: Vec<u32>,
     /// Edges starting at the current node, bottom to top, as indices into `segs`.
@@ -70,7 +72,7 @@ impl SweepLine {
         let n = topo.len();
         self.status.clear();
         self.segs.clear();
-        self.segs.reserve(topo.slots() / 2);
+        self.free.clear();
         self.below.clear();
         self.below.resize(n, NONE);
         for r in 0..n as u32 {
@@ -108,12 +110,21 @@ impl SweepLine {
                     continue;
                 }
                 let q = topo.p(w);
-                let i = self.segs.len() as u32;
-                self.segs.push(Seg {
+                let seg = Seg {
                     a: p,
                     b: q,
                     slot: k,
-                });
+                };
+                let i = match self.free.pop() {
+                    Some(i) => {
+                        self.segs[i as usize] = seg;
+                        i
+                    }
+                    None => {
+                        self.segs.push(seg);
+                        self.segs.len() as u32 - 1
+                    }
+                };
                 if q.y < p.y {
                     self.starting.insert(down, i);
                     down += 1;
@@ -124,6 +135,7 @@ impl SweepLine {
             if test && hi - lo != ending {
                 return false;
             }
+            self.free.extend_from_slice(&self.status[lo..hi]);
             let segs = &self.segs;
             if test {
                 for pair in self.starting.windows(2) {

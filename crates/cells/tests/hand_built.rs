@@ -611,6 +611,49 @@ fn non_planar_input_names_the_edges() {
 }
 
 #[test]
+fn graphs_planar_by_construction_skip_the_check_and_others_do_not() {
+    // Built by planar insertion only: the check is skipped, the cells are the same.
+    let opts = polis_cells::geom::SnapOptions::default();
+    let mut g = G::new();
+    for i in 0..4 {
+        let x = f64::from(i) * 10.0;
+        g.insert_segment(DVec2::new(x, -5.0), DVec2::new(x, 35.0), 1, &opts)
+            .unwrap();
+        g.insert_segment(DVec2::new(-5.0, x), DVec2::new(35.0, x), 2, &opts)
+            .unwrap();
+    }
+    assert!(g.is_planar_by_construction());
+    let trusted = extract(&g).unwrap();
+    assert_eq!(trusted.cells.len(), 9);
+    let mut copy = G::new();
+    let ids: Vec<NodeId> = g
+        .nodes()
+        .map(|(_, p, &n)| copy.add_node(p, n).unwrap())
+        .collect();
+    for (_, a, b, &e) in g.edges() {
+        copy.add_edge(ids[a.index()], ids[b.index()], e).unwrap();
+    }
+    assert!(!copy.is_planar_by_construction());
+    assert_eq!(extract(&copy).unwrap().cells, trusted.cells);
+    // One raw crossing edge afterwards: the flag is gone and the check finds it.
+    let (a, b) = (
+        trusted.cells[0].boundary.nodes[0],
+        trusted.cells[0].boundary.nodes[2],
+    );
+    let (c, d) = (
+        trusted.cells[0].boundary.nodes[1],
+        trusted.cells[0].boundary.nodes[3],
+    );
+    g.add_edge(a, b, 9).unwrap();
+    g.add_edge(c, d, 9).unwrap();
+    assert!(!g.is_planar_by_construction());
+    assert!(matches!(
+        extract(&g),
+        Err(Error::NotPlanar { total: 1, .. })
+    ));
+}
+
+#[test]
 fn trivial_graphs() {
     let g = G::new();
     let d = extract(&g).unwrap();

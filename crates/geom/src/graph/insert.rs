@@ -64,6 +64,12 @@ use crate::spatial::SpatialIndex;
 pub const ROUNDING_TOLERANCE: f64 = 1e-12;
 
 /// The rounding tolerance at `p`, in metres (see [`ROUNDING_TOLERANCE`]).
+/// Whether a planar insertion that returned `result` left a planar graph planar: it did
+/// unless it reports a corrupt graph (the other errors leave the graph unchanged).
+fn keeps_planarity<T>(result: &Result<T, GeomError>) -> bool {
+    !matches!(result, Err(GeomError::GraphCorrupt(_)))
+}
+
 fn rounding_eps(p: DVec2) -> f64 {
     ROUNDING_TOLERANCE * p.abs().max_element().max(1.0)
 }
@@ -189,6 +195,22 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         q: DVec2,
         payload: E,
         options: &SnapOptions,
+        make_node: impl FnMut(DVec2) -> N,
+    ) -> Result<Insertion, GeomError> {
+        let planar = self.planar_by_construction;
+        let result = self.insert_segment_unmarked(p, q, payload, options, make_node);
+        self.planar_by_construction = planar && keeps_planarity(&result);
+        result
+    }
+
+    /// [`insert_segment_with`](Self::insert_segment_with) without the bookkeeping of
+    /// [`is_planar_by_construction`](Self::is_planar_by_construction).
+    fn insert_segment_unmarked(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: E,
+        options: &SnapOptions,
         mut make_node: impl FnMut(DVec2) -> N,
     ) -> Result<Insertion, GeomError> {
         validate_point(0, p)?;
@@ -242,11 +264,19 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     ) -> Result<(NodeId, Option<(EdgeId, EdgeId)>), GeomError> {
         validate_point(0, p)?;
         options.validate()?;
+        let planar = self.planar_by_construction;
         let mut out = Insertion::default();
         let snap = options.snap_distance.max(rounding_eps(p));
         let anchor = self.anchor(p, snap);
-        let n = self.realize(anchor, &mut make_node, &mut out)?;
-        Ok((n, out.split.first().copied()))
+        let result = self.realize(anchor, &mut make_node, &mut out);
+        // A split bends the edge by rounding: vouch for planarity only if the pieces meet
+        // nothing (the same check as insert_segment's, without changing the result).
+        let pieces_ok = out
+            .split
+            .iter()
+            .all(|&(e, piece)| self.check_local(&[e, piece]).is_ok());
+        self.planar_by_construction = planar && keeps_planarity(&result) && pieces_ok;
+        Ok((result?, out.split.first().copied()))
     }
 
     fn anchor(&self, p: DVec2, snap: f64) -> Anchor {

@@ -261,6 +261,7 @@ fn check_insertions(segs: &[(DVec2, DVec2)], snap: f64, tol: f64) -> Result<(), 
                 "after segment {i} ({p} {q}): {e}"
             )));
         }
+        prop_assert!(g.is_planar_by_construction());
     }
     let near_edge = |x: DVec2| g.nearest_edge(x, tol + 3.0 * snap).is_some();
     for &(p, q) in &inserted {

@@ -156,6 +156,9 @@ pub struct PlanarGraph<N, E> {
     pub(crate) node_index: SegmentIndex<NodeId>,
     /// Every live edge as a segment.
     pub(crate) edge_index: SegmentIndex<EdgeId>,
+    /// Every change so far kept the graph planar by construction (see
+    /// [`PlanarGraph::is_planar_by_construction`]).
+    pub(crate) planar_by_construction: bool,
 }
 
 impl<N, E> Default for PlanarGraph<N, E> {
@@ -188,7 +191,22 @@ impl<N, E> PlanarGraph<N, E> {
             edge_count: 0,
             node_index: SegmentIndex::default(),
             edge_index: SegmentIndex::default(),
+            planar_by_construction: true,
         }
+    }
+
+    /// Whether the graph is planar *by construction*: every change since it was created
+    /// empty was a planar insertion ([`insert_segment`](Self::insert_segment),
+    /// [`insert_point`](Self::insert_point) and their `_with` forms, which guarantee
+    /// planarity), a removal, or a payload edit. Any raw [`add_node`](Self::add_node),
+    /// [`add_edge`](Self::add_edge) or [`split_edge`](Self::split_edge) call, a
+    /// [`GeomError::GraphCorrupt`] from an insertion, and deserialisation clear it for
+    /// good (the graph may still be planar, but nothing vouches for it).
+    ///
+    /// Consumers that would otherwise verify planarity (e.g. polis-cells' check) may skip
+    /// that work when this is `true`.
+    pub fn is_planar_by_construction(&self) -> bool {
+        self.planar_by_construction
     }
 
     /// An empty graph whose spatial indexes use `options` (a speed knob only).
@@ -488,6 +506,7 @@ impl<N, E> PlanarGraph<N, E> {
         validate_point(self.nodes.len(), pos)?;
         let id = next_id(self.nodes.len(), "node")?;
         self.node_index.insert_point(NodeId(id), pos)?;
+        self.planar_by_construction = false;
         self.nodes.push(Some(Node {
             pos,
             payload,
@@ -519,6 +538,7 @@ impl<N, E> PlanarGraph<N, E> {
         }
         let id = EdgeId(next_id(self.edges.len(), "edge")?);
         self.edge_index.insert_segment(id, pa, pb)?;
+        self.planar_by_construction = false;
         self.edges.push(Some(Edge {
             ends: [a, b],
             payload,
@@ -671,6 +691,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         // Check there is room for one more edge id before changing anything.
         next_id(self.edges.len() + 1, "edge")?;
         let new_edge = EdgeId(self.edges.len() as u32);
+        self.planar_by_construction = false;
         let m = self.add_node(point, node_payload)?;
         self.edge_index.insert_segment(e, pa, point)?;
         self.edge_index.insert_segment(new_edge, point, pb)?;
@@ -835,6 +856,51 @@ mod tests {
         assert!(g.split_edge(e, v(5.0, 0.0), 0).is_err());
         assert!(g.split_edge(e, v(f64::INFINITY, 0.0), 0).is_err());
         g.check_invariants().unwrap();
+    }
+
+    #[test]
+    fn planar_by_construction_survives_only_planar_changes() {
+        let opts = SnapOptions::default();
+        let mut g: PlanarGraph<(), u8> = PlanarGraph::new();
+        assert!(g.is_planar_by_construction());
+        g.insert_segment(v(0.0, 0.0), v(10.0, 10.0), 1, &opts)
+            .unwrap();
+        let r = g
+            .insert_segment(v(0.0, 10.0), v(10.0, 0.0), 2, &opts)
+            .unwrap();
+        g.insert_point(v(2.0, 2.0), &opts).unwrap();
+        g.insert_point(v(20.0, 2.0), &opts).unwrap();
+        // Refused input leaves the graph (and the flag) unchanged.
+        assert!(
+            g.insert_segment(v(0.0, 0.0), v(0.0, 0.0), 3, &opts)
+                .is_err()
+        );
+        g.remove_edge(r.path[0]).unwrap();
+        *g.edge_payload_mut(r.path[1]).unwrap() = 7;
+        assert!(g.is_planar_by_construction());
+        g.check_invariants().unwrap();
+        let clone = g.clone();
+        assert!(clone.is_planar_by_construction());
+
+        let mut raw = g.clone();
+        raw.add_node(v(5.0, 6.0), ()).unwrap();
+        assert!(!raw.is_planar_by_construction());
+        // Planar insertion afterwards does not restore it.
+        raw.insert_segment(v(30.0, 0.0), v(40.0, 0.0), 4, &opts)
+            .unwrap();
+        assert!(!raw.is_planar_by_construction());
+
+        let mut raw = g.clone();
+        let (a, b) = (g.node_ids().next().unwrap(), g.node_ids().last().unwrap());
+        if raw.find_edge(a, b).is_none() {
+            raw.add_edge(a, b, 0).unwrap();
+            assert!(!raw.is_planar_by_construction());
+        }
+        let mut raw = g.clone();
+        let e = raw.edge_ids().next().unwrap();
+        let (pa, pb) = raw.segment(e).unwrap();
+        raw.split_edge(e, pa.lerp(pb, 0.5), ()).unwrap();
+        assert!(!raw.is_planar_by_construction());
     }
 
     #[test]
