@@ -118,8 +118,12 @@ impl Building {
 pub(crate) struct Context<'a> {
     pub grammar: &'a BuildingGrammar,
     pub templates: &'a [Template],
-    /// The lot, local coordinates.
-    pub lot: &'a Polygon,
+    /// The lot, layout coordinates.
+    pub lot_world: &'a Polygon,
+    /// The local origin in the layout.
+    pub origin: DVec2,
+    /// The lot in local coordinates, made when first needed.
+    pub lot_local: std::cell::OnceCell<Polygon>,
     /// Unit axis along the primary street edge.
     pub frame_x: DVec2,
     /// Height limit, metres.
@@ -127,6 +131,14 @@ pub(crate) struct Context<'a> {
     pub floor_height: f64,
     pub ground_floor_height: f64,
     pub slope_default: f64,
+}
+
+impl Context<'_> {
+    /// The lot in local coordinates.
+    fn lot(&self) -> &Polygon {
+        self.lot_local
+            .get_or_init(|| self.lot_world.translated(-self.origin))
+    }
 }
 
 #[derive(Clone)]
@@ -153,8 +165,8 @@ pub(crate) fn interpret(
     s: &ParamString,
 ) -> Result<(Vec<Part>, Vec<FacadeFace>, u32), BuildingsError> {
     let mut out = Output {
-        parts: Vec::new(),
-        facades: Vec::new(),
+        parts: Vec::with_capacity(4),
+        facades: Vec::with_capacity(4 * footprint.len()),
         fallbacks: 0,
     };
     let mut cur = Shape {
@@ -209,7 +221,7 @@ pub(crate) fn interpret(
                 let Some((ring, z0, h)) = clip(cx, &cur) else {
                     continue;
                 };
-                out.emit(cx, op, &ring, z0, h, p)?;
+                out.emit(cx, op, ring, z0, h, p)?;
             }
         }
     }
@@ -309,7 +321,7 @@ impl Output {
                     x * u1 + y * v1,
                     x * u0 + y * v1,
                 ];
-                if !inside(cx.lot, &corners) {
+                if !inside(cx.lot(), &corners) {
                     self.fallbacks += 1;
                     return Ok(());
                 }
@@ -361,16 +373,18 @@ impl Output {
         let g = cx.ground_floor_height;
         for i in 0..n {
             let (a, b) = (ring[i], ring[(i + 1) % n]);
-            let mut bands: Vec<(f64, f64, FacadeRole)> = Vec::with_capacity(2);
-            if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
-                bands.push((z0, z0 + g, FacadeRole::GroundFloor));
-                bands.push((z0 + g, z0 + h, FacadeRole::Wall));
-            } else if z0 <= 0.0 {
-                bands.push((z0, z0 + h, FacadeRole::GroundFloor));
-            } else {
-                bands.push((z0, z0 + h, FacadeRole::Wall));
-            }
-            for (lo, hi, role) in bands {
+            let bands: [Option<(f64, f64, FacadeRole)>; 2] =
+                if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
+                    [
+                        Some((z0, z0 + g, FacadeRole::GroundFloor)),
+                        Some((z0 + g, z0 + h, FacadeRole::Wall)),
+                    ]
+                } else if z0 <= 0.0 {
+                    [Some((z0, z0 + h, FacadeRole::GroundFloor)), None]
+                } else {
+                    [Some((z0, z0 + h, FacadeRole::Wall)), None]
+                };
+            for (lo, hi, role) in bands.into_iter().flatten() {
                 let quad = [
                     to_world(a, lo),
                     to_world(b, lo),
@@ -442,13 +456,13 @@ fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
 }
 
 /// The part of the shape to draw: inside the lot, below the top; `None` if nothing is.
-fn clip(cx: &Context<'_>, s: &Shape) -> Option<(Vec<DVec2>, f64, f64)> {
-    let ring = s.ring.as_ref()?;
+fn clip<'s>(cx: &Context<'_>, s: &'s Shape) -> Option<(&'s [DVec2], f64, f64)> {
+    let ring = s.ring.as_deref()?;
     let top = (s.base + s.height).min(cx.top);
     if !(s.base >= 0.0 && top - s.base >= MIN_PART_HEIGHT) {
         return None;
     }
-    (s.inside || inside(cx.lot, ring)).then(|| (ring.clone(), s.base, top - s.base))
+    (s.inside || inside(cx.lot(), ring)).then_some((ring, s.base, top - s.base))
 }
 
 fn is_convex(r: &Option<Vec<DVec2>>) -> bool {

@@ -43,7 +43,6 @@ pub fn footprint(
         .filter(|&&e| e < n)
         .map(|&e| if reversed { (2 * n - 2 - e) % n } else { e })
         .collect();
-    let poly: PolygonWithHoles = ring.clone().into();
     let ring_edge = |p: &Polygon, e: usize, rev: bool| {
         let (a, b) = p.edge(if rev { (2 * n - 2 - e) % n } else { e });
         if rev { (b, a) } else { (a, b) }
@@ -51,6 +50,7 @@ pub fn footprint(
     let region = match strategy {
         FootprintStrategy::Downtown => Some(ring),
         FootprintStrategy::Industrial => {
+            let poly: PolygonWithHoles = ring.into();
             largest(polis_lots::inset(&poly, params.industrial_setback)?)
         }
         FootprintStrategy::Suburban | FootprintStrategy::SuburbanRectangle => {
@@ -66,6 +66,7 @@ pub fn footprint(
                         }
                     })
                     .collect();
+                let poly: PolygonWithHoles = ring.into();
                 largest(polis_lots::inset_weighted(&poly, &w, params.side_setback)?)
             }
         }
@@ -118,8 +119,9 @@ const RECTANGLE_REFINE_ROUNDS: usize = 3;
 /// an inside gap `(v0, v1)` is exactly the tallest rectangles over `[u0, u1]` can be. The
 /// height is therefore exact for every pair; the pairs are the vertices' `u` coordinates
 /// (which hold the optimum for orthogonal regions) and a uniform grid of
-/// [`RECTANGLE_GRID_STEPS`] steps, the widest pairs first with an area bound to skip the
-/// rest, then three rounds of a finer grid around the best pair.
+/// [`RECTANGLE_GRID_STEPS`] steps, the widest pairs first, skipping every pair whose
+/// width times the region's spread on either side line cannot beat the best so far, then
+/// three rounds of a finer grid around the best pair.
 ///
 /// # Guarantees
 /// * The result lies inside the region: it is shrunk by a relative `1e-9` margin after
@@ -174,11 +176,22 @@ pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     us.extend((1..RECTANGLE_GRID_STEPS).map(|k| lo.x + step * k as f64));
     us.sort_by(f64::total_cmp);
     us.dedup();
+    // Upper bounds: a rectangle's side at `u` is a vertical segment inside the region,
+    // no longer than the region's spread on that line.
+    let spread: Vec<f64> = us.iter().map(|&u| strip.spread(u)).collect();
     let mut best = Best::default();
     for (i, &u0) in us.iter().enumerate() {
-        for &u1 in us[i + 1..].iter().rev() {
-            if (u1 - u0) * h <= best.area {
+        let s0 = spread[i];
+        if (hi.x - u0) * s0 <= best.area {
+            continue;
+        }
+        for (j, &u1) in us.iter().enumerate().skip(i + 1).rev() {
+            let width = u1 - u0;
+            if width * s0 <= best.area {
                 break;
+            }
+            if width * spread[j] <= best.area {
+                continue;
             }
             strip.consider(u0, u1, &mut best);
         }
@@ -191,9 +204,14 @@ pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     for _ in 0..RECTANGLE_REFINE_ROUNDS {
         let (b0, b1) = (best.u0, best.u1);
         let cand = |c: f64| (-4..=4).map(move |k| c + r * 0.25 * f64::from(k));
+        let c1: Vec<(f64, f64)> = cand(b1)
+            .filter(|u| *u <= hi.x)
+            .map(|u| (u, strip.spread(u)))
+            .collect();
         for u0 in cand(b0).filter(|u| *u >= lo.x) {
-            for u1 in cand(b1).filter(|u| *u <= hi.x) {
-                if u1 > u0 && (u1 - u0) * h > best.area {
+            let s0 = strip.spread(u0);
+            for &(u1, s1) in &c1 {
+                if u1 > u0 && (u1 - u0) * s0.min(s1) > best.area {
                     strip.consider(u0, u1, &mut best);
                 }
             }
@@ -246,6 +264,29 @@ struct Strip<'a> {
 }
 
 impl Strip<'_> {
+    /// The region's extent along the line `u = const`: from its lowest to its highest
+    /// point there (0 if the line misses it).
+    fn spread(&self, u: f64) -> f64 {
+        let (mut v0, mut v1) = (f64::INFINITY, f64::NEG_INFINITY);
+        let n = self.ring.len();
+        for i in 0..n {
+            let (a, b) = (self.ring[i], self.ring[(i + 1) % n]);
+            let (p, q) = if a.x <= b.x { (a, b) } else { (b, a) };
+            if u < p.x || u > q.x {
+                continue;
+            }
+            let (va, vb) = if p.x == q.x {
+                (p.y, q.y)
+            } else {
+                let v = p.y + (q.y - p.y) * ((u - p.x) / (q.x - p.x));
+                (v, v)
+            };
+            v0 = v0.min(va.min(vb));
+            v1 = v1.max(va.max(vb));
+        }
+        (v1 - v0).max(0.0)
+    }
+
     /// The tallest rectangle over `[u0, u1]` inside the region; replaces `best` when larger.
     fn consider(&mut self, u0: f64, u1: f64, best: &mut Best) {
         self.blocked.clear();

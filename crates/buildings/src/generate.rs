@@ -239,13 +239,14 @@ impl BuildingGenerator {
             .iter()
             .map(|&p| p - origin)
             .collect();
-        let lot_local = lot.polygon.translated(-origin);
         let (w, d, frame_x) = extents(&local);
         let p = &self.params;
         let cx = Context {
             grammar,
             templates: &self.templates,
-            lot: &lot_local,
+            lot_world: &lot.polygon,
+            origin,
+            lot_local: std::cell::OnceCell::new(),
             frame_x,
             top: plan.height,
             floor_height: p.floor_height,
@@ -268,6 +269,7 @@ impl BuildingGenerator {
             ..DeriveOptions::default()
         };
         let mut derivation = Derivation::new(grammar.grammar(), axiom, options);
+        let mut footprint = plan.footprint;
         let mut out = Vec::new();
         for k in 0..=lod {
             if k > 0 {
@@ -291,7 +293,11 @@ impl BuildingGenerator {
                 floors: plan.floors,
                 lod: k,
                 origin,
-                footprint: plan.footprint.clone(),
+                footprint: if k == lod {
+                    std::mem::replace(&mut footprint, Polygon::new(Vec::new()))
+                } else {
+                    footprint.clone()
+                },
                 parts,
                 facades,
                 fallbacks,

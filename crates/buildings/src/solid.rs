@@ -11,8 +11,9 @@ use polis_geom::{
 };
 
 /// Appends the planar polygon `pts` (counter-clockwise seen from its front) as one
-/// flat-shaded face. Convex faces are fanned; others go through the constrained Delaunay
-/// triangulation. Leaves the mesh unchanged on failure.
+/// flat-shaded face. Convex faces are fanned; others are ear-clipped (or, when that gets
+/// stuck, go through the constrained Delaunay triangulation). Leaves the mesh unchanged
+/// on failure.
 pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> {
     let n = pts.len();
     if n < 3 {
@@ -44,15 +45,37 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
     };
     let b = nrm.cross(t);
     let plane: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(t), p.dot(b))).collect();
+    // Triangulation decides on an exact projection (dropping the normal's dominant axis,
+    // no arithmetic), so points collinear in space stay collinear: a rotated basis would
+    // round them apart and let a zero-area ear through.
+    let k = if nrm.x.abs() >= nrm.y.abs() && nrm.x.abs() >= nrm.z.abs() {
+        0
+    } else if nrm.y.abs() >= nrm.z.abs() {
+        1
+    } else {
+        2
+    };
+    let flip = nrm[k] < 0.0;
+    let exact: Vec<DVec2> = pts
+        .iter()
+        .map(|p| {
+            let (a, b) = (p[(k + 1) % 3], p[(k + 2) % 3]);
+            if flip {
+                DVec2::new(b, a)
+            } else {
+                DVec2::new(a, b)
+            }
+        })
+        .collect();
     let convex = (0..n).all(|i| {
-        orient2d(plane[i], plane[(i + 1) % n], plane[(i + 2) % n]) == Orientation::CounterClockwise
+        orient2d(exact[i], exact[(i + 1) % n], exact[(i + 2) % n]) == Orientation::CounterClockwise
     });
     let base = mesh.positions.len() as u32;
     let first = mesh.indices.len();
     let tris: Vec<[u32; 3]> = if convex {
         (1..n as u32 - 1).map(|i| [0, i, i + 1]).collect()
     } else {
-        triangulate_ring(&plane, false).ok_or(GeomError::DegenerateTriangle {
+        triangulate_ring(&exact, false).ok_or(GeomError::DegenerateTriangle {
             triangle: mesh.triangle_count(),
         })??
     };
@@ -371,6 +394,38 @@ mod tests {
             DVec2::new(6.0, -1.0),
         ];
         assert!(matches!(triangulate_ring(&bow, false), Some(Err(_)) | None));
+    }
+
+    #[test]
+    fn faces_with_collinear_corners_in_space_get_no_slivers() {
+        // (−2, 5), (1, 2), (2, 1) lie on x + y = 3: a rotated plane basis used to round
+        // them apart and the ear clipper took the zero-area ear (found by the mansard
+        // property test, pinned in proptest-regressions/roofs.txt).
+        let ring = [
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 4.0),
+            (-2.0, 5.0),
+            (-4.0, 4.0),
+            (-4.0, 1.0),
+            (-5.0, -1.0),
+            (-4.0, -4.0),
+            (-2.0, -4.0),
+            (0.0, -3.0),
+            (3.0, -4.0),
+            (4.0, -2.0),
+        ]
+        .map(|(x, y)| DVec2::new(x, y));
+        for z in [0.0, 1.0, 7.3] {
+            let down: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z)).collect();
+            let up: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z)).collect();
+            let mut m = Mesh::new(None);
+            add_face(&mut m, &down).unwrap();
+            add_face(&mut m, &up).unwrap();
+            m.validate().unwrap();
+            assert_eq!(m.triangle_count(), 2 * (ring.len() - 2));
+        }
     }
 
     #[test]
