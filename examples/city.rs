@@ -88,7 +88,10 @@ fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
         }
     }
     let h = config.size_m * 0.5;
-    let extent = Aabb2::new(polis::geom::DVec2::new(-h, -h), polis::geom::DVec2::new(h, h));
+    let extent = Aabb2::new(
+        polis::geom::DVec2::new(-h, -h),
+        polis::geom::DVec2::new(h, h),
+    );
     for (flag, path, scale) in maps {
         let png = MapSpec::png(path, extent);
         let scaled = |factor: f64| match &png {
@@ -172,14 +175,29 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     println!("  buildings       {:>9}", s.buildings);
     println!("  dressed         {:>9}", s.dressed_buildings);
     println!("  facade tiles    {:>9}", s.facade_tiles);
-    println!("  texture memory  {:>7.1} MiB", s.texture_bytes as f64 / 1048576.0);
+    println!(
+        "  texture memory  {:>7.1} MiB",
+        s.texture_bytes as f64 / 1048576.0
+    );
     println!("  triangles       {:>9}", s.scene_triangles);
     println!("  skipped         {:>9}", city.report.skipped.len());
     for stage in Stage::ALL {
-        println!("  {:<15} {:>7.1} ms", stage.name(), s.time(stage).as_secs_f64() * 1e3);
+        println!(
+            "  {:<15} {:>7.1} ms",
+            stage.name(),
+            s.time(stage).as_secs_f64() * 1e3
+        );
     }
-    println!("  {:<15} {:>7.1} ms", "generate total", s.total_time().as_secs_f64() * 1e3);
-    println!("  {:<15} {:>7.1} ms", "write files", write_time.as_secs_f64() * 1e3);
+    println!(
+        "  {:<15} {:>7.1} ms",
+        "generate total",
+        s.total_time().as_secs_f64() * 1e3
+    );
+    println!(
+        "  {:<15} {:>7.1} ms",
+        "write files",
+        write_time.as_secs_f64() * 1e3
+    );
     for f in &written.files {
         println!("wrote {}", f.display());
     }

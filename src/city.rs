@@ -292,7 +292,8 @@ pub fn trace_mask(mask: &dyn Field, size_m: f64, cell_m: f64) -> Vec<PolygonWith
             let y = -h + (r as f64 + 0.5) * step;
             let mut c = 0;
             while c < n {
-                let inside = |c: usize| mask.sample(DVec2::new(-h + (c as f64 + 0.5) * step, y)) >= 0.5;
+                let inside =
+                    |c: usize| mask.sample(DVec2::new(-h + (c as f64 + 0.5) * step, y)) >= 0.5;
                 if inside(c) {
                     let c0 = c;
                     while c < n && inside(c) {
@@ -336,7 +337,10 @@ mod tests {
         let polys = trace_mask(&disc, 1000.0, 10.0);
         let area: f64 = polys.iter().map(|p| p.area()).sum();
         let exact = std::f64::consts::PI * 300.0 * 300.0;
-        assert!((area - exact).abs() < 2.0 * std::f64::consts::PI * 300.0 * 10.0, "{area}");
+        assert!(
+            (area - exact).abs() < 2.0 * std::f64::consts::PI * 300.0 * 10.0,
+            "{area}"
+        );
         for p in &polys {
             p.validate().unwrap();
         }

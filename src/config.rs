@@ -261,7 +261,10 @@ const PRESETS: &[(&str, &str)] = &[
     ("default", include_str!("../presets/default.json")),
     ("manhattan", include_str!("../presets/manhattan.json")),
     ("paris", include_str!("../presets/paris.json")),
-    ("san_francisco", include_str!("../presets/san_francisco.json")),
+    (
+        "san_francisco",
+        include_str!("../presets/san_francisco.json"),
+    ),
     ("old_town", include_str!("../presets/old_town.json")),
     ("suburbia", include_str!("../presets/suburbia.json")),
 ];
@@ -368,8 +371,7 @@ impl CityConfig {
             ));
         }
         for (i, b) in self.zoning.bands.iter().enumerate() {
-            if !(b.min_density.is_finite() && b.max_height_m.is_finite() && b.max_height_m > 0.0)
-            {
+            if !(b.min_density.is_finite() && b.max_height_m.is_finite() && b.max_height_m > 0.0) {
                 return Err(Error::config(
                     format!("zoning.bands[{i}]"),
                     "min_density must be finite and max_height_m finite and > 0",
@@ -391,7 +393,8 @@ impl CityConfig {
                 format!("{ppm}; give 1 to 512 texels per metre"),
             ));
         }
-        if !(self.scene.kerb_height_m.is_finite() && (0.0..=5.0).contains(&self.scene.kerb_height_m))
+        if !(self.scene.kerb_height_m.is_finite()
+            && (0.0..=5.0).contains(&self.scene.kerb_height_m))
         {
             return Err(Error::config(
                 "scene.kerb_height_m",

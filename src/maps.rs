@@ -226,7 +226,11 @@ fn build_shape(shape: &Shape, name: &str, salt: u64) -> Result<Arc<dyn Field>> {
             wavelength_m,
             seed,
         } => {
-            finite(name, "island", &[centre[0], centre[1], angle_deg, roughness])?;
+            finite(
+                name,
+                "island",
+                &[centre[0], centre[1], angle_deg, roughness],
+            )?;
             finite_pos(name, "radii_m[0]", radii_m[0])?;
             finite_pos(name, "radii_m[1]", radii_m[1])?;
             finite_pos(name, "wavelength_m", wavelength_m)?;
@@ -492,7 +496,11 @@ mod tests {
         assert!(matches!(fbm, MapSpec::Field(FieldSpec::Fbm(_))));
         let island = island.build("water", 1).unwrap();
         assert_eq!(island.sample(DVec2::ZERO), 0.0, "the centre is land");
-        assert_eq!(island.sample(DVec2::new(5000.0, 0.0)), 1.0, "far away is water");
+        assert_eq!(
+            island.sample(DVec2::new(5000.0, 0.0)),
+            1.0,
+            "far away is water"
+        );
     }
 
     #[test]
@@ -518,7 +526,10 @@ mod tests {
             seed: 0,
         });
         let err = bad.build("maps.population", 0).err().unwrap();
-        assert!(err.to_string().contains("maps.population.radius_m"), "{err}");
+        assert!(
+            err.to_string().contains("maps.population.radius_m"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -209,11 +209,25 @@ impl Pipeline {
                     widths.push(network.edge_payload(e)?.width);
                 }
             }
+            // Islands touching the boundary at a node are moved apart by a micrometre
+            // so the region is a valid polygon with holes; a cell where that fails is
+            // skipped and reported.
+            let polygon = match cell.polygon_with_holes() {
+                Ok(p) => p,
+                Err(e) => {
+                    report.skipped.push(Skip {
+                        stage: Stage::Lots,
+                        id,
+                        reason: format!("cell {id}: {e}"),
+                    });
+                    continue;
+                }
+            };
             inputs.push(CellInput {
                 cell,
                 region: polis_lots::Cell {
                     id,
-                    polygon: cell.region(),
+                    polygon,
                     road_widths: widths,
                 },
                 seed: cx.seed(Stage::Lots, id),

@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use polis_buildings::{Building, BuildingGenerator, BuildingKind, FacadeRole};
 use polis_cells::{Cell, CellDecomposition};
-use polis_facades::{FaceRole, FacadeSpec, PreparedStyle, RasterOptions, TileSet};
+use polis_facades::{FacadeSpec, FaceRole, PreparedStyle, RasterOptions, TileSet};
 use polis_geom::{DVec2, DVec3, PolygonWithHoles};
 use polis_lots::{Block, Lot};
 use polis_roads::{GlobalGoals, GrowthReport, RoadGenerator, RoadNetwork};
@@ -459,20 +459,20 @@ impl DressBuilding for Tiler {
                 role,
                 seed: crate::seed::mix(seed, k as u64),
             };
-            let facade = prepared.facade(&spec)?;
+            let layout = prepared.layout(&spec)?;
             let [bl, br, _tr, tl] = face.quad;
             let (du, dv) = (br - bl, tl - bl);
             let at = |s: f64, t: f64| bl + du * (s / face.width) + dv * (t / face.height);
-            let tiles = facade.tile_quads(set);
+            let tiles = layout.tile_quads(set);
             let chosen: Vec<_> = match self.detail {
                 FacadeDetail::Full => tiles,
                 // The repeated tile of the face's main rows, stretched over the whole face.
                 FacadeDetail::Compact => tiles
                     .iter()
                     .filter(|q| {
-                        set.tiles.get(q.tile).is_some_and(|t| {
-                            t.cols == polis_facades::Part::Repeat && !t.entrance
-                        })
+                        set.tiles
+                            .get(q.tile)
+                            .is_some_and(|t| t.cols == polis_facades::Part::Repeat && !t.entrance)
                     })
                     .max_by(|a, b| {
                         (a.rect.width() * a.rect.height())
@@ -490,7 +490,10 @@ impl DressBuilding for Tiler {
             };
             // A face is dressed only if its quads cover it (a tile missing from the set
             // would leave a hole where the wall triangles are replaced).
-            let covered: f64 = chosen.iter().map(|q| q.rect.width() * q.rect.height()).sum();
+            let covered: f64 = chosen
+                .iter()
+                .map(|q| q.rect.width() * q.rect.height())
+                .sum();
             if (covered - face.width * face.height).abs() > 1e-6 * face.width * face.height {
                 continue;
             }

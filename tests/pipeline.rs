@@ -119,7 +119,11 @@ fn check_city(name: &str, city: &City) {
     // indices in range.
     let bytes = glb_bytes(city);
     let doc = polis::export::gltf::Gltf::from_slice(&bytes).unwrap();
-    assert_eq!(doc.materials().count(), city.scene.materials.len(), "{name}");
+    assert_eq!(
+        doc.materials().count(),
+        city.scene.materials.len(),
+        "{name}"
+    );
     assert_eq!(doc.images().count(), city.scene.images.len(), "{name}");
     assert!(doc.meshes().count() > 0);
     let stats_tris = city.stats.scene_triangles;
@@ -213,7 +217,11 @@ fn progress_reaches_every_stage_and_ends_at_one() {
         .unwrap();
     let seen = seen.lock().unwrap();
     for stage in Stage::ALL {
-        let fractions: Vec<f64> = seen.iter().filter(|(s, _)| *s == stage).map(|(_, f)| *f).collect();
+        let fractions: Vec<f64> = seen
+            .iter()
+            .filter(|(s, _)| *s == stage)
+            .map(|(_, f)| *f)
+            .collect();
         assert_eq!(fractions.last(), Some(&1.0), "{stage}");
         assert!(fractions.iter().all(|f| (0.0..=1.0).contains(f)));
     }
@@ -223,7 +231,10 @@ fn progress_reaches_every_stage_and_ends_at_one() {
 fn bad_configurations_are_errors_not_panics() {
     let mut c = small("default");
     c.size_m = f64::NAN;
-    assert!(matches!(polis::generate(&c), Err(polis::Error::Config { .. })));
+    assert!(matches!(
+        polis::generate(&c),
+        Err(polis::Error::Config { .. })
+    ));
     let mut c = small("default");
     c.threads = Some(0);
     assert!(polis::generate(&c).is_err());
