@@ -9,6 +9,7 @@ use std::error::Error;
 use std::fs::File;
 use std::io::BufWriter;
 
+use polis_export::footpaths::{FootpathOptions, footpath_mesh};
 use polis_export::geojson::{GeoJsonOptions, write_geojson};
 use polis_export::geom::field::FnField;
 use polis_export::geom::glam::DVec3;
@@ -21,7 +22,7 @@ use polis_export::map::{
 };
 use polis_export::obj::{ObjOptions, write_obj};
 use polis_export::sink::DirSink;
-use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
+use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces_with_report};
 use polis_export::svg::{SvgOptions, write_svg};
 
 /// A 64 × 64 brick pattern: 1 texel = 1/64 m… scaled by the material's metre UVs, one
@@ -108,7 +109,11 @@ fn main() -> Result<(), Box<dyn Error>> {
     let roads = [
         (
             1,
-            vec![DVec2::new(-70.0, 0.0), DVec2::new(125.0, 0.0)],
+            vec![
+                DVec2::new(-70.0, 0.0),
+                DVec2::new(50.0, 0.0),
+                DVec2::new(125.0, 0.0),
+            ],
             RoadClass::Major,
             12.0,
             false,
@@ -122,7 +127,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         ),
         (
             3,
-            vec![DVec2::new(50.0, -60.0), DVec2::new(50.0, 70.0)],
+            vec![
+                DVec2::new(50.0, -60.0),
+                DVec2::new(50.0, 0.0),
+                DVec2::new(50.0, 62.0),
+                DVec2::new(50.0, 70.0),
+            ],
             RoadClass::Street,
             8.0,
             false,
@@ -148,20 +158,18 @@ fn main() -> Result<(), Box<dyn Error>> {
             bridge,
         });
     }
-    for road in &map.roads {
-        let surface = road_surfaces(
-            std::slice::from_ref(road),
-            &terrain,
-            &RoadSurfaceOptions::default(),
-            Some(asphalt),
-        )?;
-        let mesh = scene.add_mesh(surface);
-        let node = scene.add_node(roads_node, format!("road {}", road.id))?;
-        scene.attach_mesh(node, mesh)?;
-        scene.set_metadata(node, "class", road.class.as_str())?;
-        scene.set_metadata(node, "width_m", road.width_m)?;
-        scene.set_metadata(node, "bridge", road.bridge)?;
-    }
+    // The roads meet where they share a point (the crossing at (50, 0), the T at
+    // (50, 62)): one surface of ribbons, junction polygons and round dead-end caps.
+    let (surface, report) = road_surfaces_with_report(
+        &map.roads,
+        &terrain,
+        &RoadSurfaceOptions::default(),
+        Some(asphalt),
+    )?;
+    println!("road surfaces: {} junctions and caps", report.junctions);
+    let mesh = scene.add_mesh(surface);
+    scene.attach_mesh(roads_node, mesh)?;
+    scene.set_metadata(roads_node, "roads", map.roads.len() as f64)?;
 
     // Blocks and lots, each building a prism centred on its lot (mesh around a local
     // origin, placed by the node's translation).
@@ -181,6 +189,19 @@ fn main() -> Result<(), Box<dyn Error>> {
         let block_node = scene.add_node(city, format!("block {block_id}"))?;
         scene.set_metadata(block_node, "block", block_id as f64)?;
         let (min, max) = (outline.bbox().min, outline.bbox().max);
+        // A 2.5 m footpath along the block's edge, a kerb above the road.
+        let mut inner = Polygon::rect(min + DVec2::splat(2.5), max - DVec2::splat(2.5));
+        inner.make_cw();
+        let strip = PolygonWithHoles::new(outline.clone(), vec![inner]);
+        let path = footpath_mesh(
+            &strip,
+            &terrain,
+            &FootpathOptions::default(),
+            Some(concrete),
+        )?;
+        let path_node = scene.add_node(block_node, format!("footpath {block_id}"))?;
+        let path_mesh = scene.add_mesh(path);
+        scene.attach_mesh(path_node, path_mesh)?;
         map.blocks.push(MapBlock {
             id: block_id,
             polygon: outline.into(),
