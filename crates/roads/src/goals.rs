@@ -87,7 +87,8 @@ impl DefaultGoals {
                 if best_any.is_none_or(|(bv, _)| v > bv) {
                     best_any = Some((v, p));
                 }
-                if legality.point(p).is_none() && best_legal.is_none_or(|(bv, _)| v > bv) {
+                // Legality only for a new best (the maps may be slow to sample).
+                if best_legal.is_none_or(|(bv, _)| v > bv) && legality.point(p).is_none() {
                     best_legal = Some((v, p));
                 }
             }

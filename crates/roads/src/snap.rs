@@ -3,7 +3,7 @@
 //!
 //! * **Extended bounding box exclusion** (§4.3.3.1): only junctions in the segment's
 //!   bounding box grown by the snap size, and only roads met by the segment (found by the
-//!   spatial index's segment query, which already orders them along `a–b`), are tested.
+//!   spatial index's segment query, which walks the cells along `a–b`), are tested.
 //! * **Ordered tests with an `r`-value benchmark** (§4.3.3.2–5): events are prioritised
 //!   by their position `r` along `a–b` (0 at the root `a`). Test 1 (junction proximity)
 //!   keeps the smallest `r` of a junction within the snap size of the segment body (or,
@@ -153,21 +153,18 @@ pub fn snap(net: &RoadNetwork, q: &SnapQuery) -> Option<SnapEvent> {
             });
         }
     });
-    // Test 2: road intersections before the best junction event, in order along a–b.
-    for hit in net.edges_crossing(a, b) {
-        if hit.t >= best_r.min(1.0 + f64::EPSILON) {
-            break;
-        }
-        if hit.t * len <= 1e-9 * len.max(1.0) || !edge_ok(net, hit.key, q) {
-            continue;
-        }
+    // Test 2: the first road intersection along a–b before the best junction event.
+    let limit = best_r.min(1.0 + f64::EPSILON);
+    let first = net.edge_index().first_crossing(a, b, |hit| {
+        hit.t < limit && hit.t * len > 1e-9 * len.max(1.0) && edge_ok(net, hit.key, q)
+    });
+    if let Some(hit) = first {
         let point = a + d * hit.t;
         best = Some(SnapEvent::Cross {
             edge: hit.key,
             point,
             r: hit.t,
         });
-        break;
     }
     if best.is_some() {
         return best;

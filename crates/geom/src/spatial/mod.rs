@@ -293,6 +293,32 @@ pub trait SpatialIndex<K: IndexKey> {
         out.sort_unstable_by(|x, y| x.t.total_cmp(&y.t).then(x.key.cmp(&y.key)));
         out
     }
+
+    /// The first hit of [`segments_crossing`](Self::segments_crossing)`(a, b)` that
+    /// `accept` approves — smallest `t`, ties by key — found without allocating or
+    /// sorting. `accept` is asked only about hits that would come before the best one
+    /// found so far, in unspecified order, so it should be a pure test.
+    fn first_crossing<P: FnMut(&SegmentHit<K>) -> bool>(
+        &self,
+        a: DVec2,
+        b: DVec2,
+        mut accept: P,
+    ) -> Option<SegmentHit<K>> {
+        if !a.is_finite() || !b.is_finite() {
+            return None;
+        }
+        let mut best: Option<SegmentHit<K>> = None;
+        self.for_each_candidate_along(a, b, |key, s| {
+            if let Shape::Segment(s0, s1) = *s
+                && let Some(hit) = classify_hit(key, a, b, s0, s1)
+                && best.is_none_or(|h| hit.t.total_cmp(&h.t).then(hit.key.cmp(&h.key)).is_lt())
+                && accept(&hit)
+            {
+                best = Some(hit);
+            }
+        });
+        best
+    }
 }
 
 /// The hit of stored segment `s0–s1` on query `a–b`, if they meet.

@@ -166,7 +166,14 @@ fn check_backend<I: SpatialIndex<u32>>(
             .iter()
             .map(|h| (h.key, h.t))
             .collect();
-        prop_assert_eq!(cr, brute.crossing(a, b));
+        prop_assert_eq!(&cr, &brute.crossing(a, b));
+        // The first crossing under a filter is the first of the sorted, filtered list.
+        for m in [1, 2, 3] {
+            let first = index
+                .first_crossing(a, b, |h| h.key % m == 0)
+                .map(|h| (h.key, h.t));
+            prop_assert_eq!(first, cr.iter().copied().find(|&(k, _)| k % m == 0));
+        }
     }
     Ok(())
 }
