@@ -1,6 +1,7 @@
 //! Facades: a style fitted to one face of a building.
 
 use std::collections::BTreeMap;
+use std::sync::{Arc, OnceLock};
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -14,6 +15,7 @@ use crate::profile::Profile;
 use crate::sample::{FacadeSample, mix64, unit};
 use crate::stack::LayerStack;
 use crate::style::{BuildContext, StackStyle};
+use crate::tile_plan::TileAnalysis;
 use crate::tiles::TileOptions;
 use crate::{MAX_FLOORS, MAX_LENGTH_M};
 
@@ -177,6 +179,8 @@ pub struct PreparedStyle {
     style: FacadeStyle,
     images: BTreeMap<String, ImageSet>,
     salt: u64,
+    /// What the style's tile set reproduces (computed on first use).
+    tiling: OnceLock<Arc<TileAnalysis>>,
 }
 
 /// What had to be simplified while fitting a facade.
@@ -251,7 +255,27 @@ impl PreparedStyle {
             style,
             images,
             salt,
+            tiling: OnceLock::new(),
         })
+    }
+
+    pub(crate) fn tiling_cache(&self) -> &OnceLock<Arc<TileAnalysis>> {
+        &self.tiling
+    }
+
+    /// The generator of a facade's randomness and its tint (its first draw).
+    fn facade_rng(&self, spec: &FacadeSpec) -> (Pcg64Mcg, f32) {
+        let mut rng = Pcg64Mcg::seed_from_u64(mix64(spec.seed ^ self.salt));
+        let tint = {
+            use rand::Rng;
+            1.0 + self.style.tint_jitter * (2.0 * unit(rng.next_u64()) - 1.0)
+        };
+        (rng, tint)
+    }
+
+    /// The brightness factor [`facade`](Self::facade) gives the face of `spec`.
+    pub fn tint_for(&self, spec: &FacadeSpec) -> f32 {
+        self.facade_rng(spec).1
     }
 
     /// The style.
@@ -275,11 +299,7 @@ impl PreparedStyle {
             mut report,
         } = self.layout(spec)?;
         let st = &self.style;
-        let mut rng = Pcg64Mcg::seed_from_u64(mix64(spec.seed ^ self.salt));
-        let tint = {
-            use rand::Rng;
-            1.0 + st.tint_jitter * (2.0 * unit(rng.next_u64()) - 1.0)
-        };
+        let (mut rng, tint) = self.facade_rng(spec);
         let mut ctx = BuildContext {
             grid_u: Some(&columns),
             grid_v: Some(&rows),
@@ -370,6 +390,16 @@ impl Facade {
     /// The spec it was built for.
     pub fn spec(&self) -> &FacadeSpec {
         &self.spec
+    }
+
+    /// Its primary grid alone (for [`PreparedStyle::tile_plan`]).
+    pub fn layout(&self) -> FacadeLayout {
+        FacadeLayout {
+            spec: self.spec,
+            columns: self.columns.clone(),
+            rows: self.rows.clone(),
+            report: self.report.clone(),
+        }
     }
 
     /// The fitted primary columns.

@@ -17,7 +17,7 @@
 //! | layer stacks falling through to the layer below | [`LayerStack`] |
 //! | functions between layers (scaling cells, bricks around windows) | [`Influence`] |
 //! | style texture that fits any facade size | [`FacadeStyle`] (serde data) → [`Facade`] |
-//! | building tiles fitted without splitting (Kelly) | [`TileSet`], [`Facade::tile_quads`] |
+//! | building tiles fitted without splitting (Kelly) | [`TileSet`], [`Facade::tile_quads`], [`TilePlan`] |
 //!
 //! A [`FacadeStyle`] is data: a primary grid (columns and rows as [`AxisStyle`]s with
 //! fixed margins, a repeated module and named irregular rows such as the ground floor and
@@ -63,8 +63,10 @@
 //!   the layers; per-cell choices hash the layer seed with the cell index, so a point can
 //!   be evaluated alone.
 //! * Rasterised textures equal point evaluation at the texel centres: the span rasteriser
-//!   ([`sweep`]) finds each layer's active runs per row analytically and is tested
-//!   texel-for-texel against [`Facade::sample`] on every built-in style.
+//!   ([`sweep`]) finds each layer's active runs per row analytically, emits each row as
+//!   runs of equal samples (converted once per run, normals derived per run of equal
+//!   heights), and is tested texel-for-texel against [`Facade::sample`] and byte-for-byte
+//!   against a texel-by-texel rasteriser on every built-in style.
 //! * No panics on user input: bad numbers, malformed styles and oversized textures are
 //!   [`FacadeError`]s; faces smaller than the style get a blank grid (recorded in
 //!   [`FacadeReport`]).
@@ -76,7 +78,11 @@
 //!   [`ImageStyle::Rgba`] data).
 //! * Closures ([`Eval::Custom`], [`Col::Custom`]) are available for layers built in code,
 //!   not in serialised styles.
-//! * Tile sets are exact for layers on the primary grid (see [`tiles`]).
+//! * Tile sets repeat a prototype: they are exact only where everything repeats with the
+//!   modules. [`PreparedStyle::tile_plan`] reports, per facade and without building its
+//!   stack, the regions where they are not (stretched modules, layers on their own axes or
+//!   on particular storeys, patterns out of step with the bays, entrance influences
+//!   leaving the entrance bay) and the random detail they repeat (see [`tile_plan`]).
 //!
 //! ## References
 //!
@@ -101,12 +107,15 @@ pub mod sample;
 pub mod stack;
 pub mod style;
 pub mod sweep;
+pub mod tile_plan;
 pub mod tiles;
 
 pub use axis::{AxisStyle, Segment};
 pub use color::{Bricks, Col, ColFn, PointCtx};
 pub use error::{FacadeError, Result};
-pub use facade::{Facade, FacadeReport, FacadeSpec, FacadeStyle, FaceRole, PreparedStyle};
+pub use facade::{
+    Facade, FacadeLayout, FacadeReport, FacadeSpec, FacadeStyle, FaceRole, PreparedStyle,
+};
 pub use geometry::{FacadeCell, LayerName};
 pub use image::{ImageSet, ImageStyle, MaterialImage};
 pub use interval::{Hit, Interval, IntervalGroup, Part};
@@ -116,6 +125,7 @@ pub use raster::{FacadeTextures, RasterOptions, encode_png};
 pub use sample::FacadeSample;
 pub use stack::{Influence, LayerStack, Relation};
 pub use style::{AxisRef, EvalStyle, InfluenceStyle, LayerStyle, Pick, Select, StackStyle};
+pub use tile_plan::{TileIssue, TileIssueKind, TilePlan};
 pub use tiles::{Tile, TileOptions, TileQuad, TileSet};
 
 /// Largest length of a facade, axis or segment, metres (100 km).

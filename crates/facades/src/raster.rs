@@ -121,7 +121,7 @@ pub fn encode_png(width: u32, height: u32, color: png::ColorType, data: &[u8]) -
 
 /// `[0, 1] → 0..=255`, rounding; clamps out-of-range values and maps NaN to 0.
 #[inline]
-fn to_u8(v: f32) -> u8 {
+pub(crate) fn to_u8(v: f32) -> u8 {
     let x = v * 255.0 + 0.5;
     if x >= 255.0 {
         255

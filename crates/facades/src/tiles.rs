@@ -13,9 +13,14 @@
 //! boundary, so no window is ever cut. Modules stretched by the fit stretch their tile
 //! accordingly.
 //!
-//! Limitations: layers that do not follow the primary grid (own axes, centred doors) are
-//! seen in the tiles as they fall on the prototype; per-cell random images repeat with the
-//! tile's period; inter-layer influences of the entrance apply only inside its tile.
+//! The street entrance gets the middle bay of a street-front prototype over the ground
+//! rows and, when the entrance influences storeys above it (the window shrunk above the
+//! brick house's door), a second entrance tile over those storeys.
+//!
+//! What a tile set cannot reproduce — modules stretched by the fit, layers on their own
+//! axes or on particular storeys, patterns out of step with the modules, random detail —
+//! is worked out per facade by [`PreparedStyle::tile_plan`](crate::PreparedStyle::tile_plan)
+//! ([`crate::tile_plan`]), so callers know where to fall back to a facade's own texture.
 
 use polis_geom::{Aabb2, DVec2};
 use serde::{Deserialize, Serialize};
@@ -24,6 +29,7 @@ use crate::error::{FacadeError, Result};
 use crate::facade::{Facade, FacadeLayout, FacadeReport, FacadeSpec, FaceRole, PreparedStyle};
 use crate::interval::{IntervalGroup, Part};
 use crate::raster::{FacadeTextures, RasterOptions};
+use crate::tile_plan::PROTOTYPE_SEED;
 
 /// How a style's tile set is cut.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -120,14 +126,19 @@ impl TileSet {
     /// Style errors, and rasterisation errors for bad options.
     pub fn build(style: &PreparedStyle, opts: &RasterOptions) -> Result<TileSet> {
         let st = style.style();
-        let to = st.tiles;
-        let rows_floors = st.rows.fixed_floors() + to.floors * st.rows.module_floors();
-        let spec = FacadeSpec {
-            width_m: st.columns.nominal_length(to.bays),
-            height_m: st.rows.nominal_length(to.floors),
-            floors: (st.rows.module_floors() > 0).then_some(rows_floors),
-            role: FaceRole::Side,
-            seed: 0x0711_75E7,
+        let analysis = style.tiling();
+        let spec = match analysis.proto {
+            Some(spec) => spec,
+            None => {
+                let to = st.tiles;
+                FacadeSpec {
+                    width_m: st.columns.nominal_length(to.bays),
+                    height_m: st.rows.nominal_length(to.floors),
+                    floors: None,
+                    role: FaceRole::Side,
+                    seed: PROTOTYPE_SEED,
+                }
+            }
         };
         let proto = style.facade(&spec)?;
         let mut tiles = Vec::new();
@@ -152,28 +163,34 @@ impl TileSet {
                 });
             }
         }
-        // The entrance: the middle bay of a street-front prototype's ground rows.
-        let street = style.facade(&FacadeSpec {
-            role: FaceRole::Street,
-            ..spec
-        })?;
-        if street.stack().layers().len() > proto.stack().layers().len()
-            && let (Some((y0, y1)), Some((x0, x1))) = (
-                street.rows().part_range(Part::Start),
-                street
-                    .columns()
-                    .repeat_range(street.columns().repeat_count() / 2),
-            )
-        {
-            let region = Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1));
-            tiles.push(Tile {
-                cols: Part::Repeat,
-                rows: Part::Start,
-                entrance: true,
-                modules_u: 1,
-                modules_v: 1,
-                textures: street.rasterize_region(&region, opts)?,
-            });
+        // The entrance: the middle bay of a street-front prototype, over the ground rows
+        // and over the storeys its influences reach (a window shrunk above the door).
+        if let Some(e) = &analysis.entrance {
+            let street = style.facade(&e.spec)?;
+            let (cols, rows) = (street.columns(), street.rows());
+            if let Some((x0, x1)) = cols.repeat_range(cols.repeat_count() / 2) {
+                let mut cut = |y0: f64, y1: f64, rp: Part, floors: u32| -> Result<()> {
+                    let region = Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1));
+                    tiles.push(Tile {
+                        cols: Part::Repeat,
+                        rows: rp,
+                        entrance: true,
+                        modules_u: 1,
+                        modules_v: floors,
+                        textures: street.rasterize_region(&region, opts)?,
+                    });
+                    Ok(())
+                };
+                if let Some((y0, y1)) = rows.part_range(Part::Start) {
+                    cut(y0, y1, Part::Start, 1)?;
+                }
+                if e.floors > 0
+                    && let (Some((y0, _)), Some((_, y1))) =
+                        (rows.repeat_range(0), rows.repeat_range(e.floors - 1))
+                {
+                    cut(y0, y1, Part::Repeat, e.floors)?;
+                }
+            }
         }
         Ok(TileSet {
             style: st.name.clone(),
@@ -197,7 +214,9 @@ impl Facade {
     /// Covers the facade with quads of a shared [`TileSet`] of its style: one per present
     /// (column part × row part), the ground strip of a street front split around the
     /// entrance bay. Regions whose tile is missing (a facade with margins the prototype
-    /// lacked) are skipped; blank faces get no quads.
+    /// lacked) are skipped; blank faces get no quads. A street front's entrance bay gets
+    /// the entrance tiles over the ground rows and over the storeys the entrance changes.
+    /// Where this is not exact, see [`PreparedStyle::tile_plan`].
     pub fn tile_quads(&self, set: &TileSet) -> Vec<TileQuad> {
         tile_quads(self.spec(), self.columns(), self.rows(), self.report(), set)
     }
@@ -210,79 +229,112 @@ impl FacadeLayout {
     }
 }
 
-fn tile_quads(
+/// A row band of a facade: (part, y0, y1, storeys in it, entrance tile and its v
+/// repeats).
+type Band = (Part, f64, f64, u32, Option<(usize, f64)>);
+
+/// The quads of a facade with this spec, grid and report.
+pub(crate) fn tile_quads(
     spec: &FacadeSpec,
     cols: &IntervalGroup,
     rows: &IntervalGroup,
     report: &FacadeReport,
     set: &TileSet,
 ) -> Vec<TileQuad> {
-    {
-        let mut out = Vec::new();
-        if report.blank_columns || report.blank_rows {
-            return out;
-        }
-        let tile_mod = |k: usize| {
-            set.tiles
-                .get(k)
-                .map_or([1, 1], |t| [t.modules_u, t.modules_v])
-        };
-        let n_cols = cols.repeat_count();
-        let n_rows = rows.repeat_count();
-        let has_entrance =
-            spec.role == FaceRole::Street && set.find(Part::Repeat, Part::Start, true).is_some();
-        for &(rp, y0, y1) in &parts(rows) {
-            for &(cp, x0, x1) in &parts(cols) {
-                let Some(k) = set.find(cp, rp, false) else {
-                    continue;
-                };
-                let [mu, mv] = tile_mod(k);
-                let reps = |part: Part, n: u32, m: u32| {
-                    if part == Part::Repeat {
-                        f64::from(n) / f64::from(m)
-                    } else {
-                        1.0
-                    }
-                };
-                let rv = reps(rp, n_rows, mv);
-                if has_entrance && cp == Part::Repeat && rp == Part::Start {
-                    let mid = n_cols / 2;
-                    let e = set.find(Part::Repeat, Part::Start, true).unwrap_or(k);
-                    if let Some((ex0, ex1)) = cols.repeat_range(mid) {
-                        let rect =
-                            |a: f64, b: f64| Aabb2::new(DVec2::new(a, y0), DVec2::new(b, y1));
-                        if mid > 0 {
-                            out.push(TileQuad {
-                                rect: rect(x0, ex0),
-                                tile: k,
-                                repeats: [f64::from(mid) / f64::from(mu), rv],
-                            });
-                        }
-                        out.push(TileQuad {
-                            rect: rect(ex0, ex1),
-                            tile: e,
-                            repeats: [1.0, 1.0],
-                        });
-                        let right = n_cols - mid - 1;
-                        if right > 0 {
-                            out.push(TileQuad {
-                                rect: rect(ex1, x1),
-                                tile: k,
-                                repeats: [f64::from(right) / f64::from(mu), rv],
-                            });
-                        }
-                        continue;
-                    }
-                }
-                out.push(TileQuad {
-                    rect: Aabb2::new(DVec2::new(x0, y0), DVec2::new(x1, y1)),
-                    tile: k,
-                    repeats: [reps(cp, n_cols, mu), rv],
-                });
-            }
-        }
-        out
+    let mut out = Vec::new();
+    if report.blank_columns || report.blank_rows {
+        return out;
     }
+    let tile_mod = |k: usize| {
+        set.tiles
+            .get(k)
+            .map_or([1, 1], |t| [t.modules_u, t.modules_v])
+    };
+    let n_cols = cols.repeat_count();
+    let n_rows = rows.repeat_count();
+    let street = spec.role == FaceRole::Street;
+    let entrance = |rows: Part| {
+        if street {
+            set.find(Part::Repeat, rows, true)
+        } else {
+            None
+        }
+    };
+    // Row bands: (part, y0, y1, storeys in the band, entrance tile and its v repeats).
+    let mut bands: Vec<Band> = Vec::new();
+    for &(rp, y0, y1) in &parts(rows) {
+        match rp {
+            Part::Repeat => {
+                // The entrance's upper tile covers the first storeys of the entrance bay.
+                let upper = entrance(Part::Repeat).map(|e| (e, tile_mod(e)[1].max(1)));
+                match upper {
+                    Some((e, k)) if n_rows > 0 => {
+                        let ku = k.min(n_rows);
+                        let yk = rows.repeat_range(ku - 1).map_or(y1, |r| r.1);
+                        bands.push((rp, y0, yk, ku, Some((e, f64::from(ku) / f64::from(k)))));
+                        if ku < n_rows {
+                            bands.push((rp, yk, y1, n_rows - ku, None));
+                        }
+                    }
+                    _ => bands.push((rp, y0, y1, n_rows, None)),
+                }
+            }
+            _ => bands.push((rp, y0, y1, 1, entrance(rp).map(|e| (e, 1.0)))),
+        }
+    }
+    for (rp, y0, y1, storeys, ent) in bands {
+        for &(cp, x0, x1) in &parts(cols) {
+            let Some(k) = set.find(cp, rp, false) else {
+                continue;
+            };
+            let [mu, mv] = tile_mod(k);
+            let rv = if rp == Part::Repeat {
+                f64::from(storeys) / f64::from(mv)
+            } else {
+                1.0
+            };
+            let rect = |a: f64, b: f64| Aabb2::new(DVec2::new(a, y0), DVec2::new(b, y1));
+            if cp == Part::Repeat
+                && let Some((e, ev)) = ent
+            {
+                let mid = n_cols / 2;
+                if let Some((ex0, ex1)) = cols.repeat_range(mid) {
+                    if mid > 0 {
+                        out.push(TileQuad {
+                            rect: rect(x0, ex0),
+                            tile: k,
+                            repeats: [f64::from(mid) / f64::from(mu), rv],
+                        });
+                    }
+                    out.push(TileQuad {
+                        rect: rect(ex0, ex1),
+                        tile: e,
+                        repeats: [1.0, ev],
+                    });
+                    let right = n_cols - mid - 1;
+                    if right > 0 {
+                        out.push(TileQuad {
+                            rect: rect(ex1, x1),
+                            tile: k,
+                            repeats: [f64::from(right) / f64::from(mu), rv],
+                        });
+                    }
+                    continue;
+                }
+            }
+            let ru = if cp == Part::Repeat {
+                f64::from(n_cols) / f64::from(mu)
+            } else {
+                1.0
+            };
+            out.push(TileQuad {
+                rect: rect(x0, x1),
+                tile: k,
+                repeats: [ru, rv],
+            });
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -339,7 +391,7 @@ mod tests {
                 },
             )
             .unwrap();
-            assert!(set.tiles.len() <= 10, "{} tiles", set.tiles.len());
+            assert!(set.tiles.len() <= 11, "{} tiles", set.tiles.len());
             for (w, h) in [(9.0, 8.0), (23.5, 14.2), (41.0, 60.0)] {
                 let f = p.facade(&FacadeSpec::new(w, h, 4)).unwrap();
                 if f.report().blank_columns || f.report().blank_rows {
