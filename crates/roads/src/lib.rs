@@ -17,6 +17,7 @@
 //! |---|---|
 //! | [`RoadParams`] | every knob, with units and defaults (serde) |
 //! | [`RoadInputs`] | the input maps as [`polis_geom::Field`]s; [`RoadInputs::procedural`] needs no files |
+//! | [`LazyLattice`] | a map sampled once per lattice point and interpolated: cheap legality tests on costly maps |
 //! | [`GlobalGoals`], [`DefaultGoals`] | `globalGoals` of p2: highways, streets, patterns ([`Pattern`]) |
 //! | [`LocalConstraints`], [`DefaultConstraints`] | `localConstraints` of p8 |
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
@@ -57,9 +58,12 @@
 //! * Roads stop where a proposal fails (illegal with no prune/rotate/bridge variant, or
 //!   below the minimum angle), so dead ends remain at the fringe of the city, as in the
 //!   paper's figures; there is no pass that removes or reconnects them.
-//! * Speed: about 160 k segments per CPU-second with a population map alone and about
-//!   85 k with the full procedural maps, whose noise sampling for legality dominates
-//!   (see `BENCHMARKS.md`).
+//! * Speed (see `BENCHMARKS.md`): 15,000 segments take about 80–110 ms of CPU with the
+//!   procedural maps, whose coastline and hills are sampled on a lazily cached 40 m
+//!   [`LazyLattice`]. Maps given as other fields are sampled as they are, at every
+//!   legality sample (a few hundred thousand for 15,000 segments): an expensive map
+//!   (many-octave noise, a closure doing real work) is worth wrapping in a
+//!   [`LazyLattice`] first.
 //!
 //! ## References
 //!
