@@ -2,9 +2,9 @@
 //! polygons, filament chains, the containment of whole components (the one geometric
 //! step), and self-contained cells.
 
-use polis_geom::{DVec2, EdgeId, NodeId, Polygon};
+use polis_geom::{EdgeId, NodeId, Polygon};
 
-use crate::eberly::{Owner, Span, Sweep};
+use crate::eberly::{Owner, Packed, Span, Sweep};
 use crate::output::{
     Cell, CellDecomposition, CellId, ExtractionReport, Filament, FilamentKind, IsolatedNode, Ring,
 };
@@ -13,18 +13,15 @@ use crate::topology::{NONE, Topology};
 
 fn ring(topo: &Topology, sweep: &Sweep, span: Span) -> Ring {
     let hs = &sweep.ring_buf[span.start as usize..(span.start + span.len) as usize];
-    let nodes: Vec<NodeId> = hs
-        .iter()
-        .map(|&h| NodeId::from_raw(topo.node[topo.origin[h as usize] as usize]))
-        .collect();
-    let edges: Vec<EdgeId> = hs
-        .iter()
-        .map(|&h| EdgeId::from_raw(topo.edge[h as usize]))
-        .collect();
-    let points: Vec<DVec2> = hs
-        .iter()
-        .map(|&h| topo.p(topo.origin[h as usize]))
-        .collect();
+    let mut nodes = Vec::with_capacity(hs.len());
+    let mut edges = Vec::with_capacity(hs.len());
+    let mut points = Vec::with_capacity(hs.len());
+    for &h in hs {
+        let o = topo.origin[h as usize];
+        nodes.push(NodeId::from_raw(topo.node[o as usize]));
+        edges.push(EdgeId::from_raw(topo.edge[h as usize]));
+        points.push(topo.p(o));
+    }
     Ring {
         nodes,
         edges,
@@ -48,7 +45,7 @@ fn component_containers(topo: &Topology, sweep: &Sweep, line: &SweepLine) -> Vec
         if h == NONE || h as usize >= topo.slots() {
             continue;
         }
-        out[k] = match sweep.face[h as usize] {
+        out[k] = match sweep.face[h as usize].get() {
             Owner::Cell(c) => Some(c),
             Owner::Outside(j) if (j as usize) < k => out[j as usize],
             _ => None,
@@ -65,7 +62,7 @@ fn filament_chains(
 ) -> Vec<Filament> {
     let key = |k: u32| k.min(topo.twin[k as usize]) as usize;
     let is_fil =
-        |k: u32| sweep.cycle_uses[key(k)] == 0 && sweep.filament_owner[key(k)] != Owner::Unset;
+        |k: u32| sweep.cycle_uses[key(k)] == 0 && sweep.filament_owner[key(k)] != Packed::UNSET;
     let mut used = vec![false; topo.slots()];
     let mut out = Vec::new();
     let mut chain = |start: u32, used: &mut Vec<bool>| {
@@ -101,7 +98,7 @@ fn filament_chains(
             nodes.reverse();
             edges.reverse();
         }
-        let owner = sweep.filament_owner[key(start)];
+        let owner = sweep.filament_owner[key(start)].get();
         out.push(Filament {
             points: nodes.iter().map(|&r| topo.p(r)).collect(),
             nodes: nodes

@@ -39,6 +39,37 @@ pub(crate) enum Owner {
     Outside(u32),
 }
 
+/// An [`Owner`] in four bytes (the per-half-edge tables are the sweep's largest): `Unset`
+/// as `u32::MAX`, a cell as its index, an outside with the top bit set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Packed(u32);
+
+impl Packed {
+    pub(crate) const UNSET: Packed = Packed(u32::MAX);
+    const OUTSIDE: u32 = 1 << 31;
+
+    /// The owner.
+    #[inline]
+    pub(crate) fn get(self) -> Owner {
+        match self.0 {
+            u32::MAX => Owner::Unset,
+            x if x & Self::OUTSIDE != 0 => Owner::Outside(x & !Self::OUTSIDE),
+            x => Owner::Cell(x),
+        }
+    }
+}
+
+impl From<Owner> for Packed {
+    #[inline]
+    fn from(o: Owner) -> Packed {
+        match o {
+            Owner::Unset => Packed::UNSET,
+            Owner::Cell(c) => Packed(c & !Packed::OUTSIDE),
+            Owner::Outside(k) => Packed(k | Packed::OUTSIDE),
+        }
+    }
+}
+
 /// A range of `Sweep::ring_buf`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Span {
@@ -66,9 +97,9 @@ pub(crate) struct Sweep {
     /// Half-edge lies on the outside (its left face was walked).
     out: Vec<bool>,
     /// By half-edge: the face to its left (the walk it was on).
-    pub(crate) face: Vec<Owner>,
+    pub(crate) face: Vec<Packed>,
     /// For a walked half-edge: the parent of faces entered across it.
-    tag: Vec<Owner>,
+    tag: Vec<Packed>,
     on_stack: Vec<u32>,
     stack_v: Vec<u32>,
     stack_h: Vec<u32>,
@@ -76,7 +107,7 @@ pub(crate) struct Sweep {
     /// How many cycles use each edge (indexed by the edge's smaller slot).
     pub(crate) cycle_uses: Vec<u8>,
     /// For filament edges (indexed by the smaller slot): the face they lie in.
-    pub(crate) filament_owner: Vec<Owner>,
+    pub(crate) filament_owner: Vec<Packed>,
     /// Half-edges of all cycles and loops.
     pub(crate) ring_buf: Vec<u32>,
     pub(crate) cycles: Vec<RawCycle>,
@@ -104,15 +135,15 @@ impl Sweep {
         self.out.clear();
         self.out.resize(hcount, false);
         self.tag.clear();
-        self.tag.resize(hcount, Owner::Unset);
+        self.tag.resize(hcount, Packed::UNSET);
         self.face.clear();
-        self.face.resize(hcount, Owner::Unset);
+        self.face.resize(hcount, Packed::UNSET);
         self.on_stack.clear();
         self.on_stack.resize(n, NONE);
         self.cycle_uses.clear();
         self.cycle_uses.resize(hcount, 0);
         self.filament_owner.clear();
-        self.filament_owner.resize(hcount, Owner::Unset);
+        self.filament_owner.resize(hcount, Packed::UNSET);
         self.ring_buf.clear();
         self.cycles.clear();
         self.loops.clear();
@@ -149,7 +180,7 @@ impl Sweep {
                 topo.remove_edge(e1);
             } else {
                 let cell = self.cycles.len() as u32;
-                let parent = self.tag[back as usize];
+                let parent = self.tag[back as usize].get();
                 self.walk_and_split(topo, e1, Mode::Face { cell, parent })?;
                 if self.cycles.len() as u32 != cell + 1 {
                     return Err(Error::Internal(format!(
@@ -220,7 +251,7 @@ impl Sweep {
         };
         for &h in &self.walk {
             self.out[h as usize] = true;
-            self.face[h as usize] = here;
+            self.face[h as usize] = here.into();
         }
         for k in 0..self.walk.len() {
             let h = self.walk[k];
@@ -241,9 +272,9 @@ impl Sweep {
         let back = topo.twin[h as usize];
         if len == 2 && self.stack_h[at] == back && !is_main {
             // An edge walked there and back: a filament edge in this face.
-            self.filament_owner[h.min(back) as usize] = here;
-            self.tag[h as usize] = here;
-            self.tag[back as usize] = here;
+            self.filament_owner[h.min(back) as usize] = here.into();
+            self.tag[h as usize] = here.into();
+            self.tag[back as usize] = here.into();
             return;
         }
         let span = Span {
@@ -258,14 +289,14 @@ impl Sweep {
             };
             for k in span.start as usize..self.ring_buf.len() {
                 let x = self.ring_buf[k];
-                self.tag[x as usize] = parent;
+                self.tag[x as usize] = parent.into();
                 let uses = &mut self.cycle_uses[x.min(topo.twin[x as usize]) as usize];
                 *uses = uses.saturating_add(1);
             }
             self.cycles.push(RawCycle { span, parent });
         } else {
             for k in span.start as usize..self.ring_buf.len() {
-                self.tag[self.ring_buf[k] as usize] = here;
+                self.tag[self.ring_buf[k] as usize] = here.into();
             }
             self.loops.push(RawLoop { span, owner: here });
         }
@@ -361,7 +392,7 @@ mod tests {
         let inside = s
             .filament_owner
             .iter()
-            .filter(|o| matches!(o, Owner::Cell(_)))
+            .filter(|o| matches!(o.get(), Owner::Cell(_)))
             .count();
         assert_eq!(inside, 9);
     }

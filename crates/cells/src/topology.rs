@@ -227,13 +227,19 @@ impl Topology {
         } else {
             // In the graph's id order (its memory order); the two slots of an edge pair
             // up in the order they are met.
+            // The other end comes from `ends` (just written, in rank space) rather than
+            // from the graph's edge table.
             for (id, _, _) in g.nodes() {
                 let r = self.rank_of[id.index()];
                 let s = self.adj_start[r as usize] as usize;
-                for (i, (e, m)) in g.neighbors(id)?.enumerate() {
+                for (i, &e) in g.edges_at(id)?.iter().enumerate() {
                     let k = s + i;
+                    let [a, b] = self.ends.get(e.index()).copied().unwrap_or([NONE; 2]);
+                    if a == NONE {
+                        return Err(Error::Internal(format!("edge {e} has no ends")));
+                    }
                     self.origin[k] = r;
-                    self.target[k] = self.rank_of[m.index()];
+                    self.target[k] = if a == r { b } else { a };
                     self.edge[k] = e.raw();
                     let first = self.slot_of[e.index()][0];
                     if first == NONE {
