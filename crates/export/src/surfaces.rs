@@ -25,8 +25,11 @@
 //! * **Draping.** Every vertex is lifted to the elevation field at its own layout point
 //!   plus [`RoadSurfaceOptions::lift_m`]; segments longer than
 //!   [`RoadSurfaceOptions::max_segment_m`] are subdivided. Bridges instead run straight
-//!   between their cut ends, and a node all of whose roads are bridges is a flat deck at
-//!   the bridge's height (interpolated along the road between its two end points).
+//!   between their cut ends, and a node all of whose roads are bridges is a flat deck:
+//!   inside a chain of bridge segments (one bridge road with several points, or a bridge
+//!   split into several roads) at the height interpolated by length between the chain's
+//!   ends on land; at a dead end or a branching of bridges, at the terrain height under
+//!   the bridge roads' end points, interpolated along each road.
 //! * **Classes.** Each class is lifted by [`RoadSurfaceOptions::class_lift_m`] per rank
 //!   (footpath < other < street < major < highway); a junction takes the highest rank of
 //!   its roads, and a ribbon's cut ends take their junction's height, so ribbon and
@@ -261,6 +264,33 @@ impl<'a> Drape<'a> {
                 deck[v] = Some(sum / n.ends.len() as f64);
             }
         }
+        // A deck node inside a chain of bridge segments (a bridge split into several
+        // roads): straight between the chain's ends on land, by length along the chain.
+        let mut chained = deck.clone();
+        for (v, n) in plan.nodes.iter().enumerate() {
+            if deck[v].is_none() || n.ends.len() != 2 {
+                continue;
+            }
+            let mut ends = [(0.0, 0.0); 2];
+            let mut ok = true;
+            for (side, end) in ends.iter_mut().enumerate() {
+                match walk_chain(plan, &deck, v, n.ends[side].0) {
+                    Some((u, dist)) => {
+                        let h = match deck[u] {
+                            Some(h) => h,
+                            None => sample(elevation, plan.nodes[u].pos)?,
+                        };
+                        *end = (h, dist);
+                    }
+                    None => ok = false,
+                }
+            }
+            let [(h0, d0), (h1, d1)] = ends;
+            if ok && d0 + d1 > 0.0 {
+                chained[v] = Some(h0 + (h1 - h0) * d0 / (d0 + d1));
+            }
+        }
+        let deck = chained;
         Ok(Drape {
             elevation,
             node_lift,
@@ -293,6 +323,37 @@ fn sample(elevation: &dyn Field, p: DVec2) -> Result<f64, ExportError> {
             format!("the elevation field is {h} there; it must be finite"),
         ))
     }
+}
+
+/// From node `v` along edge `e`, through deck nodes with two roads, to the first node
+/// that is on land or where the chain branches or ends: that node and the length walked.
+/// `None` for a closed loop of bridges.
+fn walk_chain(
+    plan: &junctions::Plan,
+    deck: &[Option<f64>],
+    v: usize,
+    e: usize,
+) -> Option<(usize, f64)> {
+    let (mut at, mut via, mut dist) = (v, e, 0.0);
+    for _ in 0..=plan.nodes.len() {
+        let edge = &plan.edges[via];
+        let next = if edge.a == at { edge.b } else { edge.a };
+        dist += edge.len;
+        let n = &plan.nodes[next];
+        if next == v {
+            return None;
+        }
+        if deck[next].is_none() || n.ends.len() != 2 {
+            return Some((next, dist));
+        }
+        via = if n.ends[0].0 == via {
+            n.ends[1].0
+        } else {
+            n.ends[0].0
+        };
+        at = next;
+    }
+    None
 }
 
 /// The deck height of bridge `road` at `s` metres along its centre line: straight between

@@ -453,6 +453,31 @@ fn decks_of_bridges_are_flat_at_their_nodes() {
     let m = road_surfaces(&[bridge], &valley, &flat(), None).unwrap();
     m.validate().unwrap();
     assert!(m.positions.iter().all(|p| p.y.abs() < 1e-6), "no dip");
+    // The same bridge as three roads (a graph's edges), from 0 m up to 6 m: the deck
+    // rises straight along the chain and never dips into the valley.
+    let ramp = FnField::new(|p: DVec2| {
+        if p.x.abs() < 25.0 {
+            -10.0
+        } else {
+            0.1 * (p.x + 30.0)
+        }
+    });
+    let pts = [v(-30.0, 0.0), v(-10.0, 0.0), v(10.0, 0.0), v(30.0, 0.0)];
+    let roads: Vec<MapRoad> = pts
+        .windows(2)
+        .map(|w| MapRoad {
+            bridge: true,
+            ..MapRoad::new(w.to_vec(), RoadClass::Major, 8.0)
+        })
+        .collect();
+    let m = road_surfaces(&roads, &ramp, &flat(), None).unwrap();
+    m.validate().unwrap();
+    for p in &m.positions {
+        if p.x.abs() < 25.0 {
+            let want = 0.1 * (p.x + 30.0);
+            assert!((p.y - want).abs() < 1e-3, "{p}: want {want}");
+        }
+    }
 }
 
 /// A segment between two lattice points.
