@@ -331,6 +331,35 @@ impl Topology {
             return self.first[ri];
         }
         let o = self.pos[ri];
+        // When every live edge goes to a later rank (always so at the sweep's leftmost
+        // live node), the slots' counter-clockwise order from east gives the answer
+        // without an angular comparison: the first live slot going down (into the
+        // fourth quadrant), else the first live slot.
+        let (s, t) = (self.adj_start[ri], self.adj_start[ri + 1]);
+        let (mut first_live, mut first_down) = (NONE, NONE);
+        let mut all_later = true;
+        for k in s..t {
+            if !self.live[k as usize] {
+                continue;
+            }
+            let w = self.target[k as usize];
+            all_later &= w > r;
+            if first_live == NONE {
+                first_live = k;
+            }
+            if first_down == NONE && self.p(w).y < o.y {
+                first_down = k;
+            }
+        }
+        if all_later && first_live != NONE {
+            let best = if first_down != NONE {
+                first_down
+            } else {
+                first_live
+            };
+            self.first[ri] = best;
+            return best;
+        }
         let start = self.head[ri];
         let mut best = start;
         let mut k = self.nxt[start as usize];
