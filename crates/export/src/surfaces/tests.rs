@@ -597,20 +597,38 @@ proptest! {
     fn any_widths_give_valid_meshes(
         segs in lattice_segments(),
         widths in prop::collection::vec(prop_oneof![Just(1e-3), 0.1..30.0f64, Just(200.0)], 64),
+        flags in prop::collection::vec((any::<bool>(), 0u8..5), 64),
+        raw in prop::collection::vec(((-20i32..20, -20i32..20), 0.0..12.0f64), 0..12),
     ) {
         let segs = graph_roads(&segs, 5.0);
-        let roads: Vec<MapRoad> = segs
+        let class = |k: u8| match k {
+            0 => RoadClass::Highway,
+            1 => RoadClass::Major,
+            2 => RoadClass::Street,
+            3 => RoadClass::Footpath,
+            _ => RoadClass::Other("lane".into()),
+        };
+        let mut roads: Vec<MapRoad> = segs
             .iter()
             .enumerate()
-            .map(|(i, &(a, b))| MapRoad::new(vec![a, b], RoadClass::Street, widths[i % 64]))
+            .map(|(i, &(a, b))| MapRoad {
+                bridge: flags[i % 64].0,
+                ..MapRoad::new(vec![a, b], class(flags[i % 64].1), widths[i % 64])
+            })
             .collect();
+        // Plus one raw polyline, not planar with the rest: crossings, repeats, U-turns.
+        if raw.len() >= 2 {
+            let pts = raw.iter().map(|&((x, y), _)| v(f64::from(x), f64::from(y)) * 2.0).collect();
+            roads.push(MapRoad::new(pts, RoadClass::Street, raw[0].1));
+        }
         let (m, _) = road_surfaces_with_report(
             &roads,
-            &FnField::new(|q: DVec2| 0.1 * q.y),
+            &FnField::new(|q: DVec2| 0.1 * q.y + (q.x / 9.0).sin()),
             &RoadSurfaceOptions::default(),
             None,
         )
         .unwrap();
         prop_assert!(m.validate().is_ok());
+        prop_assert!(m.positions.iter().all(|p| p.is_finite()));
     }
 }
