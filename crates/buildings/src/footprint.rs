@@ -21,6 +21,29 @@ use polis_lots::Lot;
 use crate::BuildingsError;
 use crate::params::{FootprintParams, FootprintStrategy};
 
+thread_local! {
+    /// One reusable inset worker per thread: its buffers outlive a footprint, so a city's
+    /// worth of insets does not allocate the wavefront afresh each time.
+    static INSET: std::cell::RefCell<polis_lots::Inset> =
+        std::cell::RefCell::new(polis_lots::Inset::new());
+}
+
+/// The (optionally weighted) inset by `d`, outer rings only, through this thread's worker.
+fn inset_rings(
+    poly: &PolygonWithHoles,
+    weights: Option<&[f64]>,
+    d: f64,
+) -> Result<Vec<Polygon>, polis_lots::LotsError> {
+    let shapes = INSET.with(|w| match w.try_borrow_mut() {
+        Ok(mut worker) => worker.shapes(poly, weights, d),
+        Err(_) => polis_lots::inset_shapes(poly, weights, d),
+    })?;
+    Ok(shapes
+        .into_iter()
+        .map(|s| Polygon::new(s.outer.points))
+        .collect())
+}
+
 /// Cuts the footprint of a building from `lot` with `strategy`. `Ok(None)` when nothing
 /// of at least `params.min_area` remains.
 pub fn footprint(
@@ -51,7 +74,7 @@ pub fn footprint(
         FootprintStrategy::Downtown => Some(ring),
         FootprintStrategy::Industrial => {
             let poly: PolygonWithHoles = ring.into();
-            largest(polis_lots::inset(&poly, params.industrial_setback)?)
+            largest(inset_rings(&poly, None, params.industrial_setback)?)
         }
         FootprintStrategy::Suburban | FootprintStrategy::SuburbanRectangle => {
             if params.side_setback <= 0.0 {
@@ -67,7 +90,7 @@ pub fn footprint(
                     })
                     .collect();
                 let poly: PolygonWithHoles = ring.into();
-                largest(polis_lots::inset_weighted(&poly, &w, params.side_setback)?)
+                largest(inset_rings(&poly, Some(&w), params.side_setback)?)
             }
         }
     };
@@ -93,10 +116,9 @@ pub fn footprint(
 }
 
 /// The largest outer ring of an inset result.
-fn largest(pieces: Vec<PolygonWithHoles>) -> Option<Polygon> {
+fn largest(pieces: Vec<Polygon>) -> Option<Polygon> {
     pieces
         .into_iter()
-        .map(|p| p.outer)
         .max_by(|a, b| a.area().total_cmp(&b.area()))
 }
 

@@ -10,6 +10,14 @@ use polis_geom::{
     DVec2, DVec3, GeomError, Mesh, Orientation, Polygon, PolygonWithHoles, orient2d, triangulate,
 };
 
+/// `Mesh::add_vertex` without its index, inlined into the hot loops (f32 at the end).
+#[inline]
+fn push_vertex(mesh: &mut Mesh, position: DVec3, normal: DVec3, uv: DVec2) {
+    mesh.positions.push(position.as_vec3());
+    mesh.normals.push(normal.as_vec3());
+    mesh.uvs.push(uv.as_vec2());
+}
+
 /// Appends the planar polygon `pts` (counter-clockwise seen from its front) as one
 /// flat-shaded face. Convex faces are fanned; others are ear-clipped (or, when that gets
 /// stuck, go through the constrained Delaunay triangulation). Leaves the mesh unchanged
@@ -90,7 +98,7 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
         mesh.indices.extend(tri.iter().map(|&i| base + i));
     }
     for (p, uv) in pts.iter().zip(&plane) {
-        mesh.add_vertex(*p, nrm, DVec2::new(uv.x, -uv.y));
+        push_vertex(mesh, *p, nrm, DVec2::new(uv.x, -uv.y));
     }
     Ok(())
 }
@@ -125,7 +133,7 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             (b, z1, along + len),
             (a, z1, along),
         ] {
-            m.add_vertex(to_world(p, h), normal, DVec2::new(u, -h));
+            push_vertex(&mut m, to_world(p, h), normal, DVec2::new(u, -h));
         }
         m.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
@@ -143,7 +151,7 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             };
             let base = m.positions.len() as u32;
             for &p in ring {
-                m.add_vertex(to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
+                push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
             }
             for k in 1..n as u32 - 1 {
                 if up {
@@ -173,7 +181,7 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             };
             let base = m.positions.len() as u32;
             for &p in ring {
-                m.add_vertex(to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
+                push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
             }
             for &[a, b, c] in &tris {
                 if up {
