@@ -266,28 +266,39 @@ impl<'a> Drape<'a> {
         }
         // A deck node inside a chain of bridge segments (a bridge split into several
         // roads): straight between the chain's ends on land, by length along the chain.
+        // Each chain is walked once, from its first unvisited node both ways.
         let mut chained = deck.clone();
+        let mut done = vec![false; plan.nodes.len()];
         for (v, n) in plan.nodes.iter().enumerate() {
-            if deck[v].is_none() || n.ends.len() != 2 {
+            if done[v] || deck[v].is_none() || n.ends.len() != 2 {
                 continue;
             }
-            let mut ends = [(0.0, 0.0); 2];
-            let mut ok = true;
-            for (side, end) in ends.iter_mut().enumerate() {
-                match walk_chain(plan, &deck, v, n.ends[side].0) {
-                    Some((u, dist)) => {
-                        let h = match deck[u] {
-                            Some(h) => h,
-                            None => sample(elevation, plan.nodes[u].pos)?,
-                        };
-                        *end = (h, dist);
-                    }
-                    None => ok = false,
-                }
+            done[v] = true;
+            let walks = [
+                walk_chain(plan, &deck, v, n.ends[0].0),
+                walk_chain(plan, &deck, v, n.ends[1].0),
+            ];
+            for (u, _) in walks.iter().flat_map(|w| &w.inner) {
+                done[*u] = true;
             }
-            let [(h0, d0), (h1, d1)] = ends;
-            if ok && d0 + d1 > 0.0 {
-                chained[v] = Some(h0 + (h1 - h0) * d0 / (d0 + d1));
+            let [Some(a), Some(b)] = [walks[0].end, walks[1].end] else {
+                continue; // a closed loop of bridges: keep each road's own profile
+            };
+            let height = |u: usize| match deck[u] {
+                Some(h) => Ok(h),
+                None => sample(elevation, plan.nodes[u].pos),
+            };
+            let (h0, h1) = (height(a.0)?, height(b.0)?);
+            let total = a.1 + b.1;
+            if total > 0.0 {
+                let at = |d: f64| h0 + (h1 - h0) * d / total;
+                chained[v] = Some(at(a.1));
+                for &(u, d) in &walks[0].inner {
+                    chained[u] = Some(at(a.1 - d));
+                }
+                for &(u, d) in &walks[1].inner {
+                    chained[u] = Some(at(a.1 + d));
+                }
             }
         }
         let deck = chained;
@@ -325,27 +336,35 @@ fn sample(elevation: &dyn Field, p: DVec2) -> Result<f64, ExportError> {
     }
 }
 
+/// A walk along a chain of bridge segments.
+struct Chain {
+    /// The node where the chain stops (on land, at a branching or a dead end) and the
+    /// length walked; `None` for a closed loop of bridges.
+    end: Option<(usize, f64)>,
+    /// The deck nodes passed on the way, with their distance from the start.
+    inner: Vec<(usize, f64)>,
+}
+
 /// From node `v` along edge `e`, through deck nodes with two roads, to the first node
-/// that is on land or where the chain branches or ends: that node and the length walked.
-/// `None` for a closed loop of bridges.
-fn walk_chain(
-    plan: &junctions::Plan,
-    deck: &[Option<f64>],
-    v: usize,
-    e: usize,
-) -> Option<(usize, f64)> {
+/// that is on land or where the chain branches or ends.
+fn walk_chain(plan: &junctions::Plan, deck: &[Option<f64>], v: usize, e: usize) -> Chain {
     let (mut at, mut via, mut dist) = (v, e, 0.0);
+    let mut inner = Vec::new();
     for _ in 0..=plan.nodes.len() {
         let edge = &plan.edges[via];
         let next = if edge.a == at { edge.b } else { edge.a };
         dist += edge.len;
         let n = &plan.nodes[next];
         if next == v {
-            return None;
+            break;
         }
         if deck[next].is_none() || n.ends.len() != 2 {
-            return Some((next, dist));
+            return Chain {
+                end: Some((next, dist)),
+                inner,
+            };
         }
+        inner.push((next, dist));
         via = if n.ends[0].0 == via {
             n.ends[1].0
         } else {
@@ -353,7 +372,7 @@ fn walk_chain(
         };
         at = next;
     }
-    None
+    Chain { end: None, inner }
 }
 
 /// The deck height of bridge `road` at `s` metres along its centre line: straight between
