@@ -16,7 +16,10 @@
 //! # Limitations
 //!
 //! Between two consecutive parallel input edges of different weights the inset has a short
-//! step edge with no source (`None`).
+//! step edge with no source (`None`). An event that rounding puts a hair after `d` (less
+//! than the time the fastest edge needs to move `1e-9` of the polygon's size) counts as
+//! happening at `d`, so that two pieces meeting exactly at `d` come out separated, not
+//! lying on each other.
 
 use polis_geom::polygon::locate_in_ring;
 use polis_geom::{DVec2, PointLocation, Polygon, PolygonWithHoles};
@@ -125,7 +128,7 @@ impl Inset {
             });
         }
         prepare(&mut self.engine, polygon, weights)?;
-        self.engine.run(d)?;
+        self.engine.run_through(d)?;
         Ok(wavefront_at(&self.engine, d))
     }
 }

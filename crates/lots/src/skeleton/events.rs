@@ -105,6 +105,9 @@ pub(crate) struct Engine {
     stamp: u32,
     pub now: f64,
     pub eps: f64,
+    /// The time the fastest edge needs to move `eps`: events this close after a time
+    /// count as at that time (see [`Engine::run_through`]).
+    time_eps: f64,
     /// No event can happen after this time (the polygon is gone by then).
     horizon: f64,
     bbox_min: DVec2,
@@ -158,6 +161,8 @@ impl Engine {
         // Every wavefront point stays inside the box, so its distance to any edge line, and
         // hence any event time times the weight, is at most the box diagonal.
         self.horizon = (hi - lo).length() / wmin * (1.0 + 1e-9) + self.eps;
+        let wmax = weights.iter().copied().fold(0.0, f64::max);
+        self.time_eps = self.eps / wmax.max(f64::MIN_POSITIVE);
         self.pieces.resize(self.edges.len(), Vec::new());
         let n_edges = self.edges.len();
         self.budget = 16 * n_edges + 256;
@@ -534,6 +539,14 @@ impl Engine {
             a: v,
             b: c.edge,
         }));
+    }
+
+    /// Runs events up to and including time `until`, and those that rounding put a hair
+    /// after it (within the time the fastest edge needs to move the coincidence
+    /// tolerance): at `until` the wavefront then has no two pieces lying on each other
+    /// that an event a rounding error later would have separated.
+    pub fn run_through(&mut self, until: f64) -> Result<(), LotsError> {
+        self.run(until + self.time_eps)
     }
 
     /// Runs events up to and including time `until`. Afterwards `now` is the time of the
