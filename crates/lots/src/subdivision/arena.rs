@@ -45,25 +45,32 @@ impl Arena {
         p
     }
 
+    #[inline]
     pub fn points(&self, p: Piece) -> &[DVec2] {
         &self.pts[p.start as usize..(p.start + p.len) as usize]
     }
 
+    #[inline]
     pub fn street(&self, p: Piece) -> &[bool] {
         &self.street[p.start as usize..(p.start + p.len) as usize]
     }
 
+    #[inline]
     pub fn area(&self, p: Piece) -> f64 {
         ring_signed_area(self.points(p))
     }
 
+    #[inline]
     pub fn has_street(&self, p: Piece) -> bool {
         self.street(p).iter().any(|&s| s)
     }
 
+    #[inline]
     pub fn edge(&self, p: Piece, i: usize) -> (DVec2, DVec2) {
         let pts = self.points(p);
-        (pts[i % pts.len()], pts[(i + 1) % pts.len()])
+        let n = pts.len();
+        let i = if i < n { i } else { i % n };
+        (pts[i], pts[if i + 1 == n { 0 } else { i + 1 }])
     }
 
     pub fn region(&self, p: Piece) -> Region {
@@ -83,7 +90,8 @@ impl Arena {
         (0..n).all(|i| orient2d_value(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) >= 0.0)
     }
 
-    /// The longest edge among those `filter` accepts: (index, length).
+    /// The longest edge among those `filter` accepts: (index, squared length).
+    #[inline]
     pub fn longest_edge(&self, p: Piece, filter: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
         let pts = self.points(p);
         let n = pts.len();
@@ -92,14 +100,14 @@ impl Arena {
             if !filter(i) {
                 continue;
             }
-            // Squared lengths compare the same; one square root at the end.
+            // Squared lengths compare the same (the caller takes the root if it needs it).
             let j = if i + 1 == n { 0 } else { i + 1 };
             let l2 = pts[i].distance_squared(pts[j]);
             if best.is_none_or(|(_, bl)| l2 > bl) {
                 best = Some((i, l2));
             }
         }
-        best.map(|(i, l2)| (i, l2.sqrt()))
+        best
     }
 
     /// Splits piece `p` by the line perpendicular to `a → b` through the point at fraction
@@ -160,28 +168,30 @@ impl Arena {
             self.side = side;
             return false;
         };
-        let at = |k: usize| s + k % n;
-        let cross = |pts: &[DVec2], k: usize| -> DVec2 {
-            let (k0, k1) = (k % n, (k + 1) % n);
+        let next = |k: usize| if k + 1 == n { 0 } else { k + 1 };
+        let (i1, j1) = (next(i), next(j));
+        let cross = |pts: &[DVec2], k0: usize, k1: usize| -> DVec2 {
             let t = side[k0] / (side[k0] - side[k1]);
             lerp_stable(pts[s + k0], pts[s + k1], t)
         };
-        let x = if side[(i + 1) % n] == 0.0 {
-            self.pts[at(i + 1)]
+        let x = if side[i1] == 0.0 {
+            self.pts[s + i1]
         } else {
-            cross(&self.pts, i)
+            cross(&self.pts, i, i1)
         };
         let y = if side[j] == 0.0 {
-            self.pts[at(j)]
+            self.pts[s + j]
         } else {
-            cross(&self.pts, j)
+            cross(&self.pts, j, j1)
         };
         self.side = side;
+        self.pts.reserve(n + 4);
+        self.street.reserve(n + 4);
         // Left piece: Y, p[j+1] ..= p[i], X.
         let start = self.pts.len() as u32;
         self.pts.push(y);
-        self.street.push(self.street[at(j)]);
-        let mut k = (j + 1) % n;
+        self.street.push(self.street[s + j]);
+        let mut k = j1;
         loop {
             let (pk, sk) = (self.pts[s + k], self.street[s + k]);
             self.pts.push(pk);
@@ -189,9 +199,9 @@ impl Arena {
             if k == i {
                 break;
             }
-            k = if k + 1 == n { 0 } else { k + 1 };
+            k = next(k);
         }
-        if x != self.pts[at(i)] {
+        if x != self.pts[s + i] {
             self.pts.push(x);
             self.street.push(false);
         } else if let Some(last) = self.street.last_mut() {
@@ -204,11 +214,11 @@ impl Arena {
         };
         // Right piece: X, p[i+1] ..= p[j], Y.
         let start = self.pts.len() as u32;
-        if x != self.pts[at(i + 1)] {
+        if x != self.pts[s + i1] {
             self.pts.push(x);
-            self.street.push(self.street[at(i)]);
+            self.street.push(self.street[s + i]);
         }
-        let mut k = (i + 1) % n;
+        let mut k = i1;
         loop {
             let (pk, sk) = (self.pts[s + k], self.street[s + k]);
             self.pts.push(pk);
@@ -216,9 +226,9 @@ impl Arena {
             if k == j {
                 break;
             }
-            k = if k + 1 == n { 0 } else { k + 1 };
+            k = next(k);
         }
-        if y != self.pts[at(j)] {
+        if y != self.pts[s + j] {
             self.pts.push(y);
             self.street.push(false);
         } else if let Some(last) = self.street.last_mut() {

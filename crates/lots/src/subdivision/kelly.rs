@@ -9,6 +9,21 @@ use super::arena::Piece;
 /// loops on pathological input.
 const MAX_SPLITS: usize = 100_000;
 
+/// [`split_fraction`] for an edge of squared length `length2`; an edge clearly shorter than
+/// one and a half pieces is turned down before any square root (the exact test decides
+/// the rest, so the result is the same).
+fn split_fraction_sq<R: Rng + ?Sized>(
+    length2: f64,
+    size: f64,
+    deviance: f64,
+    rng: &mut R,
+) -> Option<f64> {
+    if length2 < 2.2 * size * size {
+        return None;
+    }
+    split_fraction(length2.sqrt(), size, deviance, rng)
+}
+
 /// The split position along an edge of length `length` for pieces of `size`: the
 /// middle-most multiple of `1 / round(length / size)`, moved by the deviance (Figure 56).
 /// `None` when the edge holds fewer than two pieces.
@@ -58,13 +73,13 @@ pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R
             continue;
         }
         let mut plan = road.and_then(|(i, len)| {
-            split_fraction(len, params.lot_width, params.deviance, rng).map(|t| (i, t))
+            split_fraction_sq(len, params.lot_width, params.deviance, rng).map(|t| (i, t))
         });
         if plan.is_none() {
             let street = ctx.arena.street(r);
             let other = ctx.arena.longest_edge(r, |i| !street[i]);
             plan = other.and_then(|(i, len)| {
-                split_fraction(len, params.lot_depth, params.deviance, rng).map(|t| (i, t))
+                split_fraction_sq(len, params.lot_depth, params.deviance, rng).map(|t| (i, t))
             });
         }
         let Some((edge, t)) = plan else {

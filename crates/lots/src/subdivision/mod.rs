@@ -231,9 +231,14 @@ impl Subdivider {
         params.validate()?;
         validate_region(region)?;
         let mut out = Subdivision::default();
+        self.arena.clear();
+        if region.holes.is_empty() {
+            let piece = self.arena.push(&region.outer, None);
+            self.run(piece, block_id, params, &mut out, rng);
+            return Ok(out);
+        }
         let mut simple = Vec::new();
         cut_holes(region.clone(), &mut simple);
-        self.arena.clear();
         for r in simple {
             if !r.holes.is_empty() {
                 let area = r.area();
@@ -245,20 +250,32 @@ impl Subdivider {
                 continue;
             }
             let piece = self.arena.push(&r.outer, None);
-            let mut ctx = Ctx {
-                arena: &mut self.arena,
-                pieces: &mut self.pieces,
-                scratch: &mut self.scratch,
-                block_id,
-                params,
-                out: &mut out,
-            };
-            match params.strategy {
-                LotStrategy::Kelly => kelly::run(&mut ctx, piece, rng),
-                LotStrategy::ParishMueller => parish_mueller::run(&mut ctx, piece, rng),
-            }
+            self.run(piece, block_id, params, &mut out, rng);
         }
         Ok(out)
+    }
+
+    /// Runs the strategy on one simple piece.
+    fn run<R: Rng + ?Sized>(
+        &mut self,
+        piece: Piece,
+        block_id: u64,
+        params: &LotParams,
+        out: &mut Subdivision,
+        rng: &mut R,
+    ) {
+        let mut ctx = Ctx {
+            arena: &mut self.arena,
+            pieces: &mut self.pieces,
+            scratch: &mut self.scratch,
+            block_id,
+            params,
+            out,
+        };
+        match params.strategy {
+            LotStrategy::Kelly => kelly::run(&mut ctx, piece, rng),
+            LotStrategy::ParishMueller => parish_mueller::run(&mut ctx, piece, rng),
+        }
     }
 }
 
