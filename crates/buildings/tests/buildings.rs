@@ -214,6 +214,34 @@ fn deterministic_per_seed_and_lot() {
 }
 
 #[test]
+fn reused_workers_do_not_change_buildings() {
+    // Footprint insets reuse one worker per thread: a building is the same whether it is
+    // the first on a fresh thread or follows many others.
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let all = shapes();
+    let first: Vec<_> = std::thread::scope(|s| {
+        s.spawn(|| {
+            BuildingKind::ALL
+                .iter()
+                .map(|&k| g.build(&all[2], 5, k, 90.0, 6).unwrap())
+                .collect()
+        })
+        .join()
+        .unwrap()
+    });
+    for (i, l) in all.iter().enumerate() {
+        for kind in BuildingKind::ALL {
+            let _ = g.build(l, 100 + i as u64, kind, 90.0, 6).unwrap();
+        }
+    }
+    let again: Vec<_> = BuildingKind::ALL
+        .iter()
+        .map(|&k| g.build(&all[2], 5, k, 90.0, 6).unwrap())
+        .collect();
+    assert_eq!(first, again);
+}
+
+#[test]
 fn grammar_errors_are_clean() {
     let e = BuildingGrammar::parse("bad", "p1: Lot(h, w, d, n) -> Extrude(h *) Box\n").unwrap_err();
     let text = e.to_string();
