@@ -43,6 +43,9 @@ struct Seg {
     a: DVec2,
     b: DVec2,
     slot: u32,
+    /// Its index in the status when inserted (the index drifts as edges below it come
+    /// and go).
+    hint: u32,
 }
 
 /// Buffers and results of the sweep.
@@ -53,6 +56,8 @@ pub(crate) struct SweepLine {
     /// nodes' positions.
     segs: Vec<Seg>,
     free: Vec<u32>,
+    /// By slot leaving an edge's left end: its entry in `segs` while it is active.
+    seg_of: Vec<u32>,
     /// Active edges bottom to top, as indices into `segs`.
     status: Vec<u32>,
     /// Edges starting at the current node, bottom to top, as indices into `segs`.
@@ -73,6 +78,8 @@ impl SweepLine {
         self.status.clear();
         self.segs.clear();
         self.free.clear();
+        self.seg_of.clear();
+        self.seg_of.resize(topo.slots(), NONE);
         self.below.clear();
         self.below.resize(n, NONE);
         for r in 0..n as u32 {
@@ -80,20 +87,49 @@ impl SweepLine {
             let (s, t) = (topo.adj_start[r as usize], topo.adj_start[r as usize + 1]);
             let segs = &self.segs;
 
-            // 1. The status edges through p: the first one not below p, then those on
-            // which p lies.
-            let lo = self.status.partition_point(|&i| {
-                let e = &segs[i as usize];
-                orient2d_value(e.a, e.b, p) > 0.0
-            });
-            let mut hi = lo;
-            while let Some(&i) = self.status.get(hi) {
-                let e = &segs[i as usize];
-                if e.b != p && (!test || orient2d_value(e.a, e.b, p) != 0.0) {
-                    break;
+            // 1. The status edges through p. Where an edge ends at p, its place in the
+            // status is found near where it was inserted, and the block of edges ending
+            // at p grows from there; the edges just outside the block must not pass
+            // through p. Otherwise a binary search finds the first edge not below p.
+            let ending_here = (s..t)
+                .find(|&k| topo.target[k as usize] < r)
+                .and_then(|k| self.seg_of.get(topo.twin[k as usize] as usize))
+                .and_then(|&i| find_near(&self.status, segs, i));
+            let (lo, hi) = if let Some(j) = ending_here {
+                let (mut lo, mut hi) = (j, j + 1);
+                while lo > 0 && segs[self.status[lo - 1] as usize].b == p {
+                    lo -= 1;
                 }
-                hi += 1;
-            }
+                while hi < self.status.len() && segs[self.status[hi] as usize].b == p {
+                    hi += 1;
+                }
+                if test {
+                    let side = |x: usize| {
+                        let e = &segs[self.status[x] as usize];
+                        orient2d_value(e.a, e.b, p)
+                    };
+                    if (lo > 0 && side(lo - 1) <= 0.0)
+                        || (hi < self.status.len() && side(hi) >= 0.0)
+                    {
+                        return false;
+                    }
+                }
+                (lo, hi)
+            } else {
+                let lo = self.status.partition_point(|&i| {
+                    let e = &segs[i as usize];
+                    orient2d_value(e.a, e.b, p) > 0.0
+                });
+                let mut hi = lo;
+                while let Some(&i) = self.status.get(hi) {
+                    let e = &segs[i as usize];
+                    if e.b != p && (!test || orient2d_value(e.a, e.b, p) != 0.0) {
+                        break;
+                    }
+                    hi += 1;
+                }
+                (lo, hi)
+            };
             if lo > 0 {
                 self.below[r as usize] = segs[self.status[lo - 1] as usize].slot;
             }
@@ -114,6 +150,7 @@ impl SweepLine {
                     a: p,
                     b: q,
                     slot: k,
+                    hint: 0,
                 };
                 let i = match self.free.pop() {
                     Some(i) => {
@@ -125,6 +162,9 @@ impl SweepLine {
                         self.segs.len() as u32 - 1
                     }
                 };
+                if let Some(x) = self.seg_of.get_mut(k as usize) {
+                    *x = i;
+                }
                 if q.y < p.y {
                     self.starting.insert(down, i);
                     down += 1;
@@ -136,6 +176,11 @@ impl SweepLine {
                 return false;
             }
             self.free.extend_from_slice(&self.status[lo..hi]);
+            for (d, &i) in self.starting.iter().enumerate() {
+                if let Some(e) = self.segs.get_mut(i as usize) {
+                    e.hint = (lo + d) as u32;
+                }
+            }
             let segs = &self.segs;
             if test {
                 for pair in self.starting.windows(2) {
@@ -177,6 +222,28 @@ fn meet(e: &Seg, f: &Seg) -> bool {
         return false;
     }
     segments_intersect(e.a, e.b, f.a, f.b)
+}
+
+/// How far from its insertion index an edge is looked for before falling back to the
+/// binary search.
+const NEAR: usize = 24;
+
+/// The index of entry `i` in `status`, looked for within [`NEAR`] of its hint.
+fn find_near(status: &[u32], segs: &[Seg], i: u32) -> Option<usize> {
+    let n = status.len();
+    if n == 0 {
+        return None;
+    }
+    let h = (segs.get(i as usize)?.hint as usize).min(n - 1);
+    for d in 0..=NEAR {
+        if h + d < n && status[h + d] == i {
+            return Some(h + d);
+        }
+        if d <= h && status[h - d] == i {
+            return Some(h - d);
+        }
+    }
+    None
 }
 
 /// Replaces `v[lo..hi]` by `with`, moving the tail once.
