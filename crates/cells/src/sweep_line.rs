@@ -9,9 +9,12 @@
 //! an edge.
 //!
 //! At node `p`:
-//! 1. the status edges through `p` are located by two binary searches; they must be
-//!    exactly the edges ending at `p` (any other one has `p` inside it: a node on an edge);
-//!    the edge just below them is recorded as `below[p]`;
+//! 1. the status edges through `p` are located: they must be exactly the edges ending at
+//!    `p` (any other one has `p` inside it: a node on an edge), and the edges just outside
+//!    them must pass strictly below and above `p`; the edge just below is recorded as
+//!    `below[p]`. An edge ending at `p` is looked for near the index where it was
+//!    inserted (it drifts only as edges below it come and go); a node with no edge from
+//!    the left (a local leftmost point) is placed by binary search;
 //! 2. they are replaced by the edges starting at `p`, bottom to top (the graph's exact
 //!    rotation order); two of those leaving in the same direction overlap;
 //! 3. the new neighbours in the status are tested for contact with the exact segment
@@ -24,9 +27,9 @@
 //! contact (the order beyond it would not be consistent); listing *all* conflicts is the
 //! job of the slower grid check in [`crate::planarity`].
 //!
-//! Cost: `O(n log n)` orientation tests for the binary searches and `O(n)` segment tests;
-//! the status is a plain vector (about `√n` edges on a city-like graph), changed by one
-//! splice per node.
+//! Cost: `O(n log n)` worst case (binary searches), in practice about three orientation
+//! tests and two segment tests per node; the status is a plain vector (about `√n` edges on
+//! a city-like graph), changed by one splice per node.
 //!
 //! The `below` table gives the containment of connected components without a spatial
 //! index: the face just above the edge below a component's leftmost node is the face
