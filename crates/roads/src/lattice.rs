@@ -5,7 +5,7 @@
 //! is fractal noise, and the local constraints sample water every
 //! [`legality_step_m`](crate::RoadParams::legality_step_m) along every proposed segment:
 //! about 450,000 samples of four-octave noise for 15,000 segments. Many samples share a
-//! lattice cell (20 m by default), so evaluated once per lattice point the noise costs
+//! lattice cell (25 m by default), so evaluated once per lattice point the noise costs
 //! about a third of the evaluations, and each sample becomes four memory reads and a
 //! bilinear blend.
 //!

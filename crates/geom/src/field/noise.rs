@@ -226,7 +226,7 @@ impl SimplexNoise {
     }
 
     /// The simplex containing the finite point `q`.
-    #[inline]
+    #[inline(always)]
     fn simplex(&self, q: DVec2) -> Simplex {
         let (x, y) = (q.x, q.y);
         // Skew to find the containing half-square of the simplex grid.
