@@ -44,6 +44,7 @@ pub mod bbox;
 pub mod error;
 pub mod field;
 pub mod graph;
+pub mod lines;
 pub mod mesh;
 pub mod polygon;
 pub mod predicates;
@@ -55,6 +56,7 @@ pub use bbox::Aabb2;
 pub use error::{GeomError, Ring};
 pub use field::{Field, FieldExt};
 pub use graph::{EdgeId, NodeId, PlanarGraph, SnapOptions};
+pub use lines::{Line, ccw_cmp_from, meet, split_by_line, split_polygon_by_line};
 pub use mesh::{Aabb3, Facing, Mesh, to_layout, to_world, triangulate};
 pub use polygon::{PointLocation, Polygon, PolygonWithHoles};
 pub use predicates::{

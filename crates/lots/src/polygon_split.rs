@@ -1,23 +1,16 @@
-//! Splitting a region (outer ring plus holes) by an infinite line into *all* its pieces.
+//! Splitting a region (outer ring plus holes) by an infinite line into *all* its pieces,
+//! with street access tracked on every edge.
 //!
-//! This is a general polygon operation that belongs in `polis-geom` (it is here until the
-//! geometry kernel is free to take it). The method is Kelly 2008 §4.4.2.3, after Graphics
-//! Gems V II.3: the ring edges crossing the line get an intersection vertex, the
-//! intersections are sorted along the line and paired by the Jordan curve rule (each
-//! alternate stretch of the line is inside the region), each pair is *bridged* with two
-//! new edges, and the pieces are read off by walking the rings.
-//!
-//! Every edge carries a tag (street access, for lots) that is kept through the split; the
-//! bridge edges get `false`.
-//!
-//! Side tests are exact ([`orient2d`]). A vertex exactly on the line counts as being on
-//! its right (a symbolic shift of the line), which keeps the crossing count even; pieces
-//! of zero area that such touching produces are dropped. If the pieces' areas do not add
-//! up to the region's, the region is returned whole, so a split never loses land.
+//! The geometry is [`polis_geom::lines::split_by_line`] (Kelly 2008 §4.4.2.3: crossings
+//! sorted along the line, paired by the Jordan curve rule, bridged); this module keeps the
+//! lots' own [`Region`] / [`TaggedRing`] types, whose per-edge tag is street access. Every
+//! edge keeps its flag through the split; the bridge edges get `false`. If the pieces'
+//! areas do not add up to the region's, the region is returned whole, so a split never
+//! loses land.
 
-use polis_geom::polygon::{locate_in_ring, ring_signed_area};
-use polis_geom::predicates::orient2d_value;
-use polis_geom::{DVec2, PointLocation};
+use polis_geom::DVec2;
+use polis_geom::lines::{TaggedRegion, TaggedRing as GeomRing};
+use polis_geom::polygon::ring_signed_area;
 use serde::{Deserialize, Serialize};
 
 /// A ring with a tag per edge: `street[i]` belongs to edge `points[i] → points[i + 1]`.
@@ -71,187 +64,29 @@ impl Region {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
-struct Node {
-    p: DVec2,
-    next: usize,
-    street: bool,
-}
-
 /// Splits `region` by the infinite line through `a` and `b` (`a != b`) into all of its
 /// pieces, each a region with its own holes. Returns the region unchanged (one piece) if
 /// the line misses it or the split would be inconsistent.
 pub fn split_by_line(region: &Region, a: DVec2, b: DVec2) -> Vec<Region> {
-    if a == b {
-        return vec![region.clone()];
-    }
-    let mut nodes: Vec<Node> = Vec::new();
-    let mut crossings: Vec<(f64, usize)> = Vec::new();
-    let dir = b - a;
-    for ring in region.rings() {
-        let n = ring.points.len();
-        let base = nodes.len();
-        for (i, &p) in ring.points.iter().enumerate() {
-            nodes.push(Node {
-                p,
-                next: base + (i + 1) % n,
-                street: ring.street.get(i).copied().unwrap_or(false),
-            });
-        }
-        let side: Vec<f64> = ring
-            .points
-            .iter()
-            .map(|&p| orient2d_value(a, b, p))
-            .collect();
-        for i in 0..n {
-            let j = (i + 1) % n;
-            let (li, lj) = (side[i] > 0.0, side[j] > 0.0);
-            if li == lj {
-                continue;
-            }
-            let (pi, pj) = (ring.points[i], ring.points[j]);
-            let at = if !lj && side[j] == 0.0 {
-                base + j
-            } else if !li && side[i] == 0.0 {
-                base + i
-            } else {
-                // Proper crossing: the weights are the exact-signed distances.
-                let t = side[i] / (side[i] - side[j]);
-                let p = polis_geom::predicates::lerp_stable(pi, pj, t);
-                nodes.push(Node {
-                    p,
-                    next: nodes[base + i].next,
-                    street: nodes[base + i].street,
-                });
-                let c = nodes.len() - 1;
-                nodes[base + i].next = c;
-                c
-            };
-            crossings.push((dir.dot(nodes[at].p - a), at));
-        }
-    }
-    if crossings.len() < 2 || !crossings.len().is_multiple_of(2) {
-        return vec![region.clone()];
-    }
-    crossings.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    for pair in crossings.chunks_exact(2) {
-        let (ca, cb) = (pair[0].1, pair[1].1);
-        if ca == cb {
-            continue;
-        }
-        let na = Node {
-            p: nodes[ca].p,
-            next: nodes[ca].next,
-            street: nodes[ca].street,
-        };
-        let nb = Node {
-            p: nodes[cb].p,
-            next: nodes[cb].next,
-            street: nodes[cb].street,
-        };
-        nodes.push(na);
-        let a2 = nodes.len() - 1;
-        nodes.push(nb);
-        let b2 = nodes.len() - 1;
-        nodes[ca].next = b2;
-        nodes[ca].street = false;
-        nodes[cb].next = a2;
-        nodes[cb].street = false;
-    }
-    // Read off every cycle.
-    let mut seen = vec![false; nodes.len()];
-    let mut outers: Vec<TaggedRing> = Vec::new();
-    let mut holes: Vec<TaggedRing> = Vec::new();
-    let scale = region
-        .outer
-        .points
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
-        .max(1.0);
-    let tiny = 1e-12 * scale * scale;
-    for start in 0..nodes.len() {
-        if seen[start] {
-            continue;
-        }
-        let mut ring = TaggedRing {
-            points: Vec::new(),
-            street: Vec::new(),
-        };
-        let mut k = start;
-        let mut guard = 0;
-        while !seen[k] && guard <= nodes.len() {
-            seen[k] = true;
-            ring.points.push(nodes[k].p);
-            ring.street.push(nodes[k].street);
-            k = nodes[k].next;
-            guard += 1;
-        }
-        if k != start {
-            return vec![region.clone()];
-        }
-        dedup_ring(&mut ring);
-        if ring.points.len() < 3 {
-            continue;
-        }
-        let area = ring.signed_area();
-        if area > tiny {
-            outers.push(ring);
-        } else if area < -tiny {
-            holes.push(ring);
-        }
-    }
-    let mut pieces: Vec<Region> = outers
+    let to_geom = |r: &TaggedRing| GeomRing {
+        points: r.points.clone(),
+        tags: r.street.clone(),
+    };
+    let from_geom = |r: GeomRing<bool>| TaggedRing {
+        points: r.points,
+        street: r.tags,
+    };
+    let geom = TaggedRegion {
+        outer: to_geom(&region.outer),
+        holes: region.holes.iter().map(to_geom).collect(),
+    };
+    polis_geom::lines::split_by_line(&geom, a, b, false)
         .into_iter()
-        .map(|outer| Region {
-            outer,
-            holes: Vec::new(),
+        .map(|piece| Region {
+            outer: from_geom(piece.outer),
+            holes: piece.holes.into_iter().map(from_geom).collect(),
         })
-        .collect();
-    for h in holes {
-        let probe = h.points[0];
-        let mut best: Option<(usize, f64)> = None;
-        for (i, r) in pieces.iter().enumerate() {
-            if locate_in_ring(&r.outer.points, probe) != PointLocation::Outside {
-                let ar = r.outer.signed_area();
-                if best.is_none_or(|(_, b)| ar < b) {
-                    best = Some((i, ar));
-                }
-            }
-        }
-        match best {
-            Some((i, _)) => pieces[i].holes.push(h),
-            None => return vec![region.clone()],
-        }
-    }
-    let total: f64 = pieces.iter().map(Region::area).sum();
-    let area = region.area();
-    if pieces.is_empty() || (total - area).abs() > 1e-9 * area.abs().max(tiny) {
-        return vec![region.clone()];
-    }
-    pieces
-}
-
-/// Removes repeated consecutive points; the surviving edge keeps the tag of the edge that
-/// has length.
-fn dedup_ring(ring: &mut TaggedRing) {
-    let mut points: Vec<DVec2> = Vec::with_capacity(ring.points.len());
-    let mut street: Vec<bool> = Vec::with_capacity(ring.points.len());
-    for (&p, &s) in ring.points.iter().zip(&ring.street) {
-        if points.last() == Some(&p) {
-            if let Some(l) = street.last_mut() {
-                *l = s;
-            }
-            continue;
-        }
-        points.push(p);
-        street.push(s);
-    }
-    while points.len() > 1 && points.first() == points.last() {
-        points.pop();
-        street.pop();
-    }
-    ring.points = points;
-    ring.street = street;
+        .collect()
 }
 
 #[cfg(test)]

@@ -344,26 +344,6 @@ pub(crate) fn prepare(
     Ok(weights)
 }
 
-/// Compares the counter-clockwise angles from `r` to `a` and from `r` to `b` (in
-/// `[0, 2π)`), exactly.
-fn ccw_from(r: DVec2, a: DVec2, b: DVec2) -> std::cmp::Ordering {
-    use polis_geom::predicates::orient2d_value;
-    let half = |d: DVec2| {
-        let o = orient2d_value(DVec2::ZERO, r, d);
-        u8::from(!(o > 0.0 || (o == 0.0 && r.dot(d) > 0.0)))
-    };
-    half(a).cmp(&half(b)).then_with(|| {
-        let o = orient2d_value(DVec2::ZERO, a, b);
-        if o > 0.0 {
-            std::cmp::Ordering::Less
-        } else if o < 0.0 {
-            std::cmp::Ordering::Greater
-        } else {
-            std::cmp::Ordering::Equal
-        }
-    })
-}
-
 /// Builds each face from the arcs that bound it.
 fn assemble_faces(engine: &Engine) -> Vec<Polygon> {
     let n_edges = engine.edges.len();
@@ -407,7 +387,7 @@ fn assemble_faces(engine: &Engine) -> Vec<Polygon> {
                     let d = engine.nodes[list[k].1].position - here;
                     let better = best.is_none_or(|b| {
                         let db = engine.nodes[list[b].1].position - here;
-                        ccw_from(back, d, db) == std::cmp::Ordering::Greater
+                        polis_geom::lines::ccw_cmp_from(back, d, db) == std::cmp::Ordering::Greater
                     });
                     if better {
                         best = Some(k);

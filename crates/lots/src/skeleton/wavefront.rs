@@ -53,6 +53,15 @@ impl EdgeLine {
         self.normal.dot(x - self.a) - self.weight * t
     }
 
+    /// The supporting line of the input edge (at time 0).
+    #[inline]
+    pub fn line(&self) -> polis_geom::lines::Line {
+        polis_geom::lines::Line {
+            point: self.a,
+            normal: self.normal,
+        }
+    }
+
     /// Position of `x` along the edge direction, measured from the start point.
     #[inline]
     pub fn along(&self, x: DVec2) -> f64 {
@@ -106,16 +115,14 @@ pub(crate) fn motion(a: &EdgeLine, b: &EdgeLine) -> Motion {
 /// Where the wavefront lines of `a` and `b` cross at time `t`, solved relative to the
 /// nearby point `near` (for accuracy); `None` when they are parallel.
 pub(crate) fn meet(a: &EdgeLine, b: &EdgeLine, t: f64, near: DVec2) -> Option<DVec2> {
-    if a.dir.perp_dot(b.dir).abs() <= PARALLEL_SINE {
-        return None;
-    }
-    let (na, nb) = (a.normal, b.normal);
-    let ra = -a.ahead(near, t);
-    let rb = -b.ahead(near, t);
-    let det = na.perp_dot(nb);
-    let y = DVec2::new((ra * nb.y - rb * na.y) / det, (na.x * rb - nb.x * ra) / det);
-    let p = near + y;
-    p.is_finite().then_some(p)
+    polis_geom::lines::meet(
+        &a.line(),
+        a.weight * t,
+        &b.line(),
+        b.weight * t,
+        near,
+        PARALLEL_SINE,
+    )
 }
 
 /// Whether the turn from incoming edge direction `din` to outgoing `dout` is reflex
