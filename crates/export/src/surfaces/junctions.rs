@@ -422,72 +422,11 @@ fn junction(
     let mut clean = true;
     for i in 0..k {
         let j = (i + 1) % k;
-        let (ei, ej) = (&es[i], &es[j]);
-        let bevel = || vec![c + ei.n() * ei.w, c - ej.n() * ej.w];
-        match gaps[i] {
-            Gap::Convex { t, s } => {
-                let tol = SNAP * (ei.w + ej.w + t + s);
-                if t <= trims[i] + tol && s <= trims[j] + tol {
-                    let corner = c + ei.d * t + ei.n() * ei.w;
-                    match (trims[i] - t <= tol, trims[j] - s <= tol) {
-                        (true, true) => cuts[j][0] = cuts[i][1],
-                        (true, false) => {}
-                        (false, true) => cuts[j][0] = corner,
-                        (false, false) => extra[i].push(corner),
-                    }
-                } else {
-                    // Trims clamped by a short segment: the corner lies beyond a cut.
-                    report.clamped_corners += 1;
-                }
-            }
-            Gap::Wide { i_wide, s0 } => {
-                // Along the wide road's end line to the narrow road's border, then out.
-                let (wide, narrow, tn) = if i_wide {
-                    (ei, ej, trims[j])
-                } else {
-                    (ej, ei, trims[i])
-                };
-                let end = if i_wide {
-                    c + ei.n() * ei.w
-                } else {
-                    c - ej.n() * ej.w
-                };
-                let side = if i_wide { -1.0 } else { 1.0 };
-                let meet = c + narrow.d * s0 + narrow.n() * (side * narrow.w);
-                let tol = SNAP * (wide.w + narrow.w + s0);
-                if s0 > tn + tol {
-                    report.clamped_corners += 1;
-                    extra[i].push(end);
-                } else if i_wide {
-                    extra[i].push(end);
-                    if tn - s0 <= tol {
-                        cuts[j][0] = meet;
-                    } else {
-                        extra[i].push(meet);
-                    }
-                } else {
-                    if tn - s0 <= tol {
-                        cuts[i][1] = meet;
-                    } else {
-                        extra[i].push(meet);
-                    }
-                    extra[i].push(end);
-                }
-            }
-            Gap::Straight => extra[i] = bevel(),
-            Gap::Reflex { ts } => {
-                let miter = ts.and_then(|(t, s)| {
-                    let q = c + ei.d * t + ei.n() * ei.w;
-                    let limit = MITER_LIMIT * ei.w.max(ej.w) * (1.0 + MITER_SLACK);
-                    (t <= trims[i] && s <= trims[j] && (q - c).length() <= limit).then_some(q)
-                });
-                extra[i] = match miter {
-                    Some(q) => vec![q],
-                    None => bevel(),
-                };
-            }
-            Gap::Same => clean = false,
-        }
+        let ends = [(&es[i], trims[i], cuts[i]), (&es[j], trims[j], cuts[j])];
+        let (ci, cj, ok) = gap_corner(c, ends, gaps[i], &mut extra[i], report);
+        cuts[i] = ci;
+        cuts[j] = cj;
+        clean &= ok;
     }
     let mut ring: Vec<DVec2> = Vec::with_capacity(4 * k);
     for i in 0..k {
@@ -505,6 +444,92 @@ fn junction(
     report.approximated_junctions += 1;
     let hull = convex_hull(ring);
     (hull.len() >= 3).then_some(hull)
+}
+
+/// The corner in the gap between end `i` and the next end `j` (counter-clockwise) at node
+/// `c`, each given with its trim and cut: pushes the ring vertices between `i`'s cut and
+/// `j`'s onto `extra` and returns both cuts, a cut corner moved onto the gap's corner when
+/// they coincide. `false` in the last place when the gap cannot be joined (overlapping
+/// roads).
+fn gap_corner(
+    c: DVec2,
+    [(ei, ti, mut ci), (ej, tj, mut cj)]: [(&End, f64, [DVec2; 2]); 2],
+    gap: Gap,
+    extra: &mut Vec<DVec2>,
+    report: &mut RoadSurfaceReport,
+) -> ([DVec2; 2], [DVec2; 2], bool) {
+    let bevel = [c + ei.n() * ei.w, c - ej.n() * ej.w];
+    match gap {
+        Gap::Convex { t, s } => {
+            let corner = c + ei.d * t + ei.n() * ei.w;
+            join_at(corner, (t, ti), (s, tj), (&mut ci, &mut cj), extra, report);
+        }
+        Gap::Wide { i_wide, s0 } => {
+            // Along the wide road's end line to the narrow road's border, then out.
+            let (wide, narrow, tn) = if i_wide { (ei, ej, tj) } else { (ej, ei, ti) };
+            let end = if i_wide { bevel[0] } else { bevel[1] };
+            let side = if i_wide { -1.0 } else { 1.0 };
+            let meet = c + narrow.d * s0 + narrow.n() * (side * narrow.w);
+            let tol = SNAP * (wide.w + narrow.w + s0);
+            if s0 > tn + tol {
+                report.clamped_corners += 1;
+                extra.push(end);
+            } else if i_wide {
+                extra.push(end);
+                if tn - s0 <= tol {
+                    cj[0] = meet;
+                } else {
+                    extra.push(meet);
+                }
+            } else {
+                if tn - s0 <= tol {
+                    ci[1] = meet;
+                } else {
+                    extra.push(meet);
+                }
+                extra.push(end);
+            }
+        }
+        Gap::Straight => extra.extend(bevel),
+        Gap::Reflex { ts } => {
+            let miter = ts.and_then(|(t, s)| {
+                let q = c + ei.d * t + ei.n() * ei.w;
+                let limit = MITER_LIMIT * ei.w.max(ej.w) * (1.0 + MITER_SLACK);
+                (t <= ti && s <= tj && (q - c).length() <= limit).then_some(q)
+            });
+            match miter {
+                Some(q) => extra.push(q),
+                None => extra.extend(bevel),
+            }
+        }
+        Gap::Same => return (ci, cj, false),
+    }
+    (ci, cj, true)
+}
+
+/// Joins the left border of `i` to the right border of `j` at `corner`, `t` along `i`
+/// and `s` along `j` (with their trims `ti`, `tj`): a cut corner that coincides with it
+/// becomes it, else it is an extra ring vertex; a chord if a trim was clamped short of it.
+fn join_at(
+    corner: DVec2,
+    (t, ti): (f64, f64),
+    (s, tj): (f64, f64),
+    (ci, cj): (&mut [DVec2; 2], &mut [DVec2; 2]),
+    extra: &mut Vec<DVec2>,
+    report: &mut RoadSurfaceReport,
+) {
+    let tol = SNAP * ((ci[1] - ci[0]).length() + (cj[1] - cj[0]).length() + t + s);
+    if t <= ti + tol && s <= tj + tol {
+        match (ti - t <= tol, tj - s <= tol) {
+            (true, true) => cj[0] = ci[1],
+            (true, false) => {}
+            (false, true) => cj[0] = corner,
+            (false, false) => extra.push(corner),
+        }
+    } else {
+        // Trims clamped by a short segment: the corner lies beyond a cut.
+        report.clamped_corners += 1;
+    }
 }
 
 /// Drops consecutive repeated points (and a closing repeat).
