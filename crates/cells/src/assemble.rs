@@ -134,11 +134,6 @@ pub(crate) fn assemble(
     line: &SweepLine,
     report: ExtractionReport,
 ) -> CellDecomposition {
-    let boundaries: Vec<Ring> = sweep
-        .cycles
-        .iter()
-        .map(|c| ring(topo, sweep, c.span))
-        .collect();
     let containers = component_containers(topo, sweep, line);
     let resolve = |o: Owner| -> Option<u32> {
         match o {
@@ -148,45 +143,52 @@ pub(crate) fn assemble(
         }
     };
 
-    let n = boundaries.len();
-    let mut parents: Vec<Option<u32>> = sweep.cycles.iter().map(|c| resolve(c.parent)).collect();
-    // A parent must precede its child; anything else would be a bug: cut the link.
-    for (i, p) in parents.iter_mut().enumerate() {
-        if p.is_some_and(|p| p as usize >= i) {
-            *p = None;
-        }
-    }
-    let mut depth = vec![0u32; n];
-    let mut children: Vec<Vec<CellId>> = vec![Vec::new(); n];
+    // The cells are built in place (no per-cell side tables: at city sizes those cost
+    // as much memory traffic as the cells themselves).
+    let n = sweep.cycles.len();
+    let mut cells: Vec<Cell> = Vec::with_capacity(n);
     let mut roots = Vec::new();
-    for i in 0..n {
-        match parents[i] {
+    for (i, c) in sweep.cycles.iter().enumerate() {
+        // A parent must precede its child; anything else would be a bug: cut the link.
+        let parent = resolve(c.parent).filter(|&p| (p as usize) < i);
+        let depth = match parent {
             Some(p) => {
-                depth[i] = depth[p as usize] + 1;
-                children[p as usize].push(CellId(i as u32));
+                let pc = &mut cells[p as usize];
+                pc.children.push(CellId(i as u32));
+                pc.depth + 1
             }
-            None => roots.push(CellId(i as u32)),
-        }
+            None => {
+                roots.push(CellId(i as u32));
+                0
+            }
+        };
+        cells.push(Cell {
+            id: CellId(i as u32),
+            boundary: ring(topo, sweep, c.span),
+            parent: parent.map(CellId),
+            children: Vec::new(),
+            depth,
+            holes: Vec::new(),
+            filaments: Vec::new(),
+            isolated_nodes: Vec::new(),
+        });
     }
 
-    let mut holes: Vec<Vec<Ring>> = vec![Vec::new(); n];
     let mut outlines = Vec::new();
     for l in &sweep.loops {
         let r = ring(topo, sweep, l.span);
-        match resolve(l.owner) {
-            Some(c) => holes[c as usize].push(r),
+        match resolve(l.owner).and_then(|c| cells.get_mut(c as usize)) {
+            Some(cell) => cell.holes.push(r),
             None => outlines.push(r),
         }
     }
-    let mut fils: Vec<Vec<Filament>> = vec![Vec::new(); n];
     let mut outer_filaments = Vec::new();
     for f in filament_chains(topo, sweep, &resolve) {
-        match f.cell {
-            Some(c) => fils[c.index()].push(f),
+        match f.cell.and_then(|c| cells.get_mut(c.index())) {
+            Some(cell) => cell.filaments.push(f),
             None => outer_filaments.push(f),
         }
     }
-    let mut isolated: Vec<Vec<IsolatedNode>> = vec![Vec::new(); n];
     let mut outer_isolated = Vec::new();
     for &(v, k) in &sweep.isolated {
         let cell = resolve(Owner::Outside(k));
@@ -195,8 +197,8 @@ pub(crate) fn assemble(
             point: topo.p(v),
             cell: cell.map(CellId),
         };
-        match cell {
-            Some(c) => isolated[c as usize].push(node),
+        match cell.and_then(|c| cells.get_mut(c as usize)) {
+            Some(cell) => cell.isolated_nodes.push(node),
             None => outer_isolated.push(node),
         }
     }
@@ -210,25 +212,6 @@ pub(crate) fn assemble(
         .count();
     report.filament_edges = topo.slots() / 2 - report.cycle_edges;
 
-    let cells = boundaries
-        .into_iter()
-        .zip(holes)
-        .zip(fils)
-        .zip(isolated)
-        .enumerate()
-        .map(
-            |(i, (((boundary, holes), filaments), isolated_nodes))| Cell {
-                id: CellId(i as u32),
-                boundary,
-                parent: parents[i].map(CellId),
-                children: std::mem::take(&mut children[i]),
-                depth: depth[i],
-                holes,
-                filaments,
-                isolated_nodes,
-            },
-        )
-        .collect();
     CellDecomposition {
         cells,
         roots,
