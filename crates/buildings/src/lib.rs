@@ -9,12 +9,15 @@
 //! ```
 //!
 //! ## Key types
-//! * [`BuildingGenerator`]: the reusable worker (grammars, templates); [`generate`] is the
+//! * [`BuildingGenerator`]: the reusable worker (grammars, templates); [`generate()`] is the
 //!   one-call form over many lots.
 //! * [`BuildingGrammar`]: a building rule set in the text grammar of `polis_lsystem`
 //!   ([`grammar`] lists the shape modules); defaults ship for every [`BuildingKind`].
 //! * [`Building`]: closed [`Part`] meshes and [`FacadeFace`]s for the facades stage.
 //! * [`BuildingParams`]: the stage's options.
+//! * [`footprint::largest_rectangle`]: the largest rectangle along the street inside a
+//!   (possibly concave) region, the house footprint; [`footprint::fit_rectangle`] is
+//!   Kelly's centre-and-ray fit.
 //!
 //! ## Example
 //! ```
@@ -42,11 +45,16 @@
 //!   which never exceeds the maximum height given.
 //! * LOD `k` is the string after `k` derivation steps, drawn; the axiom (LOD 0) is the
 //!   bounding volume, and the default grammars only refine inside it.
-//! * Deterministic per (seed, lot id).
+//! * Deterministic per (seed, lot id), on any thread and in any order.
+//! * Any grammar text gives a typed error or buildings with these guarantees, never a
+//!   panic (fuzzed by property tests in `tests/grammar_fuzz.rs`).
 //!
 //! ## Limitations
 //! * One building per lot; the footprint of a suburban lot whose inset splits keeps the
 //!   largest piece.
+//! * The house rectangle is exact in height for every pair of sides tried and exact for
+//!   orthogonal regions; otherwise its area is within `2·δ·H` of the optimum (`δ` the
+//!   region's extent along the street / 16, `H` its depth), usually much closer.
 //! * A template that does not fit a footprint falls back (gable → hip → flat slab) and
 //!   is counted in [`Building::fallbacks`].
 //! * A mansard's break line keeps 1 mm clear of skeleton events (it moves 2 mm past an
