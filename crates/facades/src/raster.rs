@@ -180,10 +180,12 @@ pub fn rasterize_stack(
     )?;
     let n = n as usize;
     let (w, h) = (width as usize, height as usize);
-    let mut albedo = vec![0u8; n * 4];
-    let mut mr = vec![0u8; n * 4];
-    let mut heights = vec![0f32; n];
-    let mut normal = vec![0u8; n * 4];
+    // The outputs grow row by row (each row is zeroed just before it is written, while it
+    // is in cache, instead of zeroing whole textures up front).
+    let mut albedo = Vec::with_capacity(n * 4);
+    let mut mr = Vec::with_capacity(n * 4);
+    let mut heights = Vec::with_capacity(n);
+    let mut normal = Vec::with_capacity(n * 4);
     let ds = region.width() / w as f64;
     let dt = region.height() / h as f64;
     let mut sweep = RowSweep::new(region.min.x, ds, w);
@@ -201,9 +203,9 @@ pub fn rasterize_stack(
         if y > 0 && runs[slot] == runs[prev] {
             // Rows often repeat (inside a course of bricks, a band of cladding): copy.
             let (p4, p1) = (row4.start - w * 4, row1.start - w);
-            albedo.copy_within(p4..row4.start, row4.start);
-            mr.copy_within(p4..row4.start, row4.start);
-            heights.copy_within(p1..row1.start, row1.start);
+            albedo.extend_from_within(p4..row4.start);
+            mr.extend_from_within(p4..row4.start);
+            heights.extend_from_within(p1..row1.start);
             let [a, b, c] = &mut hsegs;
             let (dst, src) = match slot {
                 0 => (a, &*c),
@@ -212,6 +214,9 @@ pub fn rasterize_stack(
             };
             dst.clone_from(src);
         } else {
+            albedo.resize(row4.end, 0);
+            mr.resize(row4.end, 0);
+            heights.resize(row1.end, 0.0);
             let (Some(arow), Some(mrow), Some(hrow)) = (
                 albedo.get_mut(row4.clone()),
                 mr.get_mut(row4),
@@ -224,9 +229,11 @@ pub fn rasterize_stack(
         }
         // Row y − 1 now has both neighbours: derive its normals.
         if y > 0 {
+            normal.resize(y * w * 4, 0);
             normals.row(y - 1, &hsegs, &heights, &mut normal);
         }
     }
+    normal.resize(n * 4, 0);
     normals.row(h - 1, &hsegs, &heights, &mut normal);
     Ok(FacadeTextures {
         width,

@@ -126,6 +126,12 @@ pub(crate) struct RowState {
     cursor: Vec<usize>,
     /// Per layer, per border: the merged `s` spans (expanded by the margin) and a cursor.
     spans: Vec<Vec<BorderSpans>>,
+    /// Per layer, per border: every active rectangle of the source layer, in the order
+    /// [`Layer::any_rect_in`] visits them, for the stack at this address.
+    rects: Vec<Vec<Vec<Aabb2>>>,
+    rects_of: usize,
+    /// Scratch for the unmerged spans.
+    scratch: Vec<(f64, f64)>,
 }
 
 impl LayerStack {
@@ -288,32 +294,60 @@ impl LayerStack {
         state.cursor.clear();
         state.cursor.resize(self.layers.len(), 0);
         state.spans.resize_with(self.layers.len(), Vec::new);
+        // The source rectangles are collected once per stack and row sweep.
+        let me = self as *const LayerStack as usize;
+        if state.rects_of != me || state.rects.len() != self.borders.len() {
+            state.rects_of = me;
+            state.rects = self
+                .borders
+                .iter()
+                .map(|borders| {
+                    borders
+                        .iter()
+                        .map(|(source, _, _)| {
+                            let mut v = Vec::new();
+                            if let Some(src) = self.layers.get(*source) {
+                                for j in 0..src.v.len() {
+                                    for i in 0..src.u.len() {
+                                        src.cell_rects(i, j, |r| v.push(r));
+                                    }
+                                }
+                            }
+                            v
+                        })
+                        .collect()
+                })
+                .collect();
+        }
         for (k, borders) in self.borders.iter().enumerate() {
-            let Some(slot) = state.spans.get_mut(k) else {
+            let (Some(slot), Some(rects)) = (state.spans.get_mut(k), state.rects.get(k)) else {
                 continue;
             };
             slot.resize_with(borders.len(), || (Vec::new(), 0));
-            for ((source, margin, _), (spans, cur)) in borders.iter().zip(slot.iter_mut()) {
+            for (((_, margin, _), (spans, cur)), rects) in
+                borders.iter().zip(slot.iter_mut()).zip(rects)
+            {
                 spans.clear();
                 *cur = 0;
-                let Some(src) = self.layers.get(*source) else {
-                    continue;
-                };
+                // The source's rectangles meeting the band |t' − t| ≤ margin (what
+                // `Layer::any_rect_in` finds for that band), widened by the margin.
                 let q = Aabb2::new(DVec2::new(-1e9, t - margin), DVec2::new(1e9, t + margin));
-                src.any_rect_in(&q, |r| {
-                    spans.push((r.min.x - margin, r.max.x + margin));
-                    false
-                });
-                spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let scratch = &mut state.scratch;
+                scratch.clear();
+                scratch.extend(
+                    rects
+                        .iter()
+                        .filter(|r| r.intersects(&q))
+                        .map(|r| (r.min.x - margin, r.max.x + margin)),
+                );
+                scratch.sort_by(|a, b| a.0.total_cmp(&b.0));
                 // Merge overlapping spans so a forward cursor suffices.
-                let mut merged: Vec<(f64, f64)> = Vec::with_capacity(spans.len());
-                for &(a, b) in spans.iter() {
-                    match merged.last_mut() {
+                for &(a, b) in scratch.iter() {
+                    match spans.last_mut() {
                         Some(last) if a <= last.1 => last.1 = last.1.max(b),
-                        _ => merged.push((a, b)),
+                        _ => spans.push((a, b)),
                     }
                 }
-                *spans = merged;
             }
         }
     }

@@ -187,7 +187,7 @@ pub(crate) struct RowSweep {
     strips: Vec<(usize, Vec<FacadeSample>)>,
     /// Whole rows of facade-aligned brick patterns, keyed by (colour address, course,
     /// depth): every row of a course between its joints is the same.
-    brick_rows: Vec<((usize, u64, u32), RowRuns)>,
+    brick_rows: Vec<((usize, u64, u32), RowRuns, usize)>,
     /// Next entry of `brick_rows` to replace when full.
     brick_next: usize,
 }
@@ -236,26 +236,34 @@ impl RowSweep {
             course.to_bits(),
             depth.to_bits(),
         );
-        let slot = match self.brick_rows.iter().position(|(k, _)| *k == key) {
+        let slot = match self.brick_rows.iter().position(|(k, _, _)| *k == key) {
             Some(p) => p,
             None => {
                 let mut runs = RowRuns::default();
                 bricks.eval_row(&self.xs, 0, None, t, depth, &mut runs);
                 if self.brick_rows.len() < BRICK_ROWS {
-                    self.brick_rows.push((key, runs));
+                    self.brick_rows.push((key, runs, 0));
                     self.brick_rows.len() - 1
                 } else {
                     let p = self.brick_next % BRICK_ROWS;
                     self.brick_next = p + 1;
                     if let Some(e) = self.brick_rows.get_mut(p) {
-                        *e = (key, runs);
+                        *e = (key, runs, 0);
                     }
                     p
                 }
             }
         };
-        let runs = &self.brick_rows.get(slot)?.1.runs;
-        let mut start = runs.partition_point(|r| (r.end as usize) <= a);
+        let (_, cached, cursor) = self.brick_rows.get_mut(slot)?;
+        let runs = &cached.runs;
+        // Runs are asked for left to right along a row: continue from the last one.
+        let mut start = *cursor;
+        if start > 0 && runs.get(start - 1).is_none_or(|r| r.end as usize > a) {
+            start = runs.partition_point(|r| (r.end as usize) <= a);
+        }
+        while runs.get(start).is_some_and(|r| (r.end as usize) <= a) {
+            start += 1;
+        }
         let mut from = a;
         while from < b {
             let Some(r) = runs.get(start) else { break };
@@ -264,8 +272,11 @@ impl RowSweep {
                 sink.fill(from, to, m);
             }
             from = to;
-            start += 1;
+            if r.end as usize <= b {
+                start += 1;
+            }
         }
+        *cursor = start;
         Some(())
     }
 
