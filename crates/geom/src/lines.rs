@@ -306,18 +306,10 @@ pub fn split_by_line<T: Copy>(
         .collect();
     // Each hole goes to the smallest piece around it.
     for h in holes {
-        let probe = h.points[0];
-        let mut best: Option<(usize, f64)> = None;
-        for (i, r) in pieces.iter().enumerate() {
-            if locate_in_ring(&r.outer.points, probe) != PointLocation::Outside {
-                let ar = r.outer.signed_area();
-                if best.is_none_or(|(_, b)| ar < b) {
-                    best = Some((i, ar));
-                }
-            }
-        }
-        match best {
-            Some((i, _)) => pieces[i].holes.push(h),
+        let around =
+            innermost_ring_containing(pieces.iter().map(|r| &r.outer.points[..]), h.points[0]);
+        match around {
+            Some(i) => pieces[i].holes.push(h),
             None => return vec![region.clone()],
         }
     }
@@ -327,6 +319,25 @@ pub fn split_by_line<T: Copy>(
         return vec![region.clone()];
     }
     pieces
+}
+
+/// Of the counter-clockwise `rings`, the index of the one with the smallest area that has
+/// `p` inside or on its boundary (the innermost of nested rings; the first of equals), or
+/// `None`. This is where a hole found by walking a cut or offset boundary belongs.
+pub fn innermost_ring_containing<'a>(
+    rings: impl IntoIterator<Item = &'a [DVec2]>,
+    p: DVec2,
+) -> Option<usize> {
+    let mut best: Option<(usize, f64)> = None;
+    for (i, r) in rings.into_iter().enumerate() {
+        if locate_in_ring(r, p) != PointLocation::Outside {
+            let area = ring_signed_area(r);
+            if best.is_none_or(|(_, b)| area < b) {
+                best = Some((i, area));
+            }
+        }
+    }
+    best.map(|(i, _)| i)
 }
 
 /// [`split_by_line`] for a polygon with holes without edge tags.
@@ -547,6 +558,19 @@ mod tests {
             assert_eq!(pieces.len(), 1);
             assert!((pieces[0].area() - 16.0).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn innermost_of_nested_rings() {
+        let big = Polygon::rect(v(0., 0.), v(10., 10.));
+        let small = Polygon::rect(v(1., 1.), v(4., 4.));
+        let apart = Polygon::rect(v(6., 6.), v(9., 9.));
+        let rings = [big.points(), small.points(), apart.points()];
+        assert_eq!(innermost_ring_containing(rings, v(2., 2.)), Some(1));
+        assert_eq!(innermost_ring_containing(rings, v(1., 2.)), Some(1));
+        assert_eq!(innermost_ring_containing(rings, v(5., 5.)), Some(0));
+        assert_eq!(innermost_ring_containing(rings, v(7., 7.)), Some(2));
+        assert_eq!(innermost_ring_containing(rings, v(11., 5.)), None);
     }
 
     #[test]

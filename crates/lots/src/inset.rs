@@ -21,8 +21,8 @@
 //! happening at `d`, so that two pieces meeting exactly at `d` come out separated, not
 //! lying on each other.
 
-use polis_geom::polygon::locate_in_ring;
-use polis_geom::{DVec2, PointLocation, Polygon, PolygonWithHoles};
+use polis_geom::lines::innermost_ring_containing;
+use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
@@ -181,18 +181,8 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
         })
         .collect();
     for h in holes {
-        let probe = h.points[0];
-        // The smallest outer ring containing the hole.
-        let mut best: Option<(usize, f64)> = None;
-        for (i, s) in shapes.iter().enumerate() {
-            if locate_in_ring(&s.outer.points, probe) != PointLocation::Outside {
-                let a = polis_geom::polygon::ring_signed_area(&s.outer.points);
-                if best.is_none_or(|(_, b)| a < b) {
-                    best = Some((i, a));
-                }
-            }
-        }
-        if let Some((i, _)) = best {
+        let outers = shapes.iter().map(|s| &s.outer.points[..]);
+        if let Some(i) = innermost_ring_containing(outers, h.points[0]) {
             shapes[i].holes.push(h);
         }
     }
