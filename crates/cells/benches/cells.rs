@@ -1,6 +1,8 @@
 //! Cell extraction throughput on perturbed grids and random planar graphs.
 //!
-//! Run: `cargo bench -p polis-cells --bench cells`. Sizes are edge counts.
+//! Run: `cargo bench -p polis-cells --bench cells`. Sizes are edge counts (`CELLS_SIZES`
+//! picks some, e.g. `CELLS_SIZES=100000`). "unchecked" skips the planarity check, as
+//! extraction does for graphs that are planar by construction.
 
 #![allow(clippy::unwrap_used)]
 
@@ -71,9 +73,17 @@ fn random_planar(edges: usize, seed: u64) -> PlanarGraph<(), ()> {
     g
 }
 
-const SIZES: &[usize] = &[1_000, 10_000, 100_000, 1_000_000];
+/// Edge counts: 10³ … 10⁶, or the comma-separated list in `CELLS_SIZES` (to time one size
+/// alone, e.g. under `perf stat -e task-clock` on a loaded machine).
+fn sizes() -> Vec<usize> {
+    let all = vec![1_000, 10_000, 100_000, 1_000_000];
+    match std::env::var("CELLS_SIZES") {
+        Ok(s) => s.split(',').filter_map(|x| x.trim().parse().ok()).collect(),
+        Err(_) => all,
+    }
+}
 
-#[divan::bench(args = SIZES, sample_count = 10, sample_size = 1)]
+#[divan::bench(args = sizes(), sample_count = 10, sample_size = 1)]
 fn grid(bencher: Bencher<'_, '_>, edges: usize) {
     let g = perturbed_grid(edges, 7);
     let mut x = CellExtractor::new();
@@ -83,7 +93,7 @@ fn grid(bencher: Bencher<'_, '_>, edges: usize) {
         .bench_local(|| black_box(x.extract(&g, &params).unwrap()));
 }
 
-#[divan::bench(args = SIZES, sample_count = 10, sample_size = 1)]
+#[divan::bench(args = sizes(), sample_count = 10, sample_size = 1)]
 fn grid_unchecked(bencher: Bencher<'_, '_>, edges: usize) {
     let g = perturbed_grid(edges, 7);
     let mut x = CellExtractor::new();
@@ -96,7 +106,7 @@ fn grid_unchecked(bencher: Bencher<'_, '_>, edges: usize) {
         .bench_local(|| black_box(x.extract(&g, &params).unwrap()));
 }
 
-#[divan::bench(args = SIZES, sample_count = 10, sample_size = 1)]
+#[divan::bench(args = sizes(), sample_count = 10, sample_size = 1)]
 fn random(bencher: Bencher<'_, '_>, edges: usize) {
     let g = random_planar(edges, 11);
     let mut x = CellExtractor::new();
@@ -106,7 +116,7 @@ fn random(bencher: Bencher<'_, '_>, edges: usize) {
         .bench_local(|| black_box(x.extract(&g, &params).unwrap()));
 }
 
-#[divan::bench(args = SIZES, sample_count = 10, sample_size = 1)]
+#[divan::bench(args = sizes(), sample_count = 10, sample_size = 1)]
 fn random_unchecked(bencher: Bencher<'_, '_>, edges: usize) {
     let g = random_planar(edges, 11);
     let mut x = CellExtractor::new();
