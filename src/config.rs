@@ -267,6 +267,7 @@ const PRESETS: &[(&str, &str)] = &[
     ),
     ("old_town", include_str!("../presets/old_town.json")),
     ("suburbia", include_str!("../presets/suburbia.json")),
+    ("citygen", include_str!("../presets/citygen.json")),
 ];
 
 impl CityConfig {

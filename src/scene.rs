@@ -136,6 +136,7 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
         let faces: Vec<usize> = dress
             .map(|d| {
                 let mut f: Vec<usize> = d.quads.iter().map(|q| q.face).collect();
+                f.sort_unstable();
                 f.dedup();
                 f.retain(|&k| b.facades.get(k).is_some_and(|f| f.part == pi));
                 f
@@ -156,6 +157,17 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
         mesh.positions.clone_from(&part.mesh.positions);
         mesh.normals.clone_from(&part.mesh.normals);
         mesh.uvs.clone_from(&part.mesh.uvs);
+        // The dressed faces of this part as planes: origin, normal, unit axes, size.
+        let planes: Vec<_> = faces
+            .iter()
+            .filter_map(|&k| b.facades.get(k))
+            .map(|f| {
+                let u = (f.quad[1] - f.quad[0]).normalize_or_zero();
+                let v = (f.quad[3] - f.quad[0]).normalize_or_zero();
+                (f.quad[0], f.normal, u, v, f.width, f.height)
+            })
+            .collect();
+        const TOL: f64 = 1e-3;
         for t in part.mesh.triangles() {
             let p = t.map(|i| {
                 part.mesh
@@ -163,24 +175,17 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
                     .get(i as usize)
                     .map_or(DVec3::NAN, |v| v.as_dvec3())
             });
-            let covered = faces.iter().filter_map(|&k| b.facades.get(k)).any(|f| {
-                let n = f.normal;
-                let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-                if tn.dot(n) < 0.99 {
-                    return false;
-                }
-                let tol = 1e-3;
-                if p.iter().any(|v| (*v - f.quad[0]).dot(n).abs() > tol) {
-                    return false;
-                }
-                let c = (p[0] + p[1] + p[2]) / 3.0 - f.quad[0];
-                let (u, v) = (
-                    (f.quad[1] - f.quad[0]).normalize_or_zero(),
-                    (f.quad[3] - f.quad[0]).normalize_or_zero(),
-                );
-                let (s, h) = (c.dot(u), c.dot(v));
-                s > -tol && s < f.width + tol && h > -tol && h < f.height + tol
-            });
+            let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            // Only walls (horizontal normals) can be covered by a facade face.
+            let covered = tn.y.abs() < 0.1
+                && planes.iter().any(|&(o, n, u, v, w, h)| {
+                    if tn.dot(n) < 0.99 || p.iter().any(|q| (*q - o).dot(n).abs() > TOL) {
+                        return false;
+                    }
+                    let c = (p[0] + p[1] + p[2]) / 3.0 - o;
+                    let (s, t) = (c.dot(u), c.dot(v));
+                    s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
+                });
             if !covered {
                 mesh.indices.extend_from_slice(&t);
             }

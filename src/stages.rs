@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use polis_buildings::{Building, BuildingGenerator, BuildingKind, FacadeRole};
 use polis_cells::{Cell, CellDecomposition};
-use polis_facades::{FacadeSpec, FaceRole, PreparedStyle, RasterOptions, TileSet};
+use polis_facades::{FacadeSpec, FaceRole, PreparedStyle, RasterOptions, TileQuad, TileSet};
 use polis_geom::{DVec2, DVec3, PolygonWithHoles};
 use polis_lots::{Block, Lot};
 use polis_roads::{GlobalGoals, GrowthReport, RoadGenerator, RoadNetwork};
@@ -442,7 +442,8 @@ impl DressBuilding for Tiler {
         let (Some(prepared), Some(set)) = (self.styles.get(style), self.sets.get(style)) else {
             return Ok(None);
         };
-        let mut quads = Vec::new();
+        // Each wall face's tile quads, or `None` where the tiles do not cover it.
+        let mut per_face: Vec<(usize, Option<Vec<TileQuad>>)> = Vec::new();
         for (k, face) in b.facades.iter().enumerate() {
             let role = match face.role {
                 FacadeRole::Wall => FaceRole::UpperFloors,
@@ -450,6 +451,7 @@ impl DressBuilding for Tiler {
                 FacadeRole::Roof => continue,
             };
             if !(face.width > 0.5 && face.height > 0.5) {
+                per_face.push((k, None));
                 continue;
             }
             let spec = FacadeSpec {
@@ -459,44 +461,42 @@ impl DressBuilding for Tiler {
                 role,
                 seed: crate::seed::mix(seed, k as u64),
             };
-            let layout = prepared.layout(&spec)?;
+            let chosen = match self.detail {
+                FacadeDetail::Full => prepared.layout(&spec)?.tile_quads(set),
+                FacadeDetail::Compact => prepared
+                    .compact_tile_quad(&spec, set)?
+                    .into_iter()
+                    .collect(),
+            };
+            let covered: f64 = chosen.iter().map(|q| q.rect.area()).sum();
+            let area = face.width * face.height;
+            let ok = (covered - area).abs() <= 1e-6 * area;
+            per_face.push((k, ok.then_some(chosen)));
+        }
+        // A wall is dressed all or nothing: the ground-floor band and the storeys above
+        // share one plane of the mass, whose triangles the skin replaces.
+        let wall_key = |k: usize| {
+            b.facades.get(k).map(|f| {
+                let (p, q) = (f.quad[0], f.quad[1]);
+                (f.part, [p.x, p.z, q.x, q.z].map(f64::to_bits))
+            })
+        };
+        let failed: Vec<_> = per_face
+            .iter()
+            .filter(|(_, q)| q.is_none())
+            .filter_map(|(k, _)| wall_key(*k))
+            .collect();
+        let mut quads = Vec::new();
+        for (k, chosen) in per_face {
+            let (Some(chosen), Some(face)) = (chosen, b.facades.get(k)) else {
+                continue;
+            };
+            if wall_key(k).is_some_and(|key| failed.contains(&key)) {
+                continue;
+            }
             let [bl, br, _tr, tl] = face.quad;
             let (du, dv) = (br - bl, tl - bl);
             let at = |s: f64, t: f64| bl + du * (s / face.width) + dv * (t / face.height);
-            let tiles = layout.tile_quads(set);
-            let chosen: Vec<_> = match self.detail {
-                FacadeDetail::Full => tiles,
-                // The repeated tile of the face's main rows, stretched over the whole face.
-                FacadeDetail::Compact => tiles
-                    .iter()
-                    .filter(|q| {
-                        set.tiles
-                            .get(q.tile)
-                            .is_some_and(|t| t.cols == polis_facades::Part::Repeat && !t.entrance)
-                    })
-                    .max_by(|a, b| {
-                        (a.rect.width() * a.rect.height())
-                            .total_cmp(&(b.rect.width() * b.rect.height()))
-                    })
-                    .map(|q| {
-                        let mut q = *q;
-                        q.rect = polis_geom::Aabb2::new(
-                            DVec2::ZERO,
-                            DVec2::new(face.width, face.height),
-                        );
-                        vec![q]
-                    })
-                    .unwrap_or_default(),
-            };
-            // A face is dressed only if its quads cover it (a tile missing from the set
-            // would leave a hole where the wall triangles are replaced).
-            let covered: f64 = chosen
-                .iter()
-                .map(|q| q.rect.width() * q.rect.height())
-                .sum();
-            if (covered - face.width * face.height).abs() > 1e-6 * face.width * face.height {
-                continue;
-            }
             for q in chosen {
                 let (x0, y0, x1, y1) = (q.rect.min.x, q.rect.min.y, q.rect.max.x, q.rect.max.y);
                 let uv = |s: f64, t: f64| DVec2::from(q.uv_at(s, t));
