@@ -74,14 +74,19 @@
 //!   boundary containing a cell, `holes` outline its islands (the union of its children),
 //!   and a cell's own region is its boundary minus its holes.
 //! * Every left/right decision uses the exact predicates of `polis-geom` (through the
-//!   graph's exact rotation system); containment of whole components uses exact point
-//!   location. Output order is deterministic (sweep order, then ids).
+//!   graph's exact rotation system); the containment of whole components comes from an
+//!   exact line sweep (the edge directly below each component's leftmost node). Output
+//!   order is deterministic (sweep order, then ids).
+//! * [`Cell::polygon_with_holes`] always passes `PolygonWithHoles::validate`; only hole
+//!   vertices touching another ring move, by [`TOUCH_SEPARATION`] into their hole.
 //! * `O(n log n)`: one sort of the nodes, one line sweep (the planarity check, and the
 //!   containment of components), then every half-edge is walked once.
 //! * Non-planar input (crossings, overlaps, nodes inside edges) is rejected with
 //!   [`Error::NotPlanar`] naming the edges (or planarised on request with
 //!   [`extract_planarized`]); coincident nodes are merged (and reported) or rejected, see
-//!   [`CellParams`].
+//!   [`CellParams`]. The check is an exact Shamos–Hoey sweep, skipped for graphs that are
+//!   planar by construction (`PlanarGraph::is_planar_by_construction`: built only by
+//!   planar insertion).
 //!
 //! ## Limitations
 //!
@@ -99,6 +104,8 @@
 //! * D. Eberly, *The Minimal Cycle Basis for a Planar Graph*, Geometric Tools, 2005
 //!   (revised 2020 as *Constructing a Cycle Basis for a Planar Graph*).
 //! * G. Kelly, *An Interactive System for Procedural City Generation*, 2008, §4.3.1, §4.4.
+//! * M. I. Shamos, D. Hoey, *Geometric intersection problems*, FOCS 1976 (the planarity
+//!   sweep).
 
 mod assemble;
 mod cell_graph;
