@@ -179,6 +179,18 @@ fn untangled(points: &[(i32, i32)]) -> Option<Polygon> {
     None
 }
 
+/// The weighted skeleton with weights `ws` repeated over all edges (ring by ring),
+/// checked independently, and its insets.
+fn check_weighted(p: &PolygonWithHoles, ws: &[f64]) -> Result<(), TestCaseError> {
+    let count: usize = p.rings().map(|(_, r)| r.len()).sum();
+    let w: Vec<f64> = (0..count).map(|i| ws[i % ws.len()]).collect();
+    let sk = StraightSkeleton::weighted(p, &w).unwrap();
+    if let Err(e) = check_skeleton(p, &sk, 1e-8) {
+        prop_assert!(false, "{}", e);
+    }
+    check_insets(p, Some(&w), &sk)
+}
+
 /// Case count: 96 by default, `LOTS_CASES` to stress.
 fn cases() -> u32 {
     std::env::var("LOTS_CASES")
@@ -269,11 +281,7 @@ proptest! {
         }
         let p = PolygonWithHoles::new(outer, hs);
         prop_assume!(p.validate().is_ok() && p.is_normalized());
-        let count: usize = p.rings().map(|(_, r)| r.len()).sum();
-        let w: Vec<f64> = (0..count).map(|i| ws[i % ws.len()]).collect();
-        let sk = StraightSkeleton::weighted(&p, &w).unwrap();
-        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
-        check_insets(&p, Some(&w), &sk)?;
+        check_weighted(&p, &ws)?;
     }
 
     #[test]
@@ -315,11 +323,7 @@ proptest! {
         }
         let p = PolygonWithHoles::new(outer, hs);
         prop_assume!(p.validate().is_ok() && p.is_normalized());
-        let count: usize = p.rings().map(|(_, r)| r.len()).sum();
-        let w: Vec<f64> = (0..count).map(|i| ws[i % ws.len()]).collect();
-        let sk = StraightSkeleton::weighted(&p, &w).unwrap();
-        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
-        check_insets(&p, Some(&w), &sk)?;
+        check_weighted(&p, &ws)?;
     }
 
     #[test]
