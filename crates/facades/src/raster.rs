@@ -214,17 +214,7 @@ pub fn rasterize_stack(
             };
             dst.clone_from(src);
         } else {
-            albedo.resize(row4.end, 0);
-            mr.resize(row4.end, 0);
-            heights.resize(row1.end, 0.0);
-            let (Some(arow), Some(mrow), Some(hrow)) = (
-                albedo.get_mut(row4.clone()),
-                mr.get_mut(row4),
-                heights.get_mut(row1),
-            ) else {
-                continue;
-            };
-            conv.row(&runs[slot], &sweep, arow, mrow, hrow);
+            conv.row(&runs[slot], &sweep, w, &mut albedo, &mut mr, &mut heights);
             height_segments(&runs[slot], &mut hsegs[slot]);
         }
         // Row y − 1 now has both neighbours: derive its normals.
@@ -278,18 +268,21 @@ impl Converter {
         )
     }
 
-    /// Writes one row of albedo, metallic-roughness and height from its runs.
+    /// Appends one row (`w` texels) of albedo, metallic-roughness and height from its
+    /// runs.
     fn row(
         &mut self,
         runs: &RowRuns,
         sweep: &RowSweep,
-        arow: &mut [u8],
-        mrow: &mut [u8],
-        hrow: &mut [f32],
+        w: usize,
+        albedo: &mut Vec<u8>,
+        mr: &mut Vec<u8>,
+        heights: &mut Vec<f32>,
     ) {
+        let (a0, m0, h0) = (albedo.len(), mr.len(), heights.len());
         let mut a = 0usize;
         for run in &runs.runs {
-            let b = (run.end as usize).min(hrow.len());
+            let b = (run.end as usize).min(w);
             if b <= a {
                 continue;
             }
@@ -303,11 +296,9 @@ impl Converter {
                             (pa, pm)
                         }
                     };
-                    fill4(arow.get_mut(a * 4..b * 4).unwrap_or_default(), pa);
-                    fill4(mrow.get_mut(a * 4..b * 4).unwrap_or_default(), pm);
-                    if let Some(hh) = hrow.get_mut(a..b) {
-                        hh.fill(m.height);
-                    }
+                    push4(albedo, pa, b - a);
+                    push4(mr, pm, b - a);
+                    heights.extend(std::iter::repeat_n(m.height, b - a));
                 }
                 RunKind::Strip(id) => {
                     let samples = sweep.strip_samples(id);
@@ -334,22 +325,35 @@ impl Converter {
                             samples.get(a..b),
                         )
                     {
-                        arow.get_mut(a * 4..b * 4)
-                            .unwrap_or_default()
-                            .copy_from_slice(src_a);
-                        mrow.get_mut(a * 4..b * 4)
-                            .unwrap_or_default()
-                            .copy_from_slice(src_m);
-                        for (hh, m) in hrow.get_mut(a..b).unwrap_or_default().iter_mut().zip(src_h)
-                        {
-                            *hh = m.height;
-                        }
+                        albedo.extend_from_slice(src_a);
+                        mr.extend_from_slice(src_m);
+                        heights.extend(src_h.iter().map(|m| m.height));
                     }
                 }
             }
             a = b;
+            // Keep the three outputs in step even if a strip were missing.
+            albedo.resize(a0 + a * 4, 0);
+            mr.resize(m0 + a * 4, 0);
+            heights.resize(h0 + a, 0.0);
         }
+        albedo.resize(a0 + w * 4, 0);
+        mr.resize(m0 + w * 4, 0);
+        heights.resize(h0 + w, 0.0);
     }
+}
+
+/// Appends `n` copies of the texel `p` to `dst` (in 64-byte blocks, without zeroing).
+#[inline]
+fn push4(dst: &mut Vec<u8>, p: [u8; 4], n: usize) {
+    let block = [p; 16];
+    let block = block.as_flattened();
+    let mut left = n * 4;
+    while left >= block.len() {
+        dst.extend_from_slice(block);
+        left -= block.len();
+    }
+    dst.extend_from_slice(block.get(..left).unwrap_or_default());
 }
 
 /// Writes the texel `p` into every 4-byte texel of `dst`.
