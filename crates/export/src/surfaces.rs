@@ -17,11 +17,20 @@
 //!   polygon. The polygon is star-shaped around the node (checked exactly) and
 //!   triangulated with [`triangulate`](polis_geom::mesh::triangulate).
 //! * **Dead ends** (degree 1) get an [`EndCap`]: round by default.
-//! * **Short segments.** When the two junctions of a segment want more than its length,
-//!   both cuts are shortened in proportion (the ribbon vanishes) and a corner that then
-//!   lies beyond a cut is joined by a chord; if the polygon is then no longer star-shaped
-//!   (near-parallel roads on short segments, overlapping segments) the junction is the
-//!   convex hull of its corners. [`RoadSurfaceReport`] counts these cases.
+//! * **Short segments.** When the two junctions of a segment want more than its length
+//!   (a crossing split into two T's a few metres apart, a fork on a short stem), they
+//!   **merge** into one polygon: the outside roads of the group are walked
+//!   counter-clockwise around it (around each node in its order, across each short
+//!   segment), consecutive roads of one node meet as above, roads of different nodes where
+//!   their borders cross (or by a bevel), and the polygon must be simple and
+//!   counter-clockwise. Short segments forming a cycle, or ending in a dead end, are not
+//!   merged: both cuts are shortened in proportion (the ribbon vanishes) and a corner that
+//!   then lies beyond a cut is joined by a chord. A polygon that is not star-shaped around
+//!   its node (resp. not simple, when merged) after that (near-parallel roads on short
+//!   segments, overlapping segments) becomes the convex hull of its corners.
+//!   [`RoadSurfaceReport`] counts every case; on the default `polis-roads` networks
+//!   (seeds 1, 3, 7; about 3,400 segments and 2,000 junctions each) 66–91 junctions merge
+//!   and 9–18 (under 1 %) are hulls.
 //! * **Draping.** Every vertex is lifted to the elevation field at its own layout point
 //!   plus [`RoadSurfaceOptions::lift_m`]; segments longer than
 //!   [`RoadSurfaceOptions::max_segment_m`] are subdivided. Bridges instead run straight
@@ -138,6 +147,9 @@ pub struct RoadSurfaceReport {
     pub duplicate_segments: usize,
     /// Segments too short for the cuts both junctions wanted (cuts shortened).
     pub clamped_segments: usize,
+    /// Junctions merged with a neighbour into one polygon because the segment between
+    /// them is shorter than the cuts both wanted (counted once per merged polygon).
+    pub merged_junctions: usize,
     /// Corners between two roads joined by a chord because a cut was shortened.
     pub clamped_corners: usize,
     /// Junctions replaced by the convex hull of their corners (near-parallel roads on
@@ -195,7 +207,7 @@ pub fn road_surfaces_with_report(
         4 * plan.edges.len() + 8 * plan.junctions.len(),
         2 * plan.edges.len() + 6 * plan.junctions.len(),
     );
-    for e in plan.edges.iter().filter(|e| !e.dropped) {
+    for e in plan.edges.iter().filter(|e| !e.dropped && !e.internal) {
         add_ribbon(&mut mesh, roads, e, &drape, options)?;
     }
     let mut report = plan.report.clone();
@@ -241,29 +253,42 @@ impl<'a> Drape<'a> {
         o: &RoadSurfaceOptions,
     ) -> Result<Self, ExportError> {
         let lift = |r: usize| o.lift_m + o.class_lift_m * f64::from(roads[r].class.rank());
-        let mut node_lift = vec![o.lift_m; plan.nodes.len()];
-        let mut deck = vec![None; plan.nodes.len()];
-        for (v, n) in plan.nodes.iter().enumerate() {
-            let mut sum = 0.0;
-            let mut all_bridges = !n.ends.is_empty();
-            for (k, &(e, starts)) in n.ends.iter().enumerate() {
+        // Per junction (a merged junction is one): the highest class, and a deck if every
+        // road there is a bridge.
+        let n = plan.nodes.len();
+        let mut node_lift = vec![f64::NEG_INFINITY; n];
+        let mut all_bridges = vec![true; n];
+        let mut sum = vec![0.0; n];
+        let mut count = vec![0usize; n];
+        for (v, node) in plan.nodes.iter().enumerate() {
+            let r = plan.rep.get(v).copied().unwrap_or(v);
+            for &(e, starts) in &node.ends {
                 let edge = &plan.edges[e];
-                let l = lift(edge.road);
-                if k == 0 || l > node_lift[v] {
-                    node_lift[v] = l;
-                }
+                node_lift[r] = node_lift[r].max(lift(edge.road));
                 let road = &roads[edge.road];
                 if !road.bridge {
-                    all_bridges = false;
-                } else if all_bridges {
+                    all_bridges[r] = false;
+                } else if all_bridges[r] {
                     let s = edge.s_a + if starts { 0.0 } else { edge.len };
-                    sum += bridge_height(road, edge.road, s, elevation)?;
+                    sum[r] += bridge_height(road, edge.road, s, elevation)?;
+                    count[r] += 1;
                 }
             }
-            if all_bridges {
-                deck[v] = Some(sum / n.ends.len() as f64);
+        }
+        for l in &mut node_lift {
+            if !l.is_finite() {
+                *l = o.lift_m;
             }
         }
+        let deck: Vec<Option<f64>> = (0..n)
+            .map(|v| {
+                let r = plan.rep.get(v).copied().unwrap_or(v);
+                (all_bridges[r] && count[r] > 0).then(|| sum[r] / count[r] as f64)
+            })
+            .collect();
+        let node_lift: Vec<f64> = (0..n)
+            .map(|v| node_lift[plan.rep.get(v).copied().unwrap_or(v)])
+            .collect();
         // A deck node inside a chain of bridge segments (a bridge split into several
         // roads): straight between the chain's ends on land, by length along the chain.
         // Each chain is walked once, from its first unvisited node both ways.
@@ -358,7 +383,7 @@ fn walk_chain(plan: &junctions::Plan, deck: &[Option<f64>], v: usize, e: usize) 
         if next == v {
             break;
         }
-        if deck[next].is_none() || n.ends.len() != 2 {
+        if deck[next].is_none() || n.ends.len() != 2 || plan.merged.get(next) == Some(&true) {
             return Chain {
                 end: Some((next, dist)),
                 inner,

@@ -12,6 +12,7 @@
 use std::collections::BTreeMap;
 
 use polis_geom::mesh::triangulate;
+use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 
@@ -55,6 +56,8 @@ pub(crate) struct PlanEdge {
     pub trim: [f64; 2],
     /// Dropped as a duplicate of another segment between the same nodes.
     pub dropped: bool,
+    /// Inside a merged junction (too short for the cuts at its ends): no ribbon.
+    pub internal: bool,
 }
 
 /// A node of the plan.
@@ -81,6 +84,11 @@ pub(crate) struct Junction {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Plan {
     pub nodes: Vec<PlanNode>,
+    /// The node whose junction each node belongs to (itself, or the first node of its
+    /// merged junction).
+    pub rep: Vec<usize>,
+    /// Whether the node is part of a merged junction.
+    pub merged: Vec<bool>,
     pub edges: Vec<PlanEdge>,
     pub junctions: Vec<Junction>,
     pub report: RoadSurfaceReport,
@@ -225,6 +233,7 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
                 cut_b: [q; 2],
                 trim: [0.0; 2],
                 dropped: false,
+                internal: false,
             });
             // Two segments between the same nodes: keep the wider one.
             let k = (na.min(nb), na.max(nb));
@@ -268,16 +277,7 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
         };
         if !is_straight(&g) {
             for (i, gap) in g.iter().enumerate() {
-                let j = (i + 1) % k;
-                match *gap {
-                    Gap::Convex { t, s } => {
-                        want_trim(&mut p.edges, &es[i], t);
-                        want_trim(&mut p.edges, &es[j], s);
-                    }
-                    Gap::Wide { i_wide: true, s0 } => want_trim(&mut p.edges, &es[j], s0),
-                    Gap::Wide { i_wide: false, s0 } => want_trim(&mut p.edges, &es[i], s0),
-                    _ => {}
-                }
+                want_gap(&mut p.edges, &es[i], &es[(i + 1) % k], *gap);
             }
             if k >= 2 {
                 for end in es {
@@ -287,8 +287,18 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
         }
         gaps.push(g);
     }
+    // Pass 1b: junctions joined by a segment shorter than the cuts they want at its ends
+    // merge into one polygon around both (a jogged crossing, a fork on a short stem).
+    // One round: merging can lengthen the cuts of the merged junction's roads and make
+    // another segment too short; that one is clamped (merging again would grow groups
+    // around faces, which are left unmerged, and lose more than it gains).
+    p.rep = (0..p.nodes.len()).collect();
+    p.merged = vec![false; p.nodes.len()];
+    let clusters = find_clusters(&p, &ends);
+    apply_clusters(&mut p, &ends, &gaps, &clusters);
+    p.report.merged_junctions = clusters.len();
     // Pass 2: a segment too short for both trims is shared in proportion.
-    for e in p.edges.iter_mut().filter(|e| !e.dropped) {
+    for e in p.edges.iter_mut().filter(|e| !e.dropped && !e.internal) {
         let sum = e.trim[0] + e.trim[1];
         if sum > e.len {
             let f = e.len / sum;
@@ -299,6 +309,9 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
     // Pass 3: cuts and polygons.
     for (v, es) in ends.iter().enumerate() {
         let c = p.nodes[v].pos;
+        if p.merged[v] {
+            continue;
+        }
         let ring = match es.len() {
             0 => continue,
             1 => dead_end(c, &es[0], &mut p.edges, o.end_cap),
@@ -311,20 +324,29 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
             _ => junction(c, es, &gaps[v], &mut p.edges, &mut p.report),
         };
         let Some(ring) = ring else { continue };
-        match triangulate(&PolygonWithHoles::new(
-            Polygon::new(ring.clone()),
-            Vec::new(),
-        )) {
-            Ok(triangles) if !triangles.is_empty() => p.junctions.push(Junction {
-                node: v,
-                ring,
-                triangles,
-            }),
-            _ => p.report.skipped_junctions += 1,
+        push_junction(&mut p, v, ring);
+    }
+    for cl in &clusters {
+        let ring = cluster_junction(&p.nodes, &ends, &gaps, cl, &mut p.edges, &mut p.report);
+        if let Some(ring) = ring {
+            push_junction(&mut p, cl.nodes[0], ring);
         }
     }
     p.report.junctions = p.junctions.len();
     p
+}
+
+/// Triangulates a junction ring and keeps it (or counts it as skipped).
+fn push_junction(p: &mut Plan, v: usize, ring: Vec<DVec2>) {
+    let polygon = PolygonWithHoles::new(Polygon::new(ring.clone()), Vec::new());
+    match triangulate(&polygon) {
+        Ok(triangles) if !triangles.is_empty() => p.junctions.push(Junction {
+            node: v,
+            ring,
+            triangles,
+        }),
+        _ => p.report.skipped_junctions += 1,
+    }
 }
 
 /// Whether the gaps are those of a node where one road simply continues (two roads,
@@ -530,6 +552,270 @@ fn join_at(
         // Trims clamped by a short segment: the corner lies beyond a cut.
         report.clamped_corners += 1;
     }
+}
+
+/// Marks the merged junctions: their nodes, their inner segments, and the cuts their
+/// outside roads want (recomputed from the merged polygon's corners).
+fn apply_clusters(p: &mut Plan, ends: &[Vec<End>], gaps: &[Vec<Gap>], clusters: &[Cluster]) {
+    p.rep = (0..p.nodes.len()).collect();
+    p.merged = vec![false; p.nodes.len()];
+    for e in &mut p.edges {
+        e.internal = false;
+    }
+    for cl in clusters {
+        for &v in &cl.nodes {
+            p.rep[v] = cl.nodes[0];
+            p.merged[v] = true;
+        }
+        for &e in &cl.internal {
+            p.edges[e].internal = true;
+        }
+        for &(v, k) in &cl.seq {
+            let end = &ends[v][k];
+            p.edges[end.edge].trim[slot(end)] = 0.0;
+        }
+        let m = cl.seq.len();
+        for i in 0..m {
+            let (a, b) = (cl.seq[i], cl.seq[(i + 1) % m]);
+            let (ea, eb) = (&ends[a.0][a.1], &ends[b.0][b.1]);
+            match link(&p.nodes, ends, gaps, a, b) {
+                Link::Node(gap) => want_gap(&mut p.edges, ea, eb, gap),
+                Link::Cross(Some((t, s))) => {
+                    want_trim(&mut p.edges, ea, t);
+                    want_trim(&mut p.edges, eb, s);
+                }
+                Link::Cross(None) => {}
+            }
+        }
+        for &(v, k) in &cl.seq {
+            let end = &ends[v][k];
+            want_trim(&mut p.edges, end, MIN_TRIM_HALF_WIDTHS * end.w);
+        }
+    }
+}
+
+/// Records the trims a gap between `ei` and the next end `ej` wants.
+fn want_gap(edges: &mut [PlanEdge], ei: &End, ej: &End, gap: Gap) {
+    match gap {
+        Gap::Convex { t, s } => {
+            want_trim(edges, ei, t);
+            want_trim(edges, ej, s);
+        }
+        Gap::Wide { i_wide: true, s0 } => want_trim(edges, ej, s0),
+        Gap::Wide { i_wide: false, s0 } => want_trim(edges, ei, s0),
+        _ => {}
+    }
+}
+
+/// Nodes joined by segments too short for their cuts, the segments, and the outside
+/// ends in counter-clockwise order around them as `(node, index into its ends)`.
+#[derive(Debug)]
+struct Cluster {
+    nodes: Vec<usize>,
+    internal: Vec<usize>,
+    seq: Vec<(usize, usize)>,
+}
+
+fn root(parent: &mut [usize], mut v: usize) -> usize {
+    while parent[v] != v {
+        parent[v] = parent[parent[v]];
+        v = parent[v];
+    }
+    v
+}
+
+fn far_node(edges: &[PlanEdge], end: &End) -> usize {
+    let e = &edges[end.edge];
+    if end.starts { e.b } else { e.a }
+}
+
+/// Merges the ends of every segment whose two cuts overlap (neither end a dead end) and
+/// keeps the groups whose short segments form a tree (a group around a face, or with
+/// another segment inside, stays as it is: its segments are clamped).
+fn find_clusters(p: &Plan, ends: &[Vec<End>]) -> Vec<Cluster> {
+    let n = p.nodes.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    for e in p.edges.iter().filter(|e| !e.dropped) {
+        if e.trim[0] + e.trim[1] > e.len && ends[e.a].len() >= 2 && ends[e.b].len() >= 2 {
+            let (a, b) = (root(&mut parent, e.a), root(&mut parent, e.b));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|v| root(&mut parent, v)).collect();
+    let mut groups: BTreeMap<usize, Cluster> = BTreeMap::new();
+    for (v, &r) in roots.iter().enumerate() {
+        if r != v || groups.contains_key(&r) {
+            if let Some(g) = groups.get_mut(&r) {
+                g.nodes.push(v);
+            }
+            continue;
+        }
+        groups.insert(
+            r,
+            Cluster {
+                nodes: vec![v],
+                internal: Vec::new(),
+                seq: Vec::new(),
+            },
+        );
+    }
+    for (e, edge) in p.edges.iter().enumerate().filter(|(_, e)| !e.dropped) {
+        if roots[edge.a] == roots[edge.b]
+            && let Some(g) = groups.get_mut(&roots[edge.a])
+        {
+            g.internal.push(e);
+        }
+    }
+    let mut out = Vec::new();
+    for (r, mut g) in groups {
+        if g.nodes.len() < 2 || g.internal.len() + 1 != g.nodes.len() {
+            continue;
+        }
+        if let Some(seq) = walk_outside(&p.edges, ends, &roots, r, &g.nodes) {
+            g.seq = seq;
+            out.push(g);
+        }
+    }
+    out
+}
+
+/// The outside ends of a tree of short segments in counter-clockwise order: around each
+/// node in its order, crossing every inner segment to continue after it at its far node.
+fn walk_outside(
+    edges: &[PlanEdge],
+    ends: &[Vec<End>],
+    roots: &[usize],
+    r: usize,
+    nodes: &[usize],
+) -> Option<Vec<(usize, usize)>> {
+    let start = nodes.iter().find_map(|&v| {
+        ends[v]
+            .iter()
+            .position(|x| roots[far_node(edges, x)] != r)
+            .map(|k| (v, k))
+    })?;
+    let limit = 2 * nodes.iter().map(|&v| ends[v].len()).sum::<usize>() + 2;
+    let (mut v, mut k) = start;
+    let mut seq = Vec::new();
+    for _ in 0..limit {
+        let end = ends[v].get(k)?;
+        let u = far_node(edges, end);
+        if roots[u] == r {
+            let twin = ends[u].iter().position(|x| x.edge == end.edge)?;
+            v = u;
+            k = (twin + 1) % ends[u].len();
+        } else {
+            seq.push((v, k));
+            k = (k + 1) % ends[v].len();
+        }
+        if (v, k) == start {
+            return Some(seq);
+        }
+    }
+    None
+}
+
+/// How two consecutive outside ends of a merged junction meet.
+enum Link {
+    /// At one node, next to each other: the gap between them.
+    Node(Gap),
+    /// From different nodes: where the left border of the first meets the right border
+    /// of the second (distances along each from its node), if ahead of both.
+    Cross(Option<(f64, f64)>),
+}
+
+fn link(
+    nodes: &[PlanNode],
+    ends: &[Vec<End>],
+    gaps: &[Vec<Gap>],
+    (v, k): (usize, usize),
+    (u, l): (usize, usize),
+) -> Link {
+    if v == u
+        && ends[v].len() >= 2
+        && l == (k + 1) % ends[v].len()
+        && let Some(&g) = gaps[v].get(k)
+    {
+        return Link::Node(g);
+    }
+    let (ei, ej) = (&ends[v][k], &ends[u][l]);
+    let denom = ei.d.perp_dot(ej.d);
+    if denom <= 0.0 {
+        return Link::Cross(None);
+    }
+    let q = (nodes[u].pos - ej.n() * ej.w) - (nodes[v].pos + ei.n() * ei.w);
+    let (t, s) = (q.perp_dot(ej.d) / denom, q.perp_dot(ei.d) / denom);
+    Link::Cross((t >= 0.0 && s >= 0.0 && t.is_finite() && s.is_finite()).then_some((t, s)))
+}
+
+/// The polygon of a merged junction: the cuts of its outside ends joined by their
+/// corners; the convex hull if that is not a simple counter-clockwise ring.
+fn cluster_junction(
+    nodes: &[PlanNode],
+    ends: &[Vec<End>],
+    gaps: &[Vec<Gap>],
+    cl: &Cluster,
+    edges: &mut [PlanEdge],
+    report: &mut RoadSurfaceReport,
+) -> Option<Vec<DVec2>> {
+    let m = cl.seq.len();
+    let es: Vec<&End> = cl.seq.iter().map(|&(v, k)| &ends[v][k]).collect();
+    let origin: Vec<DVec2> = cl.seq.iter().map(|&(v, _)| nodes[v].pos).collect();
+    let trims: Vec<f64> = es.iter().map(|e| trim_of(edges, e)).collect();
+    let mut cuts: Vec<[DVec2; 2]> = (0..m).map(|i| cut(origin[i], es[i], trims[i])).collect();
+    let mut extra: Vec<Vec<DVec2>> = vec![Vec::new(); m];
+    let mut clean = true;
+    for i in 0..m {
+        let j = (i + 1) % m;
+        let (ei, ej) = (es[i], es[j]);
+        match link(nodes, ends, gaps, cl.seq[i], cl.seq[j]) {
+            Link::Node(gap) => {
+                let pair = [(ei, trims[i], cuts[i]), (ej, trims[j], cuts[j])];
+                let (ci, cj, ok) = gap_corner(origin[i], pair, gap, &mut extra[i], report);
+                cuts[i] = ci;
+                cuts[j] = cj;
+                clean &= ok;
+            }
+            Link::Cross(Some((t, s))) => {
+                let corner = origin[i] + ei.d * t + ei.n() * ei.w;
+                let (mut ci, mut cj) = (cuts[i], cuts[j]);
+                join_at(
+                    corner,
+                    (t, trims[i]),
+                    (s, trims[j]),
+                    (&mut ci, &mut cj),
+                    &mut extra[i],
+                    report,
+                );
+                cuts[i] = ci;
+                cuts[j] = cj;
+            }
+            Link::Cross(None) => {
+                extra[i].extend([origin[i] + ei.n() * ei.w, origin[j] - ej.n() * ej.w]);
+            }
+        }
+    }
+    let mut ring: Vec<DVec2> = Vec::with_capacity(4 * m);
+    for i in 0..m {
+        ring.extend(cuts[i]);
+        ring.extend(&extra[i]);
+    }
+    dedup_ring(&mut ring);
+    for (e, cut) in es.iter().zip(&cuts) {
+        set_cut(edges, e, *cut);
+    }
+    let simple = ring.len() >= 3
+        && ring_signed_area(&ring) > 0.0
+        && Polygon::new(ring.clone()).validate().is_ok();
+    if clean && simple {
+        return Some(ring);
+    }
+    report.approximated_junctions += 1;
+    ring.extend(cl.nodes.iter().map(|&v| nodes[v].pos));
+    let hull = convex_hull(ring);
+    (hull.len() >= 3).then_some(hull)
 }
 
 /// Drops consecutive repeated points (and a closing repeat).

@@ -7,7 +7,7 @@ use polis_geom::field::{Constant, FnField};
 use polis_geom::glam::Vec3;
 use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::distance_to_segment;
-use polis_geom::{PlanarGraph, SnapOptions};
+use polis_geom::{PlanarGraph, Polygon, SnapOptions};
 use proptest::prelude::*;
 
 fn road(points: &[(f64, f64)], class: RoadClass, w: f64) -> MapRoad {
@@ -160,7 +160,7 @@ fn flat() -> RoadSurfaceOptions {
 /// segment, junctions as triangulated.
 fn pieces(p: &Plan) -> Vec<[DVec2; 3]> {
     let mut out = Vec::new();
-    for e in p.edges.iter().filter(|e| !e.dropped) {
+    for e in p.edges.iter().filter(|e| !e.dropped && !e.internal) {
         if e.len - e.trim[0] - e.trim[1] > e.len * 1e-12 {
             let ([ra, la], [rb, lb]) = (e.cut_a, e.cut_b);
             out.push([ra, rb, lb]);
@@ -436,6 +436,62 @@ fn short_segments_overlapping_roads_and_caps() {
         m.validate().unwrap();
         assert!((m.surface_area() - (120.0 + extra)).abs() < 1e-3);
     }
+}
+
+#[test]
+fn close_junctions_merge_into_one_polygon() {
+    let o = flat();
+    // A crossing split into two T's 2.85 m apart (a jog), 8 m streets: one polygon.
+    let (a, b) = (v(0.0, 0.0), v(2.85, 0.1));
+    let roads = [
+        MapRoad::new(
+            vec![v(-80.0, 0.0), a, b, v(90.0, 0.0)],
+            RoadClass::Street,
+            8.0,
+        ),
+        MapRoad::new(vec![a, v(1.0, -70.0)], RoadClass::Street, 8.0),
+        MapRoad::new(vec![b, v(3.0, 75.0)], RoadClass::Street, 8.0),
+    ];
+    let p = plan(&roads, &o);
+    assert_eq!(p.report.merged_junctions, 1, "{:?}", p.report);
+    assert_eq!(p.report.approximated_junctions, 0);
+    assert_eq!(p.report.clamped_segments, 0);
+    assert_eq!(p.junctions.len(), 1, "flat caps: the merged junction only");
+    check_plan(&p, 10.0);
+    // The merged polygon covers the jog: both nodes and the ribbon the short segment
+    // would have had.
+    let ring = Polygon::new(p.junctions[0].ring.clone());
+    for q in [
+        a,
+        b,
+        a.lerp(b, 0.5),
+        a.lerp(b, 0.5) + v(0.0, 3.9),
+        a.lerp(b, 0.5) - v(0.0, 3.9),
+    ] {
+        assert!(ring.contains(q), "{q} outside {:?}", ring.points());
+    }
+    let m = road_surfaces(&roads, &Constant(0.0), &RoadSurfaceOptions::default(), None).unwrap();
+    m.validate().unwrap();
+    // A fork on a short stem and a wide road meeting two close side streets.
+    let roads = [
+        MapRoad::new(
+            vec![v(0.0, -60.0), v(0.0, 0.0), v(0.0, 3.0)],
+            RoadClass::Major,
+            12.0,
+        ),
+        MapRoad::new(vec![v(0.0, 3.0), v(-50.0, 60.0)], RoadClass::Street, 7.0),
+        MapRoad::new(vec![v(0.0, 3.0), v(50.0, 60.0)], RoadClass::Street, 7.0),
+        MapRoad::new(vec![v(0.0, 0.0), v(60.0, -5.0)], RoadClass::Street, 7.0),
+        MapRoad::new(vec![v(0.0, 0.0), v(-60.0, -5.0)], RoadClass::Street, 7.0),
+    ];
+    let p = plan(&roads, &o);
+    assert_eq!(p.report.merged_junctions, 1, "{:?}", p.report);
+    assert_eq!(p.report.approximated_junctions, 0);
+    check_plan(&p, 10.0);
+    let (m, _) =
+        road_surfaces_with_report(&roads, &Constant(0.0), &RoadSurfaceOptions::default(), None)
+            .unwrap();
+    m.validate().unwrap();
 }
 
 #[test]
