@@ -69,17 +69,25 @@ const BOX_CELLS_MAX: i64 = 4;
 const BIG_SPAN: i64 = 4096;
 
 /// What a cell lists: the shape itself (copied into every cell it is entered in, so a
-/// query reads each cell's list contiguously instead of chasing pointers).
+/// query reads each cell's list contiguously instead of chasing pointers). 64 bytes for
+/// `u32` keys, one cache line: the box is recomputed from the shape when needed rather
+/// than stored, since queries are bound by the memory they scan.
 #[derive(Debug, Clone, Copy)]
 struct Entry<K> {
     key: K,
-    shape: Shape,
-    /// Bounding box of the shape.
-    bbox: Aabb2,
-    /// Lowest cell of the bounding box.
-    first: Cell,
     /// Whether the shape is rasterised (entered in a subset of its box's cells).
     raster: bool,
+    /// Lowest cell of the bounding box.
+    first: Cell,
+    shape: Shape,
+}
+
+impl<K> Entry<K> {
+    /// Bounding box of the shape.
+    #[inline]
+    fn bbox(&self) -> Aabb2 {
+        self.shape.bbox()
+    }
 }
 
 /// Cells per chunk side (a power of two).
@@ -388,7 +396,7 @@ impl<K: IndexKey> GridIndex<K> {
 
     fn visit_big<F: FnMut(K, &Shape)>(&self, b: &Aabb2, f: &mut F) {
         for e in &self.big {
-            if e.bbox.intersects(b) {
+            if e.bbox().intersects(b) {
                 f(e.key, &e.shape);
             }
         }
@@ -411,7 +419,6 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         let entry = Entry {
             key,
             shape,
-            bbox: shape.bbox(),
             first,
             raster,
         };
@@ -512,7 +519,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         let mut raster: Vec<Entry<K>> = Vec::new();
         self.walk_range((i0, j0), (i1, j1), |c, list| {
             for e in list {
-                if !e.bbox.intersects(b) {
+                if !e.bbox().intersects(b) {
                     continue;
                 }
                 if e.raster {
@@ -558,7 +565,8 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
                     continue;
                 };
                 for e in list {
-                    if !e.bbox.intersects(&bb) {
+                    let ebox = e.bbox();
+                    if !ebox.intersects(&bb) {
                         continue;
                     }
                     if e.raster {
@@ -566,7 +574,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
                         continue;
                     }
                     let (ei0, ej0) = e.first;
-                    let ej1 = geo.cell_coord(e.bbox.max.y);
+                    let ej1 = geo.cell_coord(ebox.max.y);
                     if j != j0.max(ej0) {
                         continue;
                     }
@@ -584,5 +592,15 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
             }
         }
         Self::report_raster(raster, &mut f);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_entry_fits_a_cache_line() {
+        assert!(std::mem::size_of::<Entry<u32>>() <= 64);
     }
 }
