@@ -29,7 +29,7 @@
 //!   its node (resp. not simple, when merged) after that (near-parallel roads on short
 //!   segments, overlapping segments) becomes the convex hull of its corners.
 //!   [`RoadSurfaceReport`] counts every case; on the default `polis-roads` networks
-//!   (seeds 1, 3, 7; about 3,400 segments and 2,000 junctions each) 66–91 junctions merge
+//!   (seeds 1, 3, 7; about 3,400 segments and 2,000 junctions each) 68–91 junctions merge
 //!   and 9–18 (under 1 %) are hulls.
 //! * **Draping.** Every vertex is lifted to the elevation field at its own layout point
 //!   plus [`RoadSurfaceOptions::lift_m`]; segments longer than

@@ -722,7 +722,7 @@ enum Link {
     /// At one node, next to each other: the gap between them.
     Node(Gap),
     /// From different nodes: where the left border of the first meets the right border
-    /// of the second (distances along each from its node), if ahead of both.
+    /// of the second (distances along each from its node), unless far behind either.
     Cross(Option<(f64, f64)>),
 }
 
@@ -747,7 +747,11 @@ fn link(
     }
     let q = (nodes[u].pos - ej.n() * ej.w) - (nodes[v].pos + ei.n() * ei.w);
     let (t, s) = (q.perp_dot(ej.d) / denom, q.perp_dot(ei.d) / denom);
-    Link::Cross((t >= 0.0 && s >= 0.0 && t.is_finite() && s.is_finite()).then_some((t, s)))
+    // The crossing may lie a little behind a road's node (towards the other node, as at a
+    // jogged crossing), not far behind (nearly parallel roads).
+    let reach = (nodes[u].pos - nodes[v].pos).length() + ei.w + ej.w;
+    let ok = t.is_finite() && s.is_finite() && t >= -reach && s >= -reach;
+    Link::Cross(ok.then_some((t, s)))
 }
 
 /// The polygon of a merged junction: the cuts of its outside ends joined by their
