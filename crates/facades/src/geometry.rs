@@ -156,8 +156,19 @@ fn collect_layer(
     let depth_m = depth + layer.depth_m;
     // One shared name per layer and call: every cell holds a reference to it.
     let name = LayerName::from(layer.name.as_str());
+    let picked = |m: &Option<Vec<bool>>, k: usize| {
+        m.as_ref()
+            .is_none_or(|m| m.get(k).copied().unwrap_or(false))
+    };
     for j in 0..layer.v.len() {
+        // Unselected rows and columns have no cells: skip them without a look.
+        if !picked(&layer.v_mask, j) {
+            continue;
+        }
         for i in 0..layer.u.len() {
+            if !picked(&layer.u_mask, i) {
+                continue;
+            }
             layer.cell_rects(i, j, |r| {
                 out.push(FacadeCell {
                     rect: map.rect(&r),
