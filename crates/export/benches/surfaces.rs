@@ -3,8 +3,10 @@
 //!
 //! The network is an 88 × 88 grid of nodes 60 m apart, jittered by up to ±12 m (a
 //! deterministic hash, no RNG), every 8th row and column a 16 m highway, the rest 8 m
-//! streets, 2 % of the segments removed (T-junctions and dead ends): 15,006 segments,
-//! one two-point road each (as the pipeline passes graph edges). Terrain: gentle waves.
+//! streets, 2 % of the segments removed (T-junctions and dead ends), 5 % of the
+//! crossings jogged (the roads east and north leave 3 m east of the node, joined to it by
+//! a short segment: merged junctions), one two-point road per segment (as the pipeline
+//! passes graph edges). Terrain: gentle waves.
 //!
 //! Run: `cargo bench -p polis-export --bench surfaces`.
 
@@ -63,10 +65,31 @@ fn terrain() -> FnField<impl Fn(DVec2) -> f64> {
     FnField::new(|p: DVec2| 8.0 * (p.x / 700.0).sin() * (p.y / 900.0).cos())
 }
 
+/// Whether the crossing at `(i, j)` is jogged: the roads east and north leave from a
+/// point 3 m east, joined to the node by a short segment (a merged junction).
+fn jog(i: usize, j: usize) -> bool {
+    hash(i, j, 5) > 0.9
+}
+
+/// Where the roads east and north of node `(i, j)` start.
+fn start(i: usize, j: usize) -> DVec2 {
+    node(i, j)
+        + if jog(i, j) {
+            DVec2::new(3.0, 0.3)
+        } else {
+            DVec2::ZERO
+        }
+}
+
 static ROADS: LazyLock<Vec<MapRoad>> = LazyLock::new(|| {
     let mut roads = Vec::new();
     for i in 0..N {
         for j in 0..N {
+            if jog(i, j) {
+                let mut r = MapRoad::new(vec![node(i, j), start(i, j)], RoadClass::Street, 8.0);
+                r.id = roads.len() as u64;
+                roads.push(r);
+            }
             for (di, dj, salt) in [(1, 0, 3), (0, 1, 4)] {
                 let (k, l) = (i + di, j + dj);
                 if k >= N || l >= N || hash(i, j, salt) < -0.96 {
@@ -78,7 +101,7 @@ static ROADS: LazyLock<Vec<MapRoad>> = LazyLock::new(|| {
                 } else {
                     (RoadClass::Street, 8.0)
                 };
-                let mut r = MapRoad::new(vec![node(i, j), node(k, l)], class, width);
+                let mut r = MapRoad::new(vec![start(i, j), node(k, l)], class, width);
                 r.id = roads.len() as u64;
                 roads.push(r);
             }
