@@ -272,13 +272,17 @@ impl Mesh {
     /// the mesh unchanged, if a value is not finite or the whole quad has zero area.
     pub fn add_quad(&mut self, p: [DVec3; 4], uv: [DVec2; 4]) -> Result<(), GeomError> {
         let normal = (p[1] - p[0]).cross(p[2] - p[0]) + (p[2] - p[0]).cross(p[3] - p[0]);
-        let halves: Vec<[usize; 3]> = [[0, 1, 2], [0, 2, 3]]
-            .into_iter()
-            .filter(|t| {
-                !triangle_is_degenerate(p[t[0]].as_vec3(), p[t[1]].as_vec3(), p[t[2]].as_vec3())
-            })
-            .collect();
-        self.add_flat_face(&p, &uv, normal, &halves)
+        // The non-degenerate halves, without allocating.
+        let mut halves = [[0, 1, 2], [0, 2, 3]];
+        let mut n = 0;
+        for k in 0..2 {
+            let t = halves[k];
+            if !triangle_is_degenerate(p[t[0]].as_vec3(), p[t[1]].as_vec3(), p[t[2]].as_vec3()) {
+                halves[n] = t;
+                n += 1;
+            }
+        }
+        self.add_flat_face(&p, &uv, normal, &halves[..n])
     }
 
     /// Shared body of [`add_triangle`](Self::add_triangle) and [`add_quad`](Self::add_quad).

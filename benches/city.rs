@@ -1,0 +1,141 @@
+//! The whole-city benchmarks of issue 10, printed as a table.
+//!
+//! ```text
+//! cargo bench --bench city                # Citygen's test city (16 km²)
+//! cargo bench --bench city -- metropolis  # the 1,000,000-building metropolis
+//! cargo bench --bench city -- all
+//! ```
+//!
+//! Each city is generated end to end — maps, roads, cells, blocks and lots, buildings,
+//! facade tile textures and skins, and the assembled scene — by `polis::generate`; file
+//! writing is timed separately. Wall-clock time is the best of the runs; CPU time (user +
+//! system of the whole process during the run, from `/proc/self/stat`, Linux only) shows
+//! what a loaded machine hides. Peak memory is the process's high-water mark (`VmHWM`).
+
+use std::time::Instant;
+
+use polis::{CityConfig, Pipeline, Stage};
+
+/// CPU seconds used by this process so far (Linux; `None` elsewhere).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may contain spaces).
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of the whole line: 12 and 13 here.
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
+/// Peak resident memory of this process, MiB (Linux; `None` elsewhere).
+fn peak_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+fn run(label: &str, config: &CityConfig, runs: usize, scene: bool) {
+    let mut best = f64::INFINITY;
+    let mut best_cpu = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..runs {
+        let cpu0 = cpu_seconds();
+        let t = Instant::now();
+        let city = match Pipeline::default().with_scene(scene).generate(config) {
+            Ok(c) => c,
+            Err(e) => {
+                println!("{label}: error: {e}");
+                return;
+            }
+        };
+        let wall = t.elapsed().as_secs_f64();
+        if let (Some(a), Some(b)) = (cpu0, cpu_seconds()) {
+            best_cpu = best_cpu.min(b - a);
+        }
+        best = best.min(wall);
+        last = Some(city);
+    }
+    let Some(city) = last else { return };
+    let s = &city.stats;
+    println!(
+        "\n{label}: {:.1} km², lod {}",
+        (config.size_m / 1000.0).powi(2),
+        config.effective_lod()
+    );
+    println!(
+        "  road segments {:>9}   buildings {:>9}   lots {:>9}",
+        s.road_segments, s.buildings, s.lots
+    );
+    println!(
+        "  triangles     {:>9}   facade tiles {:>6} ({:.1} MiB)",
+        s.building_triangles,
+        s.facade_tiles,
+        s.texture_bytes as f64 / 1048576.0
+    );
+    print!("  stages (last run):");
+    for stage in Stage::ALL {
+        print!(
+            " {} {:.0} ms,",
+            stage.name(),
+            s.time(stage).as_secs_f64() * 1e3
+        );
+    }
+    println!();
+    let cpu = if best_cpu.is_finite() {
+        format!("{best_cpu:.2} s")
+    } else {
+        "n/a".into()
+    };
+    println!("  generate: best wall {best:.2} s, best CPU {cpu} over {runs} runs");
+    if scene {
+        let t = Instant::now();
+        let mut glb = Vec::new();
+        match city.write_glb(&mut glb) {
+            Ok(_) => println!(
+                "  glb: {:.1} MiB in {:.2} s",
+                glb.len() as f64 / 1048576.0,
+                t.elapsed().as_secs_f64()
+            ),
+            Err(e) => println!("  glb: error: {e}"),
+        }
+    }
+    if let Some(peak) = peak_mib() {
+        println!("  peak memory (process high-water mark): {peak:.0} MiB");
+    }
+}
+
+fn main() {
+    let which: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let want = |name: &str| {
+        which.is_empty() && name == "citygen" || which.iter().any(|w| w == name || w == "all")
+    };
+    let Ok(citygen) = CityConfig::preset("citygen") else {
+        println!("the citygen preset does not parse");
+        return;
+    };
+    if want("citygen") {
+        run("Citygen test city, full detail", &citygen, 3, true);
+        let lod1 = CityConfig {
+            lod: Some(1),
+            ..citygen.clone()
+        };
+        run("Citygen test city, LOD 1 (extruded masses)", &lod1, 3, true);
+    }
+    if want("metropolis") {
+        // The citygen density on a 17.5 km square: about a million buildings.
+        let mut m = CityConfig {
+            name: "metropolis".into(),
+            size_m: 17_500.0,
+            lod: Some(1),
+            ..citygen.clone()
+        };
+        m.roads.max_segments = 300_000;
+        m.roads.max_steps = 20_000;
+        run("metropolis", &m, 1, true);
+    }
+}
