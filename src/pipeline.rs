@@ -80,7 +80,7 @@ impl Ticker<'_> {
         let Some(p) = self.progress else { return };
         let d = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         let step = (self.total / 100).max(1);
-        if d % step == 0 || d == self.total {
+        if d.is_multiple_of(step) || d == self.total {
             p(self.stage, d as f64 / self.total.max(1) as f64);
         }
     }

@@ -146,7 +146,25 @@ impl std::fmt::Debug for ParishMullerRoads {
 impl RoadStage for ParishMullerRoads {
     fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput> {
         let params = cx.config.effective_road_params();
-        let mut generator = RoadGenerator::new(&params, &cx.maps.road_inputs())?;
+        // Legality is tested every few metres along every candidate: the water, park and
+        // elevation maps are read through lazily filled lattices (polis-roads'
+        // `LazyLattice`, the spacing of its procedural maps), not evaluated each time.
+        let mut inputs = cx.maps.road_inputs();
+        let spacing = polis_roads::procedural_lattice_m(&params);
+        let window = params.bounds();
+        let cache = |map: Arc<dyn polis_geom::Field>| -> Result<Arc<dyn polis_geom::Field>> {
+            Ok(Arc::new(polis_roads::LazyLattice::new(
+                map, spacing, window,
+            )?))
+        };
+        if cx.maps.has_water {
+            inputs.water = cache(inputs.water)?;
+        }
+        if cx.maps.has_parks {
+            inputs.parks = cache(inputs.parks)?;
+        }
+        inputs.elevation = cache(inputs.elevation)?;
+        let mut generator = RoadGenerator::new(&params, &inputs)?;
         if let Some(goals) = &self.goals {
             generator = generator.with_goals(Arc::clone(goals));
         }

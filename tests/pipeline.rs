@@ -1,5 +1,7 @@
 //! Integration tests of the one-call pipeline: every preset on a small city.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic on failure
+
 use std::collections::HashMap;
 
 use polis::geom::{DVec2, PointLocation, Polygon, PolygonWithHoles, SegmentIntersection};

@@ -181,6 +181,10 @@ pub struct PreparedStyle {
     salt: u64,
     /// What the style's tile set reproduces (computed on first use).
     tiling: OnceLock<Arc<TileAnalysis>>,
+    /// The rows of a ground-floor face and of an upper-floors face (the other roles use
+    /// the style's rows), derived once.
+    rows_ground: AxisStyle,
+    rows_upper: AxisStyle,
 }
 
 /// What had to be simplified while fitting a facade.
@@ -251,11 +255,27 @@ impl PreparedStyle {
         let mut images = BTreeMap::new();
         style.stack.build_images("", &mut images)?;
         let salt = fnv1a(style.name.as_bytes());
+        let rows = &style.rows;
+        let rows_ground = AxisStyle {
+            start: if rows.start.is_empty() {
+                rows.module.clone()
+            } else {
+                rows.start.clone()
+            },
+            ..AxisStyle::default()
+        };
+        let rows_upper = AxisStyle {
+            start: Vec::new(),
+            min_repeats: rows.min_repeats.max(1),
+            ..rows.clone()
+        };
         Ok(PreparedStyle {
             style,
             images,
             salt,
             tiling: OnceLock::new(),
+            rows_ground,
+            rows_upper,
         })
     }
 
@@ -325,24 +345,11 @@ impl PreparedStyle {
     }
 
     /// The rows axis a face of `role` is fitted with.
-    pub(crate) fn rows_style(&self, role: FaceRole) -> std::borrow::Cow<'_, AxisStyle> {
-        use std::borrow::Cow;
-        let rows = &self.style.rows;
+    pub(crate) fn rows_style(&self, role: FaceRole) -> &AxisStyle {
         match role {
-            FaceRole::GroundFloor => Cow::Owned(AxisStyle {
-                start: if rows.start.is_empty() {
-                    rows.module.clone()
-                } else {
-                    rows.start.clone()
-                },
-                ..AxisStyle::default()
-            }),
-            FaceRole::UpperFloors => Cow::Owned(AxisStyle {
-                start: Vec::new(),
-                min_repeats: rows.min_repeats.max(1),
-                ..rows.clone()
-            }),
-            _ => Cow::Borrowed(rows),
+            FaceRole::GroundFloor => &self.rows_ground,
+            FaceRole::UpperFloors => &self.rows_upper,
+            _ => &self.style.rows,
         }
     }
 
@@ -365,7 +372,7 @@ impl PreparedStyle {
         spec.validate()?;
         let st = &self.style;
         let rows_style = self.rows_style(spec.role);
-        let wanted = Self::wanted_rows(&rows_style, spec.floors);
+        let wanted = Self::wanted_rows(rows_style, spec.floors);
         let mut report = FacadeReport::default();
         let fit = |axis: &AxisStyle, len: f64, wanted: Option<u32>, blank: &mut bool| match axis
             .fit(len, wanted)
@@ -378,7 +385,7 @@ impl PreparedStyle {
             Err(e) => Err(e),
         };
         let columns = fit(&st.columns, spec.width_m, None, &mut report.blank_columns)?;
-        let rows = fit(&rows_style, spec.height_m, wanted, &mut report.blank_rows)?;
+        let rows = fit(rows_style, spec.height_m, wanted, &mut report.blank_rows)?;
         report.floors = rows.floor_count();
         Ok(FacadeLayout {
             spec: *spec,
@@ -416,8 +423,8 @@ impl PreparedStyle {
         let Some(n_cols) = count(&self.style().columns, spec.width_m, None)? else {
             return Ok(None);
         };
-        let wanted = Self::wanted_rows(&rows_style, spec.floors);
-        let Some(n_rows) = count(&rows_style, spec.height_m, wanted)? else {
+        let wanted = Self::wanted_rows(rows_style, spec.floors);
+        let Some(n_rows) = count(rows_style, spec.height_m, wanted)? else {
             return Ok(None);
         };
         let ground = spec.role == FaceRole::GroundFloor;
