@@ -242,6 +242,50 @@ fn reused_workers_do_not_change_buildings() {
 }
 
 #[test]
+fn mansards_on_concave_lots_need_no_fallback() {
+    // Every mansard is built (no hip fallback), also where the inset loses edges (the L)
+    // or splits (the dumbbell), and every building keeps all invariants.
+    let mut g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    g.set_grammar(
+        BuildingKind::MidRise,
+        BuildingGrammar::parse(
+            "mansard",
+            "p1: Lot(h, w, d, n) -> Extrude(h * 0.7) Box Up Extrude(h * 0.3) Mansard(3.5, 20)\n",
+        )
+        .unwrap(),
+    );
+    let dumbbell = lot([
+        (0.0, 0.0),
+        (18.0, 0.0),
+        (18.0, 7.0),
+        (26.0, 7.0),
+        (26.0, 0.0),
+        (44.0, 0.0),
+        (44.0, 22.0),
+        (26.0, 22.0),
+        (26.0, 15.0),
+        (18.0, 15.0),
+        (18.0, 22.0),
+        (0.0, 22.0),
+    ]
+    .map(|(x, y)| DVec2::new(x, y))
+    .to_vec());
+    let mut lots = shapes();
+    lots.push(dumbbell);
+    for (i, l) in lots.iter().enumerate() {
+        for id in 0..4 {
+            let b = g
+                .build(l, 50 * i as u64 + id, BuildingKind::MidRise, 60.0, 6)
+                .unwrap()
+                .unwrap();
+            check(&b, l, 60.0);
+            assert_eq!(b.fallbacks, 0, "lot {i}");
+            assert_eq!(b.parts.len(), 2);
+        }
+    }
+}
+
+#[test]
 fn grammar_errors_are_clean() {
     let e = BuildingGrammar::parse("bad", "p1: Lot(h, w, d, n) -> Extrude(h *) Box\n").unwrap_err();
     let text = e.to_string();
