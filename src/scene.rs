@@ -126,53 +126,58 @@ fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
 /// out, and one skin mesh per tile.
 fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
     let wall = pal.walls[b.kind.index().min(5)];
-    let mut out = Vec::with_capacity(b.parts.len() + 2);
+    // One output mesh per material, in order of first use.
+    let mut out: Vec<Mesh> = Vec::with_capacity(4);
+    fn target(out: &mut Vec<Mesh>, material: Option<MaterialId>) -> usize {
+        match out.iter().position(|m| m.material == material) {
+            Some(i) => i,
+            None => {
+                out.push(Mesh::new(material));
+                out.len() - 1
+            }
+        }
+    }
+    let mut faces: Vec<usize> = dress
+        .map(|d| d.quads.iter().map(|q| q.face).collect())
+        .unwrap_or_default();
+    faces.sort_unstable();
+    faces.dedup();
+    // Vertex renumbering of the part being copied (u32::MAX: not copied yet).
+    let mut remap: Vec<u32> = Vec::new();
     for (pi, part) in b.parts.iter().enumerate() {
         let material = Some(match part.role {
             PartRole::Mass => wall,
             PartRole::Roof => pal.roof,
             PartRole::Detail | PartRole::Template => pal.detail,
         });
-        let faces: Vec<usize> = dress
-            .map(|d| {
-                let mut f: Vec<usize> = d.quads.iter().map(|q| q.face).collect();
-                f.sort_unstable();
-                f.dedup();
-                f.retain(|&k| b.facades.get(k).is_some_and(|f| f.part == pi));
-                f
-            })
-            .unwrap_or_default();
-        if faces.is_empty() {
-            let mut mesh = part.mesh.clone();
-            mesh.material = material;
-            out.push(mesh);
+        let i = target(&mut out, material);
+        let Some(mesh) = out.get_mut(i) else {
             continue;
-        }
-        // Keep the triangles no dressed face covers.
-        let mut mesh = Mesh::with_capacity(
-            material,
-            part.mesh.vertex_count(),
-            part.mesh.triangle_count(),
-        );
-        mesh.positions.clone_from(&part.mesh.positions);
-        mesh.normals.clone_from(&part.mesh.normals);
-        mesh.uvs.clone_from(&part.mesh.uvs);
+        };
         // The dressed faces of this part as planes: origin, normal, unit axes, size.
         let planes: Vec<_> = faces
             .iter()
             .filter_map(|&k| b.facades.get(k))
+            .filter(|f| f.part == pi)
             .map(|f| {
                 let u = (f.quad[1] - f.quad[0]).normalize_or_zero();
                 let v = (f.quad[3] - f.quad[0]).normalize_or_zero();
                 (f.quad[0], f.normal, u, v, f.width, f.height)
             })
             .collect();
+        if planes.is_empty() {
+            mesh.append(&part.mesh);
+            continue;
+        }
+        // Copy the triangles no dressed face covers, with only the vertices they use.
+        let src = &part.mesh;
+        remap.clear();
+        remap.resize(src.vertex_count(), u32::MAX);
         const TOL: f64 = 1e-3;
-        for t in part.mesh.triangles() {
-            let p = t.map(|i| {
-                part.mesh
-                    .positions
-                    .get(i as usize)
+        for t in src.triangles() {
+            let p = t.map(|k| {
+                src.positions
+                    .get(k as usize)
                     .map_or(DVec3::NAN, |v| v.as_dvec3())
             });
             let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
@@ -186,33 +191,43 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
                     let (s, t) = (c.dot(u), c.dot(v));
                     s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
                 });
-            if !covered {
-                mesh.indices.extend_from_slice(&t);
+            if covered {
+                continue;
+            }
+            for k in t {
+                let k = k as usize;
+                let (Some(slot), Some(&pos), Some(&nrm), Some(&uv)) = (
+                    remap.get_mut(k),
+                    src.positions.get(k),
+                    src.normals.get(k),
+                    src.uvs.get(k),
+                ) else {
+                    continue;
+                };
+                if *slot == u32::MAX {
+                    *slot = mesh.positions.len() as u32;
+                    mesh.positions.push(pos);
+                    mesh.normals.push(nrm);
+                    mesh.uvs.push(uv);
+                }
+                mesh.indices.push(*slot);
             }
         }
-        out.push(mesh);
     }
-    if let Some(d) = dress {
-        let Some(materials) = pal.tiles.get(d.style) else {
-            return Ok(out);
-        };
-        let mut skins: Vec<Mesh> = materials.iter().map(|&m| Mesh::new(Some(m))).collect();
+    if let Some(d) = dress
+        && let Some(materials) = pal.tiles.get(d.style)
+    {
         for q in &d.quads {
-            if let Some(mesh) = skins.get_mut(q.tile) {
-                mesh.add_quad(q.corners, q.uvs)?;
+            if let Some(&m) = materials.get(q.tile) {
+                let i = target(&mut out, Some(m));
+                if let Some(mesh) = out.get_mut(i) {
+                    mesh.add_quad(q.corners, q.uvs)?;
+                }
             }
         }
-        out.extend(skins.into_iter().filter(|m| !m.is_empty()));
     }
-    // One mesh per material: fewer scene objects, the same triangles.
-    let mut merged: Vec<Mesh> = Vec::with_capacity(out.len());
-    for mesh in out {
-        match merged.iter_mut().find(|m| m.material == mesh.material) {
-            Some(m) => m.append(&mesh),
-            None => merged.push(mesh),
-        }
-    }
-    Ok(merged)
+    out.retain(|m| !m.is_empty());
+    Ok(out)
 }
 
 /// Everything the scene is built from.
@@ -339,5 +354,36 @@ pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
         BuildingKind::Office | BuildingKind::MidRise => K::Commercial,
         BuildingKind::House | BuildingKind::Apartment => K::Residential,
         BuildingKind::Industrial => K::Industrial,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The skin replaces wall triangles without gaps or overlaps: each building's scene
+    /// meshes have the surface area of its closed parts.
+    #[test]
+    fn skins_replace_exactly_the_walls_they_cover() {
+        let mut config = CityConfig::preset("default").unwrap();
+        config.size_m = 1200.0;
+        config.roads.max_segments = 200;
+        config.facades.pixels_per_metre = 4.0;
+        let city = crate::generate(&config).unwrap();
+        let mut scene = Scene::new();
+        let pal = palette(&mut scene, &city.tile_sets).unwrap();
+        let mut dressed = 0;
+        for (b, dress) in city.buildings.iter().zip(&city.dresses) {
+            let meshes = building_meshes(b, dress.as_ref(), &pal).unwrap();
+            let area: f64 = meshes.iter().map(Mesh::surface_area).sum();
+            let parts: f64 = b.parts.iter().map(|p| p.mesh.surface_area()).sum();
+            assert!(
+                (area - parts).abs() <= 1e-4 * parts,
+                "building {}: {area} m² in the scene, {parts} m² of parts",
+                b.id
+            );
+            dressed += usize::from(dress.is_some());
+        }
+        assert!(dressed > 10, "{dressed} dressed buildings");
     }
 }
