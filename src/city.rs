@@ -219,8 +219,8 @@ impl City {
         Ok(glb::write_glb(&self.scene, &options, out)?)
     }
 
-    /// Writes `city.glb`, `city.obj` (+ `city.mtl` and textures), `city.svg` and
-    /// `city.geojson` into `dir` (created if missing).
+    /// Writes `city.glb`, `city.obj` (+ `city.mtl` and the `city_*.png` textures),
+    /// `city.svg` and `city.geojson` into `dir` (created if missing).
     ///
     /// # Errors
     /// Export and I/O errors, naming the file.
@@ -255,7 +255,10 @@ impl City {
         let mut w = create(&path)?;
         obj::write_obj(
             &self.scene,
-            &obj::ObjOptions::default(),
+            &obj::ObjOptions {
+                stem: "city".into(),
+                ..obj::ObjOptions::default()
+            },
             &mut w,
             &mut DirSink::new(dir),
         )?;

@@ -254,3 +254,32 @@ fn bad_configurations_are_errors_not_panics() {
     ));
     assert!(polis::generate(&c).is_err());
 }
+
+#[test]
+fn write_all_writes_every_file_and_the_obj_names_its_mtl() {
+    let city = polis::generate(&small("suburbia")).unwrap();
+    let dir = std::env::temp_dir().join(format!("polis-write-all-{}", std::process::id()));
+    let written = city.write_all(&dir).unwrap();
+    for name in [
+        "city.svg",
+        "city.geojson",
+        "city.glb",
+        "city.obj",
+        "city.mtl",
+    ] {
+        let path = dir.join(name);
+        assert!(written.files.contains(&path), "{name} not reported");
+        assert!(
+            std::fs::metadata(&path).unwrap().len() > 0,
+            "{name} is empty"
+        );
+    }
+    let obj = std::fs::read_to_string(dir.join("city.obj")).unwrap();
+    assert!(obj.lines().any(|l| l == "mtllib city.mtl"));
+    // The glb on disk is the bytes of write_glb.
+    assert_eq!(
+        std::fs::read(dir.join("city.glb")).unwrap(),
+        glb_bytes(&city)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
