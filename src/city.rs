@@ -257,7 +257,6 @@ impl City {
             &self.scene,
             &obj::ObjOptions {
                 stem: "city".into(),
-                ..obj::ObjOptions::default()
             },
             &mut w,
             &mut DirSink::new(dir),
