@@ -396,70 +396,6 @@ impl PreparedStyle {
     }
 }
 
-impl PreparedStyle {
-    /// One quad covering the whole face with the style's repeated tile (the ground-floor
-    /// tile on a [`FaceRole::GroundFloor`] face), its UVs repeating the tile once per
-    /// `modules` bays and storeys, so no window is cut; margins, cornice and entrance are
-    /// left out. It needs only the repetition counts, not the fitted intervals: the
-    /// cheapest way to texture a city. `None` when the face is too small for one module
-    /// or the set has no such tile.
-    ///
-    /// # Errors
-    /// [`FacadeError::InvalidNumber`] for a bad spec.
-    pub fn compact_tile_quad(
-        &self,
-        spec: &FacadeSpec,
-        set: &crate::tiles::TileSet,
-    ) -> Result<Option<crate::tiles::TileQuad>> {
-        spec.validate()?;
-        let rows_style = self.rows_style(spec.role);
-        let count = |axis: &crate::AxisStyle, len: f64, wanted: Option<u32>| match axis
-            .repeat_count(len, wanted)
-        {
-            Ok(n) => Ok(Some(n)),
-            Err(FacadeError::TooShort { .. }) => Ok(None),
-            Err(e) => Err(e),
-        };
-        let Some(n_cols) = count(&self.style().columns, spec.width_m, None)? else {
-            return Ok(None);
-        };
-        let wanted = Self::wanted_rows(rows_style, spec.floors);
-        let Some(n_rows) = count(rows_style, spec.height_m, wanted)? else {
-            return Ok(None);
-        };
-        let ground = spec.role == FaceRole::GroundFloor;
-        let row_part = if ground {
-            crate::interval::Part::Start
-        } else {
-            crate::interval::Part::Repeat
-        };
-        let Some(k) = set.tiles.iter().position(|t| {
-            t.cols == crate::interval::Part::Repeat && t.rows == row_part && !t.entrance
-        }) else {
-            return Ok(None);
-        };
-        let Some(tile) = set.tiles.get(k) else {
-            return Ok(None);
-        };
-        if n_cols == 0 || (!ground && n_rows == 0) {
-            return Ok(None);
-        }
-        let rv = if ground {
-            1.0
-        } else {
-            f64::from(n_rows) / f64::from(tile.modules_v.max(1))
-        };
-        Ok(Some(crate::tiles::TileQuad {
-            rect: polis_geom::Aabb2::new(
-                polis_geom::DVec2::ZERO,
-                polis_geom::DVec2::new(spec.width_m, spec.height_m),
-            ),
-            tile: k,
-            repeats: [f64::from(n_cols) / f64::from(tile.modules_u.max(1)), rv],
-        }))
-    }
-}
-
 impl Facade {
     /// Fits `style` to `spec` in one call (validates the style and draws its images each
     /// time: for many facades use [`PreparedStyle`]).
@@ -526,49 +462,6 @@ impl Facade {
 mod tests {
     use super::*;
     use crate::builtin;
-    use crate::interval::Part;
-    use crate::raster::RasterOptions;
-    use crate::tiles::TileSet;
-
-    #[test]
-    fn the_compact_quad_repeats_the_main_tile_as_often_as_the_fit() {
-        for style in builtin::builtin_styles() {
-            let p = PreparedStyle::new(style).unwrap();
-            let set = TileSet::build(
-                &p,
-                &RasterOptions {
-                    pixels_per_metre: 8.0,
-                    ..Default::default()
-                },
-            )
-            .unwrap();
-            for role in [FaceRole::GroundFloor, FaceRole::UpperFloors, FaceRole::Side] {
-                for (w, h, floors) in [(9.0, 4.5, Some(1)), (23.5, 14.2, Some(4)), (0.3, 0.2, None)]
-                {
-                    let spec = FacadeSpec {
-                        floors,
-                        role,
-                        ..FacadeSpec::new(w, h, 3)
-                    };
-                    let layout = p.layout(&spec).unwrap();
-                    let Some(q) = p.compact_tile_quad(&spec, &set).unwrap() else {
-                        continue;
-                    };
-                    assert_eq!(q.rect.area(), w * h);
-                    let tile = &set.tiles[q.tile];
-                    assert!(!tile.entrance && tile.cols == Part::Repeat);
-                    // Whole modules: the repeats times the tile's modules is the fitted
-                    // repetition count of the columns.
-                    let n = q.repeats[0] * f64::from(tile.modules_u);
-                    assert!((n - f64::from(layout.columns().repeat_count())).abs() < 1e-9);
-                    if tile.rows == Part::Repeat {
-                        let m = q.repeats[1] * f64::from(tile.modules_v);
-                        assert!((m - f64::from(layout.rows().repeat_count())).abs() < 1e-9);
-                    }
-                }
-            }
-        }
-    }
 
     #[test]
     fn spec_validation() {

@@ -210,6 +210,57 @@ impl TileSet {
     }
 }
 
+impl PreparedStyle {
+    /// One quad covering the whole face with the style's repeated tile (the ground-floor
+    /// tile on a [`FaceRole::GroundFloor`] face), its UVs repeating the tile once per
+    /// `modules` bays and storeys, so no window is cut; margins, cornice and entrance are
+    /// left out. It needs only the repetition counts, not the fitted intervals: the
+    /// cheapest way to texture a city. `None` when the face is too small for one module
+    /// or the set has no such tile.
+    ///
+    /// # Errors
+    /// [`FacadeError::InvalidNumber`] for a bad spec.
+    pub fn compact_tile_quad(&self, spec: &FacadeSpec, set: &TileSet) -> Result<Option<TileQuad>> {
+        spec.validate()?;
+        let rows_style = self.rows_style(spec.role);
+        let count = |axis: &crate::AxisStyle, len: f64, wanted: Option<u32>| match axis
+            .repeat_count(len, wanted)
+        {
+            Ok(n) => Ok(Some(n)),
+            Err(FacadeError::TooShort { .. }) => Ok(None),
+            Err(e) => Err(e),
+        };
+        let Some(n_cols) = count(&self.style().columns, spec.width_m, None)? else {
+            return Ok(None);
+        };
+        let wanted = Self::wanted_rows(rows_style, spec.floors);
+        let Some(n_rows) = count(rows_style, spec.height_m, wanted)? else {
+            return Ok(None);
+        };
+        let ground = spec.role == FaceRole::GroundFloor;
+        let row_part = if ground { Part::Start } else { Part::Repeat };
+        let Some((k, tile)) = set
+            .find(Part::Repeat, row_part, false)
+            .and_then(|k| set.tiles.get(k).map(|t| (k, t)))
+        else {
+            return Ok(None);
+        };
+        if n_cols == 0 || (!ground && n_rows == 0) {
+            return Ok(None);
+        }
+        let rv = if ground {
+            1.0
+        } else {
+            f64::from(n_rows) / f64::from(tile.modules_v.max(1))
+        };
+        Ok(Some(TileQuad {
+            rect: Aabb2::new(DVec2::ZERO, DVec2::new(spec.width_m, spec.height_m)),
+            tile: k,
+            repeats: [f64::from(n_cols) / f64::from(tile.modules_u.max(1)), rv],
+        }))
+    }
+}
+
 impl Facade {
     /// Covers the facade with quads of a shared [`TileSet`] of its style: one per present
     /// (column part × row part), the ground strip of a street front split around the
@@ -342,18 +393,56 @@ mod tests {
     use super::*;
     use crate::builtin;
 
-    #[test]
-    fn the_layout_alone_gives_the_facades_quads() {
-        for style in builtin::builtin_styles() {
-            let p = PreparedStyle::new(style).unwrap();
-            let set = TileSet::build(
-                &p,
-                &RasterOptions {
+    /// Every built-in style, prepared, with its tile set at a coarse 8 texels per metre.
+    fn coarse_sets() -> Vec<(PreparedStyle, TileSet)> {
+        builtin::builtin_styles()
+            .into_iter()
+            .map(|style| {
+                let p = PreparedStyle::new(style).unwrap();
+                let opts = RasterOptions {
                     pixels_per_metre: 8.0,
                     ..Default::default()
-                },
-            )
-            .unwrap();
+                };
+                let set = TileSet::build(&p, &opts).unwrap();
+                (p, set)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_compact_quad_repeats_the_main_tile_as_often_as_the_fit() {
+        for (p, set) in coarse_sets() {
+            for role in [FaceRole::GroundFloor, FaceRole::UpperFloors, FaceRole::Side] {
+                for (w, h, floors) in [(9.0, 4.5, Some(1)), (23.5, 14.2, Some(4)), (0.3, 0.2, None)]
+                {
+                    let spec = FacadeSpec {
+                        floors,
+                        role,
+                        ..FacadeSpec::new(w, h, 3)
+                    };
+                    let layout = p.layout(&spec).unwrap();
+                    let Some(q) = p.compact_tile_quad(&spec, &set).unwrap() else {
+                        continue;
+                    };
+                    assert_eq!(q.rect.area(), w * h);
+                    let tile = &set.tiles[q.tile];
+                    assert!(!tile.entrance && tile.cols == Part::Repeat);
+                    // Whole modules: the repeats times the tile's modules is the fitted
+                    // repetition count of the columns.
+                    let n = q.repeats[0] * f64::from(tile.modules_u);
+                    assert!((n - f64::from(layout.columns().repeat_count())).abs() < 1e-9);
+                    if tile.rows == Part::Repeat {
+                        let m = q.repeats[1] * f64::from(tile.modules_v);
+                        assert!((m - f64::from(layout.rows().repeat_count())).abs() < 1e-9);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_layout_alone_gives_the_facades_quads() {
+        for (p, set) in coarse_sets() {
             for role in [
                 FaceRole::Street,
                 FaceRole::Side,
