@@ -147,20 +147,19 @@ pub struct Written {
     pub files: Vec<PathBuf>,
 }
 
-fn create(path: &Path) -> Result<BufWriter<File>> {
-    File::create(path)
-        .map(BufWriter::new)
-        .map_err(|source| Error::Io {
-            path: path.into(),
-            source,
-        })
-}
-
-fn finish(mut w: BufWriter<File>, path: &Path) -> Result<()> {
-    w.flush().map_err(|source| Error::Io {
-        path: path.into(),
+/// Creates `path`, lets `write` fill it through a buffer, flushes, and returns the path.
+fn write_file(
+    path: PathBuf,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
+) -> Result<PathBuf> {
+    let io = |source| Error::Io {
+        path: path.clone(),
         source,
-    })
+    };
+    let mut w = BufWriter::new(File::create(&path).map_err(io)?);
+    write(&mut w)?;
+    w.flush().map_err(io)?;
+    Ok(path)
 }
 
 impl City {
@@ -169,10 +168,10 @@ impl City {
     pub fn map_layers(&self) -> Result<MapLayers> {
         let mut map = MapLayers::default();
         if self.maps.has_water {
-            map.water = trace_mask(self.maps.water.as_ref(), self.config.size_m, 10.0);
+            map.water = trace_mask(self.maps.inputs.water.as_ref(), self.config.size_m, 10.0);
         }
         if self.maps.has_parks {
-            map.parks = trace_mask(self.maps.parks.as_ref(), self.config.size_m, 10.0);
+            map.parks = trace_mask(self.maps.inputs.parks.as_ref(), self.config.size_m, 10.0);
         }
         map.parks.extend(self.green_spaces.iter().cloned());
         map.roads = crate::scene::map_roads(&self.roads)?;
@@ -233,36 +232,25 @@ impl City {
         let mut written = Written::default();
         let map = self.map_layers()?;
 
-        let path = dir.join("city.svg");
-        let mut w = create(&path)?;
-        svg::write_svg(&map, &svg::SvgOptions::default(), &mut w)?;
-        finish(w, &path)?;
-        written.files.push(path);
-
-        let path = dir.join("city.geojson");
-        let mut w = create(&path)?;
-        geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), &mut w)?;
-        finish(w, &path)?;
-        written.files.push(path);
-
-        let path = dir.join("city.glb");
-        let mut w = create(&path)?;
-        self.write_glb(&mut w)?;
-        finish(w, &path)?;
-        written.files.push(path);
-
-        let path = dir.join("city.obj");
-        let mut w = create(&path)?;
-        obj::write_obj(
-            &self.scene,
-            &obj::ObjOptions {
+        let files = &mut written.files;
+        files.push(write_file(dir.join("city.svg"), |w| {
+            svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
+            Ok(())
+        })?);
+        files.push(write_file(dir.join("city.geojson"), |w| {
+            geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), w)?;
+            Ok(())
+        })?);
+        files.push(write_file(dir.join("city.glb"), |w| {
+            self.write_glb(w).map(|_| ())
+        })?);
+        files.push(write_file(dir.join("city.obj"), |w| {
+            let options = obj::ObjOptions {
                 stem: "city".into(),
-            },
-            &mut w,
-            &mut DirSink::new(dir),
-        )?;
-        finish(w, &path)?;
-        written.files.push(path);
+            };
+            obj::write_obj(&self.scene, &options, w, &mut DirSink::new(dir))?;
+            Ok(())
+        })?);
         written.files.push(dir.join("city.mtl"));
         Ok(written)
     }
@@ -278,15 +266,8 @@ pub fn trace_mask(mask: &dyn Field, size_m: f64, cell_m: f64) -> Vec<PolygonWith
     // Runs of the previous row still open: (start column, end column, start row).
     let mut open: Vec<(usize, usize, usize)> = Vec::new();
     let rect = |c0: usize, c1: usize, r0: usize, r1: usize| {
-        let (x0, x1) = (-h + c0 as f64 * step, -h + c1 as f64 * step);
-        let (y0, y1) = (-h + r0 as f64 * step, -h + r1 as f64 * step);
-        Polygon::new(vec![
-            DVec2::new(x0, y0),
-            DVec2::new(x1, y0),
-            DVec2::new(x1, y1),
-            DVec2::new(x0, y1),
-        ])
-        .into()
+        let at = |c: usize, r: usize| DVec2::new(-h + c as f64 * step, -h + r as f64 * step);
+        PolygonWithHoles::from(Polygon::rect(at(c0, r0), at(c1, r1)))
     };
     for r in 0..=n {
         let mut runs = Vec::new();

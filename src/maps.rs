@@ -404,22 +404,14 @@ impl Default for MapsConfig {
 /// The built input maps, shared by every stage.
 #[derive(Clone)]
 pub struct CityMaps {
-    /// Population density.
-    pub population: Arc<dyn Field>,
-    /// Water (≥ 0.5 is water).
-    pub water: Arc<dyn Field>,
-    /// Parks (≥ 0.5 is a park).
-    pub parks: Arc<dyn Field>,
-    /// Elevation, metres.
-    pub elevation: Arc<dyn Field>,
+    /// The maps the road generator reads — population, water (≥ 0.5 is water), parks
+    /// (≥ 0.5 is a park), elevation (metres), pattern weights, local grid angle — which
+    /// the later stages read too (zoning by population, the scene's ground).
+    pub inputs: RoadInputs,
     /// Zoning map (kind index), if given.
     pub zoning: Option<Arc<dyn Field>>,
     /// Maximum height map, metres, if given.
     pub max_height: Option<Arc<dyn Field>>,
-    /// Pattern-weight maps.
-    pub pattern_weights: Vec<(Pattern, Arc<dyn Field>)>,
-    /// Local grid angle, degrees.
-    pub grid_angle: Option<Arc<dyn Field>>,
     /// Whether a water map was given (a constant dry map otherwise).
     pub has_water: bool,
     /// Whether a park map was given.
@@ -429,12 +421,12 @@ pub struct CityMaps {
 impl std::fmt::Debug for CityMaps {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("CityMaps")
+            .field("inputs", &self.inputs)
             .field("has_water", &self.has_water)
             .field("has_parks", &self.has_parks)
             .field("zoning", &self.zoning.is_some())
             .field("max_height", &self.max_height.is_some())
-            .field("pattern_weights", &self.pattern_weights.len())
-            .finish_non_exhaustive()
+            .finish()
     }
 }
 
@@ -456,29 +448,19 @@ impl CityMaps {
             pattern_weights.push((pm.pattern, pm.map.build(&name, mix(seed, 100 + i as u64))?));
         }
         Ok(CityMaps {
-            population: config.population.build("maps.population", mix(seed, 1))?,
             has_water: water.is_some(),
             has_parks: parks.is_some(),
-            water: water.unwrap_or_else(zero),
-            parks: parks.unwrap_or_else(zero),
-            elevation: opt(&config.elevation, "maps.elevation", 4)?.unwrap_or_else(zero),
+            inputs: RoadInputs {
+                population: config.population.build("maps.population", mix(seed, 1))?,
+                water: water.unwrap_or_else(zero),
+                parks: parks.unwrap_or_else(zero),
+                elevation: opt(&config.elevation, "maps.elevation", 4)?.unwrap_or_else(zero),
+                pattern_weights,
+                grid_angle: opt(&config.grid_angle, "maps.grid_angle", 7)?,
+            },
             zoning: opt(&config.zoning, "maps.zoning", 5)?,
             max_height: opt(&config.max_height, "maps.max_height", 6)?,
-            pattern_weights,
-            grid_angle: opt(&config.grid_angle, "maps.grid_angle", 7)?,
         })
-    }
-
-    /// The maps as the road generator's inputs.
-    pub fn road_inputs(&self) -> RoadInputs {
-        RoadInputs {
-            population: Arc::clone(&self.population),
-            water: Arc::clone(&self.water),
-            parks: Arc::clone(&self.parks),
-            elevation: Arc::clone(&self.elevation),
-            pattern_weights: self.pattern_weights.clone(),
-            grid_angle: self.grid_angle.clone(),
-        }
     }
 }
 

@@ -279,7 +279,8 @@ impl Pipeline {
             .par_iter()
             .map(|l| {
                 let c = l.lot.polygon.centroid();
-                let (mut kind, mut max_height_m) = config.zoning.zone(maps.population.sample(c));
+                let (mut kind, mut max_height_m) =
+                    config.zoning.zone(maps.inputs.population.sample(c));
                 if let Some(z) = &maps.zoning {
                     kind = polis_buildings::kind_from_zoning(z.as_ref(), c);
                 }

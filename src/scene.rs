@@ -247,7 +247,7 @@ pub(crate) struct SceneInputs<'a> {
 pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     let mut scene = Scene::new();
     let pal = palette(&mut scene, inp.tile_sets)?;
-    let elevation = inp.maps.elevation.as_ref();
+    let elevation = inp.maps.inputs.elevation.as_ref();
     let root = scene.add_root(inp.config.name.clone());
     scene.set_metadata(root, "seed", inp.config.seed as f64)?;
 

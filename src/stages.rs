@@ -149,7 +149,7 @@ impl RoadStage for ParishMullerRoads {
         // Legality is tested every few metres along every candidate: the water, park and
         // elevation maps are read through lazily filled lattices (polis-roads'
         // `LazyLattice`, the spacing of its procedural maps), not evaluated each time.
-        let mut inputs = cx.maps.road_inputs();
+        let mut inputs = cx.maps.inputs.clone();
         let spacing = polis_roads::procedural_lattice_m(&params);
         let window = params.bounds();
         let cache = |map: Arc<dyn polis_geom::Field>| -> Result<Arc<dyn polis_geom::Field>> {
@@ -427,9 +427,13 @@ impl FacadeStage for TiledFacades {
                         Error::config(
                             format!("facades.style_of.{}", kind.name()),
                             format!(
-                                "no style named {name:?}: neither built in (brick_house, \
-                                 office_curtain_wall, classic_stone, industrial) nor in \
-                                 facades.styles"
+                                "no style named {name:?}: neither built in ({}) nor in \
+                                 facades.styles",
+                                polis_facades::builtin::builtin_styles()
+                                    .iter()
+                                    .map(|s| s.name.as_str())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
                             ),
                         )
                     })?;
