@@ -2,13 +2,7 @@
 //! seed and a stable id, so changing one stage (or one cell) does not reshuffle the
 //! random choices of the others, and parallel work needs no shared generator.
 
-/// SplitMix64's finaliser: a bijective 64-bit mix with full avalanche.
-fn splitmix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
+use polis_geom::hash::splitmix64 as splitmix;
 
 /// Mixes `salt` into `seed`: `mix(s, a) != mix(s, b)` for `a != b`, and the result is
 /// uncorrelated with both.

@@ -92,13 +92,10 @@ impl FacadeSample {
     }
 }
 
-/// SplitMix64 finaliser: a stateless, well-mixed 64-bit hash.
+/// SplitMix64: a stateless, well-mixed 64-bit hash ([`polis_geom::hash::splitmix64`]).
 #[inline]
-pub fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+pub fn mix64(z: u64) -> u64 {
+    polis_geom::hash::splitmix64(z)
 }
 
 /// Hash of a seed and two integer coordinates (a cell, a brick).

@@ -9,6 +9,7 @@
 //! | [`predicates`] | exact orientation and segment–segment classification |
 //! | [`polygon`] | [`Polygon`], [`PolygonWithHoles`]: area, centroid, point location, validation |
 //! | [`bbox`] | [`Aabb2`] |
+//! | [`hash`] | [`hash::splitmix64`]: the stateless mix behind derived seeds |
 //! | [`lines`] | offset lines and where they meet, angular order from any direction, splitting polygons and tagged regions by a line, which ring a hole belongs to |
 //! | [`graph`] | [`PlanarGraph`]: a planar straight-line graph with stable ids, exact counter-clockwise adjacency, planar segment insertion |
 //! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); [`spatial::RTreeIndex`] as the measured alternative |
@@ -45,6 +46,7 @@ pub mod bbox;
 pub mod error;
 pub mod field;
 pub mod graph;
+pub mod hash;
 pub mod lines;
 pub mod mesh;
 pub mod polygon;
