@@ -2,8 +2,11 @@
 //!
 //! ```text
 //! cargo bench --bench city                # Citygen's test city (16 km²)
-//! cargo bench --bench city -- metropolis  # the 1,000,000-building metropolis
+//! cargo bench --bench city -- lod1        # only its LOD 1 run
+//! cargo bench --bench city -- metropolis  # the 1,000,000-building metropolis, streamed
+//! cargo bench --bench city -- metropolis-kept  # the same kept whole in memory
 //! cargo bench --bench city -- all
+//! cargo bench --bench city_mimalloc [-- …] # the same with mimalloc, as the example
 //! ```
 //!
 //! Each city is generated end to end — maps, roads, cells, blocks and lots, buildings,
@@ -36,14 +39,38 @@ fn peak_mib() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
-fn run(label: &str, config: &CityConfig, runs: usize, scene: bool) {
+/// How a benchmark city is made.
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    /// `Pipeline::generate`, with or without the scene: the city keeps every layer.
+    Generate { scene: bool },
+    /// `Pipeline::stream` in chunks of this many cells, each dropped after counting.
+    Stream(usize),
+}
+
+fn run(label: &str, config: &CityConfig, runs: usize, mode: Mode) {
+    let scene = mode == Mode::Generate { scene: true };
+    // `POLIS_BENCH_RUNS=1` for profilers.
+    let runs = std::env::var("POLIS_BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(runs);
     let mut best = f64::INFINITY;
     let mut best_cpu = f64::INFINITY;
     let mut last = None;
     for _ in 0..runs {
         let cpu0 = cpu_seconds();
         let t = Instant::now();
-        let city = match Pipeline::default().with_scene(scene).generate(config) {
+        let pipeline = Pipeline::default();
+        let made = match mode {
+            Mode::Generate { scene } => pipeline.with_scene(scene).generate(config),
+            // The sink only looks at each chunk; the chunk is dropped after it.
+            Mode::Stream(cells) => pipeline.stream(config, cells, |chunk| {
+                std::hint::black_box(&chunk);
+                Ok(())
+            }),
+        };
+        let city = match made {
             Ok(c) => c,
             Err(e) => {
                 println!("{label}: error: {e}");
@@ -89,6 +116,9 @@ fn run(label: &str, config: &CityConfig, runs: usize, scene: bool) {
         "n/a".into()
     };
     println!("  generate: best wall {best:.2} s, best CPU {cpu} over {runs} runs");
+    if let Some(peak) = peak_mib() {
+        println!("  peak memory after generating: {peak:.0} MiB");
+    }
     if scene {
         let t = Instant::now();
         let mut glb = Vec::new();
@@ -106,7 +136,8 @@ fn run(label: &str, config: &CityConfig, runs: usize, scene: bool) {
     }
 }
 
-fn main() {
+/// Runs the benchmarks named on the command line.
+pub fn main() {
     let which: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with("--"))
@@ -119,14 +150,26 @@ fn main() {
         return;
     };
     if want("citygen") {
-        run("Citygen test city, full detail", &citygen, 3, true);
+        run(
+            "Citygen test city, full detail",
+            &citygen,
+            3,
+            Mode::Generate { scene: true },
+        );
+    }
+    if want("citygen") || want("lod1") {
         let lod1 = CityConfig {
             lod: Some(1),
             ..citygen.clone()
         };
-        run("Citygen test city, LOD 1 (extruded masses)", &lod1, 3, true);
+        run(
+            "Citygen test city, LOD 1 (extruded masses)",
+            &lod1,
+            3,
+            Mode::Generate { scene: true },
+        );
     }
-    if want("metropolis") {
+    if want("metropolis") || want("metropolis-kept") {
         // The citygen density on a 17.5 km square: about a million buildings.
         let mut m = CityConfig {
             name: "metropolis".into(),
@@ -136,8 +179,18 @@ fn main() {
         };
         m.roads.max_segments = 300_000;
         m.roads.max_steps = 20_000;
-        // The scene (a second copy of every mesh, plus textures) is left out: the city
-        // keeps every layer and every building mesh.
-        run("metropolis (no scene assembly)", &m, 1, false);
+        if want("metropolis") {
+            // Streamed in chunks of 1,024 cells: only the roads, the cells and one
+            // chunk are in memory at a time.
+            run("metropolis (streamed)", &m, 1, Mode::Stream(1024));
+        } else {
+            // Kept whole, without the scene (a second copy of every mesh).
+            run(
+                "metropolis (kept in memory, no scene)",
+                &m,
+                1,
+                Mode::Generate { scene: false },
+            );
+        }
     }
 }

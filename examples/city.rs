@@ -13,6 +13,11 @@
 //! covers the whole city square (top row = north edge); its values in [0, 1] are used as
 //! they are, except elevation and maximum height, which are scaled to the given metres
 //! and zoning, which is scaled to the six building kinds (0 skyscraper … 5 industrial).
+//!
+//! The example uses mimalloc as its global allocator: the pipeline allocates millions of
+//! small meshes and polygons from several threads, and mimalloc roughly halves the time
+//! the system allocator takes for them (BENCHMARKS.md, "Whole city"). Applications that
+//! embed polis can do the same.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -22,6 +27,9 @@ use std::time::Instant;
 use polis::geom::Aabb2;
 use polis::geom::field::FieldSpec;
 use polis::{CityConfig, MapSpec, Pipeline, Stage};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 const USAGE: &str = "usage: city [--preset NAME | --config FILE] [--seed N] [--size METRES] \
     [--lod N] [--segments N] [--threads N] [--out DIR] [--population PNG] [--water PNG] \

@@ -65,7 +65,7 @@ pub use config::{
 };
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
-pub use pipeline::{Pipeline, Progress, generate};
+pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

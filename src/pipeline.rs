@@ -8,12 +8,19 @@ use std::time::Instant;
 use polis_geom::Field;
 use rayon::prelude::*;
 
+use polis_buildings::Building;
+use polis_cells::Cell;
+use polis_geom::PolygonWithHoles;
+use polis_lots::Block;
+use polis_roads::RoadNetwork;
+
 use crate::city::{City, CityLot, CityStats, SkipReport, StageTiming};
 use crate::error::{Error, Result};
 use crate::scene::{SceneInputs, assemble};
 use crate::stages::{
-    BuildingStage, CellInput, CellStage, EberlyCells, FacadeStage, GrammarBuildings, KellyLots,
-    LotInput, LotStage, ParishMullerRoads, RoadStage, Skip, Stage, StageContext, TiledFacades,
+    BuildLot, BuildingStage, CellInput, CellStage, Dress, DressBuilding, EberlyCells, FacadeStage,
+    GrammarBuildings, KellyLots, LotInput, LotStage, ParishMullerRoads, RoadStage, Skip, Stage,
+    StageContext, TiledFacades,
 };
 use crate::{CityConfig, CityMaps};
 
@@ -67,11 +74,13 @@ impl std::fmt::Debug for Pipeline {
     }
 }
 
-/// Reports the fraction of a parallel loop done, at most about 100 times.
+/// Reports the fraction of a parallel loop done, at most about 100 times per chunk of
+/// cells; the fraction is of the whole city's cells.
 struct Ticker<'a> {
     stage: Stage,
     total: usize,
     done: AtomicUsize,
+    span: Span,
     progress: Option<&'a Progress>,
 }
 
@@ -81,7 +90,9 @@ impl Ticker<'_> {
         let d = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         let step = (self.total / 100).max(1);
         if d.is_multiple_of(step) || d == self.total {
-            p(self.stage, d as f64 / self.total.max(1) as f64);
+            let in_chunk = d as f64 / self.total.max(1) as f64;
+            let cells = self.span.first as f64 + in_chunk * self.span.len as f64;
+            p(self.stage, (cells / self.span.total.max(1) as f64).min(1.0));
         }
     }
 }
@@ -137,17 +148,10 @@ impl Pipeline {
     /// Degenerate cells and lots are skipped and listed in [`City::report`].
     pub fn generate(&self, config: &CityConfig) -> Result<City> {
         config.validate()?;
-        match config.threads {
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| Error::Threads {
-                    threads: n,
-                    message: e.to_string(),
-                })?
-                .install(|| self.run(config)),
-            None => self.run(config),
-        }
+        // One chunk of every cell: the sink is not called, the city keeps it all.
+        self.install(config, || {
+            self.run(config, usize::MAX, &mut |_| Ok(()), true)
+        })?
     }
 
     fn report(&self, stage: Stage, fraction: f64) {
@@ -156,26 +160,88 @@ impl Pipeline {
         }
     }
 
-    fn ticker(&self, stage: Stage, total: usize) -> Ticker<'_> {
+    fn ticker(&self, stage: Stage, total: usize, span: Span) -> Ticker<'_> {
         Ticker {
             stage,
             total,
             done: AtomicUsize::new(0),
+            span,
             progress: self.progress.as_deref(),
         }
     }
 
-    fn run(&self, config: &CityConfig) -> Result<City> {
+    /// Generates a city without keeping its per-cell layers: the cells are processed in
+    /// chunks of `cells_per_chunk`, and each chunk's blocks, lots, buildings and skins are
+    /// handed to `sink` (in cell order) and then dropped. Memory stays at the road
+    /// network, the cells and one chunk, so cities of millions of buildings fit.
+    ///
+    /// The chunks hold exactly what [`generate`](Self::generate) would have put in the
+    /// city for those cells (sub-seeds come from stable ids, not from the chunking). The
+    /// returned city has the maps, roads, cells, tile sets, statistics and report of the
+    /// whole city; its per-cell layers and scene are empty.
+    ///
+    /// ```no_run
+    /// use polis::{CityConfig, Pipeline};
+    ///
+    /// let config = CityConfig::preset("citygen")?;
+    /// let mut triangles = 0;
+    /// let city = Pipeline::default().stream(&config, 1024, |chunk| {
+    ///     triangles += chunk.buildings.iter().map(|b| b.triangle_count()).sum::<usize>();
+    ///     Ok(())
+    /// })?;
+    /// println!("{} buildings, {triangles} triangles", city.stats.buildings);
+    /// # Ok::<(), polis::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`generate`](Self::generate), plus the first error `sink` returns (which stops
+    /// the run); [`Error::Config`] if `cells_per_chunk` is 0.
+    pub fn stream(
+        &self,
+        config: &CityConfig,
+        cells_per_chunk: usize,
+        mut sink: impl FnMut(CityChunk) -> Result<()> + Send,
+    ) -> Result<City> {
+        if cells_per_chunk == 0 {
+            return Err(Error::config("cells_per_chunk", "must be at least 1"));
+        }
+        config.validate()?;
+        self.install(config, || {
+            self.run(config, cells_per_chunk, &mut sink, false)
+        })?
+    }
+
+    /// Runs `job` on the configured thread pool.
+    fn install<T: Send>(&self, config: &CityConfig, job: impl FnOnce() -> T + Send) -> Result<T> {
+        match config.threads {
+            Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| Error::Threads {
+                    threads: n,
+                    message: e.to_string(),
+                })?
+                .install(job)),
+            None => Ok(job()),
+        }
+    }
+
+    /// The pipeline: maps, roads and cells for the whole city, then blocks, lots,
+    /// buildings and skins chunk by chunk into `sink`, then (if `scene`) the scene of
+    /// what the sink kept in the returned city.
+    fn run(
+        &self,
+        config: &CityConfig,
+        cells_per_chunk: usize,
+        sink: &mut (dyn FnMut(CityChunk) -> Result<()> + Send),
+        scene: bool,
+    ) -> Result<City> {
         let mut timings = Vec::new();
         let mut report = SkipReport::default();
         let mut clock = Instant::now();
-        let mut lap = |stage: Stage, timings: &mut Vec<StageTiming>| {
-            timings.push(StageTiming {
-                stage,
-                time: clock.elapsed(),
-            });
-            clock = Instant::now();
-            self.report(stage, 1.0);
+        let lap = |stage: Stage, clock: &mut Instant| StageTiming {
+            stage,
+            time: restart(clock),
         };
 
         self.report(Stage::Maps, 0.0);
@@ -187,21 +253,141 @@ impl Pipeline {
             config,
             maps: &maps,
         };
-        lap(Stage::Maps, &mut timings);
+        timings.push(lap(Stage::Maps, &mut clock));
+        self.report(Stage::Maps, 1.0);
 
         self.report(Stage::Roads, 0.0);
         let roads = self.roads.roads(&cx)?;
         let network = roads.network;
-        lap(Stage::Roads, &mut timings);
+        timings.push(lap(Stage::Roads, &mut clock));
+        self.report(Stage::Roads, 1.0);
 
         self.report(Stage::Cells, 0.0);
         let cells = self.cells.cells(&network, &cx)?;
-        lap(Stage::Cells, &mut timings);
+        timings.push(lap(Stage::Cells, &mut clock));
+        self.report(Stage::Cells, 1.0);
+
+        // The per-lot and per-building stages, prepared once.
+        self.report(Stage::Lots, 0.0);
+        let builder = self.buildings.prepare(&cx)?;
+        timings.push(lap(Stage::Buildings, &mut clock));
+        let dresser = self.facades.prepare(&cx)?;
+        timings.push(lap(Stage::Facades, &mut clock));
+
+        let mut counts = CityStats::default();
+        let total = cells.cells.len();
+        let mut kept = CityChunk::default();
+        for (k, chunk) in cells.cells.chunks(cells_per_chunk).enumerate() {
+            let span = Span {
+                first: k * cells_per_chunk,
+                len: chunk.len(),
+                total,
+            };
+            let (out, chunk_timings) = self.chunk(
+                chunk,
+                span,
+                &network,
+                &cx,
+                builder.as_ref(),
+                dresser.as_ref(),
+                &mut report,
+            )?;
+            timings.extend(chunk_timings);
+            counts.blocks += out.blocks.len();
+            counts.lots += out.lots.len();
+            counts.buildings += out.buildings.len();
+            counts.dressed_buildings += out.dresses.iter().filter(|d| d.is_some()).count();
+            counts.building_triangles += out
+                .buildings
+                .iter()
+                .map(|b| b.triangle_count())
+                .sum::<usize>();
+            if scene {
+                kept.append(out);
+            } else {
+                sink(out)?;
+            }
+            clock = Instant::now();
+        }
+        drop(builder);
+        let tile_sets = dresser.tile_sets().to_vec();
+        drop(dresser);
+        self.report(Stage::Lots, 1.0);
+        self.report(Stage::Buildings, 1.0);
+        self.report(Stage::Facades, 1.0);
+
+        self.report(Stage::Scene, 0.0);
+        let scene = if scene && self.scene {
+            assemble(&SceneInputs {
+                config,
+                maps: &maps,
+                network: &network,
+                blocks: &kept.blocks,
+                buildings: &kept.buildings,
+                building_cells: &kept.building_cells,
+                dresses: &kept.dresses,
+                tile_sets: &tile_sets,
+            })?
+        } else {
+            polis_geom::Scene::new()
+        };
+        timings.push(lap(Stage::Scene, &mut clock));
+        self.report(Stage::Scene, 1.0);
+
+        let stats = CityStats {
+            road_segments: network.edge_count(),
+            junctions: network.node_count(),
+            cells: cells.cells.len(),
+            facade_tiles: tile_sets.iter().map(|s| s.tiles.len()).sum(),
+            texture_bytes: tile_sets.iter().map(|s| s.gpu_bytes()).sum(),
+            scene_triangles: scene.triangle_count(),
+            timings: merge_timings(timings),
+            ..counts
+        };
+        Ok(City {
+            config: config.clone(),
+            maps,
+            roads: network,
+            growth: roads.growth,
+            cells,
+            blocks: kept.blocks,
+            lots: kept.lots,
+            green_spaces: kept.green_spaces,
+            buildings: kept.buildings,
+            building_cells: kept.building_cells,
+            tile_sets,
+            dresses: kept.dresses,
+            scene,
+            stats,
+            report,
+        })
+    }
+
+    /// Blocks, lots, buildings and skins of a run of cells; the wall time of each stage.
+    #[allow(clippy::too_many_arguments)]
+    fn chunk(
+        &self,
+        cells: &[Cell],
+        span: Span,
+        network: &RoadNetwork,
+        cx: &StageContext<'_>,
+        builder: &dyn BuildLot,
+        dresser: &dyn DressBuilding,
+        report: &mut SkipReport,
+    ) -> Result<(CityChunk, [StageTiming; 3])> {
+        let mut clock = Instant::now();
+        let mut lap = |stage: Stage| StageTiming {
+            stage,
+            time: restart(&mut clock),
+        };
+        let mut out = CityChunk {
+            cells: cells.iter().map(|c| c.id.index() as u64).collect(),
+            ..CityChunk::default()
+        };
 
         // Blocks and lots, cell by cell in parallel; results in cell order.
-        self.report(Stage::Lots, 0.0);
-        let mut inputs = Vec::with_capacity(cells.cells.len());
-        for cell in &cells.cells {
+        let mut inputs = Vec::with_capacity(cells.len());
+        for cell in cells {
             let id = cell.id.index() as u64;
             let mut widths = Vec::new();
             for ring in std::iter::once(&cell.boundary).chain(cell.holes.iter()) {
@@ -233,25 +419,22 @@ impl Pipeline {
                 seed: cx.seed(Stage::Lots, id),
             });
         }
-        let ticker = self.ticker(Stage::Lots, inputs.len());
+        let ticker = self.ticker(Stage::Lots, inputs.len(), span);
         let per_cell: Vec<Result<_>> = inputs
             .par_iter()
             .map(|input| {
-                let r = self.lots.lots(input, &cx);
+                let r = self.lots.lots(input, cx);
                 ticker.tick();
                 r
             })
             .collect();
-        let mut blocks = Vec::new();
-        let mut lots = Vec::new();
-        let mut green_spaces = Vec::new();
         for (input, result) in inputs.iter().zip(per_cell) {
-            let out = result?;
+            let lots = result?;
             let cell = input.region.id;
-            report.skipped.extend(out.skipped);
-            blocks.extend(out.blocks);
-            green_spaces.extend(out.green_spaces);
-            for (i, lot) in out.lots.into_iter().enumerate() {
+            report.skipped.extend(lots.skipped);
+            out.blocks.extend(lots.blocks);
+            out.green_spaces.extend(lots.green_spaces);
+            for (i, lot) in lots.lots.into_iter().enumerate() {
                 if i >= 1 << 24 || cell >= 1 << 40 {
                     report.skipped.push(Skip {
                         stage: Stage::Lots,
@@ -260,7 +443,7 @@ impl Pipeline {
                     });
                     break;
                 }
-                lots.push(CityLot {
+                out.lots.push(CityLot {
                     id: cell << 24 | i as u64,
                     cell,
                     lot,
@@ -268,14 +451,15 @@ impl Pipeline {
             }
         }
         drop(inputs);
-        lap(Stage::Lots, &mut timings);
+        let lots_time = lap(Stage::Lots);
 
         // Buildings, lot by lot in parallel.
-        self.report(Stage::Buildings, 0.0);
-        let builder = self.buildings.prepare(&cx)?;
+        let config = cx.config;
+        let maps = cx.maps;
         let lod = config.effective_lod();
-        let ticker = self.ticker(Stage::Buildings, lots.len());
-        let built: Vec<Result<Option<_>>> = lots
+        let ticker = self.ticker(Stage::Buildings, out.lots.len(), span);
+        let built: Vec<Result<Option<_>>> = out
+            .lots
             .par_iter()
             .map(|l| {
                 let c = l.lot.polygon.centroid();
@@ -301,13 +485,11 @@ impl Pipeline {
                 r
             })
             .collect();
-        let mut buildings = Vec::new();
-        let mut building_cells = Vec::new();
-        for (l, b) in lots.iter().zip(built) {
+        for (l, b) in out.lots.iter().zip(built) {
             match b {
                 Ok(Some(b)) => {
-                    buildings.push(b);
-                    building_cells.push(l.cell);
+                    out.buildings.push(b);
+                    out.building_cells.push(l.cell);
                 }
                 Ok(None) => {}
                 Err(e) => report.skipped.push(Skip {
@@ -317,14 +499,12 @@ impl Pipeline {
                 }),
             }
         }
-        drop(builder);
-        lap(Stage::Buildings, &mut timings);
+        let buildings_time = lap(Stage::Buildings);
 
-        // Facades: tile sets once, skins building by building.
-        self.report(Stage::Facades, 0.0);
-        let dresser = self.facades.prepare(&cx)?;
-        let ticker = self.ticker(Stage::Facades, buildings.len());
-        let dressed: Vec<Result<Option<_>>> = buildings
+        // Facade skins, building by building.
+        let ticker = self.ticker(Stage::Facades, out.buildings.len(), span);
+        let dressed: Vec<Result<Option<_>>> = out
+            .buildings
             .par_iter()
             .map(|b| {
                 let r = dresser.dress(b, cx.seed(Stage::Facades, b.id));
@@ -332,9 +512,9 @@ impl Pipeline {
                 r
             })
             .collect();
-        let mut dresses = Vec::with_capacity(buildings.len());
-        for (b, d) in buildings.iter().zip(dressed) {
-            dresses.push(match d {
+        out.dresses.reserve_exact(out.buildings.len());
+        for (b, d) in out.buildings.iter().zip(dressed) {
+            out.dresses.push(match d {
                 Ok(d) => d,
                 Err(e) => {
                     report.skipped.push(Skip {
@@ -346,58 +526,76 @@ impl Pipeline {
                 }
             });
         }
-        let tile_sets = dresser.tile_sets().to_vec();
-        drop(dresser);
-        lap(Stage::Facades, &mut timings);
+        let facades_time = lap(Stage::Facades);
+        Ok((out, [lots_time, buildings_time, facades_time]))
+    }
+}
 
-        self.report(Stage::Scene, 0.0);
-        let scene = if self.scene {
-            assemble(&SceneInputs {
-                config,
-                maps: &maps,
-                network: &network,
-                blocks: &blocks,
-                buildings: &buildings,
-                building_cells: &building_cells,
-                dresses: &dresses,
-                tile_sets: &tile_sets,
-            })?
-        } else {
-            polis_geom::Scene::new()
-        };
-        lap(Stage::Scene, &mut timings);
+/// The time since `clock`, restarting it.
+fn restart(clock: &mut Instant) -> std::time::Duration {
+    let t = clock.elapsed();
+    *clock = Instant::now();
+    t
+}
 
-        let stats = CityStats {
-            road_segments: network.edge_count(),
-            junctions: network.node_count(),
-            cells: cells.cells.len(),
-            blocks: blocks.len(),
-            lots: lots.len(),
-            buildings: buildings.len(),
-            dressed_buildings: dresses.iter().filter(|d| d.is_some()).count(),
-            facade_tiles: tile_sets.iter().map(|s| s.tiles.len()).sum(),
-            texture_bytes: tile_sets.iter().map(|s| s.gpu_bytes()).sum(),
-            building_triangles: buildings.iter().map(|b| b.triangle_count()).sum(),
-            scene_triangles: scene.triangle_count(),
-            timings,
-        };
-        Ok(City {
-            config: config.clone(),
-            maps,
-            roads: network,
-            growth: roads.growth,
-            cells,
-            blocks,
-            lots,
-            green_spaces,
-            buildings,
-            building_cells,
-            tile_sets,
-            dresses,
-            scene,
-            stats,
-            report,
+/// Sums the timings of each stage (chunks report theirs separately), in stage order.
+fn merge_timings(timings: Vec<StageTiming>) -> Vec<StageTiming> {
+    Stage::ALL
+        .iter()
+        .filter_map(|&stage| {
+            let mut of = timings.iter().filter(|t| t.stage == stage).peekable();
+            of.peek()?;
+            Some(StageTiming {
+                stage,
+                time: of.map(|t| t.time).sum(),
+            })
         })
+        .collect()
+}
+
+/// Which cells a chunk covers, for progress reports.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    first: usize,
+    len: usize,
+    total: usize,
+}
+
+/// A run of cells with everything built on them, handed to the sink of
+/// [`Pipeline::stream`]: the same data [`City`] keeps for those cells.
+#[derive(Debug, Default)]
+pub struct CityChunk {
+    /// Ids of the cells, ascending.
+    pub cells: Vec<u64>,
+    /// Blocks, cell by cell.
+    pub blocks: Vec<Block>,
+    /// Lots, cell by cell.
+    pub lots: Vec<CityLot>,
+    /// Green spaces inside blocks.
+    pub green_spaces: Vec<PolygonWithHoles>,
+    /// Buildings (one per built lot; `id` = the lot's id).
+    pub buildings: Vec<Building>,
+    /// Cell of each building (parallel to `buildings`).
+    pub building_cells: Vec<u64>,
+    /// Facade skin of each building (parallel to `buildings`), textured with the tile
+    /// sets of the city [`Pipeline::stream`] returns.
+    pub dresses: Vec<Option<Dress>>,
+}
+
+impl CityChunk {
+    /// Moves `other`'s layers to the end of this chunk's.
+    fn append(&mut self, mut other: CityChunk) {
+        if self.cells.is_empty() && self.buildings.is_empty() && self.lots.is_empty() {
+            *self = other;
+            return;
+        }
+        self.cells.append(&mut other.cells);
+        self.blocks.append(&mut other.blocks);
+        self.lots.append(&mut other.lots);
+        self.green_spaces.append(&mut other.green_spaces);
+        self.buildings.append(&mut other.buildings);
+        self.building_cells.append(&mut other.building_cells);
+        self.dresses.append(&mut other.dresses);
     }
 }
 

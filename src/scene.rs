@@ -10,7 +10,9 @@ use polis_buildings::{Building, BuildingKind, PartRole};
 use polis_export::map::{MapRoad, RoadClass as MapClass};
 use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
-use polis_geom::scene::{Image, ImageData, Texture};
+use std::collections::BTreeMap;
+
+use polis_geom::scene::{Image, ImageData, MetaValue, Node, Texture};
 use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
@@ -122,112 +124,177 @@ fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
     if e.is_finite() { e } else { 0.0 }
 }
 
-/// The meshes of one building: parts with their materials, walls covered by the skin left
-/// out, and one skin mesh per tile.
-fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
-    let wall = pal.walls[b.kind.index().min(5)];
-    // One output mesh per material, in order of first use.
-    let mut out: Vec<Mesh> = Vec::with_capacity(4);
-    fn target(out: &mut Vec<Mesh>, material: Option<MaterialId>) -> usize {
-        match out.iter().position(|m| m.material == material) {
+/// A dressed wall plane of a part: origin, outward normal, unit axes, width, height.
+type Plane = (DVec3, DVec3, DVec3, DVec3, f64, f64);
+
+/// Meshes by material, reused from building to building: the first `used` are the
+/// current building's.
+#[derive(Default)]
+struct Targets {
+    meshes: Vec<Mesh>,
+    used: usize,
+}
+
+impl Targets {
+    /// The mesh of `material`, started (reusing an old one's memory) if new.
+    fn get(&mut self, material: Option<MaterialId>) -> Option<&mut Mesh> {
+        let used = self.used;
+        let current = self.meshes.get(..used)?;
+        let i = match current.iter().position(|m| m.material == material) {
             Some(i) => i,
             None => {
-                out.push(Mesh::new(material));
-                out.len() - 1
-            }
-        }
-    }
-    let mut faces: Vec<usize> = dress
-        .map(|d| d.quads.iter().map(|q| q.face).collect())
-        .unwrap_or_default();
-    faces.sort_unstable();
-    faces.dedup();
-    // Vertex renumbering of the part being copied (u32::MAX: not copied yet).
-    let mut remap: Vec<u32> = Vec::new();
-    for (pi, part) in b.parts.iter().enumerate() {
-        let material = Some(match part.role {
-            PartRole::Mass => wall,
-            PartRole::Roof => pal.roof,
-            PartRole::Detail | PartRole::Template => pal.detail,
-        });
-        let i = target(&mut out, material);
-        let Some(mesh) = out.get_mut(i) else {
-            continue;
-        };
-        // The dressed faces of this part as planes: origin, normal, unit axes, size.
-        let planes: Vec<_> = faces
-            .iter()
-            .filter_map(|&k| b.facades.get(k))
-            .filter(|f| f.part == pi)
-            .map(|f| {
-                let u = (f.quad[1] - f.quad[0]).normalize_or_zero();
-                let v = (f.quad[3] - f.quad[0]).normalize_or_zero();
-                (f.quad[0], f.normal, u, v, f.width, f.height)
-            })
-            .collect();
-        if planes.is_empty() {
-            mesh.append(&part.mesh);
-            continue;
-        }
-        // Copy the triangles no dressed face covers, with only the vertices they use.
-        let src = &part.mesh;
-        remap.clear();
-        remap.resize(src.vertex_count(), u32::MAX);
-        const TOL: f64 = 1e-3;
-        for t in src.triangles() {
-            let p = t.map(|k| {
-                src.positions
-                    .get(k as usize)
-                    .map_or(DVec3::NAN, |v| v.as_dvec3())
-            });
-            let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-            // Only walls (horizontal normals) can be covered by a facade face.
-            let covered = tn.y.abs() < 0.1
-                && planes.iter().any(|&(o, n, u, v, w, h)| {
-                    if tn.dot(n) < 0.99 || p.iter().any(|q| (*q - o).dot(n).abs() > TOL) {
-                        return false;
+                match self.meshes.get_mut(used) {
+                    Some(m) => {
+                        m.positions.clear();
+                        m.normals.clear();
+                        m.uvs.clear();
+                        m.indices.clear();
+                        m.material = material;
                     }
-                    let c = (p[0] + p[1] + p[2]) / 3.0 - o;
-                    let (s, t) = (c.dot(u), c.dot(v));
-                    s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
-                });
-            if covered {
-                continue;
+                    None => self.meshes.push(Mesh::new(material)),
+                }
+                self.used += 1;
+                used
             }
-            for k in t {
-                let k = k as usize;
-                let (Some(slot), Some(&pos), Some(&nrm), Some(&uv)) = (
-                    remap.get_mut(k),
-                    src.positions.get(k),
-                    src.normals.get(k),
-                    src.uvs.get(k),
+        };
+        self.meshes.get_mut(i)
+    }
+}
+
+/// Per-thread scratch of [`building_meshes`], reused so that a building allocates only
+/// its finished meshes (each exactly sized).
+#[derive(Default)]
+struct MeshScratch {
+    targets: Targets,
+    /// Dressed face indices.
+    faces: Vec<usize>,
+    /// The dressed faces of the part being copied.
+    planes: Vec<Plane>,
+    /// Vertex renumbering of the part being copied (`u32::MAX`: not copied yet).
+    remap: Vec<u32>,
+}
+
+thread_local! {
+    static MESH_SCRATCH: std::cell::RefCell<MeshScratch> = std::cell::RefCell::default();
+}
+
+/// The meshes of one building: parts with their materials, walls covered by the skin left
+/// out, and one skin mesh per tile; one mesh per material, in order of first use.
+fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
+    MESH_SCRATCH.with(|scratch| {
+        let mut scratch = scratch.borrow_mut();
+        let MeshScratch {
+            targets,
+            faces,
+            planes,
+            remap,
+        } = &mut *scratch;
+        targets.used = 0;
+        faces.clear();
+        if let Some(d) = dress {
+            faces.extend(d.quads.iter().map(|q| q.face as usize));
+        }
+        faces.sort_unstable();
+        faces.dedup();
+        let wall = pal.walls[b.kind.index().min(5)];
+        for (pi, part) in b.parts.iter().enumerate() {
+            let material = Some(match part.role {
+                PartRole::Mass => wall,
+                PartRole::Roof => pal.roof,
+                PartRole::Detail | PartRole::Template => pal.detail,
+            });
+            let Some(mesh) = targets.get(material) else {
+                continue;
+            };
+            planes.clear();
+            planes.extend(
+                faces
+                    .iter()
+                    .filter_map(|&k| b.facades.get(k))
+                    .filter(|f| f.part == pi)
+                    .map(|f| {
+                        let u = (f.quad[1] - f.quad[0]).normalize_or_zero();
+                        let v = (f.quad[3] - f.quad[0]).normalize_or_zero();
+                        (f.quad[0], f.normal, u, v, f.width, f.height)
+                    }),
+            );
+            if planes.is_empty() {
+                mesh.append(&part.mesh);
+            } else {
+                remap.clear();
+                remap.resize(part.mesh.vertex_count(), u32::MAX);
+                copy_uncovered(mesh, &part.mesh, planes, remap);
+            }
+        }
+        if let Some(d) = dress
+            && let Some(materials) = pal.tiles.get(d.style)
+        {
+            for q in &d.quads {
+                let (Some(&m), Some(face)) = (
+                    materials.get(q.tile as usize),
+                    b.facades.get(q.face as usize),
                 ) else {
                     continue;
                 };
-                if *slot == u32::MAX {
-                    *slot = mesh.positions.len() as u32;
-                    mesh.positions.push(pos);
-                    mesh.normals.push(nrm);
-                    mesh.uvs.push(uv);
-                }
-                mesh.indices.push(*slot);
-            }
-        }
-    }
-    if let Some(d) = dress
-        && let Some(materials) = pal.tiles.get(d.style)
-    {
-        for q in &d.quads {
-            if let Some(&m) = materials.get(q.tile) {
-                let i = target(&mut out, Some(m));
-                if let Some(mesh) = out.get_mut(i) {
-                    mesh.add_quad(q.corners, q.uvs)?;
+                if let Some(mesh) = targets.get(Some(m)) {
+                    mesh.add_quad(q.corners(face), q.uvs())?;
                 }
             }
         }
+        Ok(targets
+            .meshes
+            .get(..targets.used)
+            .unwrap_or_default()
+            .iter()
+            .filter(|m| !m.is_empty())
+            .cloned()
+            .collect())
+    })
+}
+
+/// Appends the triangles of `src` that no dressed plane covers, with only the vertices
+/// they use.
+fn copy_uncovered(mesh: &mut Mesh, src: &Mesh, planes: &[Plane], remap: &mut [u32]) {
+    const TOL: f64 = 1e-3;
+    for t in src.triangles() {
+        let p = t.map(|k| {
+            src.positions
+                .get(k as usize)
+                .map_or(DVec3::NAN, |v| v.as_dvec3())
+        });
+        let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        // Only walls (horizontal normals) can be covered by a facade face.
+        let covered = tn.y.abs() < 0.1
+            && planes.iter().any(|&(o, n, u, v, w, h)| {
+                if tn.dot(n) < 0.99 || p.iter().any(|q| (*q - o).dot(n).abs() > TOL) {
+                    return false;
+                }
+                let c = (p[0] + p[1] + p[2]) / 3.0 - o;
+                let (s, t) = (c.dot(u), c.dot(v));
+                s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
+            });
+        if covered {
+            continue;
+        }
+        for k in t {
+            let k = k as usize;
+            let (Some(slot), Some(&pos), Some(&nrm), Some(&uv)) = (
+                remap.get_mut(k),
+                src.positions.get(k),
+                src.normals.get(k),
+                src.uvs.get(k),
+            ) else {
+                continue;
+            };
+            if *slot == u32::MAX {
+                *slot = mesh.positions.len() as u32;
+                mesh.positions.push(pos);
+                mesh.normals.push(nrm);
+                mesh.uvs.push(uv);
+            }
+            mesh.indices.push(*slot);
+        }
     }
-    out.retain(|m| !m.is_empty());
-    Ok(out)
 }
 
 /// Everything the scene is built from.
@@ -265,11 +332,24 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             Some(pal.road),
         )?))
     };
-    let buildings_job = || -> Vec<Result<Vec<Mesh>>> {
+    // Each building's node (name, placement, metadata) and meshes.
+    let buildings_job = || -> Vec<Result<(Node, Vec<Mesh>)>> {
         inp.buildings
             .par_iter()
             .enumerate()
-            .map(|(i, b)| building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal))
+            .map(|(i, b)| {
+                let meshes = building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal)?;
+                let base = ground(elevation, b.footprint.points());
+                let mut node = Node::new(format!("building {}", b.id));
+                node.transform = Transform::from_translation(to_world(b.origin, base));
+                node.metadata = BTreeMap::from([
+                    ("kind".to_owned(), MetaValue::from(b.kind.name())),
+                    ("height".to_owned(), MetaValue::from(b.height)),
+                    ("floors".to_owned(), MetaValue::from(f64::from(b.floors))),
+                    ("lot".to_owned(), MetaValue::from(b.lot_id as f64)),
+                ]);
+                Ok((node, meshes))
+            })
             .collect()
     };
     let (road, meshes) = rayon::join(road_mesh, buildings_job);
@@ -327,21 +407,24 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         scene.attach_mesh(node, mesh)?;
     }
 
-    for ((b, meshes), &cell) in inp.buildings.iter().zip(meshes).zip(inp.building_cells) {
+    scene.meshes.reserve(
+        meshes
+            .iter()
+            .map(|m| m.as_ref().map_or(0, |m| m.1.len()))
+            .sum(),
+    );
+    scene.nodes.reserve(meshes.len());
+    for (built, &cell) in meshes.into_iter().zip(inp.building_cells) {
+        let (mut node, meshes) = built?;
         let Some(parent) = cell_node(cell) else {
             continue;
         };
-        let node = scene.add_node(parent, format!("building {}", b.id))?;
-        let base = ground(elevation, b.footprint.points());
-        scene.node_mut(node)?.transform = Transform::from_translation(to_world(b.origin, base));
-        scene.set_metadata(node, "kind", b.kind.name())?;
-        scene.set_metadata(node, "height", b.height)?;
-        scene.set_metadata(node, "floors", f64::from(b.floors))?;
-        scene.set_metadata(node, "lot", b.lot_id as f64)?;
-        for mesh in meshes? {
-            let mesh = scene.add_mesh(mesh);
-            scene.attach_mesh(node, mesh)?;
+        let id = scene.add_node(parent, String::new())?;
+        node.meshes = Vec::with_capacity(meshes.len());
+        for mesh in meshes {
+            node.meshes.push(scene.add_mesh(mesh));
         }
+        *scene.node_mut(id)? = node;
     }
     Ok(scene)
 }

@@ -344,17 +344,49 @@ impl BuildLot for BuildingGenerator {
 // ---------------------------------------------------------------------------------------
 // Facades.
 
-/// A textured quad of a building's skin (relative to the building's origin, glTF axes).
+/// A textured quad of a building's skin: a rectangle of one facade face, textured with
+/// one tile repeated a whole number of modules. It is stored in the face's own frame
+/// (48 bytes); [`corners`](Self::corners) and [`uvs`](Self::uvs) give the geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SkinQuad {
-    /// Corners: bottom-left, bottom-right, top-right, top-left seen from outside.
-    pub corners: [DVec3; 4],
-    /// Texture coordinates of the corners (glTF convention, repeating sampler).
-    pub uvs: [DVec2; 4],
+    /// The rectangle on the face, metres from its bottom-left corner: `[s0, t0, s1, t1]`,
+    /// `s` along the bottom edge, `t` up the left edge.
+    pub rect: [f64; 4],
+    /// Tile repetitions across and up (whole modules), for a repeating sampler.
+    pub repeats: [f32; 2],
     /// The tile of the style's tile set.
-    pub tile: usize,
+    pub tile: u32,
     /// The facade face (index into [`Building::facades`]) it covers.
-    pub face: usize,
+    pub face: u32,
+}
+
+impl SkinQuad {
+    /// The corners on `face` (which must be the building's face [`SkinQuad::face`]):
+    /// bottom-left, bottom-right, top-right, top-left seen from outside, relative to the
+    /// building's origin (glTF axes).
+    pub fn corners(&self, face: &polis_buildings::FacadeFace) -> [DVec3; 4] {
+        let [bl, br, _tr, tl] = face.quad;
+        let du = (br - bl) / face.width;
+        let dv = (tl - bl) / face.height;
+        let [s0, t0, s1, t1] = self.rect;
+        let at = |s: f64, t: f64| bl + du * s + dv * t;
+        [at(s0, t0), at(s1, t0), at(s1, t1), at(s0, t1)]
+    }
+
+    /// Texture coordinates of the corners, in the order of [`corners`](Self::corners)
+    /// (glTF convention: the tile's top edge at `v = 0`, the quad's bottom at
+    /// `v = ⌈repeats up⌉`).
+    pub fn uvs(&self) -> [DVec2; 4] {
+        let [ru, rv] = self.repeats.map(f64::from);
+        let bottom = rv.ceil();
+        let top = bottom - rv;
+        [
+            DVec2::new(0.0, bottom),
+            DVec2::new(ru, bottom),
+            DVec2::new(ru, top),
+            DVec2::new(0.0, top),
+        ]
+    }
 }
 
 /// A building's facade skin: quads textured with one style's tiles. The quads replace the
@@ -392,6 +424,20 @@ pub trait FacadeStage: Send + Sync {
 /// covered by quads whose UVs repeat the tiles a whole number of modules.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TiledFacades;
+
+/// Per-thread scratch of [`Tiler::dress`]: reused so dressing a building allocates only
+/// its result.
+#[derive(Default)]
+struct DressScratch {
+    /// Each wall face and the range of its quads in `tiles` (`None`: not covered).
+    faces: Vec<(usize, Option<std::ops::Range<usize>>)>,
+    /// The tile quads of every face.
+    tiles: Vec<TileQuad>,
+}
+
+thread_local! {
+    static DRESS_SCRATCH: std::cell::RefCell<DressScratch> = std::cell::RefCell::default();
+}
 
 struct Tiler {
     styles: Vec<PreparedStyle>,
@@ -464,72 +510,80 @@ impl DressBuilding for Tiler {
         let (Some(prepared), Some(set)) = (self.styles.get(style), self.sets.get(style)) else {
             return Ok(None);
         };
-        // Each wall face's tile quads, or `None` where the tiles do not cover it.
-        let mut per_face: Vec<(usize, Option<Vec<TileQuad>>)> = Vec::new();
-        for (k, face) in b.facades.iter().enumerate() {
-            let role = match face.role {
-                FacadeRole::Wall => FaceRole::UpperFloors,
-                FacadeRole::GroundFloor => FaceRole::GroundFloor,
-                FacadeRole::Roof => continue,
-            };
-            if !(face.width > 0.5 && face.height > 0.5) {
-                per_face.push((k, None));
-                continue;
+        DRESS_SCRATCH.with(|scratch| {
+            let mut scratch = scratch.borrow_mut();
+            let DressScratch { faces, tiles } = &mut *scratch;
+            faces.clear();
+            tiles.clear();
+            // Each wall face's tile quads (a range of `tiles`), or `None` where the tiles
+            // do not cover it.
+            for (k, face) in b.facades.iter().enumerate() {
+                let role = match face.role {
+                    FacadeRole::Wall => FaceRole::UpperFloors,
+                    FacadeRole::GroundFloor => FaceRole::GroundFloor,
+                    FacadeRole::Roof => continue,
+                };
+                if !(face.width > 0.5 && face.height > 0.5) {
+                    faces.push((k, None));
+                    continue;
+                }
+                let spec = FacadeSpec {
+                    width_m: face.width,
+                    height_m: face.height,
+                    floors: Some(face.floors),
+                    role,
+                    seed: crate::seed::mix(seed, k as u64),
+                };
+                let first = tiles.len();
+                match self.detail {
+                    FacadeDetail::Full => tiles.extend(prepared.layout(&spec)?.tile_quads(set)),
+                    FacadeDetail::Compact => tiles.extend(prepared.compact_tile_quad(&spec, set)?),
+                }
+                let covered: f64 = tiles
+                    .get(first..)
+                    .map_or(0.0, |c| c.iter().map(|q| q.rect.area()).sum());
+                let area = face.width * face.height;
+                let ok = (covered - area).abs() <= 1e-6 * area;
+                faces.push((k, ok.then_some(first..tiles.len())));
             }
-            let spec = FacadeSpec {
-                width_m: face.width,
-                height_m: face.height,
-                floors: Some(face.floors),
-                role,
-                seed: crate::seed::mix(seed, k as u64),
+            // A wall is dressed all or nothing: the ground-floor band and the storeys
+            // above share one plane of the mass, whose triangles the skin replaces.
+            let wall_key = |k: usize| {
+                b.facades.get(k).map(|f| {
+                    let (p, q) = (f.quad[0], f.quad[1]);
+                    (f.part, [p.x, p.z, q.x, q.z].map(f64::to_bits))
+                })
             };
-            let chosen = match self.detail {
-                FacadeDetail::Full => prepared.layout(&spec)?.tile_quads(set),
-                FacadeDetail::Compact => prepared
-                    .compact_tile_quad(&spec, set)?
-                    .into_iter()
-                    .collect(),
+            let failed = |k: usize| {
+                let key = wall_key(k);
+                faces
+                    .iter()
+                    .any(|(j, range)| range.is_none() && wall_key(*j) == key)
             };
-            let covered: f64 = chosen.iter().map(|q| q.rect.area()).sum();
-            let area = face.width * face.height;
-            let ok = (covered - area).abs() <= 1e-6 * area;
-            per_face.push((k, ok.then_some(chosen)));
-        }
-        // A wall is dressed all or nothing: the ground-floor band and the storeys above
-        // share one plane of the mass, whose triangles the skin replaces.
-        let wall_key = |k: usize| {
-            b.facades.get(k).map(|f| {
-                let (p, q) = (f.quad[0], f.quad[1]);
-                (f.part, [p.x, p.z, q.x, q.z].map(f64::to_bits))
-            })
-        };
-        let failed: Vec<_> = per_face
-            .iter()
-            .filter(|(_, q)| q.is_none())
-            .filter_map(|(k, _)| wall_key(*k))
-            .collect();
-        let mut quads = Vec::new();
-        for (k, chosen) in per_face {
-            let (Some(chosen), Some(face)) = (chosen, b.facades.get(k)) else {
-                continue;
+            let kept = |(k, range): &(usize, Option<std::ops::Range<usize>>)| {
+                range.clone().filter(|_| !failed(*k)).map(|r| (*k, r))
             };
-            if wall_key(k).is_some_and(|key| failed.contains(&key)) {
-                continue;
+            let count: usize = faces.iter().filter_map(kept).map(|(_, r)| r.len()).sum();
+            if count == 0 {
+                return Ok(None);
             }
-            let [bl, br, _tr, tl] = face.quad;
-            let (du, dv) = (br - bl, tl - bl);
-            let at = |s: f64, t: f64| bl + du * (s / face.width) + dv * (t / face.height);
-            for q in chosen {
-                let (x0, y0, x1, y1) = (q.rect.min.x, q.rect.min.y, q.rect.max.x, q.rect.max.y);
-                let uv = |s: f64, t: f64| DVec2::from(q.uv_at(s, t));
-                quads.push(SkinQuad {
-                    corners: [at(x0, y0), at(x1, y0), at(x1, y1), at(x0, y1)],
-                    uvs: [uv(x0, y0), uv(x1, y0), uv(x1, y1), uv(x0, y1)],
-                    tile: q.tile,
-                    face: k,
-                });
+            let mut quads = Vec::with_capacity(count);
+            for (k, range) in faces.iter().filter_map(kept) {
+                // Buildings have far fewer than 2^32 faces and tiles.
+                let Ok(face) = u32::try_from(k) else { continue };
+                for q in tiles.get(range).unwrap_or_default() {
+                    let Ok(tile) = u32::try_from(q.tile) else {
+                        continue;
+                    };
+                    quads.push(SkinQuad {
+                        rect: [q.rect.min.x, q.rect.min.y, q.rect.max.x, q.rect.max.y],
+                        repeats: q.repeats.map(|r| r as f32),
+                        tile,
+                        face,
+                    });
+                }
             }
-        }
-        Ok((!quads.is_empty()).then_some(Dress { style, quads }))
+            Ok(Some(Dress { style, quads }))
+        })
     }
 }

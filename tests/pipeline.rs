@@ -208,6 +208,60 @@ fn a_replaced_lot_stage_is_used() {
 }
 
 #[test]
+fn streamed_chunks_hold_exactly_what_generate_keeps() {
+    let config = small("manhattan");
+    let whole = Pipeline::default()
+        .with_scene(false)
+        .generate(&config)
+        .unwrap();
+    // Small chunks, so the city comes in many of them.
+    let mut chunks = Vec::new();
+    let streamed = Pipeline::default()
+        .stream(&config, 7, |chunk| {
+            chunks.push(chunk);
+            Ok(())
+        })
+        .unwrap();
+    assert!(chunks.len() > 3, "{} chunks", chunks.len());
+    let cells: Vec<u64> = chunks.iter().flat_map(|c| c.cells.clone()).collect();
+    assert!(cells.windows(2).all(|w| w[0] < w[1]), "cells in order");
+    assert_eq!(cells.len(), whole.cells.cells.len());
+    let lots: Vec<_> = chunks.iter().flat_map(|c| c.lots.clone()).collect();
+    let blocks: Vec<_> = chunks.iter().flat_map(|c| c.blocks.clone()).collect();
+    let buildings: Vec<_> = chunks.iter().flat_map(|c| c.buildings.clone()).collect();
+    let dresses: Vec<_> = chunks.iter().flat_map(|c| c.dresses.clone()).collect();
+    let building_cells: Vec<_> = chunks
+        .iter()
+        .flat_map(|c| c.building_cells.clone())
+        .collect();
+    assert_eq!(lots, whole.lots);
+    assert_eq!(blocks, whole.blocks);
+    assert_eq!(buildings, whole.buildings);
+    assert_eq!(dresses, whole.dresses);
+    assert_eq!(building_cells, whole.building_cells);
+    assert!(!buildings.is_empty());
+    // The returned city has the whole-city layers and counts, not the streamed ones.
+    assert!(streamed.buildings.is_empty() && streamed.lots.is_empty());
+    assert_eq!(streamed.stats.buildings, whole.stats.buildings);
+    assert_eq!(streamed.stats.lots, whole.stats.lots);
+    assert_eq!(
+        streamed.stats.building_triangles,
+        whole.stats.building_triangles
+    );
+    assert_eq!(streamed.report, whole.report);
+    assert_eq!(streamed.tile_sets.len(), whole.tile_sets.len());
+    // A sink's error stops the run; a chunk size of 0 is a configuration error.
+    let err = Pipeline::default()
+        .stream(&config, 7, |_| Err(polis::Error::config("sink", "full")))
+        .unwrap_err();
+    assert!(err.to_string().contains("full"), "{err}");
+    assert!(matches!(
+        Pipeline::default().stream(&config, 0, |_| Ok(())),
+        Err(polis::Error::Config { .. })
+    ));
+}
+
+#[test]
 fn progress_reaches_every_stage_and_ends_at_one() {
     use std::sync::{Arc, Mutex};
     let seen: Arc<Mutex<Vec<(Stage, f64)>>> = Arc::default();
