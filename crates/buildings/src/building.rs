@@ -1,8 +1,10 @@
 //! The output types and the shape interpreter that turns a derived string into them.
 
 use polis_geom::mesh::to_world;
+use polis_geom::polygon::{locate_in_ring, ring_signed_area};
 use polis_geom::{
-    DVec2, DVec3, Mesh, Polygon, PolygonWithHoles, SegmentIntersection, segment_intersection,
+    DVec2, DVec3, Mesh, PointLocation, Polygon, PolygonWithHoles, SegmentIntersection,
+    segment_intersection,
 };
 use polis_lsystem::ParamString;
 use serde::{Deserialize, Serialize};
@@ -141,9 +143,11 @@ impl Context<'_> {
     }
 }
 
-#[derive(Clone)]
+/// A shape's footprint: a range of the ring arena (rings are never changed in place, so
+/// saved shapes on the branch stack may share them).
+#[derive(Clone, Copy)]
 struct Shape {
-    ring: Option<Vec<DVec2>>,
+    ring: Option<(usize, usize)>,
     /// The ring is known to lie inside the lot (the footprint, its setbacks, convex
     /// shrinks of those): no containment test needed.
     inside: bool,
@@ -157,25 +161,86 @@ pub const MANSARD_UPPER_PITCH_DEG: f64 = 15.0;
 /// Smallest part height drawn, metres.
 const MIN_PART_HEIGHT: f64 = 0.05;
 
-/// Draws a derived string: returns parts, facade faces and the number of fallbacks.
+/// Reusable buffers of the shape interpreter (one set per thread): interpreting a
+/// string allocates only what the returned building keeps.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// Every ring of the current string, appended as shapes change.
+    rings: Vec<DVec2>,
+    /// The branch stack.
+    stack: Vec<Shape>,
+    /// Parts and facade faces before they are copied into exactly sized vectors.
+    parts: Vec<Part>,
+    facades: Vec<FacadeFace>,
+    /// A ring buffer lent to `Polygon` for its centroid and validation.
+    poly: Vec<DVec2>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's interpreter buffers (fresh ones if they are in use).
+pub(crate) fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|s| match s.try_borrow_mut() {
+        Ok(mut s) => f(&mut s),
+        Err(_) => f(&mut Scratch::default()),
+    })
+}
+
+/// A vector holding exactly the elements of `v` (no spare capacity), emptying `v` but
+/// keeping its buffer.
+fn exact<T>(v: &mut Vec<T>) -> Vec<T> {
+    let mut out = Vec::with_capacity(v.len());
+    out.append(v);
+    out
+}
+
+/// `Polygon` operations on a borrowed ring, through a reusable buffer: `f` gets the ring
+/// as a polygon (built exactly as `Polygon::new(ring.to_vec())`).
+fn with_polygon<R>(buf: &mut Vec<DVec2>, ring: &[DVec2], f: impl FnOnce(&Polygon) -> R) -> R {
+    let mut v = std::mem::take(buf);
+    v.clear();
+    v.extend_from_slice(ring);
+    let poly = Polygon::new(v);
+    let r = f(&poly);
+    *buf = poly.into_points();
+    r
+}
+
+/// Draws a derived string: returns parts, facade faces and the number of fallbacks. The
+/// returned vectors are exactly sized.
 pub(crate) fn interpret(
     cx: &Context<'_>,
+    scratch: &mut Scratch,
     footprint: &[DVec2],
     height: f64,
     s: &ParamString,
 ) -> Result<(Vec<Part>, Vec<FacadeFace>, u32), BuildingsError> {
+    let Scratch {
+        rings,
+        stack,
+        parts,
+        facades,
+        poly,
+    } = scratch;
+    rings.clear();
+    stack.clear();
+    parts.clear();
+    facades.clear();
+    rings.extend_from_slice(footprint);
     let mut out = Output {
-        parts: Vec::with_capacity(4),
-        facades: Vec::with_capacity(4 * footprint.len()),
+        parts,
+        facades,
+        poly,
         fallbacks: 0,
     };
     let mut cur = Shape {
-        ring: Some(footprint.to_vec()),
+        ring: Some((0, footprint.len())),
         inside: true,
         base: 0.0,
         height,
     };
-    let mut stack: Vec<Shape> = Vec::new();
     for i in 0..s.len() {
         let p = s.params(i);
         let arg = |k: usize, default: f64| {
@@ -186,7 +251,7 @@ pub(crate) fn interpret(
         };
         match cx.grammar.op(s.symbol(i)) {
             Op::Ignore => {}
-            Op::Push => stack.push(cur.clone()),
+            Op::Push => stack.push(cur),
             Op::Pop => {
                 if let Some(sh) = stack.pop() {
                     cur = sh;
@@ -197,44 +262,59 @@ pub(crate) fn interpret(
             Op::Scale => {
                 let (sx, sy, sz) = (arg(0, 1.0), arg(1, 1.0), arg(2, 1.0));
                 cur.height *= sz.max(0.0);
-                cur.inside &= sx <= 1.0 && sx == sy && is_convex(&cur.ring);
-                cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, sx, sy));
+                cur.inside &= sx <= 1.0 && sx == sy && is_convex(ring_of(rings, cur.ring));
+                cur.ring = cur
+                    .ring
+                    .and_then(|r| scaled(rings, out.poly, r, cx.frame_x, sx, sy));
             }
             Op::Taper => {
                 let f = arg(0, 1.0);
-                cur.inside &= f <= 1.0 && is_convex(&cur.ring);
-                cur.ring = cur.ring.take().and_then(|r| scaled(&r, cx.frame_x, f, f));
+                cur.inside &= f <= 1.0 && is_convex(ring_of(rings, cur.ring));
+                cur.ring = cur
+                    .ring
+                    .and_then(|r| scaled(rings, out.poly, r, cx.frame_x, f, f));
             }
             Op::Move => {
                 let d = cx.frame_x * arg(0, 0.0) + cx.frame_x.perp() * arg(1, 0.0);
                 cur.base += arg(2, 0.0);
                 cur.inside &= d == DVec2::ZERO;
-                if let Some(r) = cur.ring.as_mut() {
-                    r.iter_mut().for_each(|q| *q += d);
+                // A moved copy: saved shapes may share the ring.
+                if let Some((start, len)) = cur.ring {
+                    let at = rings.len();
+                    rings.extend_from_within(start..start + len);
+                    rings[at..].iter_mut().for_each(|q| *q += d);
+                    cur.ring = Some((at, len));
                 }
             }
             Op::Setback => {
                 let d = arg(0, 0.0);
-                cur.ring = cur.ring.take().and_then(|r| setback(&r, d));
+                cur.ring = cur.ring.and_then(|r| setback(rings, r, d));
             }
             op => {
-                let Some((ring, z0, h)) = clip(cx, &cur) else {
+                let Some((ring, z0, h)) = clip(cx, rings, &cur) else {
                     continue;
                 };
                 out.emit(cx, op, ring, z0, h, p)?;
             }
         }
     }
-    Ok((out.parts, out.facades, out.fallbacks))
+    let fallbacks = out.fallbacks;
+    Ok((exact(parts), exact(facades), fallbacks))
 }
 
-struct Output {
-    parts: Vec<Part>,
-    facades: Vec<FacadeFace>,
+/// The ring of a shape in the arena.
+fn ring_of(rings: &[DVec2], r: Option<(usize, usize)>) -> Option<&[DVec2]> {
+    r.and_then(|(start, len)| rings.get(start..start + len))
+}
+
+struct Output<'s> {
+    parts: &'s mut Vec<Part>,
+    facades: &'s mut Vec<FacadeFace>,
+    poly: &'s mut Vec<DVec2>,
     fallbacks: u32,
 }
 
-impl Output {
+impl Output<'_> {
     fn emit(
         &mut self,
         cx: &Context<'_>,
@@ -274,12 +354,12 @@ impl Output {
             Op::Pyramid => roofs::pyramid(ring, z0, h),
             Op::Spire | Op::Antenna => {
                 let r = arg(0, 1.0).clamp(0.05, 50.0);
-                let centre = Polygon::new(ring.to_vec()).centroid();
+                let centre = with_polygon(self.poly, ring, Polygon::centroid);
                 let sides = if op == Op::Spire { 8 } else { 4 };
                 let small = roofs::regular(centre, r, sides);
                 if !small
                     .iter()
-                    .all(|&q| Polygon::new(ring.to_vec()).contains(q))
+                    .all(|&q| locate_in_ring(ring, q) != PointLocation::Outside)
                 {
                     self.fallbacks += 1;
                     return Ok(());
@@ -325,7 +405,7 @@ impl Output {
                     self.fallbacks += 1;
                     return Ok(());
                 }
-                let mesh = t.instance(ring, cx.frame_x, z0, h)?;
+                let mesh = exact_mesh(t.instance(ring, cx.frame_x, z0, h)?);
                 if roofs::check_solid(&mesh).is_err() {
                     self.fallbacks += 1;
                     return Ok(());
@@ -456,8 +536,8 @@ fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
 }
 
 /// The part of the shape to draw: inside the lot, below the top; `None` if nothing is.
-fn clip<'s>(cx: &Context<'_>, s: &'s Shape) -> Option<(&'s [DVec2], f64, f64)> {
-    let ring = s.ring.as_deref()?;
+fn clip<'r>(cx: &Context<'_>, rings: &'r [DVec2], s: &Shape) -> Option<(&'r [DVec2], f64, f64)> {
+    let ring = ring_of(rings, s.ring)?;
     let top = (s.base + s.height).min(cx.top);
     if !(s.base >= 0.0 && top - s.base >= MIN_PART_HEIGHT) {
         return None;
@@ -465,8 +545,8 @@ fn clip<'s>(cx: &Context<'_>, s: &'s Shape) -> Option<(&'s [DVec2], f64, f64)> {
     (s.inside || inside(cx.lot(), ring)).then_some((ring, s.base, top - s.base))
 }
 
-fn is_convex(r: &Option<Vec<DVec2>>) -> bool {
-    r.as_ref().is_some_and(|r| {
+fn is_convex(r: Option<&[DVec2]>) -> bool {
+    r.is_some_and(|r| {
         let n = r.len();
         (0..n).all(|i| {
             polis_geom::orient2d(r[i], r[(i + 1) % n], r[(i + 2) % n])
@@ -490,40 +570,57 @@ pub(crate) fn inside(lot: &Polygon, ring: &[DVec2]) -> bool {
         })
 }
 
-/// The ring scaled about its centroid by `sx` along `x` and `sy` across; `None` if the
-/// result is degenerate.
-fn scaled(r: &[DVec2], x: DVec2, sx: f64, sy: f64) -> Option<Vec<DVec2>> {
+/// The ring `r` of the arena scaled about its centroid by `sx` along `x` and `sy`
+/// across, appended to the arena; `None` if the result is degenerate.
+fn scaled(
+    rings: &mut Vec<DVec2>,
+    buf: &mut Vec<DVec2>,
+    (start, len): (usize, usize),
+    x: DVec2,
+    sx: f64,
+    sy: f64,
+) -> Option<(usize, usize)> {
     if !(sx > 0.0 && sy > 0.0) {
         return None;
     }
-    let c = Polygon::new(r.to_vec()).centroid();
+    let c = with_polygon(buf, rings.get(start..start + len)?, Polygon::centroid);
     let y = x.perp();
-    let out: Vec<DVec2> = r
-        .iter()
-        .map(|&p| {
-            let d = p - c;
-            c + x * (d.dot(x) * sx) + y * (d.dot(y) * sy)
-        })
-        .collect();
-    let poly = Polygon::new(out);
-    (poly.validate().is_ok() && poly.is_ccw() && poly.len() == r.len()).then(|| poly.into_points())
+    let at = rings.len();
+    rings.extend_from_within(start..start + len);
+    for p in &mut rings[at..] {
+        let d = *p - c;
+        *p = c + x * (d.dot(x) * sx) + y * (d.dot(y) * sy);
+    }
+    // Scaling keeps a simple ring simple only in exact arithmetic: rounding may merge
+    // or cross vertices of tiny rings, so the result is checked.
+    let ok = with_polygon(buf, &rings[at..], |poly| {
+        poly.validate().is_ok() && poly.is_ccw() && poly.len() == len
+    });
+    if ok {
+        Some((at, len))
+    } else {
+        rings.truncate(at);
+        None
+    }
 }
 
-/// The largest piece of the ring inset by `d`, starting as close as possible to the
-/// original first vertex; `None` when nothing is left.
-fn setback(r: &[DVec2], d: f64) -> Option<Vec<DVec2>> {
+/// The largest piece of the arena's ring `r` inset by `d`, starting as close as possible
+/// to the original first vertex, appended to the arena; `None` when nothing is left.
+fn setback(rings: &mut Vec<DVec2>, r: (usize, usize), d: f64) -> Option<(usize, usize)> {
     if !(d.is_finite() && d >= 0.0) {
         return None;
     }
     if d == 0.0 {
-        return Some(r.to_vec());
+        // Rings are never changed in place: the shape may share it.
+        return Some(r);
     }
-    let poly = PolygonWithHoles::from(Polygon::new(r.to_vec()));
+    let (start, len) = r;
+    let poly = PolygonWithHoles::from(Polygon::new(rings.get(start..start + len)?.to_vec()));
     let pieces = polis_lots::inset_shapes(&poly, None, d).ok()?;
     let best = pieces.into_iter().max_by(|a, b| {
-        Polygon::new(a.outer.points.clone())
-            .area()
-            .total_cmp(&Polygon::new(b.outer.points.clone()).area())
+        ring_signed_area(&a.outer.points)
+            .abs()
+            .total_cmp(&ring_signed_area(&b.outer.points).abs())
     })?;
     // Keep the street edge first: rotate so the edge from input edge 0 (or the lowest) leads.
     let k = best
@@ -537,5 +634,28 @@ fn setback(r: &[DVec2], d: f64) -> Option<Vec<DVec2>> {
     let mut pts = best.outer.points;
     pts.rotate_left(k);
     let poly = Polygon::new(pts);
-    (poly.validate().is_ok() && poly.area() > 0.0).then(|| poly.into_points())
+    if !(poly.validate().is_ok() && poly.area() > 0.0) {
+        return None;
+    }
+    let at = rings.len();
+    rings.extend_from_slice(poly.points());
+    Some((at, poly.len()))
+}
+
+/// `mesh` with exactly sized vectors (copied only when some has spare capacity).
+pub(crate) fn exact_mesh(mesh: Mesh) -> Mesh {
+    let tight = mesh.positions.capacity() == mesh.positions.len()
+        && mesh.normals.capacity() == mesh.normals.len()
+        && mesh.uvs.capacity() == mesh.uvs.len()
+        && mesh.indices.capacity() == mesh.indices.len();
+    if tight {
+        return mesh;
+    }
+    Mesh {
+        positions: mesh.positions.as_slice().to_vec(),
+        normals: mesh.normals.as_slice().to_vec(),
+        uvs: mesh.uvs.as_slice().to_vec(),
+        indices: mesh.indices.as_slice().to_vec(),
+        material: mesh.material,
+    }
 }

@@ -22,26 +22,48 @@ use crate::BuildingsError;
 use crate::params::{FootprintParams, FootprintStrategy};
 
 thread_local! {
-    /// One reusable inset worker per thread: its buffers outlive a footprint, so a city's
-    /// worth of insets does not allocate the wavefront afresh each time.
-    static INSET: std::cell::RefCell<polis_lots::Inset> =
-        std::cell::RefCell::new(polis_lots::Inset::new());
+    /// One reusable inset worker per thread with its input buffers: they outlive a
+    /// footprint, so a city's worth of insets does not allocate the wavefront, the input
+    /// ring or the weights afresh each time.
+    static INSET: std::cell::RefCell<InsetWork> = std::cell::RefCell::new(InsetWork::default());
 }
 
-/// The (optionally weighted) inset by `d`, outer rings only, through this thread's worker.
-fn inset_rings(
-    poly: &PolygonWithHoles,
-    weights: Option<&[f64]>,
+/// The inset worker and its reusable input (the lot, counter-clockwise, and the weights).
+#[derive(Default)]
+struct InsetWork {
+    worker: polis_lots::Inset,
+    input: PolygonWithHoles,
+    weights: Vec<f64>,
+}
+
+/// The largest outer ring of the (optionally weighted) inset by `d` of the valid ring
+/// `ring` (made counter-clockwise first), through this thread's worker. `weight(i)` gives
+/// the weight of edge `i` of the counter-clockwise ring.
+fn inset_largest(
+    ring: &Polygon,
+    weight: Option<&dyn Fn(usize) -> f64>,
     d: f64,
-) -> Result<Vec<Polygon>, polis_lots::LotsError> {
-    let shapes = INSET.with(|w| match w.try_borrow_mut() {
-        Ok(mut worker) => worker.shapes(poly, weights, d),
-        Err(_) => polis_lots::inset_shapes(poly, weights, d),
-    })?;
-    Ok(shapes
-        .into_iter()
-        .map(|s| Polygon::new(s.outer.points))
-        .collect())
+) -> Result<Option<Polygon>, polis_lots::LotsError> {
+    let run = |work: &mut InsetWork| {
+        let mut pts = std::mem::take(&mut work.input.outer).into_points();
+        pts.clear();
+        pts.extend_from_slice(ring.points());
+        work.input.outer = Polygon::new(pts);
+        work.input.outer.make_ccw();
+        work.weights.clear();
+        if let Some(w) = weight {
+            work.weights.extend((0..ring.len()).map(w));
+        }
+        let weights = weight.map(|_| work.weights.as_slice());
+        let shapes = work.worker.shapes(&work.input, weights, d)?;
+        Ok(largest(
+            shapes.into_iter().map(|s| Polygon::new(s.outer.points)),
+        ))
+    };
+    INSET.with(|w| match w.try_borrow_mut() {
+        Ok(mut work) => run(&mut work),
+        Err(_) => run(&mut InsetWork::default()),
+    })
 }
 
 /// Cuts the footprint of a building from `lot` with `strategy`. `Ok(None)` when nothing
@@ -53,44 +75,41 @@ pub fn footprint(
     params: &FootprintParams,
 ) -> Result<Option<Polygon>, BuildingsError> {
     let lot_err = |reason: String| BuildingsError::Lot { lot_id, reason };
-    let mut ring = lot.polygon.clone();
+    let ring = &lot.polygon;
     ring.validate()
         .map_err(|e| lot_err(format!("invalid lot polygon: {e}")))?;
-    ring.make_ccw();
     let n = ring.len();
-    // `make_ccw` reverses when needed; street edge i then becomes edge n − 2 − i.
-    let reversed = !lot.polygon.is_ccw();
-    let street: Vec<usize> = lot
+    // Made counter-clockwise, a clockwise lot's street edge i becomes edge n − 2 − i.
+    let reversed = !ring.is_ccw();
+    let ccw_edge = |e: usize| if reversed { (2 * n - 2 - e) % n } else { e };
+    let mut street = lot
         .street_edges
         .iter()
         .filter(|&&e| e < n)
-        .map(|&e| if reversed { (2 * n - 2 - e) % n } else { e })
-        .collect();
+        .map(|&e| ccw_edge(e));
+    let primary = street.next().unwrap_or(0);
     let ring_edge = |p: &Polygon, e: usize, rev: bool| {
         let (a, b) = p.edge(if rev { (2 * n - 2 - e) % n } else { e });
         if rev { (b, a) } else { (a, b) }
     };
+    let lot_ccw = || {
+        let mut r = ring.clone();
+        r.make_ccw();
+        r
+    };
     let region = match strategy {
-        FootprintStrategy::Downtown => Some(ring),
-        FootprintStrategy::Industrial => {
-            let poly: PolygonWithHoles = ring.into();
-            largest(inset_rings(&poly, None, params.industrial_setback)?)
-        }
+        FootprintStrategy::Downtown => Some(lot_ccw()),
+        FootprintStrategy::Industrial => inset_largest(ring, None, params.industrial_setback)?,
         FootprintStrategy::Suburban | FootprintStrategy::SuburbanRectangle => {
             if params.side_setback <= 0.0 {
-                Some(ring)
+                Some(lot_ccw())
             } else {
-                let w: Vec<f64> = (0..n)
-                    .map(|i| {
-                        if street.contains(&i) {
-                            params.street_setback / params.side_setback
-                        } else {
-                            1.0
-                        }
-                    })
-                    .collect();
-                let poly: PolygonWithHoles = ring.into();
-                largest(inset_rings(&poly, Some(&w), params.side_setback)?)
+                let street_weight = params.street_setback / params.side_setback;
+                let weight = |i: usize| {
+                    let on_street = lot.street_edges.iter().any(|&e| e < n && ccw_edge(e) == i);
+                    if on_street { street_weight } else { 1.0 }
+                };
+                inset_largest(ring, Some(&weight), params.side_setback)?
             }
         }
     };
@@ -98,7 +117,6 @@ pub fn footprint(
         return Ok(None);
     };
     let region = if strategy == FootprintStrategy::SuburbanRectangle {
-        let primary = street.first().copied().unwrap_or(0);
         let (a, b) = ring_edge(&lot.polygon, primary, reversed);
         match largest_rectangle(&region, b - a) {
             Some(r) => r,
@@ -116,10 +134,8 @@ pub fn footprint(
 }
 
 /// The largest outer ring of an inset result.
-fn largest(pieces: Vec<Polygon>) -> Option<Polygon> {
-    pieces
-        .into_iter()
-        .max_by(|a, b| a.area().total_cmp(&b.area()))
+fn largest(pieces: impl Iterator<Item = Polygon>) -> Option<Polygon> {
+    pieces.max_by(|a, b| a.area().total_cmp(&b.area()))
 }
 
 /// Uniform steps across the region's extent along the street in the first pass of
@@ -163,22 +179,57 @@ const RECTANGLE_REFINE_ROUNDS: usize = 3;
 /// this crate's own; K. Daniels, V. Milenkovic, D. Roth, *Finding the largest area
 /// axis-parallel rectangle in a polygon*, CGTA 7 (1997) for exact algorithms.
 pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
+    RECTANGLE.with(|w| match w.try_borrow_mut() {
+        Ok(mut work) => rectangle_in(&mut work, region, dir),
+        Err(_) => rectangle_in(&mut RectangleWork::default(), region, dir),
+    })
+}
+
+thread_local! {
+    /// Reusable buffers of [`largest_rectangle`], one set per thread.
+    static RECTANGLE: std::cell::RefCell<RectangleWork> =
+        std::cell::RefCell::new(RectangleWork::default());
+}
+
+/// The buffers of [`largest_rectangle`]: the region in the street frame, the candidate
+/// side coordinates with their spreads, the blocked intervals of a strip, and the
+/// refinement candidates.
+#[derive(Default)]
+struct RectangleWork {
+    frame: Vec<DVec2>,
+    us: Vec<f64>,
+    spread: Vec<f64>,
+    blocked: Vec<(f64, f64)>,
+    c1: Vec<(f64, f64)>,
+}
+
+/// [`largest_rectangle`] with the buffers of `work`.
+fn rectangle_in(work: &mut RectangleWork, region: &Polygon, dir: DVec2) -> Option<Polygon> {
+    let RectangleWork {
+        frame,
+        us,
+        spread,
+        blocked,
+        c1,
+    } = work;
     let len = dir.length();
     if !(len > 0.0 && len.is_finite()) || region.len() < 3 {
         return None;
     }
     let x = dir / len;
     let y = x.perp();
-    let frame: Vec<DVec2> = region
-        .points()
-        .iter()
-        .map(|p| DVec2::new(p.dot(x), p.dot(y)))
-        .collect();
+    frame.clear();
+    frame.extend(
+        region
+            .points()
+            .iter()
+            .map(|p| DVec2::new(p.dot(x), p.dot(y))),
+    );
     if frame.iter().any(|p| !p.is_finite()) {
         return None;
     }
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    for p in &frame {
+    for p in frame.iter() {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
@@ -186,21 +237,24 @@ pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     if !(w > 0.0 && h > 0.0) {
         return None;
     }
+    blocked.clear();
     let mut strip = Strip {
-        ring: &frame,
+        ring: frame,
         vmin: lo.y,
         vmax: hi.y,
-        blocked: Vec::with_capacity(frame.len()),
+        blocked,
     };
     // First pass: vertex coordinates and a uniform grid.
-    let mut us: Vec<f64> = frame.iter().map(|p| p.x).collect();
+    us.clear();
+    us.extend(strip.ring.iter().map(|p| p.x));
     let step = w / RECTANGLE_GRID_STEPS as f64;
     us.extend((1..RECTANGLE_GRID_STEPS).map(|k| lo.x + step * k as f64));
     us.sort_by(f64::total_cmp);
     us.dedup();
     // Upper bounds: a rectangle's side at `u` is a vertical segment inside the region,
     // no longer than the region's spread on that line.
-    let spread: Vec<f64> = us.iter().map(|&u| strip.spread(u)).collect();
+    spread.clear();
+    spread.extend(us.iter().map(|&u| strip.spread(u)));
     let mut best = Best::default();
     for (i, &u0) in us.iter().enumerate() {
         let s0 = spread[i];
@@ -226,13 +280,15 @@ pub fn largest_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     for _ in 0..RECTANGLE_REFINE_ROUNDS {
         let (b0, b1) = (best.u0, best.u1);
         let cand = |c: f64| (-4..=4).map(move |k| c + r * 0.25 * f64::from(k));
-        let c1: Vec<(f64, f64)> = cand(b1)
-            .filter(|u| *u <= hi.x)
-            .map(|u| (u, strip.spread(u)))
-            .collect();
+        c1.clear();
+        c1.extend(
+            cand(b1)
+                .filter(|u| *u <= hi.x)
+                .map(|u| (u, strip.spread(u))),
+        );
         for u0 in cand(b0).filter(|u| *u >= lo.x) {
             let s0 = strip.spread(u0);
-            for &(u1, s1) in &c1 {
+            for &(u1, s1) in c1.iter() {
                 if u1 > u0 && (u1 - u0) * s0.min(s1) > best.area {
                     strip.consider(u0, u1, &mut best);
                 }
@@ -282,7 +338,7 @@ struct Strip<'a> {
     ring: &'a [DVec2],
     vmin: f64,
     vmax: f64,
-    blocked: Vec<(f64, f64)>,
+    blocked: &'a mut Vec<(f64, f64)>,
 }
 
 impl Strip<'_> {

@@ -2,12 +2,12 @@
 
 use polis_geom::{DVec2, Field, Polygon};
 use polis_lots::Lot;
-use polis_lsystem::{Derivation, DeriveOptions, ParamString};
+use polis_lsystem::{Derivation, DeriveOptions, ModuleString, ParamString};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::BuildingsError;
-use crate::building::{Building, Context, interpret};
+use crate::building::{Building, Context, interpret, with_scratch};
 use crate::footprint::footprint;
 use crate::grammar::BuildingGrammar;
 use crate::params::{BuildingKind, BuildingParams, HeightDistribution};
@@ -128,6 +128,10 @@ impl BuildingGenerator {
             };
         let mut pts = fp.into_points();
         pts.rotate_left(lead);
+        if pts.capacity() != pts.len() {
+            // The footprint is kept by the building: no spare capacity.
+            pts = pts.as_slice().to_vec();
+        }
         fp = Polygon::new(pts);
         let seed = mix_seed(self.params.seed, lot_id);
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x6865_6967_6874);
@@ -191,15 +195,17 @@ impl BuildingGenerator {
         max_height: f64,
         lod: usize,
     ) -> Result<Option<Building>, BuildingsError> {
-        let mut all = self.build_lods(
+        let mut last = None;
+        self.build_lods(
             lot,
             lot_id,
             kind,
             max_height,
             lod.min(self.params.max_lod),
             true,
+            &mut |b| last = Some(b),
         )?;
-        Ok(all.pop())
+        Ok(last)
     }
 
     /// Every level of detail `0..=max_lod` of one building (LOD `k + 1` refines LOD `k`).
@@ -210,9 +216,23 @@ impl BuildingGenerator {
         kind: BuildingKind,
         max_height: f64,
     ) -> Result<Vec<Building>, BuildingsError> {
-        self.build_lods(lot, lot_id, kind, max_height, self.params.max_lod, false)
+        let mut out = Vec::with_capacity(self.params.max_lod + 1);
+        self.build_lods(
+            lot,
+            lot_id,
+            kind,
+            max_height,
+            self.params.max_lod,
+            false,
+            &mut |b| out.push(b),
+        )?;
+        Ok(out)
     }
 
+    /// Builds LOD `lod` (and, unless `last_only`, every LOD below it) and hands each
+    /// building to `sink`. Allocates only what the buildings keep: the derivation, the
+    /// local footprint and the interpreter run in per-thread buffers.
+    #[allow(clippy::too_many_arguments)]
     fn build_lods(
         &self,
         lot: &Lot,
@@ -221,25 +241,27 @@ impl BuildingGenerator {
         max_height: f64,
         lod: usize,
         last_only: bool,
-    ) -> Result<Vec<Building>, BuildingsError> {
+        sink: &mut dyn FnMut(Building),
+    ) -> Result<(), BuildingsError> {
         let Some(plan) = self.plan(lot, lot_id, kind, max_height)? else {
-            return Ok(Vec::new());
+            return Ok(());
         };
-        let grammar = self
-            .grammars
-            .get(kind.index())
-            .ok_or(BuildingsError::InvalidParameter {
+        let Some(grammar) = self.grammars.get(kind.index()) else {
+            return Err(BuildingsError::InvalidParameter {
                 name: "kind",
                 reason: "no grammar for this kind".into(),
-            })?;
+            });
+        };
+        let derivation_error = |source| BuildingsError::Derivation {
+            kind: kind.name().into(),
+            source,
+        };
         let origin = plan.footprint.centroid();
-        let local: Vec<DVec2> = plan
-            .footprint
-            .points()
-            .iter()
-            .map(|&p| p - origin)
-            .collect();
-        let (w, d, frame_x) = extents(&local);
+        let mut work = LOCAL.with(|l| l.take());
+        let (local, axiom) = (&mut work.0, &mut work.1);
+        local.clear();
+        local.extend(plan.footprint.points().iter().map(|&p| p - origin));
+        let (w, d, frame_x) = extents(local);
         let p = &self.params;
         let cx = Context {
             grammar,
@@ -253,39 +275,36 @@ impl BuildingGenerator {
             ground_floor_height: p.ground_floor_height,
             slope_default: p.roof_pitch_deg.to_radians().tan(),
         };
-        let mut axiom = ParamString::with_capacity(1, 4);
+        axiom.clear();
         axiom
             .push(
                 grammar.lot_symbol(),
                 &[plan.height, w, d, f64::from(plan.floors)],
             )
-            .map_err(|source| BuildingsError::Derivation {
-                kind: kind.name().into(),
-                source,
-            })?;
+            .map_err(derivation_error)?;
         let options = DeriveOptions {
             seed: plan.seed,
             max_len: MAX_BUILDING_MODULES,
             ..DeriveOptions::default()
         };
-        let mut derivation = Derivation::new(grammar.grammar(), axiom, options);
-        let mut footprint = plan.footprint;
-        let mut out = Vec::new();
+        let mut derivation = Derivation::new(grammar.grammar(), std::mem::take(axiom), options);
+        let mut footprint = Some(plan.footprint);
         for k in 0..=lod {
             if k > 0 {
-                derivation
-                    .step()
-                    .map_err(|source| BuildingsError::Derivation {
-                        kind: kind.name().into(),
-                        source,
-                    })?;
+                derivation.step().map_err(derivation_error)?;
             }
             if last_only && k < lod {
                 continue;
             }
-            let (parts, facades, fallbacks) =
-                interpret(&cx, &local, plan.height, derivation.string())?;
-            out.push(Building {
+            let (parts, facades, fallbacks) = with_scratch(|scratch| {
+                interpret(&cx, scratch, local, plan.height, derivation.string())
+            })?;
+            let footprint = if k == lod {
+                footprint.take()
+            } else {
+                footprint.clone()
+            };
+            sink(Building {
                 id: lot_id,
                 lot_id,
                 kind,
@@ -293,18 +312,25 @@ impl BuildingGenerator {
                 floors: plan.floors,
                 lod: k,
                 origin,
-                footprint: if k == lod {
-                    std::mem::replace(&mut footprint, Polygon::new(Vec::new()))
-                } else {
-                    footprint.clone()
-                },
+                footprint: footprint.unwrap_or_else(|| Polygon::new(Vec::new())),
                 parts,
                 facades,
                 fallbacks,
             });
         }
-        Ok(out)
+        // The derivation's last string keeps its buffers for the next building's axiom.
+        *axiom = derivation.into_string();
+        LOCAL.with(|l| l.set(work));
+        Ok(())
     }
+}
+
+thread_local! {
+    /// Per-thread buffers of [`BuildingGenerator::build_lods`]: the footprint relative to
+    /// the origin and the axiom string (taken while in use, so a nested call gets fresh
+    /// ones).
+    static LOCAL: std::cell::Cell<(Vec<DVec2>, ParamString)> =
+        std::cell::Cell::new((Vec::new(), ParamString::new()));
 }
 
 /// Width along and depth across the first edge, and the first edge's unit direction.

@@ -101,8 +101,7 @@ pub(crate) fn skeleton_roof(
         let q = moved.iter().find(|m| m.0 == key(p)).map_or(p, |m| m.1);
         to_world(q, h)
     };
-    let mut mesh = Mesh::with_capacity(None, 8 * ring.len(), 4 * ring.len());
-    let mut faces = RoofFaces::new();
+    let mut faces = RoofFaces::with_capacity(sk.faces().len());
     for (e, f) in sk.faces().iter().enumerate() {
         let mut pts: Vec<DVec3> = Vec::with_capacity(f.len());
         for &p in f.points() {
@@ -114,13 +113,26 @@ pub(crate) fn skeleton_roof(
         if pts.len() < 3 {
             continue;
         }
-        add_face(&mut mesh, &pts)?;
         faces.push(pts);
     }
-    let bottom: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
-    add_face(&mut mesh, &bottom)?;
+    let mesh = solid_of(&faces, ring, z0)?;
     check_solid(&mesh)?;
     Ok((mesh, faces))
+}
+
+/// The solid of the planar `faces` (in order) closed by the bottom face, `ring` at `z0`
+/// facing down, in a mesh sized exactly (a face of `n` corners has `n` vertices and
+/// `n − 2` triangles).
+fn solid_of(faces: &[Vec<DVec3>], ring: &[DVec2], z0: f64) -> Result<Mesh, GeomError> {
+    let bottom: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
+    let all = || faces.iter().map(Vec::as_slice).chain([bottom.as_slice()]);
+    let vertices = all().map(<[DVec3]>::len).sum();
+    let triangles = all().map(|f| f.len().saturating_sub(2)).sum();
+    let mut mesh = Mesh::with_capacity(None, vertices, triangles);
+    for f in all() {
+        add_face(&mut mesh, f)?;
+    }
+    Ok(mesh)
 }
 
 /// Distance, metres, that a mansard's break line keeps from every skeleton event: when a
@@ -258,8 +270,7 @@ pub(crate) fn mansard(
     let s_up = if t_up > 0.0 { h_up / t_up } else { 0.0 };
     let s_low = (h - h_up) / d;
     let z_break = z0 + s_low * d;
-    let mut mesh = Mesh::with_capacity(None, 8 * ring.len(), 6 * ring.len());
-    let mut faces = RoofFaces::new();
+    let mut faces = RoofFaces::with_capacity(bands.len() + uppers.len());
     for band in &bands {
         if band.len() < 3 {
             continue;
@@ -268,7 +279,6 @@ pub(crate) fn mansard(
             .iter()
             .map(|&(p, t)| to_world(p, if t == d { z_break } else { z0 + s_low * t }))
             .collect();
-        add_face(&mut mesh, &f)?;
         faces.push(f);
     }
     for (piece, sk_up) in &uppers {
@@ -296,19 +306,16 @@ pub(crate) fn mansard(
                     if pts.len() < 3 {
                         continue;
                     }
-                    add_face(&mut mesh, &pts)?;
                     faces.push(pts);
                 }
             }
             None => {
                 let top: Vec<DVec3> = piece.iter().map(|&p| to_world(p, z_break)).collect();
-                add_face(&mut mesh, &top)?;
                 faces.push(top);
             }
         }
     }
-    let bottom: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
-    add_face(&mut mesh, &bottom)?;
+    let mesh = solid_of(&faces, ring, z0)?;
     check_solid(&mesh)?;
     Ok((mesh, faces))
 }

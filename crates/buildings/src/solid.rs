@@ -52,7 +52,6 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
         t.normalize()
     };
     let b = nrm.cross(t);
-    let plane: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(t), p.dot(b))).collect();
     // Triangulation decides on an exact projection (dropping the normal's dominant axis,
     // no arithmetic), so points collinear in space stay collinear: a rotated basis would
     // round them apart and let a zero-area ear through.
@@ -64,43 +63,79 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
         2
     };
     let flip = nrm[k] < 0.0;
-    let exact: Vec<DVec2> = pts
-        .iter()
-        .map(|p| {
+    with_work(|w| {
+        let TriWork {
+            exact,
+            tris,
+            left,
+            poly,
+        } = w;
+        exact.clear();
+        exact.extend(pts.iter().map(|p| {
             let (a, b) = (p[(k + 1) % 3], p[(k + 2) % 3]);
             if flip {
                 DVec2::new(b, a)
             } else {
                 DVec2::new(a, b)
             }
-        })
-        .collect();
-    let convex = (0..n).all(|i| {
-        orient2d(exact[i], exact[(i + 1) % n], exact[(i + 2) % n]) == Orientation::CounterClockwise
-    });
-    let base = mesh.positions.len() as u32;
-    let first = mesh.indices.len();
-    let tris: Vec<[u32; 3]> = if convex {
-        (1..n as u32 - 1).map(|i| [0, i, i + 1]).collect()
-    } else {
-        triangulate_ring(&exact, false).ok_or(GeomError::DegenerateTriangle {
-            triangle: mesh.triangle_count(),
-        })??
-    };
-    for tri in &tris {
-        let [p, q, r] = tri.map(|i| pts[i as usize].as_vec3().as_dvec3());
-        if (q - p).cross(r - p) == DVec3::ZERO {
-            mesh.indices.truncate(first);
-            return Err(GeomError::DegenerateTriangle {
-                triangle: first / 3,
-            });
+        }));
+        let convex = (0..n).all(|i| {
+            orient2d(exact[i], exact[(i + 1) % n], exact[(i + 2) % n])
+                == Orientation::CounterClockwise
+        });
+        let base = mesh.positions.len() as u32;
+        let first = mesh.indices.len();
+        tris.clear();
+        if convex {
+            tris.extend((1..n as u32 - 1).map(|i| [0, i, i + 1]));
+        } else {
+            triangulate_into(exact, false, left, poly, tris).ok_or(
+                GeomError::DegenerateTriangle {
+                    triangle: mesh.triangle_count(),
+                },
+            )??;
         }
-        mesh.indices.extend(tri.iter().map(|&i| base + i));
-    }
-    for (p, uv) in pts.iter().zip(&plane) {
-        push_vertex(mesh, *p, nrm, DVec2::new(uv.x, -uv.y));
-    }
-    Ok(())
+        for tri in tris.iter() {
+            let [p, q, r] = tri.map(|i| pts[i as usize].as_vec3().as_dvec3());
+            if (q - p).cross(r - p) == DVec3::ZERO {
+                mesh.indices.truncate(first);
+                return Err(GeomError::DegenerateTriangle {
+                    triangle: first / 3,
+                });
+            }
+            mesh.indices.extend(tri.iter().map(|&i| base + i));
+        }
+        for p in pts {
+            let uv = DVec2::new(p.dot(t), p.dot(b));
+            push_vertex(mesh, *p, nrm, DVec2::new(uv.x, -uv.y));
+        }
+        Ok(())
+    })
+}
+
+/// Reusable buffers of the triangulations (one set per thread).
+#[derive(Default)]
+struct TriWork {
+    /// A face's exact projection.
+    exact: Vec<DVec2>,
+    /// Triangles found.
+    tris: Vec<[u32; 3]>,
+    /// Ear clipping's remaining vertices.
+    left: Vec<u32>,
+    /// A ring lent to `Polygon` for validation.
+    poly: Vec<DVec2>,
+}
+
+thread_local! {
+    static TRI_WORK: std::cell::RefCell<TriWork> = std::cell::RefCell::new(TriWork::default());
+}
+
+/// Runs `f` with this thread's triangulation buffers (fresh ones if they are in use).
+fn with_work<R>(f: impl FnOnce(&mut TriWork) -> R) -> R {
+    TRI_WORK.with(|w| match w.try_borrow_mut() {
+        Ok(mut w) => f(&mut w),
+        Err(_) => f(&mut TriWork::default()),
+    })
 }
 
 /// A closed prism over the counter-clockwise ring `ring` from elevation `z0` to `z1`:
@@ -113,7 +148,9 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
     if n < 3 || z1.partial_cmp(&z0) != Some(std::cmp::Ordering::Greater) {
         return Err(GeomError::DegenerateTriangle { triangle: 0 });
     }
-    let mut m = Mesh::with_capacity(None, 6 * n, 4 * n);
+    // 4 vertices and 2 triangles per wall, n vertices and n − 2 triangles per cap (every
+    // triangulation of a simple ring has n − 2): the mesh is sized exactly.
+    let mut m = Mesh::with_capacity(None, 6 * n, 4 * n - 4);
     let mut along = 0.0;
     for i in 0..n {
         let (a, b) = (ring[i], ring[(i + 1) % n]);
@@ -171,26 +208,32 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
     } else {
         // One triangulation serves both caps (reversed for the bottom).
         // The ring is simple: a validated lot, an inset of one, or a checked shrink.
-        let tris =
-            triangulate_ring(ring, true).ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
-        for (h, up) in [(z1, true), (z0, false)] {
-            let (normal, sign) = if up {
-                (DVec3::Y, -1.0)
-            } else {
-                (-DVec3::Y, 1.0)
-            };
-            let base = m.positions.len() as u32;
-            for &p in ring {
-                push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
-            }
-            for &[a, b, c] in &tris {
-                if up {
-                    m.indices.extend_from_slice(&[base + a, base + b, base + c]);
+        with_work(|w| {
+            let TriWork {
+                tris, left, poly, ..
+            } = w;
+            triangulate_into(ring, true, left, poly, tris)
+                .ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
+            for (h, up) in [(z1, true), (z0, false)] {
+                let (normal, sign) = if up {
+                    (DVec3::Y, -1.0)
                 } else {
-                    m.indices.extend_from_slice(&[base + a, base + c, base + b]);
+                    (-DVec3::Y, 1.0)
+                };
+                let base = m.positions.len() as u32;
+                for &p in ring {
+                    push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
+                }
+                for &[a, b, c] in tris.iter() {
+                    if up {
+                        m.indices.extend_from_slice(&[base + a, base + b, base + c]);
+                    } else {
+                        m.indices.extend_from_slice(&[base + a, base + c, base + b]);
+                    }
                 }
             }
-        }
+            Ok::<(), GeomError>(())
+        })?;
         let first_cap = 6 * n;
         if m.indices[first_cap..].chunks_exact(3).any(|t| {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
@@ -212,10 +255,26 @@ const EAR_CLIPPING_MAX: usize = 64;
 /// degenerate; when no such ear exists (collinear runs), or for long rings, the
 /// constrained Delaunay triangulation of polis-geom decides. `None` when the ring is not
 /// counter-clockwise. Unless `simple` promises it, the ring is validated first.
+#[cfg(test)]
 pub(crate) fn triangulate_ring(
     ring: &[DVec2],
     simple: bool,
 ) -> Option<Result<Vec<[u32; 3]>, GeomError>> {
+    let mut out = Vec::new();
+    let r = triangulate_into(ring, simple, &mut Vec::new(), &mut Vec::new(), &mut out)?;
+    Some(r.map(|()| out))
+}
+
+/// [`triangulate_ring`] into `out` (cleared first), with the buffers `left` (ear
+/// clipping) and `poly` (validation).
+fn triangulate_into(
+    ring: &[DVec2],
+    simple: bool,
+    left: &mut Vec<u32>,
+    poly: &mut Vec<DVec2>,
+    out: &mut Vec<[u32; 3]>,
+) -> Option<Result<(), GeomError>> {
+    out.clear();
     let n = ring.len();
     if n < 3
         || polis_geom::polygon::ring_signed_area(ring).partial_cmp(&0.0)
@@ -227,23 +286,35 @@ pub(crate) fn triangulate_ring(
         return None;
     }
     if n <= EAR_CLIPPING_MAX {
-        if !simple && let Err(e) = Polygon::new(ring.to_vec()).validate() {
-            return Some(Err(e));
+        if !simple {
+            let mut v = std::mem::take(poly);
+            v.clear();
+            v.extend_from_slice(ring);
+            let p = Polygon::new(v);
+            let valid = p.validate();
+            *poly = p.into_points();
+            if let Err(e) = valid {
+                return Some(Err(e));
+            }
         }
-        if let Some(t) = ear_clip(ring) {
-            return Some(Ok(t));
+        if ear_clip(ring, left, out) {
+            return Some(Ok(()));
         }
+        out.clear();
     }
-    Some(triangulate(&PolygonWithHoles::from(Polygon::new(
-        ring.to_vec(),
-    ))))
+    Some(
+        triangulate(&PolygonWithHoles::from(Polygon::new(ring.to_vec()))).map(|t| {
+            out.extend(t);
+        }),
+    )
 }
 
-/// Ear clipping of a counter-clockwise simple ring; `None` when it gets stuck.
-fn ear_clip(ring: &[DVec2]) -> Option<Vec<[u32; 3]>> {
+/// Ear clipping of a counter-clockwise simple ring into `out`; `false` when it gets
+/// stuck.
+fn ear_clip(ring: &[DVec2], left: &mut Vec<u32>, out: &mut Vec<[u32; 3]>) -> bool {
     let n = ring.len();
-    let mut left: Vec<u32> = (0..n as u32).collect();
-    let mut out = Vec::with_capacity(n - 2);
+    left.clear();
+    left.extend(0..n as u32);
     let at = |i: u32| ring[i as usize];
     let mut i = 0usize;
     let mut misses = 0usize;
@@ -270,17 +341,17 @@ fn ear_clip(ring: &[DVec2]) -> Option<Vec<[u32; 3]>> {
         } else {
             misses += 1;
             if misses > m {
-                return None;
+                return false;
             }
             i = (i + 1) % m;
         }
     }
     let [a, b, c] = [left[0], left[1], left[2]];
     if orient2d(at(a), at(b), at(c)) != Orientation::CounterClockwise {
-        return None;
+        return false;
     }
     out.push([a, b, c]);
-    Some(out)
+    true
 }
 
 /// A closed pyramid-like solid: the ring at `z0` (bottom cap facing down) joined to the
@@ -294,13 +365,16 @@ pub(crate) fn cone(ring: &[DVec2], z0: f64, apex: DVec2, z1: f64) -> Result<Mesh
             reason: "the footprint is not star-shaped from the apex".into(),
         });
     }
-    let mut m = Mesh::with_capacity(None, 4 * n, 2 * n);
+    // n side triangles of 3 vertices, a bottom of n vertices and n − 2 triangles.
+    let mut m = Mesh::with_capacity(None, 4 * n, (2 * n).saturating_sub(2));
     let top = to_world(apex, z1);
-    let bottom: Vec<DVec3> = ring.iter().map(|&p| to_world(p, z0)).collect();
     for i in 0..n {
-        add_face(&mut m, &[bottom[i], bottom[(i + 1) % n], top])?;
+        add_face(
+            &mut m,
+            &[to_world(ring[i], z0), to_world(ring[(i + 1) % n], z0), top],
+        )?;
     }
-    let rev: Vec<DVec3> = bottom.iter().rev().copied().collect();
+    let rev: Vec<DVec3> = ring.iter().rev().map(|&p| to_world(p, z0)).collect();
     add_face(&mut m, &rev)?;
     Ok(m)
 }

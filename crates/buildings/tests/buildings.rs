@@ -130,6 +130,64 @@ fn every_kind_on_every_shape_is_closed_inside_and_under_the_limit() {
     assert!(built > 500);
 }
 
+/// Asserts that every vector a building keeps is exactly sized (no spare capacity).
+fn assert_tight(b: Building) {
+    let what = format!("{:?} lot {} LOD {}", b.kind, b.lot_id, b.lod);
+    assert_eq!(b.parts.capacity(), b.parts.len(), "parts of {what}");
+    assert_eq!(b.facades.capacity(), b.facades.len(), "facades of {what}");
+    for (i, p) in b.parts.iter().enumerate() {
+        let m = &p.mesh;
+        for (name, len, cap) in [
+            ("positions", m.positions.len(), m.positions.capacity()),
+            ("normals", m.normals.len(), m.normals.capacity()),
+            ("uvs", m.uvs.len(), m.uvs.capacity()),
+            ("indices", m.indices.len(), m.indices.capacity()),
+        ] {
+            assert_eq!(cap, len, "{name} of part {i} ({:?}) of {what}", p.role);
+        }
+    }
+    let pts = b.footprint.into_points();
+    assert_eq!(pts.capacity(), pts.len(), "footprint of {what}");
+}
+
+#[test]
+fn returned_buildings_keep_no_spare_capacity() {
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    let mut checked = 0;
+    for (li, l) in shapes().iter().enumerate() {
+        for kind in BuildingKind::ALL {
+            for seed in 0..4u64 {
+                let id = li as u64 * 100 + seed;
+                for lod in [0, 1, 2, 6] {
+                    if let Some(b) = g.build(l, id, kind, 200.0, lod).unwrap() {
+                        assert_tight(b);
+                        checked += 1;
+                    }
+                }
+                for b in g.lods(l, id, kind, 200.0).unwrap() {
+                    assert_tight(b);
+                }
+            }
+        }
+    }
+    assert!(checked > 400, "{checked}");
+    // A user template's instance too (its collapsed triangles are left out).
+    let mut g = g;
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nv 0 1 0\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    let i = g.add_template(Template::from_obj_str("tetra", obj).unwrap());
+    let text = format!("p1: Lot(h,w,d,n) -> Extrude(h/2) Box Up Template({i})\n");
+    g.set_grammar(
+        BuildingKind::Office,
+        BuildingGrammar::parse("user", &text).unwrap(),
+    );
+    let b = g
+        .build(&shapes()[0], 3, BuildingKind::Office, 80.0, 1)
+        .unwrap()
+        .unwrap();
+    assert_eq!(b.parts.len(), 2);
+    assert_tight(b);
+}
+
 #[test]
 fn heights_follow_the_max_height_map() {
     let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
@@ -448,8 +506,9 @@ proptest! {
         let kind = BuildingKind::ALL[kind];
         match g.lods(&l, id, kind, max_h) {
             Ok(lods) => {
-                for b in &lods {
-                    check(b, &l, max_h);
+                for b in lods {
+                    check(&b, &l, max_h);
+                    assert_tight(b);
                 }
             }
             // Star lots are simple polygons: only a numerically failed skeleton may refuse.
