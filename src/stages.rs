@@ -433,6 +433,8 @@ struct DressScratch {
     faces: Vec<(usize, Option<std::ops::Range<usize>>)>,
     /// The tile quads of every face.
     tiles: Vec<TileQuad>,
+    /// The walls (part and bottom edge) with a face the tiles do not cover.
+    failed: Vec<(usize, [u64; 4])>,
 }
 
 thread_local! {
@@ -512,7 +514,11 @@ impl DressBuilding for Tiler {
         };
         DRESS_SCRATCH.with(|scratch| {
             let mut scratch = scratch.borrow_mut();
-            let DressScratch { faces, tiles } = &mut *scratch;
+            let DressScratch {
+                faces,
+                tiles,
+                failed,
+            } = &mut *scratch;
             faces.clear();
             tiles.clear();
             // Each wall face's tile quads (a range of `tiles`), or `None` where the tiles
@@ -554,14 +560,17 @@ impl DressBuilding for Tiler {
                     (f.part, [p.x, p.z, q.x, q.z].map(f64::to_bits))
                 })
             };
-            let failed = |k: usize| {
-                let key = wall_key(k);
+            failed.clear();
+            failed.extend(
                 faces
                     .iter()
-                    .any(|(j, range)| range.is_none() && wall_key(*j) == key)
-            };
+                    .filter(|(_, range)| range.is_none())
+                    .filter_map(|(k, _)| wall_key(*k)),
+            );
             let kept = |(k, range): &(usize, Option<std::ops::Range<usize>>)| {
-                range.clone().filter(|_| !failed(*k)).map(|r| (*k, r))
+                let wall_failed =
+                    !failed.is_empty() && wall_key(*k).is_some_and(|key| failed.contains(&key));
+                range.clone().filter(|_| !wall_failed).map(|r| (*k, r))
             };
             let count: usize = faces.iter().filter_map(kept).map(|(_, r)| r.len()).sum();
             if count == 0 {
