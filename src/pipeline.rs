@@ -256,23 +256,41 @@ impl Pipeline {
         timings.push(lap(Stage::Maps, &mut clock));
         self.report(Stage::Maps, 1.0);
 
+        // Road growth is serial; the facade tile sets are rasterised and the building
+        // grammars prepared on the other thread meanwhile. Each stage's time is its own
+        // elapsed time, so these overlap.
         self.report(Stage::Roads, 0.0);
-        let roads = self.roads.roads(&cx)?;
+        let (roads, prepared) = rayon::join(
+            || timed(|| self.roads.roads(&cx)),
+            || {
+                let builder = timed(|| self.buildings.prepare(&cx))?;
+                let dresser = timed(|| self.facades.prepare(&cx))?;
+                Ok::<_, Error>((builder, dresser))
+            },
+        );
+        let (roads, roads_time) = roads?;
+        let ((builder, buildings_time), (dresser, facades_time)) = prepared?;
         let network = roads.network;
-        timings.push(lap(Stage::Roads, &mut clock));
+        timings.push(StageTiming {
+            stage: Stage::Roads,
+            time: roads_time,
+        });
+        timings.push(StageTiming {
+            stage: Stage::Buildings,
+            time: buildings_time,
+        });
+        timings.push(StageTiming {
+            stage: Stage::Facades,
+            time: facades_time,
+        });
         self.report(Stage::Roads, 1.0);
 
         self.report(Stage::Cells, 0.0);
+        clock = Instant::now();
         let cells = self.cells.cells(&network, &cx)?;
         timings.push(lap(Stage::Cells, &mut clock));
         self.report(Stage::Cells, 1.0);
-
-        // The per-lot and per-building stages, prepared once.
         self.report(Stage::Lots, 0.0);
-        let builder = self.buildings.prepare(&cx)?;
-        timings.push(lap(Stage::Buildings, &mut clock));
-        let dresser = self.facades.prepare(&cx)?;
-        timings.push(lap(Stage::Facades, &mut clock));
 
         let mut counts = CityStats::default();
         let total = cells.cells.len();
@@ -529,6 +547,12 @@ impl Pipeline {
         let facades_time = lap(Stage::Facades);
         Ok((out, [lots_time, buildings_time, facades_time]))
     }
+}
+
+/// Runs `job` and measures its time.
+fn timed<T>(job: impl FnOnce() -> Result<T>) -> Result<(T, std::time::Duration)> {
+    let clock = Instant::now();
+    job().map(|out| (out, clock.elapsed()))
 }
 
 /// The time since `clock`, restarting it.
