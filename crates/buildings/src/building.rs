@@ -3,8 +3,7 @@
 use polis_geom::mesh::to_world;
 use polis_geom::polygon::{locate_in_ring, ring_signed_area};
 use polis_geom::{
-    DVec2, DVec3, Mesh, PointLocation, Polygon, PolygonWithHoles, SegmentIntersection,
-    segment_intersection,
+    DVec2, DVec3, Mesh, PointLocation, Polygon, SegmentIntersection, segment_intersection,
 };
 use polis_lsystem::ParamString;
 use serde::{Deserialize, Serialize};
@@ -615,8 +614,7 @@ fn setback(rings: &mut Vec<DVec2>, r: (usize, usize), d: f64) -> Option<(usize, 
         return Some(r);
     }
     let (start, len) = r;
-    let poly = PolygonWithHoles::from(Polygon::new(rings.get(start..start + len)?.to_vec()));
-    let pieces = polis_lots::inset_shapes(&poly, None, d).ok()?;
+    let pieces = crate::footprint::inset_ring(rings.get(start..start + len)?, d).ok()?;
     let best = pieces.into_iter().max_by(|a, b| {
         ring_signed_area(&a.outer.points)
             .abs()

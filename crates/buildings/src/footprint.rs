@@ -66,6 +66,25 @@ fn inset_largest(
     })
 }
 
+/// The unweighted inset by `d` of `ring` (taken as it is, not reoriented) through this
+/// thread's worker: the same shapes as `polis_lots::inset_shapes`.
+pub(crate) fn inset_ring(
+    ring: &[DVec2],
+    d: f64,
+) -> Result<Vec<polis_lots::InsetShape>, polis_lots::LotsError> {
+    let run = |work: &mut InsetWork| {
+        let mut pts = std::mem::take(&mut work.input.outer).into_points();
+        pts.clear();
+        pts.extend_from_slice(ring);
+        work.input.outer = Polygon::new(pts);
+        work.worker.shapes(&work.input, None, d)
+    };
+    INSET.with(|w| match w.try_borrow_mut() {
+        Ok(mut work) => run(&mut work),
+        Err(_) => run(&mut InsetWork::default()),
+    })
+}
+
 /// Cuts the footprint of a building from `lot` with `strategy`. `Ok(None)` when nothing
 /// of at least `params.min_area` remains.
 pub fn footprint(

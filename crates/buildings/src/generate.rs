@@ -2,7 +2,6 @@
 
 use polis_geom::{DVec2, Field, Polygon};
 use polis_lots::Lot;
-use polis_lsystem::{Derivation, DeriveOptions, ModuleString, ParamString};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -257,11 +256,10 @@ impl BuildingGenerator {
             source,
         };
         let origin = plan.footprint.centroid();
-        let mut work = LOCAL.with(|l| l.take());
-        let (local, axiom) = (&mut work.0, &mut work.1);
+        let mut local = LOCAL.with(std::cell::Cell::take);
         local.clear();
         local.extend(plan.footprint.points().iter().map(|&p| p - origin));
-        let (w, d, frame_x) = extents(local);
+        let (w, d, frame_x) = extents(&local);
         let p = &self.params;
         let cx = Context {
             grammar,
@@ -275,62 +273,49 @@ impl BuildingGenerator {
             ground_floor_height: p.ground_floor_height,
             slope_default: p.roof_pitch_deg.to_radians().tan(),
         };
-        axiom.clear();
-        axiom
-            .push(
-                grammar.lot_symbol(),
-                &[plan.height, w, d, f64::from(plan.floors)],
-            )
-            .map_err(derivation_error)?;
-        let options = DeriveOptions {
-            seed: plan.seed,
-            max_len: MAX_BUILDING_MODULES,
-            ..DeriveOptions::default()
-        };
-        let mut derivation = Derivation::new(grammar.grammar(), std::mem::take(axiom), options);
+        let axiom = [plan.height, w, d, f64::from(plan.floors)];
         let mut footprint = Some(plan.footprint);
-        for k in 0..=lod {
-            if k > 0 {
-                derivation.step().map_err(derivation_error)?;
+        grammar.derive(plan.seed, &axiom, derivation_error, |derivation| {
+            for k in 0..=lod {
+                if k > 0 {
+                    derivation.step().map_err(derivation_error)?;
+                }
+                if last_only && k < lod {
+                    continue;
+                }
+                let (parts, facades, fallbacks) = with_scratch(|scratch| {
+                    interpret(&cx, scratch, &local, plan.height, derivation.string())
+                })?;
+                let footprint = if k == lod {
+                    footprint.take()
+                } else {
+                    footprint.clone()
+                };
+                sink(Building {
+                    id: lot_id,
+                    lot_id,
+                    kind,
+                    height: plan.height,
+                    floors: plan.floors,
+                    lod: k,
+                    origin,
+                    footprint: footprint.unwrap_or_else(|| Polygon::new(Vec::new())),
+                    parts,
+                    facades,
+                    fallbacks,
+                });
             }
-            if last_only && k < lod {
-                continue;
-            }
-            let (parts, facades, fallbacks) = with_scratch(|scratch| {
-                interpret(&cx, scratch, local, plan.height, derivation.string())
-            })?;
-            let footprint = if k == lod {
-                footprint.take()
-            } else {
-                footprint.clone()
-            };
-            sink(Building {
-                id: lot_id,
-                lot_id,
-                kind,
-                height: plan.height,
-                floors: plan.floors,
-                lod: k,
-                origin,
-                footprint: footprint.unwrap_or_else(|| Polygon::new(Vec::new())),
-                parts,
-                facades,
-                fallbacks,
-            });
-        }
-        // The derivation's last string keeps its buffers for the next building's axiom.
-        *axiom = derivation.into_string();
-        LOCAL.with(|l| l.set(work));
+            Ok(())
+        })?;
+        LOCAL.with(|l| l.set(local));
         Ok(())
     }
 }
 
 thread_local! {
-    /// Per-thread buffers of [`BuildingGenerator::build_lods`]: the footprint relative to
-    /// the origin and the axiom string (taken while in use, so a nested call gets fresh
-    /// ones).
-    static LOCAL: std::cell::Cell<(Vec<DVec2>, ParamString)> =
-        std::cell::Cell::new((Vec::new(), ParamString::new()));
+    /// Per-thread buffer of [`BuildingGenerator::build_lods`]: the footprint relative to
+    /// the origin (taken while in use, so a nested call gets a fresh one).
+    static LOCAL: std::cell::Cell<Vec<DVec2>> = const { std::cell::Cell::new(Vec::new()) };
 }
 
 /// Width along and depth across the first edge, and the first edge's unit direction.

@@ -33,9 +33,18 @@
 //! Parts are clipped to the building's volume: anything above `h` is cut down or dropped,
 //! and a footprint that leaves the lot terminates that part.
 
-use polis_lsystem::{Grammar, LsystemError};
+use std::cell::RefCell;
+use std::sync::Arc;
+
+use polis_lsystem::{
+    BranchIndex, Command, Derivation, DeriveOptions, Grammar, LsystemError, ModuleKind,
+    ParamString, QueryKind, Rules, TurtleState,
+};
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
 
 use crate::BuildingsError;
+use crate::generate::MAX_BUILDING_MODULES;
 use crate::params::BuildingKind;
 
 /// The shape modules, declared in front of every building grammar.
@@ -73,7 +82,8 @@ pub(crate) enum Op {
 #[derive(Debug, Clone)]
 pub struct BuildingGrammar {
     name: String,
-    grammar: Grammar,
+    /// Shared with the per-thread derivations that reuse their buffers.
+    grammar: Arc<Grammar>,
     ops: Vec<Op>,
     lot: u32,
 }
@@ -137,7 +147,7 @@ impl BuildingGrammar {
         }
         Ok(BuildingGrammar {
             name: name.to_string(),
-            grammar,
+            grammar: Arc::new(grammar),
             ops,
             lot,
         })
@@ -161,10 +171,6 @@ impl BuildingGrammar {
     pub(crate) fn op(&self, symbol: u32) -> Op {
         self.ops.get(symbol as usize).copied().unwrap_or(Op::Ignore)
     }
-
-    pub(crate) fn lot_symbol(&self) -> u32 {
-        self.lot
-    }
 }
 
 /// The text of a kind's default grammar.
@@ -176,5 +182,235 @@ pub fn default_text(kind: BuildingKind) -> &'static str {
         BuildingKind::House => include_str!("../grammars/house.lsys"),
         BuildingKind::Apartment => include_str!("../grammars/apartment.lsys"),
         BuildingKind::Industrial => include_str!("../grammars/industrial.lsys"),
+    }
+}
+
+/// A derivation the generator can step and read.
+pub(crate) trait Steps {
+    /// One derivation step.
+    fn step(&mut self) -> Result<(), LsystemError>;
+    /// The current string.
+    fn string(&self) -> &ParamString;
+}
+
+impl<R: Rules<String = ParamString>> Steps for Derivation<R> {
+    fn step(&mut self) -> Result<(), LsystemError> {
+        Derivation::step(self).map(|_| ())
+    }
+
+    fn string(&self) -> &ParamString {
+        Derivation::string(self)
+    }
+}
+
+/// A building grammar's rules drawing from a generator of their own. The engine seeds its
+/// generator once, when a derivation is made; these rules are reseeded per building with
+/// the seed a fresh derivation would get, so one derivation per thread and grammar (with
+/// its string buffers and scratch space) serves every building, and each building's
+/// derivation is the one a fresh `Derivation::new` with that seed would give. Only for
+/// grammars without an interpretation pass (no query or communication modules): the pass
+/// draws from a generator derived from the engine's seed.
+struct Reseeded {
+    grammar: Arc<Grammar>,
+    rng: RefCell<Pcg64Mcg>,
+}
+
+impl Rules for Reseeded {
+    type String = ParamString;
+    type Scratch = <Grammar as Rules>::Scratch;
+
+    #[inline]
+    fn kind(&self, s: &ParamString, i: usize) -> ModuleKind {
+        self.grammar.kind(s, i)
+    }
+    #[inline]
+    fn command(&self, s: &ParamString, i: usize) -> Command {
+        self.grammar.command(s, i)
+    }
+    #[inline]
+    fn is_ignored(&self, s: &ParamString, i: usize) -> bool {
+        self.grammar.is_ignored(s, i)
+    }
+    fn is_context_sensitive(&self) -> bool {
+        self.grammar.is_context_sensitive()
+    }
+    #[inline]
+    fn rewrite(
+        &self,
+        src: &ParamString,
+        i: usize,
+        branches: &BranchIndex,
+        _rng: &mut Pcg64Mcg,
+        scratch: &mut Self::Scratch,
+        dst: &mut ParamString,
+    ) -> polis_lsystem::Result<bool> {
+        let mut rng = self.rng.borrow_mut();
+        self.grammar
+            .rewrite(src, i, branches, &mut rng, scratch, dst)
+    }
+    fn has_decomposition(&self) -> bool {
+        self.grammar.has_decomposition()
+    }
+    fn decompose(
+        &self,
+        src: &ParamString,
+        i: usize,
+        _rng: &mut Pcg64Mcg,
+        scratch: &mut Self::Scratch,
+        dst: &mut ParamString,
+    ) -> polis_lsystem::Result<bool> {
+        let mut rng = self.rng.borrow_mut();
+        self.grammar.decompose(src, i, &mut rng, scratch, dst)
+    }
+    fn has_interpretation(&self) -> bool {
+        self.grammar.has_interpretation()
+    }
+    fn interpret(
+        &self,
+        src: &ParamString,
+        i: usize,
+        _rng: &mut Pcg64Mcg,
+        scratch: &mut Self::Scratch,
+        dst: &mut ParamString,
+    ) -> polis_lsystem::Result<bool> {
+        let mut rng = self.rng.borrow_mut();
+        self.grammar.interpret(src, i, &mut rng, scratch, dst)
+    }
+    fn fill_query(&self, s: &mut ParamString, i: usize, kind: QueryKind, state: &TurtleState) {
+        self.grammar.fill_query(s, i, kind, state);
+    }
+    fn needs_pass(&self, s: &ParamString) -> bool {
+        self.grammar.needs_pass(s)
+    }
+    fn check_storage(&self, s: &ParamString) -> polis_lsystem::Result<()> {
+        self.grammar.check_storage(s)
+    }
+}
+
+/// Derivations kept per thread (one per grammar met, the most recent last).
+const KEPT_DERIVATIONS: usize = 8;
+
+thread_local! {
+    static DERIVATIONS: RefCell<Vec<Derivation<Reseeded>>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The options of every building derivation with `seed`.
+fn options(seed: u64) -> DeriveOptions {
+    DeriveOptions {
+        seed,
+        max_len: MAX_BUILDING_MODULES,
+        ..DeriveOptions::default()
+    }
+}
+
+impl BuildingGrammar {
+    /// Runs `f` on the derivation of `grammar` from the axiom `Lot(axiom)` with `seed`:
+    /// this thread's kept derivation of the grammar, restarted in place, when the grammar
+    /// has no interpretation pass; a fresh one otherwise. Both derive the same strings.
+    /// `error` wraps an error of writing the axiom.
+    pub(crate) fn derive<T>(
+        &self,
+        seed: u64,
+        axiom: &[f64],
+        error: impl Fn(LsystemError) -> BuildingsError,
+        f: impl FnOnce(&mut dyn Steps) -> Result<T, BuildingsError>,
+    ) -> Result<T, BuildingsError> {
+        if self.grammar.needs_pass(&ParamString::new()) {
+            let mut start = ParamString::with_capacity(1, axiom.len());
+            start.push(self.lot, axiom).map_err(&error)?;
+            let mut d = Derivation::new(&*self.grammar, start, options(seed));
+            return f(&mut d);
+        }
+        let kept = DERIVATIONS.with(|k| {
+            let mut k = k.try_borrow_mut().ok()?;
+            let i = k
+                .iter()
+                .position(|d| Arc::ptr_eq(&d.rules().grammar, &self.grammar))?;
+            Some(k.remove(i))
+        });
+        let mut d = kept.unwrap_or_else(|| {
+            let rules = Reseeded {
+                grammar: Arc::clone(&self.grammar),
+                rng: RefCell::new(Pcg64Mcg::seed_from_u64(seed)),
+            };
+            Derivation::new(rules, ParamString::new(), options(0))
+        });
+        // Restart without giving up the string's buffers: take them out, restart from
+        // the empty string (a copy that allocates nothing), write the axiom back in.
+        let mut start = std::mem::take(d.string_mut());
+        d.restart(&ParamString::new());
+        polis_lsystem::ModuleString::clear(&mut start);
+        start.push(self.lot, axiom).map_err(&error)?;
+        *d.string_mut() = start;
+        *d.rules().rng.borrow_mut() = Pcg64Mcg::seed_from_u64(seed);
+        let out = f(&mut d);
+        DERIVATIONS.with(|k| {
+            if let Ok(mut k) = k.try_borrow_mut() {
+                if k.len() >= KEPT_DERIVATIONS {
+                    k.remove(0);
+                }
+                k.push(d);
+            }
+        });
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The strings of a fresh derivation with `seed`, step by step.
+    fn fresh(g: &BuildingGrammar, seed: u64, axiom: &[f64], steps: usize) -> Vec<ParamString> {
+        let mut start = ParamString::new();
+        start.push(g.lot, axiom).unwrap();
+        let mut d = Derivation::new(g.grammar(), start, options(seed));
+        let mut out = vec![d.string().clone()];
+        for _ in 0..steps {
+            d.step().unwrap();
+            out.push(d.string().clone());
+        }
+        out
+    }
+
+    #[test]
+    fn kept_derivations_derive_what_fresh_ones_do() {
+        // Interleaved kinds and seeds, so every kept derivation is restarted many times
+        // after strings of other lengths; stochastic grammars show any generator drift.
+        let grammars: Vec<BuildingGrammar> = BuildingKind::ALL
+            .iter()
+            .map(|&k| BuildingGrammar::default_for(k).unwrap())
+            .collect();
+        for round in 0..3u64 {
+            for (gi, g) in grammars.iter().enumerate() {
+                for seed in 0..20u64 {
+                    let seed = seed * 7919 + round + gi as u64 * 1_000_003;
+                    let axiom = [40.0 + seed as f64 % 90.0, 20.0, 30.0, 12.0];
+                    let steps = (seed % 7) as usize;
+                    let want = fresh(g, seed, &axiom, steps);
+                    let got = g
+                        .derive(
+                            seed,
+                            &axiom,
+                            |source| BuildingsError::Derivation {
+                                kind: "test".into(),
+                                source,
+                            },
+                            |d| {
+                                let mut out = vec![d.string().clone()];
+                                for _ in 0..steps {
+                                    d.step().unwrap();
+                                    out.push(d.string().clone());
+                                }
+                                Ok(out)
+                            },
+                        )
+                        .unwrap();
+                    assert_eq!(got, want, "{} seed {seed}", g.name());
+                }
+            }
+        }
+        // Only the grammars met are kept, at most `KEPT_DERIVATIONS`.
+        DERIVATIONS.with(|k| assert!(k.borrow().len() <= KEPT_DERIVATIONS));
     }
 }
