@@ -227,14 +227,14 @@ impl Pipeline {
     }
 
     /// The pipeline: maps, roads and cells for the whole city, then blocks, lots,
-    /// buildings and skins chunk by chunk into `sink`, then (if `scene`) the scene of
-    /// what the sink kept in the returned city.
+    /// buildings and skins chunk by chunk, either into `sink` or (`keep`) into the
+    /// returned city, whose scene is then assembled unless switched off.
     fn run(
         &self,
         config: &CityConfig,
         cells_per_chunk: usize,
         sink: &mut (dyn FnMut(CityChunk) -> Result<()> + Send),
-        scene: bool,
+        keep: bool,
     ) -> Result<City> {
         let mut timings = Vec::new();
         let mut report = SkipReport::default();
@@ -320,7 +320,7 @@ impl Pipeline {
                 .iter()
                 .map(|b| b.triangle_count())
                 .sum::<usize>();
-            if scene {
+            if keep {
                 kept.append(out);
             } else {
                 sink(out)?;
@@ -335,7 +335,7 @@ impl Pipeline {
         self.report(Stage::Facades, 1.0);
 
         self.report(Stage::Scene, 0.0);
-        let scene = if scene && self.scene {
+        let scene = if keep && self.scene {
             assemble(&SceneInputs {
                 config,
                 maps: &maps,
