@@ -48,6 +48,17 @@
 //! * Deterministic per (seed, lot id), on any thread and in any order.
 //! * Any grammar text gives a typed error or buildings with these guarantees, never a
 //!   panic (fuzzed by property tests in `tests/grammar_fuzz.rs`).
+//! * Every vector a returned [`Building`] holds (parts, facades, each mesh's vertices and
+//!   indices, the footprint) is exactly sized: no spare capacity for a city to keep.
+//!
+//! ## Memory
+//! [`BuildingGenerator::build`] allocates little beyond what the returned building
+//! keeps: the derivation, the shape interpreter, the triangulations, the footprint
+//! insets and the house rectangle work in per-thread buffers that are reused from one
+//! building to the next. Each thread that builds keeps those buffers (a few kilobytes)
+//! and one derivation per grammar it met (at most 8, each holding its grammar alive)
+//! until it exits. The lot's validation and the inset engine of `polis_lots` still
+//! allocate per building.
 //!
 //! ## Limitations
 //! * One building per lot; the footprint of a suburban lot whose inset splits keeps the
