@@ -138,6 +138,17 @@ fn with_work<R>(f: impl FnOnce(&mut TriWork) -> R) -> R {
     })
 }
 
+/// The vertices of a horizontal cap over `ring` at elevation `h` (what `push_vertex` per
+/// corner writes, one attribute at a time).
+fn push_cap(m: &mut Mesh, ring: &[DVec2], h: f64, normal: DVec3, sign: f64) {
+    m.positions
+        .extend(ring.iter().map(|&p| to_world(p, h).as_vec3()));
+    m.normals
+        .extend(std::iter::repeat_n(normal.as_vec3(), ring.len()));
+    m.uvs
+        .extend(ring.iter().map(|&p| DVec2::new(p.x, sign * p.y).as_vec2()));
+}
+
 /// A closed prism over the counter-clockwise ring `ring` from elevation `z0` to `z1`:
 /// walls, a top cap facing up and a bottom cap facing down.
 ///
@@ -162,16 +173,20 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             });
         }
         let d = (b - a) / len;
-        let normal = to_world(DVec2::new(d.y, -d.x), 0.0);
+        let normal = to_world(DVec2::new(d.y, -d.x), 0.0).as_vec3();
         let base = m.positions.len() as u32;
-        for (p, h, u) in [
+        // One slice per attribute (a capacity check each, not one per vertex).
+        let corners = [
             (a, z0, along),
             (b, z0, along + len),
             (b, z1, along + len),
             (a, z1, along),
-        ] {
-            push_vertex(&mut m, to_world(p, h), normal, DVec2::new(u, -h));
-        }
+        ];
+        m.positions
+            .extend_from_slice(&corners.map(|(p, h, _)| to_world(p, h).as_vec3()));
+        m.normals.extend_from_slice(&[normal; 4]);
+        m.uvs
+            .extend_from_slice(&corners.map(|(_, h, u)| DVec2::new(u, -h).as_vec2()));
         m.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
         along += len;
@@ -187,9 +202,7 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
                 (-DVec3::Y, 1.0)
             };
             let base = m.positions.len() as u32;
-            for &p in ring {
-                push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
-            }
+            push_cap(&mut m, ring, h, normal, sign);
             for k in 1..n as u32 - 1 {
                 if up {
                     m.indices.extend_from_slice(&[base, base + k, base + k + 1]);
@@ -221,9 +234,7 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
                     (-DVec3::Y, 1.0)
                 };
                 let base = m.positions.len() as u32;
-                for &p in ring {
-                    push_vertex(&mut m, to_world(p, h), normal, DVec2::new(p.x, sign * p.y));
-                }
+                push_cap(&mut m, ring, h, normal, sign);
                 for &[a, b, c] in tris.iter() {
                     if up {
                         m.indices.extend_from_slice(&[base + a, base + b, base + c]);
