@@ -55,9 +55,10 @@
 //! [`BuildingGenerator::build`] allocates little beyond what the returned building
 //! keeps: the derivation, the shape interpreter, the triangulations, the footprint
 //! insets and the house rectangle work in per-thread buffers that are reused from one
-//! building to the next. Each thread that builds keeps those buffers (a few kilobytes)
-//! and one derivation per grammar it met (at most 8, each holding its grammar alive)
-//! until it exits. The lot's validation and the inset engine of `polis_lots` still
+//! building to the next. Each thread that builds keeps those buffers (sized by the
+//! largest building it has built: a few kilobytes for the default grammars) and one
+//! derivation per grammar it met (at most 8, each holding its grammar alive) until it
+//! exits. The lot's validation and the inset engine of `polis_lots` still
 //! allocate per building.
 //!
 //! ## Limitations
