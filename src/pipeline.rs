@@ -18,9 +18,9 @@ use crate::city::{City, CityLot, CityStats, SkipReport, StageTiming};
 use crate::error::{Error, Result};
 use crate::scene::{SceneInputs, assemble};
 use crate::stages::{
-    BuildLot, BuildingStage, CellInput, CellStage, Dress, DressBuilding, EberlyCells, FacadeStage,
-    GrammarBuildings, KellyLots, LotInput, LotStage, ParishMullerRoads, RoadStage, Skip, Stage,
-    StageContext, TiledFacades,
+    BuildLot, BuildingStage, CellInput, CellLots, CellStage, Dress, DressBuilding, EberlyCells,
+    FacadeStage, GrammarBuildings, KellyLots, LotInput, LotStage, ParishMullerRoads, RoadStage,
+    Skip, Stage, StageContext, TiledFacades,
 };
 use crate::{CityConfig, CityMaps};
 
@@ -403,52 +403,54 @@ impl Pipeline {
             ..CityChunk::default()
         };
 
-        // Blocks and lots, cell by cell in parallel; results in cell order.
-        let mut inputs = Vec::with_capacity(cells.len());
-        for cell in cells {
-            let id = cell.id.index() as u64;
-            let mut widths = Vec::new();
-            for ring in std::iter::once(&cell.boundary).chain(cell.holes.iter()) {
-                for &e in &ring.edges {
-                    widths.push(network.edge_payload(e)?.width);
+        // Blocks and lots, cell by cell in parallel (the cell's input is made in its own
+        // task); results in cell order.
+        let ticker = self.ticker(Stage::Lots, cells.len(), span);
+        let per_cell: Vec<Result<std::result::Result<(u64, CellLots), Skip>>> = cells
+            .par_iter()
+            .map(|cell| {
+                let id = cell.id.index() as u64;
+                let mut widths = Vec::new();
+                for ring in std::iter::once(&cell.boundary).chain(cell.holes.iter()) {
+                    for &e in &ring.edges {
+                        widths.push(network.edge_payload(e)?.width);
+                    }
                 }
-            }
-            // Islands touching the boundary at a node are moved apart by a micrometre
-            // so the region is a valid polygon with holes; a cell where that fails is
-            // skipped and reported.
-            let polygon = match cell.polygon_with_holes() {
-                Ok(p) => p,
-                Err(e) => {
-                    report.skipped.push(Skip {
-                        stage: Stage::Lots,
+                // Islands touching the boundary at a node are moved apart by a
+                // micrometre so the region is a valid polygon with holes; a cell where
+                // that fails is skipped and reported.
+                let polygon = match cell.polygon_with_holes() {
+                    Ok(p) => p,
+                    Err(e) => {
+                        return Ok(Err(Skip {
+                            stage: Stage::Lots,
+                            id,
+                            reason: format!("cell {id}: {e}"),
+                        }));
+                    }
+                };
+                let input = CellInput {
+                    cell,
+                    region: polis_lots::Cell {
                         id,
-                        reason: format!("cell {id}: {e}"),
-                    });
+                        polygon,
+                        road_widths: widths,
+                    },
+                    seed: cx.seed(Stage::Lots, id),
+                };
+                let lots = self.lots.lots(&input, cx);
+                ticker.tick();
+                Ok(Ok((id, lots?)))
+            })
+            .collect();
+        for result in per_cell {
+            let (cell, lots) = match result? {
+                Ok(done) => done,
+                Err(skip) => {
+                    report.skipped.push(skip);
                     continue;
                 }
             };
-            inputs.push(CellInput {
-                cell,
-                region: polis_lots::Cell {
-                    id,
-                    polygon,
-                    road_widths: widths,
-                },
-                seed: cx.seed(Stage::Lots, id),
-            });
-        }
-        let ticker = self.ticker(Stage::Lots, inputs.len(), span);
-        let per_cell: Vec<Result<_>> = inputs
-            .par_iter()
-            .map(|input| {
-                let r = self.lots.lots(input, cx);
-                ticker.tick();
-                r
-            })
-            .collect();
-        for (input, result) in inputs.iter().zip(per_cell) {
-            let lots = result?;
-            let cell = input.region.id;
             report.skipped.extend(lots.skipped);
             out.blocks.extend(lots.blocks);
             out.green_spaces.extend(lots.green_spaces);
@@ -468,7 +470,6 @@ impl Pipeline {
                 });
             }
         }
-        drop(inputs);
         let lots_time = lap(Stage::Lots);
 
         // Buildings, lot by lot in parallel.
