@@ -12,7 +12,7 @@ use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 use std::collections::BTreeMap;
 
-use polis_geom::scene::{Image, ImageData, MetaValue, Node, Texture};
+use polis_geom::scene::{Image, ImageData, MetaValue, Node, NodeId, Texture};
 use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
@@ -352,7 +352,24 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect()
     };
-    let (road, meshes) = rayon::join(road_mesh, buildings_job);
+    // Each block's node and kerb-high plinth.
+    let kerb = inp.config.scene.kerb_height_m;
+    let blocks_job = || -> Vec<Result<(Node, Vec<Mesh>)>> {
+        if kerb <= 0.0 {
+            return Vec::new();
+        }
+        inp.blocks
+            .par_iter()
+            .map(|block| {
+                let base = ground(elevation, block.polygon.outer.points());
+                let plinth =
+                    polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?;
+                Ok((Node::new(format!("block {}", block.id())), vec![plinth]))
+            })
+            .collect()
+    };
+    let (road, (blocks, buildings)) =
+        rayon::join(road_mesh, || rayon::join(blocks_job, buildings_job));
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;
         let mesh = scene.add_mesh(mesh);
@@ -381,52 +398,35 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .and_then(|i| cell_nodes.get(i).copied())
     };
 
-    let kerb = inp.config.scene.kerb_height_m;
-    let plinths: Vec<Result<Option<Mesh>>> = inp
-        .blocks
-        .par_iter()
-        .map(|block| {
-            if kerb <= 0.0 {
-                return Ok(None);
-            }
-            let base = ground(elevation, block.polygon.outer.points());
-            Ok(Some(polis_geom::mesh::prism(
-                &block.polygon,
-                base,
-                base + kerb,
-                Some(pal.pavement),
-            )?))
-        })
-        .collect();
-    for (block, mesh) in inp.blocks.iter().zip(plinths) {
-        let (Some(mesh), Some(parent)) = (mesh?, cell_node(block.cell_id)) else {
-            continue;
-        };
-        let node = scene.add_node(parent, format!("block {}", block.id()))?;
-        let mesh = scene.add_mesh(mesh);
-        scene.attach_mesh(node, mesh)?;
-    }
-
-    scene.meshes.reserve(
-        meshes
-            .iter()
-            .map(|m| m.as_ref().map_or(0, |m| m.1.len()))
-            .sum(),
-    );
-    scene.nodes.reserve(meshes.len());
-    for (built, &cell) in meshes.into_iter().zip(inp.building_cells) {
-        let (mut node, meshes) = built?;
-        let Some(parent) = cell_node(cell) else {
-            continue;
-        };
-        let id = scene.add_node(parent, String::new())?;
-        node.meshes = Vec::with_capacity(meshes.len());
-        for mesh in meshes {
-            node.meshes.push(scene.add_mesh(mesh));
+    // Blocks, then buildings, under their cells.
+    let mut leaves = Vec::with_capacity(blocks.len() + buildings.len());
+    let block_cells = inp.blocks.iter().map(|b| b.cell_id);
+    for (made, cell) in blocks.into_iter().zip(block_cells).chain(
+        buildings
+            .into_iter()
+            .zip(inp.building_cells.iter().copied()),
+    ) {
+        let (node, meshes) = made?;
+        if let Some(parent) = cell_node(cell) {
+            leaves.push((parent, node, meshes));
         }
+    }
+    insert_leaves(&mut scene, leaves)?;
+    Ok(scene)
+}
+
+/// Adds prepared leaf nodes with their meshes under their parents, in order.
+fn insert_leaves(scene: &mut Scene, leaves: Vec<(NodeId, Node, Vec<Mesh>)>) -> Result<()> {
+    scene.nodes.reserve(leaves.len());
+    scene
+        .meshes
+        .reserve(leaves.iter().map(|(_, _, meshes)| meshes.len()).sum());
+    for (parent, mut node, meshes) in leaves {
+        let id = scene.add_node(parent, String::new())?;
+        node.meshes = meshes.into_iter().map(|m| scene.add_mesh(m)).collect();
         *scene.node_mut(id)? = node;
     }
-    Ok(scene)
+    Ok(())
 }
 
 /// The SVG/GeoJSON kind of a building kind.
