@@ -198,7 +198,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!(
         "  {:<15} {:>7.1} ms",
-        "generate total",
+        "generate (wall)",
         s.total_time().as_secs_f64() * 1e3
     );
     println!(

@@ -66,14 +66,20 @@ pub struct CityStats {
     pub building_triangles: usize,
     /// Triangles of the whole scene (0 when the scene was not built).
     pub scene_triangles: usize,
-    /// Time per stage, in pipeline order.
+    /// Time per stage, in pipeline order. The building grammars and the facade tile
+    /// sets are prepared while the roads grow, so the stage times can add up to more
+    /// than [`wall_time`](Self::wall_time).
     pub timings: Vec<StageTiming>,
+    /// Wall-clock time of the whole run (with [`Pipeline::stream`](crate::Pipeline::stream),
+    /// including the sink's time).
+    #[serde(default)]
+    pub wall_time: Duration,
 }
 
 impl CityStats {
-    /// Total time of all stages.
+    /// Wall-clock time of the whole run ([`wall_time`](Self::wall_time)).
     pub fn total_time(&self) -> Duration {
-        self.timings.iter().map(|t| t.time).sum()
+        self.wall_time
     }
 
     /// Time of one stage (zero if it did not run).

@@ -236,6 +236,7 @@ impl Pipeline {
         sink: &mut (dyn FnMut(CityChunk) -> Result<()> + Send),
         keep: bool,
     ) -> Result<City> {
+        let started = Instant::now();
         let mut timings = Vec::new();
         let mut report = SkipReport::default();
         let mut clock = Instant::now();
@@ -360,6 +361,7 @@ impl Pipeline {
             texture_bytes: tile_sets.iter().map(|s| s.gpu_bytes()).sum(),
             scene_triangles: scene.triangle_count(),
             timings: merge_timings(timings),
+            wall_time: started.elapsed(),
             ..counts
         };
         Ok(City {
