@@ -329,8 +329,7 @@ impl Pipeline {
             clock = Instant::now();
         }
         drop(builder);
-        let tile_sets = dresser.tile_sets().to_vec();
-        drop(dresser);
+        let tile_sets = dresser.into_tile_sets();
         self.report(Stage::Lots, 1.0);
         self.report(Stage::Buildings, 1.0);
         self.report(Stage::Facades, 1.0);

@@ -12,7 +12,7 @@ use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 use std::collections::BTreeMap;
 
-use polis_geom::scene::{Image, ImageData, MetaValue, Node, NodeId, Texture};
+use polis_geom::scene::{Image, ImageData, MetaValue, Node, Texture};
 use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
@@ -399,34 +399,25 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     };
 
     // Blocks, then buildings, under their cells.
-    let mut leaves = Vec::with_capacity(blocks.len() + buildings.len());
+    let count = blocks.len() + buildings.len();
+    scene.nodes.reserve(count);
+    scene.meshes.reserve(count * 3);
     let block_cells = inp.blocks.iter().map(|b| b.cell_id);
-    for (made, cell) in blocks.into_iter().zip(block_cells).chain(
-        buildings
-            .into_iter()
-            .zip(inp.building_cells.iter().copied()),
-    ) {
-        let (node, meshes) = made?;
-        if let Some(parent) = cell_node(cell) {
-            leaves.push((parent, node, meshes));
-        }
-    }
-    insert_leaves(&mut scene, leaves)?;
-    Ok(scene)
-}
-
-/// Adds prepared leaf nodes with their meshes under their parents, in order.
-fn insert_leaves(scene: &mut Scene, leaves: Vec<(NodeId, Node, Vec<Mesh>)>) -> Result<()> {
-    scene.nodes.reserve(leaves.len());
-    scene
-        .meshes
-        .reserve(leaves.iter().map(|(_, _, meshes)| meshes.len()).sum());
-    for (parent, mut node, meshes) in leaves {
+    let building_cells = inp.building_cells.iter().copied();
+    let leaves = blocks
+        .into_iter()
+        .zip(block_cells)
+        .chain(buildings.into_iter().zip(building_cells));
+    for (made, cell) in leaves {
+        let (mut node, meshes) = made?;
+        let Some(parent) = cell_node(cell) else {
+            continue;
+        };
         let id = scene.add_node(parent, String::new())?;
         node.meshes = meshes.into_iter().map(|m| scene.add_mesh(m)).collect();
         *scene.node_mut(id)? = node;
     }
-    Ok(())
+    Ok(scene)
 }
 
 /// The SVG/GeoJSON kind of a building kind.

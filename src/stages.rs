@@ -403,6 +403,11 @@ pub struct Dress {
 pub trait DressBuilding: Send + Sync {
     /// The shared tile sets (one per style), indexed by [`Dress::style`].
     fn tile_sets(&self) -> &[TileSet];
+    /// The tile sets, for the city to keep once every building is dressed. The default
+    /// copies [`tile_sets`](Self::tile_sets); implementations that own them move them.
+    fn into_tile_sets(self: Box<Self>) -> Vec<TileSet> {
+        self.tile_sets().to_vec()
+    }
     /// The skin of one building, or `None` to leave it plain.
     ///
     /// # Errors
@@ -503,6 +508,10 @@ impl FacadeStage for TiledFacades {
 impl DressBuilding for Tiler {
     fn tile_sets(&self) -> &[TileSet] {
         &self.sets
+    }
+
+    fn into_tile_sets(self: Box<Self>) -> Vec<TileSet> {
+        self.sets
     }
 
     fn dress(&self, b: &Building, seed: u64) -> Result<Option<Dress>> {
