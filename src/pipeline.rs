@@ -330,9 +330,12 @@ impl Pipeline {
         }
         drop(builder);
         let tile_sets = dresser.into_tile_sets();
-        self.report(Stage::Lots, 1.0);
-        self.report(Stage::Buildings, 1.0);
-        self.report(Stage::Facades, 1.0);
+        if total == 0 {
+            // No chunk ran: the per-item stages are trivially done.
+            for stage in [Stage::Lots, Stage::Buildings, Stage::Facades] {
+                self.report(stage, 1.0);
+            }
+        }
 
         self.report(Stage::Scene, 0.0);
         let scene = if keep && self.scene {
@@ -472,6 +475,7 @@ impl Pipeline {
             }
         }
         let lots_time = lap(Stage::Lots);
+        self.report(Stage::Lots, span.done());
 
         // Buildings, lot by lot in parallel.
         let config = cx.config;
@@ -520,6 +524,7 @@ impl Pipeline {
             }
         }
         let buildings_time = lap(Stage::Buildings);
+        self.report(Stage::Buildings, span.done());
 
         // Facade skins, building by building.
         let ticker = self.ticker(Stage::Facades, out.buildings.len(), span);
@@ -547,6 +552,7 @@ impl Pipeline {
             });
         }
         let facades_time = lap(Stage::Facades);
+        self.report(Stage::Facades, span.done());
         Ok((out, [lots_time, buildings_time, facades_time]))
     }
 }
@@ -585,6 +591,17 @@ struct Span {
     first: usize,
     len: usize,
     total: usize,
+}
+
+impl Span {
+    /// The fraction of the city's cells done once this chunk is (1 for the last chunk).
+    fn done(self) -> f64 {
+        if self.first + self.len >= self.total {
+            1.0
+        } else {
+            (self.first + self.len) as f64 / self.total.max(1) as f64
+        }
+    }
 }
 
 /// A run of cells with everything built on them, handed to the sink of
