@@ -15,8 +15,8 @@
 //! and zoning, which is scaled to the six building kinds (0 skyscraper … 5 industrial).
 //!
 //! The example uses mimalloc as its global allocator: the pipeline allocates millions of
-//! small meshes and polygons from several threads, and mimalloc roughly halves the time
-//! the system allocator takes for them (BENCHMARKS.md, "Whole city"). Applications that
+//! small meshes and polygons from several threads, and mimalloc generates cities 10–20 %
+//! faster than the system allocator (BENCHMARKS.md, "Whole city"). Applications that
 //! embed polis can do the same.
 
 use std::io::Write;
