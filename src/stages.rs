@@ -605,3 +605,60 @@ impl DressBuilding for Tiler {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polis_buildings::FacadeFace;
+    use polis_geom::Aabb2;
+
+    /// A skin quad stored in its face's frame gives the corners on the face and the
+    /// texture coordinates `TileQuad::uv_at` gives there.
+    #[test]
+    fn skin_quads_place_and_texture_like_their_tile_quads() {
+        let bl = DVec3::new(2.0, 0.0, -1.0);
+        let (u, v) = (DVec3::new(0.6, 0.0, 0.8), DVec3::Y);
+        let (width, height) = (10.0, 7.5);
+        let face = FacadeFace {
+            quad: [
+                bl,
+                bl + u * width,
+                bl + u * width + v * height,
+                bl + v * height,
+            ],
+            width,
+            height,
+            floors: 2,
+            normal: u.cross(v),
+            role: FacadeRole::Wall,
+            part: 0,
+        };
+        let tile = TileQuad {
+            rect: Aabb2::new(DVec2::new(1.0, 0.5), DVec2::new(9.0, 7.5)),
+            tile: 3,
+            repeats: [4.0, 2.5],
+        };
+        let r = tile.rect;
+        let skin = SkinQuad {
+            rect: [r.min.x, r.min.y, r.max.x, r.max.y],
+            repeats: tile.repeats.map(|x| x as f32),
+            tile: 3,
+            face: 0,
+        };
+        let st = [
+            (r.min.x, r.min.y),
+            (r.max.x, r.min.y),
+            (r.max.x, r.max.y),
+            (r.min.x, r.max.y),
+        ];
+        for ((corner, uv), (s, t)) in skin.corners(&face).iter().zip(skin.uvs()).zip(st) {
+            let want = bl + u * s + v * t;
+            assert!((*corner - want).length() < 1e-12, "{corner} vs {want}");
+            let [wu, wv] = tile.uv_at(s, t);
+            assert!(
+                (uv - DVec2::new(wu, wv)).length() < 1e-6,
+                "{uv} vs ({wu}, {wv})"
+            );
+        }
+    }
+}
