@@ -194,7 +194,20 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
     let convex = (0..n).all(|i| {
         orient2d(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]) == Orientation::CounterClockwise
     });
-    if convex {
+    // One triangulation serves both caps (reversed for the bottom): a fan for a convex
+    // ring, as in `add_face`, else ear clipping or CDT. The ring is simple: a validated
+    // lot, an inset of one, or a checked shrink.
+    with_work(|w| {
+        let TriWork {
+            tris, left, poly, ..
+        } = w;
+        if convex {
+            tris.clear();
+            tris.extend((1..n as u32 - 1).map(|k| [0, k, k + 1]));
+        } else {
+            triangulate_into(ring, true, left, poly, tris)
+                .ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
+        }
         for (h, up) in [(z1, true), (z0, false)] {
             let (normal, sign) = if up {
                 (DVec3::Y, -1.0)
@@ -203,55 +216,24 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             };
             let base = m.positions.len() as u32;
             push_cap(&mut m, ring, h, normal, sign);
-            for k in 1..n as u32 - 1 {
+            for &[a, b, c] in tris.iter() {
                 if up {
-                    m.indices.extend_from_slice(&[base, base + k, base + k + 1]);
+                    m.indices.extend_from_slice(&[base + a, base + b, base + c]);
                 } else {
-                    m.indices.extend_from_slice(&[base, base + k + 1, base + k]);
+                    m.indices.extend_from_slice(&[base + a, base + c, base + b]);
                 }
             }
         }
-        // Fans of exactly convex rings can only collapse when rounded to f32.
-        if m.triangles().any(|[a, b, c]| {
-            let [a, b, c] = [a, b, c].map(|i| m.positions[i as usize].as_dvec3());
-            (b - a).cross(c - a) == DVec3::ZERO
-        }) {
-            return Err(GeomError::DegenerateTriangle { triangle: 0 });
-        }
-    } else {
-        // One triangulation serves both caps (reversed for the bottom).
-        // The ring is simple: a validated lot, an inset of one, or a checked shrink.
-        with_work(|w| {
-            let TriWork {
-                tris, left, poly, ..
-            } = w;
-            triangulate_into(ring, true, left, poly, tris)
-                .ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
-            for (h, up) in [(z1, true), (z0, false)] {
-                let (normal, sign) = if up {
-                    (DVec3::Y, -1.0)
-                } else {
-                    (-DVec3::Y, 1.0)
-                };
-                let base = m.positions.len() as u32;
-                push_cap(&mut m, ring, h, normal, sign);
-                for &[a, b, c] in tris.iter() {
-                    if up {
-                        m.indices.extend_from_slice(&[base + a, base + b, base + c]);
-                    } else {
-                        m.indices.extend_from_slice(&[base + a, base + c, base + b]);
-                    }
-                }
-            }
-            Ok::<(), GeomError>(())
-        })?;
-        let first_cap = 6 * n;
-        if m.indices[first_cap..].chunks_exact(3).any(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
-            (b - a).cross(c - a) == DVec3::ZERO
-        }) {
-            return Err(GeomError::DegenerateTriangle { triangle: 0 });
-        }
+        Ok::<(), GeomError>(())
+    })?;
+    // Triangles can still collapse when rounded to f32: a convex prism is checked whole
+    // (walls and fans), a triangulated one on its caps.
+    let checked_from = if convex { 0 } else { 6 * n };
+    if m.indices[checked_from..].chunks_exact(3).any(|t| {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
+        (b - a).cross(c - a) == DVec3::ZERO
+    }) {
+        return Err(GeomError::DegenerateTriangle { triangle: 0 });
     }
     Ok(m)
 }
