@@ -36,12 +36,7 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use polis_lsystem::{
-    BranchIndex, Command, Derivation, DeriveOptions, Grammar, LsystemError, ModuleKind,
-    ParamString, QueryKind, Rules, TurtleState,
-};
-use rand::SeedableRng;
-use rand_pcg::Pcg64Mcg;
+use polis_lsystem::{Derivation, DeriveOptions, Grammar, LsystemError, ParamString};
 
 use crate::BuildingsError;
 use crate::generate::MAX_BUILDING_MODULES;
@@ -185,113 +180,11 @@ pub fn default_text(kind: BuildingKind) -> &'static str {
     }
 }
 
-/// A derivation the generator can step and read.
-pub(crate) trait Steps {
-    /// One derivation step.
-    fn step(&mut self) -> Result<(), LsystemError>;
-    /// The current string.
-    fn string(&self) -> &ParamString;
-}
-
-impl<R: Rules<String = ParamString>> Steps for Derivation<R> {
-    fn step(&mut self) -> Result<(), LsystemError> {
-        Derivation::step(self).map(|_| ())
-    }
-
-    fn string(&self) -> &ParamString {
-        Derivation::string(self)
-    }
-}
-
-/// A building grammar's rules drawing from a generator of their own. The engine seeds its
-/// generator once, when a derivation is made; these rules are reseeded per building with
-/// the seed a fresh derivation would get, so one derivation per thread and grammar (with
-/// its string buffers and scratch space) serves every building, and each building's
-/// derivation is the one a fresh `Derivation::new` with that seed would give. Only for
-/// grammars without an interpretation pass (no query or communication modules): the pass
-/// draws from a generator derived from the engine's seed.
-struct Reseeded {
-    grammar: Arc<Grammar>,
-    rng: RefCell<Pcg64Mcg>,
-}
-
-impl Rules for Reseeded {
-    type String = ParamString;
-    type Scratch = <Grammar as Rules>::Scratch;
-
-    #[inline]
-    fn kind(&self, s: &ParamString, i: usize) -> ModuleKind {
-        self.grammar.kind(s, i)
-    }
-    #[inline]
-    fn command(&self, s: &ParamString, i: usize) -> Command {
-        self.grammar.command(s, i)
-    }
-    #[inline]
-    fn is_ignored(&self, s: &ParamString, i: usize) -> bool {
-        self.grammar.is_ignored(s, i)
-    }
-    fn is_context_sensitive(&self) -> bool {
-        self.grammar.is_context_sensitive()
-    }
-    #[inline]
-    fn rewrite(
-        &self,
-        src: &ParamString,
-        i: usize,
-        branches: &BranchIndex,
-        _rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut ParamString,
-    ) -> polis_lsystem::Result<bool> {
-        let mut rng = self.rng.borrow_mut();
-        self.grammar
-            .rewrite(src, i, branches, &mut rng, scratch, dst)
-    }
-    fn has_decomposition(&self) -> bool {
-        self.grammar.has_decomposition()
-    }
-    fn decompose(
-        &self,
-        src: &ParamString,
-        i: usize,
-        _rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut ParamString,
-    ) -> polis_lsystem::Result<bool> {
-        let mut rng = self.rng.borrow_mut();
-        self.grammar.decompose(src, i, &mut rng, scratch, dst)
-    }
-    fn has_interpretation(&self) -> bool {
-        self.grammar.has_interpretation()
-    }
-    fn interpret(
-        &self,
-        src: &ParamString,
-        i: usize,
-        _rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut ParamString,
-    ) -> polis_lsystem::Result<bool> {
-        let mut rng = self.rng.borrow_mut();
-        self.grammar.interpret(src, i, &mut rng, scratch, dst)
-    }
-    fn fill_query(&self, s: &mut ParamString, i: usize, kind: QueryKind, state: &TurtleState) {
-        self.grammar.fill_query(s, i, kind, state);
-    }
-    fn needs_pass(&self, s: &ParamString) -> bool {
-        self.grammar.needs_pass(s)
-    }
-    fn check_storage(&self, s: &ParamString) -> polis_lsystem::Result<()> {
-        self.grammar.check_storage(s)
-    }
-}
-
 /// Derivations kept per thread (one per grammar met, the most recent last).
 const KEPT_DERIVATIONS: usize = 8;
 
 thread_local! {
-    static DERIVATIONS: RefCell<Vec<Derivation<Reseeded>>> = const { RefCell::new(Vec::new()) };
+    static DERIVATIONS: RefCell<Vec<Derivation<Arc<Grammar>>>> = const { RefCell::new(Vec::new()) };
 }
 
 /// The options of every building derivation with `seed`.
@@ -304,45 +197,34 @@ fn options(seed: u64) -> DeriveOptions {
 }
 
 impl BuildingGrammar {
-    /// Runs `f` on the derivation of `grammar` from the axiom `Lot(axiom)` with `seed`:
-    /// this thread's kept derivation of the grammar, restarted in place, when the grammar
-    /// has no interpretation pass; a fresh one otherwise. Both derive the same strings.
-    /// `error` wraps an error of writing the axiom.
+    /// Runs `f` on the derivation of this grammar from the axiom `Lot(axiom)` with
+    /// `seed`: this thread's kept derivation of the grammar, restarted in place with the
+    /// seed (it derives what a fresh `Derivation::new` would), so its string buffers and
+    /// scratch space serve every building. `error` wraps an error of writing the axiom.
     pub(crate) fn derive<T>(
         &self,
         seed: u64,
         axiom: &[f64],
         error: impl Fn(LsystemError) -> BuildingsError,
-        f: impl FnOnce(&mut dyn Steps) -> Result<T, BuildingsError>,
+        f: impl FnOnce(&mut Derivation<Arc<Grammar>>) -> Result<T, BuildingsError>,
     ) -> Result<T, BuildingsError> {
-        if self.grammar.needs_pass(&ParamString::new()) {
-            let mut start = ParamString::with_capacity(1, axiom.len());
-            start.push(self.lot, axiom).map_err(&error)?;
-            let mut d = Derivation::new(&*self.grammar, start, options(seed));
-            return f(&mut d);
-        }
         let kept = DERIVATIONS.with(|k| {
             let mut k = k.try_borrow_mut().ok()?;
             let i = k
                 .iter()
-                .position(|d| Arc::ptr_eq(&d.rules().grammar, &self.grammar))?;
+                .position(|d| Arc::ptr_eq(d.rules(), &self.grammar))?;
             Some(k.remove(i))
         });
         let mut d = kept.unwrap_or_else(|| {
-            let rules = Reseeded {
-                grammar: Arc::clone(&self.grammar),
-                rng: RefCell::new(Pcg64Mcg::seed_from_u64(seed)),
-            };
-            Derivation::new(rules, ParamString::new(), options(0))
+            Derivation::new(Arc::clone(&self.grammar), ParamString::new(), options(seed))
         });
         // Restart without giving up the string's buffers: take them out, restart from
         // the empty string (a copy that allocates nothing), write the axiom back in.
         let mut start = std::mem::take(d.string_mut());
-        d.restart(&ParamString::new());
+        d.restart_seeded(&ParamString::new(), seed);
         polis_lsystem::ModuleString::clear(&mut start);
         start.push(self.lot, axiom).map_err(&error)?;
         *d.string_mut() = start;
-        *d.rules().rng.borrow_mut() = Pcg64Mcg::seed_from_u64(seed);
         let out = f(&mut d);
         DERIVATIONS.with(|k| {
             if let Ok(mut k) = k.try_borrow_mut() {

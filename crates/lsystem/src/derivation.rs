@@ -251,72 +251,80 @@ pub trait Rules {
     }
 }
 
-impl<R: Rules + ?Sized> Rules for &R {
-    type String = R::String;
-    type Scratch = R::Scratch;
-    #[inline]
-    fn kind(&self, s: &Self::String, i: usize) -> ModuleKind {
-        (**self).kind(s, i)
-    }
-    #[inline]
-    fn command(&self, s: &Self::String, i: usize) -> Command {
-        (**self).command(s, i)
-    }
-    #[inline]
-    fn is_ignored(&self, s: &Self::String, i: usize) -> bool {
-        (**self).is_ignored(s, i)
-    }
-    fn is_context_sensitive(&self) -> bool {
-        (**self).is_context_sensitive()
-    }
-    #[inline]
-    fn rewrite(
-        &self,
-        src: &Self::String,
-        i: usize,
-        branches: &BranchIndex,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut Self::String,
-    ) -> Result<bool> {
-        (**self).rewrite(src, i, branches, rng, scratch, dst)
-    }
-    fn has_decomposition(&self) -> bool {
-        (**self).has_decomposition()
-    }
-    fn decompose(
-        &self,
-        src: &Self::String,
-        i: usize,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut Self::String,
-    ) -> Result<bool> {
-        (**self).decompose(src, i, rng, scratch, dst)
-    }
-    fn has_interpretation(&self) -> bool {
-        (**self).has_interpretation()
-    }
-    fn interpret(
-        &self,
-        src: &Self::String,
-        i: usize,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut Self::Scratch,
-        dst: &mut Self::String,
-    ) -> Result<bool> {
-        (**self).interpret(src, i, rng, scratch, dst)
-    }
-    fn fill_query(&self, s: &mut Self::String, i: usize, kind: QueryKind, state: &TurtleState) {
-        (**self).fill_query(s, i, kind, state);
-    }
-    fn needs_pass(&self, s: &Self::String) -> bool {
-        (**self).needs_pass(s)
-    }
-    fn check_storage(&self, s: &Self::String) -> Result<()> {
-        (**self).check_storage(s)
-    }
+/// Rules behind a reference or a shared pointer are rules: a derivation can borrow its
+/// rules or share them (`Arc`) with derivations kept on other threads.
+macro_rules! forward_rules {
+    ($($ptr:ty),*) => {$(
+        impl<R: Rules + ?Sized> Rules for $ptr {
+            type String = R::String;
+            type Scratch = R::Scratch;
+            #[inline]
+            fn kind(&self, s: &Self::String, i: usize) -> ModuleKind {
+                (**self).kind(s, i)
+            }
+            #[inline]
+            fn command(&self, s: &Self::String, i: usize) -> Command {
+                (**self).command(s, i)
+            }
+            #[inline]
+            fn is_ignored(&self, s: &Self::String, i: usize) -> bool {
+                (**self).is_ignored(s, i)
+            }
+            fn is_context_sensitive(&self) -> bool {
+                (**self).is_context_sensitive()
+            }
+            #[inline]
+            fn rewrite(
+                &self,
+                src: &Self::String,
+                i: usize,
+                branches: &BranchIndex,
+                rng: &mut Pcg64Mcg,
+                scratch: &mut Self::Scratch,
+                dst: &mut Self::String,
+            ) -> Result<bool> {
+                (**self).rewrite(src, i, branches, rng, scratch, dst)
+            }
+            fn has_decomposition(&self) -> bool {
+                (**self).has_decomposition()
+            }
+            fn decompose(
+                &self,
+                src: &Self::String,
+                i: usize,
+                rng: &mut Pcg64Mcg,
+                scratch: &mut Self::Scratch,
+                dst: &mut Self::String,
+            ) -> Result<bool> {
+                (**self).decompose(src, i, rng, scratch, dst)
+            }
+            fn has_interpretation(&self) -> bool {
+                (**self).has_interpretation()
+            }
+            fn interpret(
+                &self,
+                src: &Self::String,
+                i: usize,
+                rng: &mut Pcg64Mcg,
+                scratch: &mut Self::Scratch,
+                dst: &mut Self::String,
+            ) -> Result<bool> {
+                (**self).interpret(src, i, rng, scratch, dst)
+            }
+            fn fill_query(&self, s: &mut Self::String, i: usize, kind: QueryKind, state: &TurtleState) {
+                (**self).fill_query(s, i, kind, state);
+            }
+            fn needs_pass(&self, s: &Self::String) -> bool {
+                (**self).needs_pass(s)
+            }
+            fn check_storage(&self, s: &Self::String) -> Result<()> {
+                (**self).check_storage(s)
+            }
+        }
+    )*};
 }
+
+forward_rules!(&R, std::sync::Arc<R>);
 
 /// A string seen through its rules, for the context matchers.
 pub struct View<'a, R: Rules + ?Sized> {
@@ -382,8 +390,16 @@ impl<R: Rules> Derivation<R> {
     /// Starts over from `axiom` (step 0, generator reseeded), keeping every buffer: the
     /// reusable-worker entry point when many strings are derived with the same rules.
     pub fn restart(&mut self, axiom: &R::String) {
+        self.restart_seeded(axiom, self.options.seed);
+    }
+
+    /// [`restart`](Self::restart) with a new [`DeriveOptions::seed`]: the derivation then
+    /// derives exactly what `Derivation::new` with that seed would, interpretation passes
+    /// included, while keeping its buffers.
+    pub fn restart_seeded(&mut self, axiom: &R::String, seed: u64) {
+        self.options.seed = seed;
         self.current.clone_from(axiom);
-        self.rng = Pcg64Mcg::seed_from_u64(self.options.seed);
+        self.rng = Pcg64Mcg::seed_from_u64(seed);
         self.step = 0;
         self.passed = false;
     }

@@ -59,10 +59,26 @@ struct Head {
 /// [`params(i)`](Self::params). 8 bytes per module plus 8 bytes per parameter. The
 /// meaning of symbol ids is given by the [`Grammar`](crate::Grammar) that produced the
 /// string ([`Grammar::symbol_name`](crate::Grammar::symbol_name)).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct ParamString {
     heads: Vec<Head>,
     params: Vec<f64>,
+}
+
+impl Clone for ParamString {
+    fn clone(&self) -> Self {
+        Self {
+            heads: self.heads.clone(),
+            params: self.params.clone(),
+        }
+    }
+
+    /// Reuses this string's buffers (what [`Derivation::restart`](crate::Derivation::restart)
+    /// relies on to restart without allocating).
+    fn clone_from(&mut self, source: &Self) {
+        self.heads.clone_from(&source.heads);
+        self.params.clone_from(&source.params);
+    }
 }
 
 impl ParamString {
