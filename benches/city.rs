@@ -145,7 +145,8 @@ fn run(label: &str, config: &CityConfig, runs: usize, mode: Mode) {
             f as f64 * 4096.0 / 1048576.0
         );
     }
-    if scene {
+    // `POLIS_BENCH_GLB=0` leaves the glb out (for profiling the generation alone).
+    if scene && std::env::var("POLIS_BENCH_GLB").map_or(true, |v| v != "0") {
         let t = Instant::now();
         let mut glb = Vec::new();
         match city.write_glb(&mut glb) {

@@ -10,9 +10,8 @@ use polis_buildings::{Building, BuildingKind, PartRole};
 use polis_export::map::{MapRoad, RoadClass as MapClass};
 use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
-use std::collections::BTreeMap;
 
-use polis_geom::scene::{Image, ImageData, MetaValue, Node, Texture};
+use polis_geom::scene::{Image, ImageData, MetaValue, Metadata, Node, Texture};
 use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
@@ -342,11 +341,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                 let base = ground(elevation, b.footprint.points());
                 let mut node = Node::new(format!("building {}", b.id));
                 node.transform = Transform::from_translation(to_world(b.origin, base));
-                node.metadata = BTreeMap::from([
-                    ("kind".to_owned(), MetaValue::from(b.kind.name())),
-                    ("height".to_owned(), MetaValue::from(b.height)),
-                    ("floors".to_owned(), MetaValue::from(f64::from(b.floors))),
-                    ("lot".to_owned(), MetaValue::from(b.lot_id as f64)),
+                node.metadata = Metadata::from([
+                    ("kind", MetaValue::from_static(b.kind.name())),
+                    ("height", MetaValue::from(b.height)),
+                    ("floors", MetaValue::from(f64::from(b.floors))),
+                    ("lot", MetaValue::from(b.lot_id as f64)),
                 ]);
                 Ok((node, meshes))
             })

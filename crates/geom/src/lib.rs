@@ -49,6 +49,7 @@ pub mod graph;
 pub mod hash;
 pub mod lines;
 pub mod mesh;
+pub mod metadata;
 pub mod polygon;
 pub mod predicates;
 pub mod scene;

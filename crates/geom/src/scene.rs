@@ -31,13 +31,14 @@
 //! [`Mesh`] is a primitive with one material); [`ImageData::Png`] bytes are embedded as
 //! they are and [`ImageData::Rgba8`] pixels are encoded to PNG by the exporter.
 
-use std::collections::BTreeMap;
+use std::borrow::Cow;
 
 use glam::{DMat4, DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::GeomError;
 use crate::mesh::Mesh;
+pub use crate::metadata::{MetaValue, Metadata};
 
 macro_rules! typed_id {
     ($(#[$doc:meta])* $name:ident) => {
@@ -168,39 +169,6 @@ impl Transform {
     }
 }
 
-/// A metadata value (exported as glTF `extras`, GeoJSON properties).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum MetaValue {
-    /// Text, e.g. a building kind.
-    String(String),
-    /// A finite number, e.g. a height in metres.
-    Number(f64),
-    /// A flag, e.g. "is a bridge".
-    Bool(bool),
-}
-
-impl From<&str> for MetaValue {
-    fn from(s: &str) -> Self {
-        MetaValue::String(s.to_string())
-    }
-}
-impl From<String> for MetaValue {
-    fn from(s: String) -> Self {
-        MetaValue::String(s)
-    }
-}
-impl From<f64> for MetaValue {
-    fn from(x: f64) -> Self {
-        MetaValue::Number(x)
-    }
-}
-impl From<bool> for MetaValue {
-    fn from(b: bool) -> Self {
-        MetaValue::Bool(b)
-    }
-}
-
 /// One node of the scene tree.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Node {
@@ -213,7 +181,7 @@ pub struct Node {
     /// Child nodes, in order.
     pub children: Vec<NodeId>,
     /// Metadata in key order (deterministic output).
-    pub metadata: BTreeMap<String, MetaValue>,
+    pub metadata: Metadata,
 }
 
 impl Node {
@@ -459,12 +427,10 @@ impl Scene {
     pub fn set_metadata(
         &mut self,
         node: NodeId,
-        key: impl Into<String>,
+        key: impl Into<Cow<'static, str>>,
         value: impl Into<MetaValue>,
     ) -> Result<(), GeomError> {
-        self.node_mut(node)?
-            .metadata
-            .insert(key.into(), value.into());
+        self.node_mut(node)?.metadata.insert(key, value);
         Ok(())
     }
 
@@ -782,7 +748,7 @@ mod tests {
         let p = w[4].transform_point3(DVec3::ZERO);
         assert_eq!(p, DVec3::new(40.0, 1.0, 0.0));
         // Metadata iterates in key order.
-        let keys: Vec<&String> = s.nodes[2].metadata.keys().collect();
+        let keys: Vec<&str> = s.nodes[2].metadata.keys().collect();
         assert_eq!(keys, ["bridge", "height", "kind"]);
         // Round trip through serde.
         let json = serde_json::to_string(&s).unwrap();

@@ -5,7 +5,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use polis_geom::Mesh;
-use polis_geom::scene::{MaterialId, MeshId, MetaValue, NodeId, Scene};
+use polis_geom::scene::{MaterialId, MeshId, Metadata, NodeId, Scene};
 use serde::Serialize;
 
 use crate::ExportError;
@@ -16,7 +16,7 @@ pub(crate) struct Plan<'a> {
     /// Vertex and index data; each becomes four accessors (position, normal, uv, indices).
     pub geometries: Vec<Cow<'a, Mesh>>,
     /// glTF meshes.
-    pub meshes: Vec<PlannedMesh>,
+    pub meshes: Vec<PlannedMesh<'a>>,
     /// glTF nodes.
     pub nodes: Vec<PlannedNode>,
     /// glTF indices of the scene's root nodes.
@@ -29,12 +29,12 @@ pub(crate) struct Plan<'a> {
 
 /// One glTF mesh.
 #[derive(Debug)]
-pub(crate) struct PlannedMesh {
+pub(crate) struct PlannedMesh<'a> {
     pub name: String,
     /// (geometry index, material) per primitive.
     pub primitives: Vec<(usize, Option<MaterialId>)>,
     /// The objects merged into this mesh, when batching.
-    pub objects: Vec<BatchedObject>,
+    pub objects: Vec<BatchedObject<'a>>,
 }
 
 /// One glTF node.
@@ -49,11 +49,11 @@ pub(crate) struct PlannedNode {
 /// A leaf node whose geometry was merged into its parent's mesh (batched mode), recorded in
 /// the mesh's `extras.objects` so that tools can still pick it.
 #[derive(Debug, Serialize)]
-pub(crate) struct BatchedObject {
+pub(crate) struct BatchedObject<'a> {
     /// The leaf node's name.
-    pub name: String,
+    pub name: &'a str,
     /// The leaf node's metadata.
-    pub metadata: BTreeMap<String, MetaValue>,
+    pub metadata: &'a Metadata,
     /// `[primitive, first triangle, triangle count]` per piece of geometry it contributed.
     pub ranges: Vec<[usize; 3]>,
 }
@@ -82,7 +82,7 @@ pub(crate) fn per_node(scene: &Scene) -> Plan<'_> {
     let mut geometry_of: Vec<Option<usize>> = vec![None; scene.meshes.len()];
     let mut geometries: Vec<Cow<'_, Mesh>> = Vec::new();
     let mut mesh_of: BTreeMap<Vec<MeshId>, usize> = BTreeMap::new();
-    let mut meshes: Vec<PlannedMesh> = Vec::new();
+    let mut meshes: Vec<PlannedMesh<'_>> = Vec::new();
     let mut nodes = Vec::with_capacity(scene.nodes.len());
     for (i, node) in scene.nodes.iter().enumerate() {
         let ids = drawn(scene, &node.meshes);
@@ -134,7 +134,7 @@ pub(crate) fn per_node(scene: &Scene) -> Plan<'_> {
 /// has a parent is merged into its parent's mesh (transformed by its local transform), one
 /// primitive per material; its name and metadata go to the mesh's `extras.objects` with the
 /// triangle ranges it occupies. Other nodes are kept.
-pub(crate) fn batched(scene: &Scene) -> Result<Plan<'static>, ExportError> {
+pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
     let n = scene.nodes.len();
     let mut has_parent = vec![false; n];
     for node in &scene.nodes {
@@ -160,7 +160,7 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'static>, ExportError> {
         }
     }
     let mut used = vec![false; scene.meshes.len()];
-    let mut geometries: Vec<Cow<'static, Mesh>> = Vec::new();
+    let mut geometries: Vec<Cow<'_, Mesh>> = Vec::new();
     let mut meshes = Vec::new();
     let mut nodes = Vec::new();
     for (i, node) in scene.nodes.iter().enumerate() {
@@ -170,7 +170,7 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'static>, ExportError> {
         // Material key → (merged mesh, [(object, first triangle, count)]).
         type Group = (Mesh, Vec<(usize, usize, usize)>);
         let mut groups: BTreeMap<Option<MaterialId>, Group> = BTreeMap::new();
-        let mut objects: Vec<BatchedObject> = Vec::new();
+        let mut objects: Vec<BatchedObject<'_>> = Vec::new();
         for id in drawn(scene, &node.meshes) {
             used[id.index()] = true;
             let m = &scene.meshes[id.index()];
@@ -186,8 +186,8 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'static>, ExportError> {
             let child = &scene.nodes[c.index()];
             let object = objects.len();
             objects.push(BatchedObject {
-                name: child.name.clone(),
-                metadata: child.metadata.clone(),
+                name: &child.name,
+                metadata: &child.metadata,
                 ranges: Vec::new(),
             });
             let matrix = child.transform.matrix();
