@@ -210,12 +210,8 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
                 faces
                     .iter()
                     .filter_map(|&k| b.facades.get(k))
-                    .filter(|f| f.part == pi)
-                    .map(|f| {
-                        let u = (f.quad[1] - f.quad[0]).normalize_or_zero();
-                        let v = (f.quad[3] - f.quad[0]).normalize_or_zero();
-                        (f.quad[0], f.normal, u, v, f.width, f.height)
-                    }),
+                    .filter(|f| f.part_index() == pi)
+                    .map(|f| (f.origin, f.normal(), f.u, f.v, f.width, f.height)),
             );
             if planes.is_empty() {
                 mesh.append(&part.mesh);

@@ -365,12 +365,13 @@ impl SkinQuad {
     /// bottom-left, bottom-right, top-right, top-left seen from outside, relative to the
     /// building's origin (glTF axes).
     pub fn corners(&self, face: &polis_buildings::FacadeFace) -> [DVec3; 4] {
-        let [bl, br, _tr, tl] = face.quad;
-        let du = (br - bl) / face.width;
-        let dv = (tl - bl) / face.height;
         let [s0, t0, s1, t1] = self.rect;
-        let at = |s: f64, t: f64| bl + du * s + dv * t;
-        [at(s0, t0), at(s1, t0), at(s1, t1), at(s0, t1)]
+        [
+            face.at(s0, t0),
+            face.at(s1, t0),
+            face.at(s1, t1),
+            face.at(s0, t1),
+        ]
     }
 
     /// Texture coordinates of the corners, in the order of [`corners`](Self::corners)
@@ -439,7 +440,7 @@ struct DressScratch {
     /// The tile quads of every face.
     tiles: Vec<TileQuad>,
     /// The walls (part and bottom edge) with a face the tiles do not cover.
-    failed: Vec<(usize, [u64; 4])>,
+    failed: Vec<(u32, [u64; 4])>,
 }
 
 thread_local! {
@@ -565,8 +566,8 @@ impl DressBuilding for Tiler {
             // above share one plane of the mass, whose triangles the skin replaces.
             let wall_key = |k: usize| {
                 b.facades.get(k).map(|f| {
-                    let (p, q) = (f.quad[0], f.quad[1]);
-                    (f.part, [p.x, p.z, q.x, q.z].map(f64::to_bits))
+                    let (p, u) = (f.origin, f.u);
+                    (f.part, [p.x, p.z, u.x, u.z].map(f64::to_bits))
                 })
             };
             failed.clear();
@@ -620,18 +621,14 @@ mod tests {
         let (u, v) = (DVec3::new(0.6, 0.0, 0.8), DVec3::Y);
         let (width, height) = (10.0, 7.5);
         let face = FacadeFace {
-            quad: [
-                bl,
-                bl + u * width,
-                bl + u * width + v * height,
-                bl + v * height,
-            ],
+            origin: bl,
+            u,
+            v,
             width,
             height,
             floors: 2,
-            normal: u.cross(v),
-            role: FacadeRole::Wall,
             part: 0,
+            role: FacadeRole::Wall,
         };
         let tile = TileQuad {
             rect: Aabb2::new(DVec2::new(1.0, 0.5), DVec2::new(9.0, 7.5)),

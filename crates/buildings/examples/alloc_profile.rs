@@ -60,7 +60,7 @@ impl Digest {
             }
         }
         for f in &b.facades {
-            for q in f.quad.iter().chain([&f.normal]) {
+            for q in [f.origin, f.u, f.v] {
                 for c in q.to_array() {
                     self.word(c.to_bits());
                 }
@@ -69,7 +69,7 @@ impl Digest {
             self.word(f.height.to_bits());
             self.word(u64::from(f.floors));
             self.word(f.role as u64);
-            self.word(f.part as u64);
+            self.word(u64::from(f.part));
         }
     }
 }

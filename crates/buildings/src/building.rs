@@ -50,24 +50,63 @@ pub enum FacadeRole {
 
 /// A facade face: a planar rectangle of a building's surface that the facades stage
 /// textures or fills with window geometry.
+///
+/// Stored as its bottom-left corner and two unit axes (88 bytes): [`corners`](Self::corners),
+/// [`normal`](Self::normal) and [`at`](Self::at) give the geometry. A city keeps eight
+/// faces per building, so the derived values are not stored.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FacadeFace {
-    /// Corners, counter-clockwise seen from outside: bottom-left, bottom-right, top-right,
-    /// top-left, metres relative to [`Building::origin`] (glTF axes). For roof planes,
-    /// the bounding rectangle of the plane's polygon (`u` horizontal, `v` up the slope).
-    pub quad: [DVec3; 4],
-    /// Width (bottom edge), metres.
+    /// The bottom-left corner seen from outside, metres relative to [`Building::origin`]
+    /// (glTF axes).
+    pub origin: DVec3,
+    /// Unit vector along the bottom edge, from bottom-left to bottom-right (horizontal).
+    pub u: DVec3,
+    /// Unit vector up the face, from bottom-left to top-left, perpendicular to `u`:
+    /// straight up for walls, up the slope for roof planes.
+    pub v: DVec3,
+    /// Width along `u`, metres.
     pub width: f64,
-    /// Height (left edge), metres.
+    /// Height along `v`, metres. For roof planes, the face is the bounding rectangle of
+    /// the plane's polygon.
     pub height: f64,
     /// Storeys in the face (0 for roofs).
     pub floors: u32,
-    /// Outward unit normal (orientation).
-    pub normal: DVec3,
+    /// Index of the part in [`Building::parts`] it belongs to.
+    pub part: u32,
     /// What it is.
     pub role: FacadeRole,
-    /// Index of the part in [`Building::parts`] it belongs to.
-    pub part: usize,
+}
+
+impl FacadeFace {
+    /// The point `s` metres along and `t` metres up the face from its bottom-left corner.
+    #[inline]
+    pub fn at(&self, s: f64, t: f64) -> DVec3 {
+        self.origin + self.u * s + self.v * t
+    }
+
+    /// Corners, counter-clockwise seen from outside: bottom-left, bottom-right, top-right,
+    /// top-left.
+    pub fn corners(&self) -> [DVec3; 4] {
+        let (w, h) = (self.width, self.height);
+        [
+            self.at(0.0, 0.0),
+            self.at(w, 0.0),
+            self.at(w, h),
+            self.at(0.0, h),
+        ]
+    }
+
+    /// The outward unit normal, `u × v`.
+    #[inline]
+    pub fn normal(&self) -> DVec3 {
+        self.u.cross(self.v)
+    }
+
+    /// The part index as a `usize`.
+    #[inline]
+    pub fn part_index(&self) -> usize {
+        self.part as usize
+    }
 }
 
 /// A building: closed solids and facade faces.
@@ -336,7 +375,7 @@ impl Output<'_> {
         let roof: Result<(Mesh, RoofFaces), BuildingsError> = match op {
             Op::Box | Op::Volume => {
                 let mesh = prism(ring, z0, z0 + h)?;
-                self.walls(cx, ring, z0, h);
+                self.walls(cx, ring, z0, h)?;
                 self.parts.push(Part {
                     mesh,
                     role: PartRole::Mass,
@@ -427,7 +466,7 @@ impl Output<'_> {
                 }
             }
         };
-        let part = self.parts.len();
+        let part = self.next_part()?;
         for f in &faces {
             if let Some(q) = bounding_quad(f) {
                 self.facades.push(FacadeFace {
@@ -446,8 +485,14 @@ impl Output<'_> {
     }
 
     /// Facade faces of a prism's walls: a ground-floor band on the ground, walls above.
-    fn walls(&mut self, cx: &Context<'_>, ring: &[DVec2], z0: f64, h: f64) {
-        let part = self.parts.len();
+    fn walls(
+        &mut self,
+        cx: &Context<'_>,
+        ring: &[DVec2],
+        z0: f64,
+        h: f64,
+    ) -> Result<(), BuildingsError> {
+        let part = self.next_part()?;
         let n = ring.len();
         let g = cx.ground_floor_height;
         for i in 0..n {
@@ -464,12 +509,6 @@ impl Output<'_> {
                     [Some((z0, z0 + h, FacadeRole::Wall)), None]
                 };
             for (lo, hi, role) in bands.into_iter().flatten() {
-                let quad = [
-                    to_world(a, lo),
-                    to_world(b, lo),
-                    to_world(b, hi),
-                    to_world(a, hi),
-                ];
                 let fh = if role == FacadeRole::GroundFloor {
                     g
                 } else {
@@ -478,16 +517,26 @@ impl Output<'_> {
                 let floors = ((hi - lo) / fh).round().max(1.0) as u32;
                 let d = b - a;
                 self.facades.push(FacadeFace {
-                    quad,
+                    origin: to_world(a, lo),
+                    u: to_world(d.normalize_or_zero(), 0.0),
+                    v: DVec3::Y,
                     width: d.length(),
                     height: hi - lo,
                     floors,
-                    normal: to_world(DVec2::new(d.y, -d.x).normalize_or_zero(), 0.0),
-                    role,
                     part,
+                    role,
                 });
             }
         }
+        Ok(())
+    }
+
+    /// The index the next part will have, as facade faces store it.
+    fn next_part(&self) -> Result<u32, BuildingsError> {
+        u32::try_from(self.parts.len()).map_err(|_| BuildingsError::InvalidParameter {
+            name: "lod",
+            reason: "a building would have more than 2^32 parts; lower the level of detail".into(),
+        })
     }
 }
 
@@ -522,15 +571,15 @@ fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
         v1 = v1.max(p.dot(v));
     }
     let off = nrm * pts[0].dot(nrm);
-    let at = |a: f64, b: f64| off + t * a + v * b;
     Some(FacadeFace {
-        quad: [at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)],
+        origin: off + t * u0 + v * v0,
+        u: t,
+        v,
         width: u1 - u0,
         height: v1 - v0,
         floors: 0,
-        normal: nrm,
-        role: FacadeRole::Roof,
         part: 0,
+        role: FacadeRole::Roof,
     })
 }
 

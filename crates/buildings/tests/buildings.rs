@@ -102,8 +102,10 @@ fn check(b: &Building, lot: &Lot, max_height: f64) {
         );
     }
     for f in &b.facades {
-        assert!(f.width > 0.0 && f.height > 0.0 && f.part < b.parts.len());
-        assert!((f.normal.length() - 1.0).abs() < 1e-9);
+        assert!(f.width > 0.0 && f.height > 0.0 && f.part_index() < b.parts.len());
+        assert!((f.u.length() - 1.0).abs() < 1e-9 && (f.v.length() - 1.0).abs() < 1e-9);
+        assert!(f.u.dot(f.v).abs() < 1e-9 && f.u.y.abs() < 1e-9);
+        assert!((f.normal().length() - 1.0).abs() < 1e-9);
         if f.role != FacadeRole::Roof {
             assert!(f.floors >= 1);
         }
