@@ -51,7 +51,7 @@ pub enum FacadeRole {
 /// A facade face: a planar rectangle of a building's surface that the facades stage
 /// textures or fills with window geometry.
 ///
-/// Stored as its bottom-left corner and two unit axes (88 bytes): [`corners`](Self::corners),
+/// Stored as its bottom-left corner and two unit axes (104 bytes): [`corners`](Self::corners),
 /// [`normal`](Self::normal) and [`at`](Self::at) give the geometry. A city keeps eight
 /// faces per building, so the derived values are not stored.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -704,5 +704,38 @@ pub(crate) fn exact_mesh(mesh: Mesh) -> Mesh {
         uvs: mesh.uvs.as_slice().to_vec(),
         indices: mesh.indices.as_slice().to_vec(),
         material: mesh.material,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn facade_faces_are_compact_and_derive_their_corners() {
+        assert!(std::mem::size_of::<FacadeFace>() <= 104);
+        // A roof plane rising to the north (−Z) at 30°.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let face = FacadeFace {
+            origin: DVec3::new(1.0, 3.0, 2.0),
+            u: DVec3::X,
+            v: DVec3::new(0.0, s, -c),
+            width: 4.0,
+            height: 2.0,
+            floors: 0,
+            part: 1,
+            role: FacadeRole::Roof,
+        };
+        let [bl, br, tr, tl] = face.corners();
+        assert_eq!(bl, face.origin);
+        assert!((br - bl - DVec3::X * 4.0).length() < 1e-12);
+        assert!((tr - br - (tl - bl)).length() < 1e-12);
+        assert!((tl.y - bl.y - 2.0 * s).abs() < 1e-12);
+        // Counter-clockwise seen from outside: the normal follows the right-hand rule;
+        // a roof rising to the north faces up and south (+Z).
+        let n = (br - bl).cross(tl - bl).normalize();
+        assert!((face.normal() - n).length() < 1e-12);
+        assert!(face.normal().y > 0.0 && face.normal().z > 0.0);
+        assert_eq!(face.part_index(), 1);
     }
 }
