@@ -6,7 +6,7 @@
 //! `cell`. With [`Batching::PerParentAndMaterial`](polis_export::glb::Batching) the glb
 //! writer merges each cell's leaves into one primitive per material.
 
-use polis_buildings::{Building, BuildingKind, PartRole};
+use polis_buildings::{Building, BuildingKind, FacadeFace, PartRole};
 use polis_export::map::{MapRoad, RoadClass as MapClass};
 use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
@@ -18,7 +18,7 @@ use polis_roads::{RoadClass, RoadNetwork};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::stages::Dress;
+use crate::stages::{Dress, SkinQuad};
 use crate::{CityConfig, CityMaps};
 
 /// Plain materials of the scene, by role.
@@ -232,7 +232,7 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
                     continue;
                 };
                 if let Some(mesh) = targets.get(Some(m)) {
-                    mesh.add_quad(q.corners(face), q.uvs())?;
+                    push_skin_quad(mesh, q, face)?;
                 }
             }
         }
@@ -247,6 +247,33 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
     })
 }
 
+/// Appends a skin quad: four vertices with the face's normal and the quad's texture
+/// coordinates, two triangles. Quads too small to stay a rectangle in `f32` (and any
+/// non-finite value) go through [`Mesh::add_quad`], which checks them.
+fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()> {
+    let corners = q.corners(face);
+    let [s0, t0, s1, t1] = q.rect;
+    let scale = corners
+        .iter()
+        .fold(1.0f64, |m, c| m.max(c.abs().max_element()));
+    let normal = face.normal();
+    let plain = (s1 - s0).min(t1 - t0) >= 1e-4 * scale
+        && scale.is_finite()
+        && (normal.length_squared() - 1.0).abs() < 1e-6;
+    if !plain {
+        mesh.add_quad(corners, q.uvs())?;
+        return Ok(());
+    }
+    let base = mesh.positions.len() as u32;
+    let n = normal.as_vec3();
+    mesh.positions.extend(corners.map(|c| c.as_vec3()));
+    mesh.normals.extend([n; 4]);
+    mesh.uvs.extend(q.uvs().map(|t| t.as_vec2()));
+    mesh.indices
+        .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    Ok(())
+}
+
 /// Appends the triangles of `src` that no dressed plane covers, with only the vertices
 /// they use.
 fn copy_uncovered(mesh: &mut Mesh, src: &Mesh, planes: &[Plane], remap: &mut [u32]) {
@@ -257,11 +284,17 @@ fn copy_uncovered(mesh: &mut Mesh, src: &Mesh, planes: &[Plane], remap: &mut [u3
                 .get(k as usize)
                 .map_or(DVec3::NAN, |v| v.as_dvec3())
         });
-        let tn = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        // Only walls (horizontal normals) can be covered by a facade face.
-        let covered = tn.y.abs() < 0.1
+        // The unnormalised normal: a covered triangle is a wall (|n̂.y| < 0.1) facing
+        // a plane's way (n̂ · n ≥ 0.99), compared in squares to spare the square root.
+        let tn = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len2 = tn.length_squared();
+        let covered = tn.y * tn.y < 0.01 * len2
             && planes.iter().any(|&(o, n, u, v, w, h)| {
-                if tn.dot(n) < 0.99 || p.iter().any(|q| (*q - o).dot(n).abs() > TOL) {
+                let along = tn.dot(n);
+                if along <= 0.0
+                    || along * along < 0.9801 * len2
+                    || p.iter().any(|q| (*q - o).dot(n).abs() > TOL)
+                {
                     return false;
                 }
                 let c = (p[0] + p[1] + p[2]) / 3.0 - o;
