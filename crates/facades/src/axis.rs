@@ -226,39 +226,23 @@ impl AxisStyle {
     /// [`FacadeError::TooShort`] when `length` < [`min_length`](Self::min_length);
     /// [`FacadeError::TooManyIntervals`] when the count would exceed [`MAX_INTERVALS`].
     pub fn repeat_count(&self, length: f64, wanted: Option<u32>) -> Result<u32> {
-        check_range("axis length", length, 0.0, MAX_LENGTH_M, "[0, 100000] m")?;
-        let minimum = self.min_length();
-        // A tolerance of a micrometre absorbs rounding in the sums.
-        if length + 1e-6 < minimum {
-            return Err(FacadeError::TooShort { length, minimum });
+        self.sums().repeat_count(length, wanted)
+    }
+
+    /// The sums [`repeat_count`](Self::repeat_count) reads, computed once for many fits.
+    pub(crate) fn sums(&self) -> AxisSums {
+        AxisSums {
+            min_length: self.min_length(),
+            module_min: self.module.iter().map(Segment::min_len).sum(),
+            module_nom: self.module.iter().map(|s| s.length_m).sum(),
+            fixed_min: self.fixed().map(Segment::min_len).sum(),
+            fixed_nom: self.fixed().map(|s| s.length_m).sum(),
+            module_len: self.module.len(),
+            max_repeats: self.max_repeats,
+            min_repeats: self.effective_min_repeats(),
+            module_floors: self.module_floors(),
+            fixed_floors: self.fixed_floors(),
         }
-        if self.module.is_empty() {
-            return Ok(0);
-        }
-        let module_min: f64 = self.module.iter().map(Segment::min_len).sum();
-        let module_nom: f64 = self.module.iter().map(|s| s.length_m).sum();
-        let fixed_min: f64 = self.fixed().map(Segment::min_len).sum();
-        let fixed_nom: f64 = self.fixed().map(|s| s.length_m).sum();
-        let fit_max = ((length - fixed_min + 1e-6) / module_min).floor().max(0.0);
-        let cap = (MAX_INTERVALS / self.module.len().max(1)) as f64;
-        let mut hi = fit_max.min(cap);
-        if let Some(m) = self.max_repeats {
-            hi = hi.min(f64::from(m));
-        }
-        let lo = f64::from(self.effective_min_repeats());
-        if fit_max > cap && hi >= cap {
-            return Err(FacadeError::TooManyIntervals {
-                count: (fit_max as usize).saturating_mul(self.module.len()),
-                limit: MAX_INTERVALS,
-            });
-        }
-        let n = match wanted {
-            Some(w) if f64::from(w) >= lo && f64::from(w) <= hi => f64::from(w),
-            _ => ((length - fixed_nom) / module_nom)
-                .round()
-                .clamp(lo, hi.max(lo)),
-        };
-        Ok(n as u32)
     }
 
     /// Fits the axis to `length` metres and returns its interval group (see module docs).
@@ -386,6 +370,73 @@ fn distribute(mult: &[(&Segment, f64)], params: &[(f64, f64, f64)], delta: f64) 
         remaining -= used;
     }
     lens
+}
+
+/// The per-style sums of an [`AxisStyle`] that fitting a length reads: computed once by
+/// [`AxisStyle::sums`] (a prepared style keeps them) instead of once per face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct AxisSums {
+    /// [`AxisStyle::min_length`].
+    min_length: f64,
+    /// One module at its minimum and at its nominal length.
+    module_min: f64,
+    module_nom: f64,
+    /// The start and end segments at their minimum and nominal lengths.
+    fixed_min: f64,
+    fixed_nom: f64,
+    /// Segments per module.
+    module_len: usize,
+    max_repeats: Option<u32>,
+    /// [`AxisStyle::effective_min_repeats`].
+    min_repeats: u32,
+    /// [`AxisStyle::module_floors`] and [`AxisStyle::fixed_floors`].
+    module_floors: u32,
+    fixed_floors: u32,
+}
+
+impl AxisSums {
+    /// The module repetitions asked for by a face of `floors` storeys with these rows.
+    pub(crate) fn wanted_rows(&self, floors: Option<u32>) -> Option<u32> {
+        floors.and_then(|f| {
+            let (per, fixed) = (self.module_floors, self.fixed_floors);
+            (per > 0 && f >= fixed).then(|| (f - fixed) / per)
+        })
+    }
+
+    /// [`AxisStyle::repeat_count`] from the sums.
+    pub(crate) fn repeat_count(&self, length: f64, wanted: Option<u32>) -> Result<u32> {
+        check_range("axis length", length, 0.0, MAX_LENGTH_M, "[0, 100000] m")?;
+        let minimum = self.min_length;
+        // A tolerance of a micrometre absorbs rounding in the sums.
+        if length + 1e-6 < minimum {
+            return Err(FacadeError::TooShort { length, minimum });
+        }
+        if self.module_len == 0 {
+            return Ok(0);
+        }
+        let fit_max = ((length - self.fixed_min + 1e-6) / self.module_min)
+            .floor()
+            .max(0.0);
+        let cap = (MAX_INTERVALS / self.module_len) as f64;
+        let mut hi = fit_max.min(cap);
+        if let Some(m) = self.max_repeats {
+            hi = hi.min(f64::from(m));
+        }
+        let lo = f64::from(self.min_repeats);
+        if fit_max > cap && hi >= cap {
+            return Err(FacadeError::TooManyIntervals {
+                count: (fit_max as usize).saturating_mul(self.module_len),
+                limit: MAX_INTERVALS,
+            });
+        }
+        let n = match wanted {
+            Some(w) if f64::from(w) >= lo && f64::from(w) <= hi => f64::from(w),
+            _ => ((length - self.fixed_nom) / self.module_nom)
+                .round()
+                .clamp(lo, hi.max(lo)),
+        };
+        Ok(n as u32)
+    }
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
-use crate::axis::AxisStyle;
+use crate::axis::{AxisStyle, AxisSums};
 use crate::error::{FacadeError, Result, check_range};
 use crate::image::ImageSet;
 use crate::interval::IntervalGroup;
@@ -185,6 +185,10 @@ pub struct PreparedStyle {
     /// the style's rows), derived once.
     rows_ground: AxisStyle,
     rows_upper: AxisStyle,
+    /// The fitting sums of the columns and of the rows of each role (ground floor, upper
+    /// floors, any other), computed once.
+    columns_sums: AxisSums,
+    rows_sums: [AxisSums; 3],
 }
 
 /// What had to be simplified while fitting a facade.
@@ -269,6 +273,8 @@ impl PreparedStyle {
             min_repeats: rows.min_repeats.max(1),
             ..rows.clone()
         };
+        let columns_sums = style.columns.sums();
+        let rows_sums = [rows_ground.sums(), rows_upper.sums(), style.rows.sums()];
         Ok(PreparedStyle {
             style,
             images,
@@ -276,6 +282,8 @@ impl PreparedStyle {
             tiling: OnceLock::new(),
             rows_ground,
             rows_upper,
+            columns_sums,
+            rows_sums,
         })
     }
 
@@ -353,13 +361,14 @@ impl PreparedStyle {
         }
     }
 
-    /// The row repetitions asked for by a face of `floors` storeys with these rows.
-    pub(crate) fn wanted_rows(rows_style: &AxisStyle, floors: Option<u32>) -> Option<u32> {
-        floors.and_then(|f| {
-            let per = rows_style.module_floors();
-            let fixed = rows_style.fixed_floors();
-            (per > 0 && f >= fixed).then(|| (f - fixed) / per)
-        })
+    /// The fitting sums of the columns and of the rows `role` uses.
+    pub(crate) fn sums(&self, role: FaceRole) -> (&AxisSums, &AxisSums) {
+        let rows = match role {
+            FaceRole::GroundFloor => &self.rows_sums[0],
+            FaceRole::UpperFloors => &self.rows_sums[1],
+            _ => &self.rows_sums[2],
+        };
+        (&self.columns_sums, rows)
     }
 
     /// Fits only the primary grid (columns and rows) of the style to a face: what
@@ -372,7 +381,7 @@ impl PreparedStyle {
         spec.validate()?;
         let st = &self.style;
         let rows_style = self.rows_style(spec.role);
-        let wanted = Self::wanted_rows(rows_style, spec.floors);
+        let wanted = self.sums(spec.role).1.wanted_rows(spec.floors);
         let mut report = FacadeReport::default();
         let fit = |axis: &AxisStyle, len: f64, wanted: Option<u32>, blank: &mut bool| match axis
             .fit(len, wanted)

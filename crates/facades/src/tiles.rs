@@ -222,19 +222,19 @@ impl PreparedStyle {
     /// [`FacadeError::InvalidNumber`] for a bad spec.
     pub fn compact_tile_quad(&self, spec: &FacadeSpec, set: &TileSet) -> Result<Option<TileQuad>> {
         spec.validate()?;
-        let rows_style = self.rows_style(spec.role);
-        let count = |axis: &crate::AxisStyle, len: f64, wanted: Option<u32>| match axis
+        let (columns, rows) = self.sums(spec.role);
+        let count = |axis: &crate::axis::AxisSums, len: f64, wanted: Option<u32>| match axis
             .repeat_count(len, wanted)
         {
             Ok(n) => Ok(Some(n)),
             Err(FacadeError::TooShort { .. }) => Ok(None),
             Err(e) => Err(e),
         };
-        let Some(n_cols) = count(&self.style().columns, spec.width_m, None)? else {
+        let Some(n_cols) = count(columns, spec.width_m, None)? else {
             return Ok(None);
         };
-        let wanted = Self::wanted_rows(rows_style, spec.floors);
-        let Some(n_rows) = count(rows_style, spec.height_m, wanted)? else {
+        let wanted = rows.wanted_rows(spec.floors);
+        let Some(n_rows) = count(rows, spec.height_m, wanted)? else {
             return Ok(None);
         };
         let ground = spec.role == FaceRole::GroundFloor;
