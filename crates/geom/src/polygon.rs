@@ -554,11 +554,9 @@ fn find_intersection_with(
         // (sharing their vertex is allowed; only folding back onto each other is not,
         // which needs them collinear). Both tests are exact, so the first contact found
         // is the same as testing every pair.
-        for i in 0..edges.len() {
-            let (ri, ei, a0, a1) = edges[i];
+        for (i, &(ri, ei, a0, a1)) in edges.iter().enumerate() {
             let (alo, ahi) = (a0.min(a1), a0.max(a1));
-            for j in i + 1..edges.len() {
-                let (rj, ej, b0, b1) = edges[j];
+            for (j, &(rj, ej, b0, b1)) in edges.iter().enumerate().skip(i + 1) {
                 if alo.x > b0.x.max(b1.x)
                     || alo.y > b0.y.max(b1.y)
                     || ahi.x < b0.x.min(b1.x)
