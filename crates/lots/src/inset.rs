@@ -26,8 +26,11 @@ use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
-use crate::skeleton::events::Engine;
-use crate::skeleton::prepare;
+use polis_geom::predicates::{Orientation, orient2d};
+
+use crate::skeleton::events::{COINCIDENCE_REL, Engine};
+use crate::skeleton::wavefront::{EdgeLine, Motion, motion};
+use crate::skeleton::{check_input, reset_checked};
 
 /// One ring of an inset shape, with the input edge each of its edges comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -127,10 +130,91 @@ impl Inset {
                 reason: format!("the inset distance is {d}; it must be finite and not negative"),
             });
         }
-        prepare(&mut self.engine, polygon, weights)?;
+        check_input(polygon, weights)?;
+        if let Some(shapes) = convex_before_any_event(polygon, weights, d) {
+            return Ok(shapes);
+        }
+        reset_checked(&mut self.engine, polygon, weights);
         self.engine.run_through(d)?;
         Ok(wavefront_at(&self.engine, d))
     }
+}
+
+/// Convex polygons with at most this many vertices may skip the event engine.
+const CONVEX_FAST_VERTICES: usize = 32;
+
+/// The inset of a convex polygon without holes when no edge of its wavefront vanishes
+/// before `d` (the common case of a setback much smaller than the lot): every vertex is
+/// moved along its (weighted) bisector by exactly the engine's arithmetic, so the result
+/// is the engine's, without building its event queue. `None` when that does not hold —
+/// a hole, a reflex or straight vertex, parallel neighbours, an edge that vanishes before
+/// `d` or within a safety margin after it — and the engine decides.
+///
+/// Convexity makes this exact: the wavefront of a convex polygon stays the intersection
+/// of the moving half-planes, whose structure changes only when an edge shrinks to zero,
+/// and no split event can happen without a reflex vertex.
+fn convex_before_any_event(
+    polygon: &PolygonWithHoles,
+    weights: Option<&[f64]>,
+    d: f64,
+) -> Option<Vec<InsetShape>> {
+    let pts = polygon.outer.points();
+    let n = pts.len();
+    if !polygon.holes.is_empty() || !(3..=CONVEX_FAST_VERTICES).contains(&n) {
+        return None;
+    }
+    let weight = |i: usize| weights.map_or(Some(1.0), |w| w.get(i).copied());
+    let mut edges = [None; CONVEX_FAST_VERTICES];
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    let mut wmax = 0.0f64;
+    for i in 0..n {
+        let (a, b, c) = (pts[i], pts[(i + 1) % n], pts[(i + 2) % n]);
+        if orient2d(a, b, c) != Orientation::CounterClockwise {
+            return None;
+        }
+        let w = weight(i)?;
+        wmax = wmax.max(w);
+        lo = lo.min(a);
+        hi = hi.max(a);
+        edges[i] = Some(EdgeLine::new(a, b, w));
+    }
+    // Vertex i joins edge i − 1 (in) and edge i (out), as in the engine.
+    let mut velocity = [DVec2::ZERO; CONVEX_FAST_VERTICES];
+    for (i, v) in velocity.iter_mut().enumerate().take(n) {
+        let (ein, eout) = (edges[(i + n - 1) % n]?, edges[i]?);
+        match motion(&ein, &eout) {
+            Motion::Moving(m) if m.is_finite() => *v = m,
+            _ => return None,
+        }
+    }
+    // The engine's tolerances; an edge must outlive `d` by a wide margin.
+    let size = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let eps = COINCIDENCE_REL * size;
+    let time_eps = eps / wmax.max(f64::MIN_POSITIVE);
+    let safe_until = (d + time_eps) * (1.0 + 1e-6) + 16.0 * time_eps;
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let along = pts[j] - pts[i];
+        let length = along.length();
+        // How fast the edge shrinks: its end closing in on its start along it.
+        let closing = (velocity[i] - velocity[j]).dot(along) / length;
+        if !(length > 0.0 && closing.is_finite())
+            || (closing > 0.0 && length / closing <= safe_until)
+        {
+            return None;
+        }
+    }
+    let mut ring = InsetRing {
+        points: (0..n).map(|i| pts[i] + velocity[i] * (d - 0.0)).collect(),
+        sources: (0..n).map(Some).collect(),
+    };
+    Some(match finish_ring(&mut ring, eps) {
+        Some(true) => vec![InsetShape {
+            outer: ring,
+            holes: Vec::new(),
+        }],
+        _ => Vec::new(),
+    })
 }
 
 /// The rings of the wavefront at time `d`, grouped into shapes.
@@ -158,19 +242,10 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
                 break;
             }
         }
-        clean_ring(&mut ring, engine.eps);
-        separate_pinches(&mut ring, engine.eps);
-        if ring.points.len() < 3 {
-            continue;
-        }
-        let area = polis_geom::polygon::ring_signed_area(&ring.points);
-        if area.abs() <= engine.eps * engine.eps {
-            continue;
-        }
-        if area > 0.0 {
-            outers.push(ring);
-        } else {
-            holes.push(ring);
+        match finish_ring(&mut ring, engine.eps) {
+            Some(true) => outers.push(ring),
+            Some(false) => holes.push(ring),
+            None => {}
         }
     }
     let mut shapes: Vec<InsetShape> = outers
@@ -187,6 +262,21 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
         }
     }
     shapes
+}
+
+/// Cleans a wavefront ring (zero-length edges, pinches) and tells whether it is an outer
+/// ring (`true`) or a hole (`false`); `None` when nothing of it is left.
+fn finish_ring(ring: &mut InsetRing, eps: f64) -> Option<bool> {
+    clean_ring(ring, eps);
+    separate_pinches(ring, eps);
+    if ring.points.len() < 3 {
+        return None;
+    }
+    let area = polis_geom::polygon::ring_signed_area(&ring.points);
+    if area.abs() <= eps * eps {
+        return None;
+    }
+    Some(area > 0.0)
 }
 
 /// At the exact time of an event a ring can touch itself in a point (a hole meeting the
@@ -265,4 +355,111 @@ fn clean_ring(ring: &mut InsetRing, eps: f64) {
     }
     ring.points = points;
     ring.sources = sources;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The engine's inset, never the fast path.
+    fn engine_shapes(
+        polygon: &PolygonWithHoles,
+        weights: Option<&[f64]>,
+        d: f64,
+    ) -> Vec<InsetShape> {
+        let mut engine = Engine::default();
+        crate::skeleton::prepare(&mut engine, polygon, weights).unwrap();
+        engine.run_through(d).unwrap();
+        wavefront_at(&engine, d)
+    }
+
+    #[test]
+    fn a_lot_with_a_small_setback_takes_the_fast_path() {
+        let lot: PolygonWithHoles = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 0.5),
+            DVec2::new(9.5, 18.0),
+            DVec2::new(-0.5, 17.0),
+        ])
+        .into();
+        let weights = [3.0, 1.0, 1.0, 1.0];
+        for w in [None, Some(&weights[..])] {
+            for d in [0.0, 1.0, 1.6] {
+                let fast = convex_before_any_event(&lot, w, d).expect("no event before d");
+                assert_eq!(fast, engine_shapes(&lot, w, d));
+                assert_eq!(Inset::new().shapes(&lot, w, d).unwrap(), fast);
+            }
+        }
+        // Past the first edge event the engine decides.
+        assert!(convex_before_any_event(&lot, None, 5.5).is_none());
+        // Not convex, or with a hole: the engine.
+        let l: PolygonWithHoles = Polygon::new(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 4.0),
+            DVec2::new(4.0, 4.0),
+            DVec2::new(4.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ])
+        .into();
+        assert!(convex_before_any_event(&l, None, 0.5).is_none());
+    }
+
+    fn convex_polygon() -> impl Strategy<Value = Vec<DVec2>> {
+        // Points on an ellipse in angular order (convex), some nearly collinear triples
+        // from angles close together; or a lot-like quadrilateral.
+        prop_oneof![
+            (
+                prop::collection::vec(0.0f64..1.0, 3..14),
+                1.0f64..60.0,
+                0.05f64..1.0,
+                0.0f64..3.2
+            )
+                .prop_map(|(mut t, a, ratio, rot)| {
+                    t.sort_by(f64::total_cmp);
+                    let (s, c) = rot.sin_cos();
+                    t.iter()
+                        .map(|&u| {
+                            let ang = std::f64::consts::TAU * u;
+                            let p = DVec2::new(a * ang.cos(), a * ratio * ang.sin());
+                            DVec2::new(c * p.x - s * p.y + 100.0, s * p.x + c * p.y - 40.0)
+                        })
+                        .collect()
+                }),
+            (2.0f64..30.0, 2.0f64..40.0, -1.0f64..1.0, -1.0f64..1.0).prop_map(|(w, h, dx, dy)| {
+                vec![
+                    DVec2::new(0.0, 0.0),
+                    DVec2::new(w, dy),
+                    DVec2::new(w + dx, h),
+                    DVec2::new(0.0, h + dy),
+                ]
+            }),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// Whenever the fast path answers, its answer is exactly the engine's (every bit),
+        /// for any weights and distances up to and past the polygon's collapse.
+        #[test]
+        fn the_fast_path_answers_exactly_as_the_engine(
+            pts in convex_polygon(),
+            weights in prop::collection::vec(prop_oneof![Just(1.0), Just(2.0), 0.2f64..4.0], 14),
+            weighted in any::<bool>(),
+            frac in prop_oneof![Just(0.0), 0.0f64..0.05, 0.0f64..1.2],
+        ) {
+            let polygon: PolygonWithHoles = Polygon::new(pts).into();
+            prop_assume!(check_input(&polygon, None).is_ok());
+            let n = polygon.outer.len();
+            let w = weighted.then(|| &weights[..n]);
+            let size = polygon.outer.bbox().size().max_element();
+            let d = frac * size;
+            if let Some(fast) = convex_before_any_event(&polygon, w, d) {
+                prop_assert_eq!(&fast, &engine_shapes(&polygon, w, d));
+            }
+            prop_assert_eq!(Inset::new().shapes(&polygon, w, d).unwrap(), engine_shapes(&polygon, w, d));
+        }
+    }
 }

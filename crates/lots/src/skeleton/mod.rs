@@ -311,6 +311,32 @@ pub(crate) fn prepare(
     polygon: &PolygonWithHoles,
     weights: Option<&[f64]>,
 ) -> Result<Vec<f64>, LotsError> {
+    check_input(polygon, weights)?;
+    Ok(reset_checked(engine, polygon, weights))
+}
+
+/// [`prepare`] of an input that passed [`check_input`].
+pub(crate) fn reset_checked(
+    engine: &mut Engine,
+    polygon: &PolygonWithHoles,
+    weights: Option<&[f64]>,
+) -> Vec<f64> {
+    let total: usize = polygon.rings().map(|(_, r)| r.len()).sum();
+    let weights = match weights {
+        Some(w) => w.to_vec(),
+        None => vec![1.0; total],
+    };
+    let rings: Vec<&[DVec2]> = polygon.rings().map(|(_, r)| r.points()).collect();
+    engine.reset(&rings, &weights);
+    weights
+}
+
+/// The checks of [`prepare`]: a valid polygon, normalised (counter-clockwise outer ring,
+/// clockwise holes), with one positive finite weight per edge if weights are given.
+pub(crate) fn check_input(
+    polygon: &PolygonWithHoles,
+    weights: Option<&[f64]>,
+) -> Result<(), LotsError> {
     polygon.validate()?;
     if polygon.outer.signed_area() <= 0.0 {
         return Err(LotsError::WrongOrientation { ring: Ring::Outer });
@@ -322,26 +348,20 @@ pub(crate) fn prepare(
             });
         }
     }
-    let total: usize = polygon.rings().map(|(_, r)| r.len()).sum();
-    let weights = match weights {
-        Some(w) => {
-            if w.len() != total {
-                return Err(LotsError::EdgeCountMismatch {
-                    what: "weights",
-                    expected: total,
-                    got: w.len(),
-                });
-            }
-            for (e, &x) in w.iter().enumerate() {
-                check_positive("weight", e, x)?;
-            }
-            w.to_vec()
+    if let Some(w) = weights {
+        let total: usize = polygon.rings().map(|(_, r)| r.len()).sum();
+        if w.len() != total {
+            return Err(LotsError::EdgeCountMismatch {
+                what: "weights",
+                expected: total,
+                got: w.len(),
+            });
         }
-        None => vec![1.0; total],
-    };
-    let rings: Vec<&[DVec2]> = polygon.rings().map(|(_, r)| r.points()).collect();
-    engine.reset(&rings, &weights);
-    Ok(weights)
+        for (e, &x) in w.iter().enumerate() {
+            check_positive("weight", e, x)?;
+        }
+    }
+    Ok(())
 }
 
 /// Builds each face from the arcs that bound it.
