@@ -128,6 +128,33 @@ fn small_rect(bencher: Bencher<'_, '_>) {
     });
 }
 
+/// The worst shapes for ear clipping at the direct path's size limit: a comb of 15 teeth
+/// (62 vertices, 30 reflex) and a spiral corridor (64 vertices, 32 reflex).
+#[divan::bench(args = ["comb_62", "spiral_64"])]
+fn small_worst(bencher: Bencher<'_, '_>, shape: &str) {
+    let p: PolygonWithHoles = match shape {
+        "comb_62" => comb(15),
+        _ => spiral(32),
+    }
+    .into();
+    assert!(p.validate().is_ok(), "{shape} is not a valid polygon");
+    bencher
+        .counter(ItemsCount::new(1usize))
+        .bench(|| triangulate(black_box(&p)));
+}
+
+/// A spiral corridor 1 m wide, 8 vertices per turn on each wall: `2·points` vertices,
+/// the inner wall's all reflex.
+fn spiral(points: usize) -> Polygon {
+    let at = |k: usize, inset: f64| {
+        let a = std::f64::consts::TAU * k as f64 / 8.0;
+        (3.0 + a - inset) * DVec2::new(a.cos(), a.sin())
+    };
+    let outer = (0..points).map(|k| at(k, 0.0));
+    let inner = (0..points).rev().map(|k| at(k, 1.0));
+    Polygon::new(outer.chain(inner).collect())
+}
+
 /// Validation alone on small polygons, to separate its share (counter: polygons/s).
 #[divan::bench(args = [6, 12, 24])]
 fn small_validate(bencher: Bencher<'_, '_>, n: usize) {

@@ -67,14 +67,50 @@ pub(super) fn triangulate_ring(ring: &[DVec2]) -> Option<Vec<[u32; 3]>> {
     Some(out)
 }
 
+/// Edges waiting for the in-circle check, as triangle slots `3·t + e` (the edge of `t`
+/// opposite its corner `e`), each at most once: a stack in a fixed buffer.
+struct Pending {
+    stack: [u8; 3 * MAX_VERTICES],
+    len: usize,
+    queued: [u64; 3],
+}
+
+impl Default for Pending {
+    fn default() -> Self {
+        Pending {
+            stack: [0; 3 * MAX_VERTICES],
+            len: 0,
+            queued: [0; 3],
+        }
+    }
+}
+
+impl Pending {
+    fn push(&mut self, slot: usize) {
+        let bit = 1u64 << (slot % 64);
+        if self.queued[slot / 64] & bit == 0 {
+            self.queued[slot / 64] |= bit;
+            self.stack[self.len] = slot as u8;
+            self.len += 1;
+        }
+    }
+
+    fn pop(&mut self) -> Option<usize> {
+        self.len = self.len.checked_sub(1)?;
+        let slot = usize::from(self.stack[self.len]);
+        self.queued[slot / 64] &= !(1u64 << (slot % 64));
+        Some(slot)
+    }
+}
+
 /// The working state: the ring counter-clockwise, its triangles and their adjacency, all
 /// in fixed buffers (no allocation but the result).
-struct Work {
+struct Work<'a> {
     /// Vertex count.
     n: usize,
-    /// The points in counter-clockwise order.
-    pts: [DVec2; MAX_VERTICES],
-    /// Input index of each working position.
+    /// The input ring.
+    ring: &'a [DVec2],
+    /// Input index of each working position (positions run counter-clockwise).
     index: [u8; MAX_VERTICES],
     /// Triangles so far, counter-clockwise.
     tris: [Tri; MAX_VERTICES],
@@ -82,10 +118,10 @@ struct Work {
     adj: [Tri; MAX_VERTICES],
 }
 
-impl Work {
-    /// Copies the ring in counter-clockwise order; `None` if its orientation is not
+impl<'a> Work<'a> {
+    /// Numbers the ring's vertices counter-clockwise; `None` if its orientation is not
     /// decided (a valid ring always has it).
-    fn new(ring: &[DVec2]) -> Option<Work> {
+    fn new(ring: &'a [DVec2]) -> Option<Work<'a>> {
         let n = ring.len();
         // The lexicographically least vertex is strictly convex in a valid ring: its
         // neighbours both lie on one side, and they cannot both lie on one ray from it
@@ -103,7 +139,7 @@ impl Work {
         }
         let mut w = Work {
             n,
-            pts: [DVec2::ZERO; MAX_VERTICES],
+            ring,
             index: [0; MAX_VERTICES],
             tris: [[0; 3]; MAX_VERTICES],
             adj: [[NONE; 3]; MAX_VERTICES],
@@ -111,7 +147,6 @@ impl Work {
         for k in 0..n {
             // Clockwise rings are walked backwards from vertex 0.
             let i = if turn > 0.0 { k } else { (n - k) % n };
-            w.pts[k] = ring[i];
             w.index[k] = i as u8;
         }
         Some(w)
@@ -122,7 +157,7 @@ impl Work {
     }
 
     fn p(&self, k: u8) -> DVec2 {
-        self.pts[usize::from(k)]
+        self.ring[usize::from(self.index[usize::from(k)])]
     }
 
     /// Ear clipping into `tris` and `adj`. `None` if no ear is found in a whole turn of
@@ -204,12 +239,19 @@ impl Work {
         if blocking & (1 << c) != 0 {
             return false;
         }
-        let (a, b, d) = (self.p(p), self.p(c), self.p(q));
         let mut rest = blocking & !(1u64 << p) & !(1u64 << q);
+        if rest == 0 {
+            return true;
+        }
+        let (a, b, d) = (self.p(p), self.p(c), self.p(q));
+        // The triangle's box: a cheap, exact rejection before the orientation tests.
+        let (low, high) = (a.min(b).min(d), a.max(b).max(d));
         while rest != 0 {
-            let r = self.pts[rest.trailing_zeros() as usize];
+            let r = self.p(rest.trailing_zeros() as u8);
             rest &= rest - 1;
-            if orient2d_value(a, b, r) >= 0.0
+            if r.cmpge(low).all()
+                && r.cmple(high).all()
+                && orient2d_value(a, b, r) >= 0.0
                 && orient2d_value(b, d, r) >= 0.0
                 && orient2d_value(d, a, r) >= 0.0
             {
@@ -230,25 +272,36 @@ impl Work {
         self.adj[usize::from(u)][usize::from(f)] = t as u8;
     }
 
-    /// Lawson flips until every interior edge is locally Delaunay. `None` if that takes
-    /// more than `n²` passes (it cannot, see the module docs).
+    /// Lawson flips until every interior edge is locally Delaunay: every diagonal is
+    /// checked once, and after a flip the four outer edges of its quadrilateral again
+    /// (the new diagonal is locally Delaunay). `None` after more than `n − 2 + 2n²` flips
+    /// (Lawson: at most `n(n − 1)/2`; cannot happen).
     fn flip_to_delaunay(&mut self) -> Option<()> {
         let count = self.n - 2;
-        for _ in 0..self.n * self.n {
-            let mut flipped = false;
-            for t in 0..count {
-                for e in 0..3 {
-                    let u = usize::from(self.adj[t][e]);
-                    if u < count && u > t && self.flip_if_illegal(t, e, u) {
-                        flipped = true;
-                    }
+        let mut pending = Pending::default();
+        for t in 0..count {
+            for e in 0..3 {
+                let u = usize::from(self.adj[t][e]);
+                if u < count && u > t {
+                    pending.push(3 * t + e);
                 }
             }
-            if !flipped {
-                return Some(());
+        }
+        let mut budget = count + 2 * self.n * self.n;
+        while let Some(slot) = pending.pop() {
+            let (t, e) = (slot / 3, slot % 3);
+            let u = usize::from(self.adj[t][e]);
+            if u >= count || !self.flip_if_illegal(t, e, u) {
+                continue;
+            }
+            budget = budget.checked_sub(1)?;
+            // New t = (a, b, d): outer edges opposite corners 0 and 2; new u = (a, d, c):
+            // opposite corners 0 and 1.
+            for s in [3 * t, 3 * t + 2, 3 * u, 3 * u + 1] {
+                pending.push(s);
             }
         }
-        None
+        Some(())
     }
 
     /// Flips the edge of `t` opposite its corner `e` (shared with `u`) if `u`'s far
