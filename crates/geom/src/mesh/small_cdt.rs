@@ -1,6 +1,6 @@
 //! The constrained Delaunay triangulation of a small simple polygon without holes, built
 //! directly: ear clipping with exact orientation tests, then Lawson flips with the exact
-//! in-circle test. [`triangulate`](super::triangulate) uses it below
+//! in-circle test. [`triangulate`](super::triangulate) uses it up to
 //! [`MAX_VERTICES`] vertices instead of building a spade triangulation, which costs more
 //! than the whole triangulation for junction polygons and building footprints.
 //!
@@ -13,8 +13,10 @@
 //!   (validation allows them) are never clipped while they are straight: no triangle has
 //!   zero area.
 //! * Only vertices that are not strictly convex need the containment test: if any other
-//!   vertex lies in the closed ear triangle, the one deepest towards the ear's tip does,
-//!   and the polygon's inside lies above it, so its inside angle is at least 180°.
+//!   vertex lies in the closed ear triangle, take the one nearest the ear's tip (measured
+//!   from the line through the ear's two neighbours). No edge can leave it towards the
+//!   tip, and the polygon's inside lies on the tip's side of it, so its inside angle is at
+//!   least 180°: it is not strictly convex, and it blocks the ear.
 //! * A Lawson flip replaces the diagonal of two triangles when the fourth vertex lies
 //!   *strictly* inside the circumcircle of the first triangle. Then the quadrilateral is
 //!   strictly convex, so both new triangles have positive area. Each flip raises the
@@ -26,8 +28,7 @@
 //!
 //! # References
 //! C. L. Lawson, *Software for C¹ surface interpolation*, Mathematical Software III (1977);
-//! D. T. Lee and B. J. Schachter / D. T. Lee and A. K. Lin, *Generalized Delaunay
-//! triangulation for planar graphs*, Discrete Comput. Geom. 1 (1986); G. H. Meisters,
+//! D. T. Lee and A. K. Lin, *Generalized Delaunay triangulation for planar graphs*, Discrete Comput. Geom. 1 (1986); G. H. Meisters,
 //! *Polygons have ears*, Amer. Math. Monthly 82 (1975); D. Eberly, *Triangulation by ear
 //! clipping* (Geometric Tools, 2002).
 
