@@ -64,6 +64,108 @@ fn triangulate_comb_10k(bencher: Bencher<'_, '_>) {
     bench_triangulate(bencher, comb(2_500).into());
 }
 
+/// A batch of 64 small seeded polygons of `n` vertices each (convex: on a rotated
+/// 12 × 8 m ellipse at random angles, like a junction polygon; star: random angle per
+/// sector and radius in [6, 12] m, reflex vertices).
+fn small_batch(n: usize, convex: bool) -> Vec<PolygonWithHoles> {
+    let mut rng = Pcg64Mcg::seed_from_u64(n as u64 * 2 + u64::from(convex));
+    (0..64)
+        .map(|k| {
+            let centre = DVec2::new(60.0 * k as f64, -35.0 * k as f64);
+            let tilt: f64 = rng.random_range(0.0..std::f64::consts::PI);
+            let (s, c) = tilt.sin_cos();
+            let pts = (0..n)
+                .map(|i| {
+                    let a =
+                        std::f64::consts::TAU * (i as f64 + 0.9 * rng.random::<f64>()) / n as f64;
+                    let q = if convex {
+                        DVec2::new(12.0 * a.cos(), 8.0 * a.sin())
+                    } else {
+                        rng.random_range(6.0..12.0) * DVec2::new(a.cos(), a.sin())
+                    };
+                    centre + DVec2::new(c * q.x - s * q.y, s * q.x + c * q.y)
+                })
+                .collect();
+            Polygon::new(pts).into()
+        })
+        .collect()
+}
+
+fn bench_small(bencher: Bencher<'_, '_>, n: usize, convex: bool) {
+    let batch = small_batch(n, convex);
+    bencher.counter(ItemsCount::new(batch.len())).bench(|| {
+        for p in &batch {
+            let _ = black_box(triangulate(black_box(p)));
+        }
+    });
+}
+
+/// Small convex polygons, `n` vertices (counter: polygons/s, including validation).
+#[divan::bench(args = [4, 6, 8, 12, 16, 24, 32, 48, 64])]
+fn small_convex(bencher: Bencher<'_, '_>, n: usize) {
+    bench_small(bencher, n, true);
+}
+
+/// Small star-shaped polygons with reflex vertices (counter: polygons/s).
+#[divan::bench(args = [6, 8, 12, 16, 24, 32, 48, 64])]
+fn small_star(bencher: Bencher<'_, '_>, n: usize) {
+    bench_small(bencher, n, false);
+}
+
+/// 64 axis-aligned rectangles (co-circular corners: the Delaunay tie).
+#[divan::bench]
+fn small_rect(bencher: Bencher<'_, '_>) {
+    let batch: Vec<PolygonWithHoles> = (0..64)
+        .map(|k| {
+            let min = DVec2::new(13.0 * k as f64, 0.5 * k as f64);
+            Polygon::rect(min, min + DVec2::new(8.0 + 0.25 * k as f64, 20.0)).into()
+        })
+        .collect();
+    bencher.counter(ItemsCount::new(batch.len())).bench(|| {
+        for p in &batch {
+            let _ = black_box(triangulate(black_box(p)));
+        }
+    });
+}
+
+/// The worst shapes for ear clipping at the direct path's size limit: a comb of 15 teeth
+/// (62 vertices, 30 reflex) and a spiral corridor (64 vertices, 32 reflex).
+#[divan::bench(args = ["comb_62", "spiral_64"])]
+fn small_worst(bencher: Bencher<'_, '_>, shape: &str) {
+    let p: PolygonWithHoles = match shape {
+        "comb_62" => comb(15),
+        _ => spiral(32),
+    }
+    .into();
+    assert!(p.validate().is_ok(), "{shape} is not a valid polygon");
+    bencher
+        .counter(ItemsCount::new(1usize))
+        .bench(|| triangulate(black_box(&p)));
+}
+
+/// A spiral corridor 1 m wide, 8 vertices per turn on each wall: `2·points` vertices,
+/// the inner wall's all reflex.
+fn spiral(points: usize) -> Polygon {
+    let at = |k: usize, inset: f64| {
+        let a = std::f64::consts::TAU * k as f64 / 8.0;
+        (3.0 + a - inset) * DVec2::new(a.cos(), a.sin())
+    };
+    let outer = (0..points).map(|k| at(k, 0.0));
+    let inner = (0..points).rev().map(|k| at(k, 1.0));
+    Polygon::new(outer.chain(inner).collect())
+}
+
+/// Validation alone on small polygons, to separate its share (counter: polygons/s).
+#[divan::bench(args = [6, 12, 24])]
+fn small_validate(bencher: Bencher<'_, '_>, n: usize) {
+    let batch = small_batch(n, true);
+    bencher.counter(ItemsCount::new(batch.len())).bench(|| {
+        for p in &batch {
+            let _ = black_box(black_box(p).validate());
+        }
+    });
+}
+
 /// Validation alone on the 10,000-vertex star, to separate its share.
 #[divan::bench]
 fn validate_star_10k(bencher: Bencher<'_, '_>) {

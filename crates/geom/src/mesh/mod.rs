@@ -62,6 +62,7 @@ use crate::scene::MaterialId;
 mod extrude;
 mod normals;
 mod planar;
+mod small_cdt;
 mod triangulate;
 
 pub use extrude::{Facing, flat_polygon, prism};

@@ -9,6 +9,7 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
+use super::small_cdt;
 use crate::{GeomError, PolygonWithHoles};
 
 /// Triangulates a polygon with holes without adding vertices.
@@ -19,10 +20,15 @@ use crate::{GeomError, PolygonWithHoles};
 /// plane, whatever the rings' orientations.
 ///
 /// The polygon is validated first ([`PolygonWithHoles::validate`]); its error is returned
-/// unchanged. The triangulation is spade's constrained Delaunay triangulation with every
-/// ring edge as a constraint; the triangles inside are those reached from the outside by
-/// crossing an odd number of constraint edges (a breadth-first walk over the triangles,
-/// in spade's deterministic face order).
+/// unchanged. A polygon without holes of at most 64 vertices (junctions, footprints, lot
+/// caps) is triangulated directly: ear clipping with exact orientation tests, then Lawson
+/// flips with the exact in-circle test until every interior edge is locally Delaunay, in
+/// fixed buffers. Any other polygon goes through spade's constrained Delaunay
+/// triangulation with every ring edge as a constraint; the triangles inside are those
+/// reached from the outside by crossing an odd number of constraint edges (a
+/// breadth-first walk over the triangles, in spade's deterministic face order). Both give
+/// a constrained Delaunay triangulation; where several exist (four or more co-circular
+/// vertices) the two paths may choose differently, and the triangles' order differs.
 ///
 /// # Guarantees
 /// * Exactly `n + 2h − 2` triangles for `n` vertices and `h` holes, none of zero area,
@@ -31,6 +37,8 @@ use crate::{GeomError, PolygonWithHoles};
 /// * Among all triangulations of the polygon that use only its vertices, the constrained
 ///   Delaunay one maximises the smallest angle (few slivers).
 /// * Deterministic: the same polygon gives the same triangles in the same order.
+/// * Allocation: the direct path allocates only the returned vector (validation allocates
+///   its own scratch).
 ///
 /// # Errors
 /// The polygon's validation error; [`GeomError::Triangulation`] if spade rejects a
@@ -49,10 +57,28 @@ use crate::{GeomError, PolygonWithHoles};
 ///
 /// # References
 /// L. P. Chew, *Constrained Delaunay triangulations*, Algorithmica 4 (1989);
+/// C. L. Lawson, *Software for C¹ surface interpolation* (1977) for the flips;
 /// spade's `ConstrainedDelaunayTriangulation` (Stoeoef/spade), which decides every
 /// orientation and in-circle test exactly.
 pub fn triangulate(polygon: &PolygonWithHoles) -> Result<Vec<[u32; 3]>, GeomError> {
-    let cdt = constrained(polygon)?;
+    polygon.validate()?;
+    let ring = polygon.outer.points();
+    // Coordinates spade rejects (non-zero below about 1.8e-43) go to spade for its error.
+    if polygon.holes.is_empty()
+        && ring.len() <= small_cdt::MAX_VERTICES
+        && ring.iter().all(|p| {
+            spade::validate_coordinate(p.x).is_ok() && spade::validate_coordinate(p.y).is_ok()
+        })
+        && let Some(triangles) = small_cdt::triangulate_ring(ring)
+    {
+        return Ok(triangles);
+    }
+    spade_triangles(polygon)
+}
+
+/// The spade path of [`triangulate`] for a validated polygon.
+pub(super) fn spade_triangles(polygon: &PolygonWithHoles) -> Result<Vec<[u32; 3]>, GeomError> {
+    let cdt = build_constrained(polygon)?;
     let total = cdt.num_vertices();
     let depth = constraint_depth(&cdt);
     let mut triangles = Vec::with_capacity(total + 2 * polygon.holes.len());
@@ -182,6 +208,13 @@ fn constrained(
     polygon: &PolygonWithHoles,
 ) -> Result<ConstrainedDelaunayTriangulation<Point2<f64>>, GeomError> {
     polygon.validate()?;
+    build_constrained(polygon)
+}
+
+/// [`constrained`] for a polygon already validated.
+fn build_constrained(
+    polygon: &PolygonWithHoles,
+) -> Result<ConstrainedDelaunayTriangulation<Point2<f64>>, GeomError> {
     let total: usize = polygon.rings().map(|(_, r)| r.len()).sum();
     if u32::try_from(total).is_err() {
         return Err(GeomError::InvalidParameter {
@@ -434,12 +467,19 @@ pub(crate) mod tests {
             .map(|&(x, y)| DVec2::new(x, y))
             .collect(),
         );
-        let tris = triangulate(&l.clone().into()).unwrap();
+        let l: PolygonWithHoles = l.into();
+        // spade's path (taken by polygons with holes or of more than 64 vertices).
         assert_eq!(
-            tris,
+            spade_triangles(&l).unwrap(),
             vec![[0, 4, 6], [4, 0, 1], [1, 3, 4], [5, 6, 4], [2, 3, 1]]
         );
-        check_triangulation(&l.into());
+        // The direct path (ear clipping + Lawson flips) that this polygon takes: the same
+        // triangles (no four vertices are co-circular), in its own order.
+        assert_eq!(
+            triangulate(&l).unwrap(),
+            vec![[1, 2, 3], [4, 5, 6], [1, 3, 4], [4, 6, 0], [1, 4, 0]]
+        );
+        check_triangulation(&l);
     }
 
     #[test]
