@@ -493,10 +493,9 @@ impl Output<'_> {
         h: f64,
     ) -> Result<(), BuildingsError> {
         let part = self.next_part()?;
-        let n = ring.len();
         let g = cx.ground_floor_height;
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
+        for (i, &a) in ring.iter().enumerate() {
+            let b = ring.get(i + 1).or(ring.first()).copied().unwrap_or(a);
             let bands: [Option<(f64, f64, FacadeRole)>; 2] =
                 if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
                     [
@@ -544,8 +543,8 @@ impl Output<'_> {
 fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
     let n = pts.len();
     let mut nrm = DVec3::ZERO;
-    for i in 0..n {
-        nrm += pts[i].cross(pts[(i + 1) % n]);
+    for (i, p) in pts.iter().enumerate() {
+        nrm += p.cross(pts[if i + 1 < n { i + 1 } else { 0 }]);
     }
     let nrm = nrm.normalize_or_zero();
     if nrm == DVec3::ZERO {
@@ -596,8 +595,9 @@ fn clip<'r>(cx: &Context<'_>, rings: &'r [DVec2], s: &Shape) -> Option<(&'r [DVe
 fn is_convex(r: Option<&[DVec2]>) -> bool {
     r.is_some_and(|r| {
         let n = r.len();
+        let after = |i: usize| if i + 1 < n { i + 1 } else { 0 };
         (0..n).all(|i| {
-            polis_geom::orient2d(r[i], r[(i + 1) % n], r[(i + 2) % n])
+            polis_geom::orient2d(r[i], r[after(i)], r[after(after(i))])
                 != polis_geom::Orientation::Clockwise
         })
     })
@@ -608,7 +608,7 @@ pub(crate) fn inside(lot: &Polygon, ring: &[DVec2]) -> bool {
     let n = ring.len();
     ring.iter().all(|&p| lot.contains(p))
         && (0..n).all(|i| {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            let (a, b) = (ring[i], ring[if i + 1 < n { i + 1 } else { 0 }]);
             lot.edges().all(|(c, d)| {
                 !matches!(
                     segment_intersection(a, b, c, d),
