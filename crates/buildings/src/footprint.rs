@@ -280,8 +280,16 @@ fn rect_inside(region: &Polygon, q: &[DVec2; 4]) -> bool {
         return false;
     }
     (0..4).all(|i| {
+        let (c, d) = (q[i], q[(i + 1) % 4]);
+        let (lo, hi) = (c.min(d), c.max(d));
         region.edges().all(|(a, b)| {
-            segment_intersection(q[i], q[(i + 1) % 4], a, b) == SegmentIntersection::Disjoint
+            // Strictly apart boxes are disjoint: `segment_intersection`'s own first
+            // verdict, without the call.
+            a.x.max(b.x) < lo.x
+                || hi.x < a.x.min(b.x)
+                || a.y.max(b.y) < lo.y
+                || hi.y < a.y.min(b.y)
+                || segment_intersection(c, d, a, b) == SegmentIntersection::Disjoint
         })
     })
 }
@@ -541,6 +549,47 @@ mod tests {
                 if rect_inside(&fp, &shrunk) { brute = area; }
             }}}}
             proptest::prop_assert!(r.area() >= brute * (1.0 - 1e-5) - bound, "largest {} vs grid brute force {brute} (bound {bound})", r.area());
+        }
+    }
+
+    /// `rect_inside` before its box pre-test: every edge pair through
+    /// `segment_intersection`.
+    fn rect_inside_reference(region: &Polygon, q: &[DVec2; 4]) -> bool {
+        if !q.iter().all(|&p| region.contains(p)) {
+            return false;
+        }
+        let inside_q =
+            |p: DVec2| (0..4).all(|i| orient2d(q[i], q[(i + 1) % 4], p) != Orientation::Clockwise);
+        if region.points().iter().any(|&p| inside_q(p)) {
+            return false;
+        }
+        (0..4).all(|i| {
+            region.edges().all(|(a, b)| {
+                segment_intersection(q[i], q[(i + 1) % 4], a, b) == SegmentIntersection::Disjoint
+            })
+        })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 256, ..Default::default() })]
+        /// Quads on a small integer grid (touching, collinear and degenerate corners
+        /// abound) against the regions of `region()`: the box pre-test changes no verdict.
+        #[test]
+        fn rect_inside_box_pretest_changes_nothing(
+            (poly, _) in region(),
+            c in proptest::collection::vec((-2i32..15, -2i32..15), 4),
+            small in proptest::collection::vec((0i32..7, 0i32..7), 2),
+            scale in proptest::prop_oneof![proptest::strategy::Just(1.0f64), 0.5f64..8.0],
+        ) {
+            let q = [c[0], c[1], c[2], c[3]]
+                .map(|(x, y)| DVec2::new(f64::from(x), f64::from(y)) * scale);
+            proptest::prop_assert_eq!(rect_inside(&poly, &q), rect_inside_reference(&poly, &q));
+            // Axis-parallel rectangles near the origin, as the sweep produces them: in
+            // the integer L-shapes their corners often lie on an edge.
+            let [p, q] = [small[0], small[1]].map(|(x, y)| DVec2::new(f64::from(x), f64::from(y)));
+            let (lo, hi) = (p.min(q), p.max(q));
+            let r = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+            proptest::prop_assert_eq!(rect_inside(&poly, &r), rect_inside_reference(&poly, &r));
         }
     }
 

@@ -36,7 +36,7 @@ struct RectangleWork {
     us: Vec<f64>,
     spread: Vec<Option<f64>>,
     blocked: Vec<(f64, f64)>,
-    c1: Vec<(f64, f64)>,
+    c1: Vec<(f64, Option<f64>)>,
 }
 
 /// An edge of the region in the frame, its endpoints ordered by `u` (`x0 <= x1`), with
@@ -203,31 +203,25 @@ fn rectangle_in(work: &mut RectangleWork, region: &Polygon, dir: DVec2) -> Optio
         let (b0, b1) = (best.u0, best.u1);
         let cand = |c: f64| (-4..=4).map(move |k| c + r * 0.25 * f64::from(k));
         c1.clear();
-        c1.extend(
-            cand(b1)
-                .filter(|u| *u <= hi.x)
-                .map(|u| (u, strip.spread(u))),
-        );
-        // With finite spreads no pair beats the widest one times the largest right
-        // spread; both candidate lists ascend, so once that cannot win, no later `u0`
-        // can.
+        c1.extend(cand(b1).filter(|u| *u <= hi.x).map(|u| (u, None)));
+        // Both candidate lists ascend: once the widest pair left cannot win, no later
+        // `u0` can. Spreads are computed when a pair first needs them.
         let last = c1.last().map_or(f64::NEG_INFINITY, |c| c.0);
-        let s1max = if bounded {
-            c1.iter().fold(0.0, |m: f64, c| m.max(c.1))
-        } else {
-            f64::INFINITY
-        };
         for u0 in cand(b0).filter(|u| *u >= lo.x) {
-            if last <= u0 || (last - u0) * s1max <= best.area {
+            if last <= u0 || (last - u0) * bound <= best.area {
                 break;
             }
             let mut s0 = None;
-            for &(u1, s1) in c1.iter() {
-                // (Finite spreads: the minimum below cannot exceed `s1`.)
-                if u1 > u0 && (!bounded || (u1 - u0) * s1 > best.area) {
-                    let s0 = *s0.get_or_insert_with(|| strip.spread(u0));
-                    if (u1 - u0) * s0.min(s1) > best.area {
-                        strip.consider(u0, u1, &mut best);
+            for (u1, s1) in c1.iter_mut() {
+                let u1 = *u1;
+                if u1 > u0 && (u1 - u0) * bound > best.area {
+                    let s1 = *s1.get_or_insert_with(|| strip.spread(u1));
+                    // (Finite spreads: the minimum below cannot exceed `s1`.)
+                    if !bounded || (u1 - u0) * s1 > best.area {
+                        let s0 = *s0.get_or_insert_with(|| strip.spread(u0));
+                        if (u1 - u0) * s0.min(s1) > best.area {
+                            strip.consider(u0, u1, &mut best);
+                        }
                     }
                 }
             }
