@@ -49,6 +49,9 @@ struct Edge {
     y1: f64,
     dx: f64,
     dy: f64,
+    /// The lower and upper end of the edge's `v` range.
+    ylo: f64,
+    yhi: f64,
 }
 
 impl Edge {
@@ -62,6 +65,8 @@ impl Edge {
             y1: q.y,
             dx: q.x - p.x,
             dy: q.y - p.y,
+            ylo: p.y.min(q.y),
+            yhi: p.y.max(q.y),
         }
     }
 
@@ -290,14 +295,15 @@ impl Strip<'_> {
             if u < e.x0 || u > e.x1 {
                 continue;
             }
+            // (The interpolated point is both ends of its interval: one `min`, one `max`.)
             let (va, vb) = if e.dx == 0.0 {
-                (e.y0, e.y1)
+                (e.ylo, e.yhi)
             } else {
                 let v = e.at(u);
                 (v, v)
             };
-            v0 = v0.min(va.min(vb));
-            v1 = v1.max(va.max(vb));
+            v0 = v0.min(va);
+            v1 = v1.max(vb);
         }
         (v1 - v0).max(0.0)
     }
@@ -309,15 +315,13 @@ impl Strip<'_> {
             if e.x1 <= u0 || e.x0 >= u1 {
                 continue;
             }
-            let (va, vb) = if e.dx == 0.0 {
-                (e.y0, e.y1)
+            self.blocked.push(if e.dx == 0.0 {
+                (e.ylo, e.yhi)
             } else {
-                (
-                    if e.x0 < u0 { e.at(u0) } else { e.y0 },
-                    if e.x1 > u1 { e.at(u1) } else { e.y1 },
-                )
-            };
-            self.blocked.push((va.min(vb), va.max(vb)));
+                let va = if e.x0 < u0 { e.at(u0) } else { e.y0 };
+                let vb = if e.x1 > u1 { e.at(u1) } else { e.y1 };
+                (va.min(vb), va.max(vb))
+            });
         }
         sort_by_start(self.blocked);
         let width = u1 - u0;
