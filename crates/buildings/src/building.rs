@@ -494,32 +494,45 @@ impl Output<'_> {
     ) -> Result<(), BuildingsError> {
         let part = self.next_part()?;
         let g = cx.ground_floor_height;
-        for (i, &a) in ring.iter().enumerate() {
-            let b = ring.get(i + 1).or(ring.first()).copied().unwrap_or(a);
-            let bands: [Option<(f64, f64, FacadeRole)>; 2] =
-                if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
-                    [
-                        Some((z0, z0 + g, FacadeRole::GroundFloor)),
-                        Some((z0 + g, z0 + h, FacadeRole::Wall)),
-                    ]
-                } else if z0 <= 0.0 {
-                    [Some((z0, z0 + h, FacadeRole::GroundFloor)), None]
-                } else {
-                    [Some((z0, z0 + h, FacadeRole::Wall)), None]
-                };
-            for (lo, hi, role) in bands.into_iter().flatten() {
+        // The bands (and their storeys) are the same for every wall.
+        let bands: [Option<(f64, f64, FacadeRole)>; 2] =
+            if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
+                [
+                    Some((z0, z0 + g, FacadeRole::GroundFloor)),
+                    Some((z0 + g, z0 + h, FacadeRole::Wall)),
+                ]
+            } else if z0 <= 0.0 {
+                [Some((z0, z0 + h, FacadeRole::GroundFloor)), None]
+            } else {
+                [Some((z0, z0 + h, FacadeRole::Wall)), None]
+            };
+        let bands = bands.map(|band| {
+            band.map(|(lo, hi, role)| {
                 let fh = if role == FacadeRole::GroundFloor {
                     g
                 } else {
                     cx.floor_height
                 };
-                let floors = ((hi - lo) / fh).round().max(1.0) as u32;
-                let d = b - a;
+                (lo, hi, role, ((hi - lo) / fh).round().max(1.0) as u32)
+            })
+        });
+        for (i, &a) in ring.iter().enumerate() {
+            let b = ring.get(i + 1).or(ring.first()).copied().unwrap_or(a);
+            let d = b - a;
+            // `d.normalize_or_zero()` and `d.length()` with one square root.
+            let width = d.length();
+            let rcp = 1.0 / width;
+            let u = if rcp.is_finite() && rcp > 0.0 {
+                d * rcp
+            } else {
+                DVec2::ZERO
+            };
+            for &(lo, hi, role, floors) in bands.iter().flatten() {
                 self.facades.push(FacadeFace {
                     origin: to_world(a, lo),
-                    u: to_world(d.normalize_or_zero(), 0.0),
+                    u: to_world(u, 0.0),
                     v: DVec3::Y,
-                    width: d.length(),
+                    width,
                     height: hi - lo,
                     floors,
                     part,
