@@ -216,6 +216,28 @@ fn rectangle_in(work: &mut RectangleWork, region: &Polygon, dir: DVec2) -> Optio
             if last <= u0 || (last - u0) * bound <= best.area {
                 break;
             }
+            if bounded {
+                // Finite spreads: a pair needs `width × s0 > best` (and the same with
+                // `s1`), which holds on a suffix of the ascending right candidates only.
+                let s0 = strip.spread(u0);
+                let mut from = c1.len();
+                while let Some(&(u1, _)) = from.checked_sub(1).and_then(|j| c1.get(j)) {
+                    if !(u1 > u0 && (u1 - u0) * s0 > best.area) {
+                        break;
+                    }
+                    from -= 1;
+                }
+                for (u1, s1) in c1.iter_mut().skip(from) {
+                    let u1 = *u1;
+                    if (u1 - u0) * s0 > best.area {
+                        let s1 = *s1.get_or_insert_with(|| strip.spread(u1));
+                        if (u1 - u0) * s0.min(s1) > best.area {
+                            strip.consider(u0, u1, &mut best);
+                        }
+                    }
+                }
+                continue;
+            }
             let mut s0 = None;
             for (u1, s1) in c1.iter_mut() {
                 let u1 = *u1;
