@@ -493,34 +493,46 @@ impl Output<'_> {
         h: f64,
     ) -> Result<(), BuildingsError> {
         let part = self.next_part()?;
-        let n = ring.len();
         let g = cx.ground_floor_height;
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            let bands: [Option<(f64, f64, FacadeRole)>; 2] =
-                if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
-                    [
-                        Some((z0, z0 + g, FacadeRole::GroundFloor)),
-                        Some((z0 + g, z0 + h, FacadeRole::Wall)),
-                    ]
-                } else if z0 <= 0.0 {
-                    [Some((z0, z0 + h, FacadeRole::GroundFloor)), None]
-                } else {
-                    [Some((z0, z0 + h, FacadeRole::Wall)), None]
-                };
-            for (lo, hi, role) in bands.into_iter().flatten() {
+        // The bands (and their storeys) are the same for every wall.
+        let bands: [Option<(f64, f64, FacadeRole)>; 2] =
+            if z0 <= 0.0 && h > g + 0.5 * cx.floor_height {
+                [
+                    Some((z0, z0 + g, FacadeRole::GroundFloor)),
+                    Some((z0 + g, z0 + h, FacadeRole::Wall)),
+                ]
+            } else if z0 <= 0.0 {
+                [Some((z0, z0 + h, FacadeRole::GroundFloor)), None]
+            } else {
+                [Some((z0, z0 + h, FacadeRole::Wall)), None]
+            };
+        let bands = bands.map(|band| {
+            band.map(|(lo, hi, role)| {
                 let fh = if role == FacadeRole::GroundFloor {
                     g
                 } else {
                     cx.floor_height
                 };
-                let floors = ((hi - lo) / fh).round().max(1.0) as u32;
-                let d = b - a;
+                (lo, hi, role, ((hi - lo) / fh).round().max(1.0) as u32)
+            })
+        });
+        for (i, &a) in ring.iter().enumerate() {
+            let b = ring.get(i + 1).or(ring.first()).copied().unwrap_or(a);
+            let d = b - a;
+            // `d.normalize_or_zero()` and `d.length()` with one square root.
+            let width = d.length();
+            let rcp = 1.0 / width;
+            let u = if rcp.is_finite() && rcp > 0.0 {
+                d * rcp
+            } else {
+                DVec2::ZERO
+            };
+            for &(lo, hi, role, floors) in bands.iter().flatten() {
                 self.facades.push(FacadeFace {
                     origin: to_world(a, lo),
-                    u: to_world(d.normalize_or_zero(), 0.0),
+                    u: to_world(u, 0.0),
                     v: DVec3::Y,
-                    width: d.length(),
+                    width,
                     height: hi - lo,
                     floors,
                     part,
@@ -544,8 +556,8 @@ impl Output<'_> {
 fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
     let n = pts.len();
     let mut nrm = DVec3::ZERO;
-    for i in 0..n {
-        nrm += pts[i].cross(pts[(i + 1) % n]);
+    for (i, p) in pts.iter().enumerate() {
+        nrm += p.cross(pts[if i + 1 < n { i + 1 } else { 0 }]);
     }
     let nrm = nrm.normalize_or_zero();
     if nrm == DVec3::ZERO {
@@ -596,8 +608,9 @@ fn clip<'r>(cx: &Context<'_>, rings: &'r [DVec2], s: &Shape) -> Option<(&'r [DVe
 fn is_convex(r: Option<&[DVec2]>) -> bool {
     r.is_some_and(|r| {
         let n = r.len();
+        let after = |i: usize| if i + 1 < n { i + 1 } else { 0 };
         (0..n).all(|i| {
-            polis_geom::orient2d(r[i], r[(i + 1) % n], r[(i + 2) % n])
+            polis_geom::orient2d(r[i], r[after(i)], r[after(after(i))])
                 != polis_geom::Orientation::Clockwise
         })
     })
@@ -608,7 +621,7 @@ pub(crate) fn inside(lot: &Polygon, ring: &[DVec2]) -> bool {
     let n = ring.len();
     ring.iter().all(|&p| lot.contains(p))
         && (0..n).all(|i| {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            let (a, b) = (ring[i], ring[if i + 1 < n { i + 1 } else { 0 }]);
             lot.edges().all(|(c, d)| {
                 !matches!(
                     segment_intersection(a, b, c, d),

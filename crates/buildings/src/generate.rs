@@ -91,6 +91,19 @@ impl BuildingGenerator {
         kind: BuildingKind,
         max_height: f64,
     ) -> Result<Option<Plan>, BuildingsError> {
+        Ok(self
+            .plan_centred(lot, lot_id, kind, max_height)?
+            .map(|(plan, _)| plan))
+    }
+
+    /// [`plan`](Self::plan) with the footprint's centroid (the building's origin).
+    fn plan_centred(
+        &self,
+        lot: &Lot,
+        lot_id: u64,
+        kind: BuildingKind,
+        max_height: f64,
+    ) -> Result<Option<(Plan, DVec2)>, BuildingsError> {
         if !(max_height.is_finite()) {
             return Err(BuildingsError::Lot {
                 lot_id,
@@ -110,20 +123,16 @@ impl BuildingGenerator {
             return Ok(None);
         };
         // Primary street edge first: the longest edge when the lot names none.
-        let n = fp.len();
-        let lead = (0..n)
-            .max_by(|&a, &b| {
-                let (p, q) = (fp.edge(a), fp.edge(b));
-                p.0.distance(p.1)
-                    .total_cmp(&q.0.distance(q.1))
-                    .then(b.cmp(&a))
-            })
-            .unwrap_or(0);
+        // (Each edge's length once; on equal lengths the first edge leads.)
         let lead =
             if kind.footprint_strategy() == crate::params::FootprintStrategy::SuburbanRectangle {
                 0
             } else {
-                lead
+                fp.edges()
+                    .enumerate()
+                    .map(|(i, (a, b))| (a.distance(b), i))
+                    .max_by(|p, q| p.0.total_cmp(&q.0).then(q.1.cmp(&p.1)))
+                    .map_or(0, |(_, i)| i)
             };
         let mut pts = fp.into_points();
         pts.rotate_left(lead);
@@ -134,8 +143,9 @@ impl BuildingGenerator {
         fp = Polygon::new(pts);
         let seed = mix_seed(self.params.seed, lot_id);
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x6865_6967_6874);
+        let centroid = fp.centroid();
         let height = self
-            .draw_height(kind, fp.centroid(), &mut rng)
+            .draw_height(kind, centroid, &mut rng)
             .clamp(MIN_BUILDING_HEIGHT, max_height);
         let p = &self.params;
         let floors = if height <= p.ground_floor_height {
@@ -143,12 +153,15 @@ impl BuildingGenerator {
         } else {
             1 + ((height - p.ground_floor_height) / p.floor_height).floor() as u32
         };
-        Ok(Some(Plan {
-            footprint: fp,
-            height,
-            floors,
-            seed,
-        }))
+        Ok(Some((
+            Plan {
+                footprint: fp,
+                height,
+                floors,
+                seed,
+            },
+            centroid,
+        )))
     }
 
     /// A height drawn from the configured distribution for `kind` at layout point `at`.
@@ -242,7 +255,7 @@ impl BuildingGenerator {
         last_only: bool,
         sink: &mut dyn FnMut(Building),
     ) -> Result<(), BuildingsError> {
-        let Some(plan) = self.plan(lot, lot_id, kind, max_height)? else {
+        let Some((plan, origin)) = self.plan_centred(lot, lot_id, kind, max_height)? else {
             return Ok(());
         };
         let Some(grammar) = self.grammars.get(kind.index()) else {
@@ -255,7 +268,6 @@ impl BuildingGenerator {
             kind: kind.name().into(),
             source,
         };
-        let origin = plan.footprint.centroid();
         let mut local = LOCAL.with(std::cell::Cell::take);
         local.clear();
         local.extend(plan.footprint.points().iter().map(|&p| p - origin));

@@ -5,6 +5,7 @@
 //! follow `polis_geom::mesh`'s convention (metres, `u` along the horizontal tangent,
 //! `v = −` distance upwards).
 
+use polis_geom::glam::Vec3;
 use polis_geom::mesh::to_world;
 use polis_geom::{
     DVec2, DVec3, GeomError, Mesh, Orientation, Polygon, PolygonWithHoles, orient2d, triangulate,
@@ -140,6 +141,7 @@ fn with_work<R>(f: impl FnOnce(&mut TriWork) -> R) -> R {
 
 /// The vertices of a horizontal cap over `ring` at elevation `h` (what `push_vertex` per
 /// corner writes, one attribute at a time).
+#[inline]
 fn push_cap(m: &mut Mesh, ring: &[DVec2], h: f64, normal: DVec3, sign: f64) {
     m.positions
         .extend(ring.iter().map(|&p| to_world(p, h).as_vec3()));
@@ -162,9 +164,18 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
     // 4 vertices and 2 triangles per wall, n vertices and n − 2 triangles per cap (every
     // triangulation of a simple ring has n − 2): the mesh is sized exactly.
     let mut m = Mesh::with_capacity(None, 6 * n, 4 * n - 4);
+    let after = |i: usize| if i + 1 < n { i + 1 } else { 0 };
+    let convex = (0..n).all(|i| {
+        let (j, k) = (after(i), after(after(i)));
+        orient2d(ring[i], ring[j], ring[k]) == Orientation::CounterClockwise
+    });
+    // Triangles can still collapse when rounded to f32: a convex prism is checked whole
+    // (walls and fans), a triangulated one on its caps; each triangle is checked from
+    // the f32 corners it is written with, as they are stored.
+    let mut collapsed = false;
     let mut along = 0.0;
     for i in 0..n {
-        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        let (a, b) = (ring[i], ring[after(i)]);
         let len = a.distance(b);
         if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || a.as_vec2() == b.as_vec2()
         {
@@ -182,8 +193,11 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             (b, z1, along + len),
             (a, z1, along),
         ];
-        m.positions
-            .extend_from_slice(&corners.map(|(p, h, _)| to_world(p, h).as_vec3()));
+        let p = corners.map(|(p, h, _)| to_world(p, h).as_vec3());
+        if convex {
+            collapsed |= flat(p[0], p[1], p[2]) || flat(p[0], p[2], p[3]);
+        }
+        m.positions.extend_from_slice(&p);
         m.normals.extend_from_slice(&[normal; 4]);
         m.uvs
             .extend_from_slice(&corners.map(|(_, h, u)| DVec2::new(u, -h).as_vec2()));
@@ -191,9 +205,6 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
         along += len;
     }
-    let convex = (0..n).all(|i| {
-        orient2d(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]) == Orientation::CounterClockwise
-    });
     // One triangulation serves both caps (reversed for the bottom): a fan for a convex
     // ring, as in `add_face`, else ear clipping or CDT. The ring is simple: a validated
     // lot, an inset of one, or a checked shrink.
@@ -214,28 +225,31 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
             } else {
                 (-DVec3::Y, 1.0)
             };
-            let base = m.positions.len() as u32;
+            let start = m.positions.len();
+            let base = start as u32;
             push_cap(&mut m, ring, h, normal, sign);
+            let cap = m.positions.get(start..).unwrap_or_default();
+            let at = |i: u32| cap.get(i as usize).copied().unwrap_or_default();
             for &[a, b, c] in tris.iter() {
-                if up {
-                    m.indices.extend_from_slice(&[base + a, base + b, base + c]);
-                } else {
-                    m.indices.extend_from_slice(&[base + a, base + c, base + b]);
-                }
+                let [a, b, c] = if up { [a, b, c] } else { [a, c, b] };
+                m.indices.extend_from_slice(&[base + a, base + b, base + c]);
+                collapsed = collapsed || flat(at(a), at(b), at(c));
             }
         }
         Ok::<(), GeomError>(())
     })?;
-    // Triangles can still collapse when rounded to f32: a convex prism is checked whole
-    // (walls and fans), a triangulated one on its caps.
-    let checked_from = if convex { 0 } else { 6 * n };
-    if m.indices[checked_from..].chunks_exact(3).any(|t| {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize].as_dvec3());
-        (b - a).cross(c - a) == DVec3::ZERO
-    }) {
+    if collapsed {
         return Err(GeomError::DegenerateTriangle { triangle: 0 });
     }
     Ok(m)
+}
+
+/// Whether the triangle of the stored (f32) corners `a`, `b`, `c` has collapsed: a zero
+/// cross product in f64.
+#[inline]
+fn flat(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    let [a, b, c] = [a, b, c].map(Vec3::as_dvec3);
+    (b - a).cross(c - a) == DVec3::ZERO
 }
 
 /// Largest ring ear clipping handles; longer rings go to the constrained Delaunay
