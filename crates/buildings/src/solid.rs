@@ -55,7 +55,9 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
     let b = nrm.cross(t);
     // Triangulation decides on an exact projection (dropping the normal's dominant axis,
     // no arithmetic), so points collinear in space stay collinear: a rotated basis would
-    // round them apart and let a zero-area ear through.
+    // round them apart and let a zero-area ear through. It projects the points as the
+    // mesh stores them (rounded to `f32`), so a vertex that rounding makes straight is
+    // seen straight and never becomes the tip of a zero-area triangle.
     let k = if nrm.x.abs() >= nrm.y.abs() && nrm.x.abs() >= nrm.z.abs() {
         0
     } else if nrm.y.abs() >= nrm.z.abs() {
@@ -73,6 +75,7 @@ pub(crate) fn add_face(mesh: &mut Mesh, pts: &[DVec3]) -> Result<(), GeomError> 
         } = w;
         exact.clear();
         exact.extend(pts.iter().map(|p| {
+            let p = p.as_vec3().as_dvec3();
             let (a, b) = (p[(k + 1) % 3], p[(k + 2) % 3]);
             if flip {
                 DVec2::new(b, a)
