@@ -11,7 +11,7 @@ use polis_export::map::{MapRoad, RoadClass as MapClass};
 use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 
-use polis_geom::scene::{Image, ImageData, MetaValue, Metadata, Node, Texture};
+use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, Node, NodeId, Texture};
 use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
@@ -426,26 +426,87 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .and_then(|i| cell_nodes.get(i).copied())
     };
 
-    // Blocks, then buildings, under their cells.
-    let count = blocks.len() + buildings.len();
-    scene.nodes.reserve(count);
-    scene.meshes.reserve(count * 3);
-    let block_cells = inp.blocks.iter().map(|b| b.cell_id);
-    let building_cells = inp.building_cells.iter().copied();
-    let leaves = blocks
-        .into_iter()
-        .zip(block_cells)
-        .chain(buildings.into_iter().zip(building_cells));
-    for (made, cell) in leaves {
-        let (mut node, meshes) = made?;
-        let Some(parent) = cell_node(cell) else {
-            continue;
-        };
-        let id = scene.add_node(parent, String::new())?;
-        node.meshes = meshes.into_iter().map(|m| scene.add_mesh(m)).collect();
-        *scene.node_mut(id)? = node;
-    }
+    // Blocks, then buildings, under their cells (every leaf's cell has a node; the root
+    // would adopt one that had not).
+    let mut blocks = blocks;
+    let mut buildings = buildings;
+    let parents: Vec<NodeId> = inp
+        .blocks
+        .iter()
+        .map(|b| b.cell_id)
+        .chain(inp.building_cells.iter().copied())
+        .map(|c| cell_node(c).unwrap_or(root))
+        .collect();
+    let (block_parents, building_parents) = parents.split_at(blocks.len().min(parents.len()));
+    insert_leaves(&mut scene, &mut blocks, block_parents)?;
+    insert_leaves(&mut scene, &mut buildings, building_parents)?;
     Ok(scene)
+}
+
+/// A leaf made in parallel: its node (meshes not attached yet) and its meshes.
+type Leaf = Result<(Node, Vec<Mesh>)>;
+
+/// Appends `made` (in order) as children of `parents`: node ids, mesh ids and the
+/// parents' child lists are assigned serially, which is cheap; the nodes and meshes are
+/// moved into the scene's arrays in parallel, so their fresh pages are touched on every
+/// core. The first error in order is returned, as a serial insertion would.
+fn insert_leaves(scene: &mut Scene, made: &mut [Leaf], parents: &[NodeId]) -> Result<()> {
+    if let Some(bad) = made.iter_mut().find(|m| m.is_err()) {
+        return std::mem::replace(bad, Ok(Default::default())).map(|_| ());
+    }
+    let count = made.len().min(parents.len());
+    let made = made.get_mut(..count).unwrap_or_default();
+    let node_base = scene.nodes.len();
+    let mesh_base = scene.meshes.len();
+    let mut first_mesh = Vec::with_capacity(count);
+    let mut next_mesh = mesh_base;
+    for (k, (m, &parent)) in made.iter().zip(parents).enumerate() {
+        first_mesh.push(next_mesh);
+        next_mesh += m.as_ref().map_or(0, |(_, meshes)| meshes.len());
+        scene
+            .node_mut(parent)?
+            .children
+            .push(NodeId((node_base + k) as u32));
+    }
+    scene.nodes.par_extend(
+        made.par_iter_mut()
+            .zip(first_mesh.par_iter())
+            .map(|(m, &first)| {
+                let (node, len) = m
+                    .as_mut()
+                    .map(|(node, meshes)| (std::mem::take(node), meshes.len()))
+                    .unwrap_or_default();
+                Node {
+                    meshes: (first..first + len).map(|i| MeshId(i as u32)).collect(),
+                    ..node
+                }
+            }),
+    );
+    // Fresh slots (filled on every core), then each leaf's meshes moved into its own.
+    scene.meshes.par_extend(
+        (mesh_base..next_mesh)
+            .into_par_iter()
+            .map(|_| Mesh::default()),
+    );
+    let mut rest = scene.meshes.get_mut(mesh_base..).unwrap_or_default();
+    let mut slots = Vec::with_capacity(count);
+    for m in made.iter() {
+        let len = m.as_ref().map_or(0, |(_, meshes)| meshes.len());
+        let Some((slot, tail)) = std::mem::take(&mut rest).split_at_mut_checked(len) else {
+            break;
+        };
+        slots.push(slot);
+        rest = tail;
+    }
+    made.par_iter_mut().zip(slots).for_each(|(m, slot)| {
+        if let Ok((_, meshes)) = m {
+            for (to, mesh) in slot.iter_mut().zip(meshes.drain(..)) {
+                *to = mesh;
+            }
+            *meshes = Vec::new();
+        }
+    });
+    Ok(())
 }
 
 /// The SVG/GeoJSON kind of a building kind.
