@@ -268,15 +268,21 @@ pub fn fit_rectangle(region: &Polygon, dir: DVec2) -> Option<Polygon> {
     None
 }
 
-/// Whether the convex quad `q` lies strictly inside `region`: corners inside, no region
-/// vertex inside or on the quad, no crossing.
-fn rect_inside(region: &Polygon, q: &[DVec2; 4]) -> bool {
+/// The vertex tests of [`rect_inside`]: every corner of `q` inside `region`, no vertex of
+/// `region` inside or on `q`.
+fn corners_clear(region: &Polygon, q: &[DVec2; 4]) -> bool {
     if !q.iter().all(|&p| region.contains(p)) {
         return false;
     }
     let inside_q =
         |p: DVec2| (0..4).all(|i| orient2d(q[i], q[(i + 1) % 4], p) != Orientation::Clockwise);
-    if region.points().iter().any(|&p| inside_q(p)) {
+    !region.points().iter().any(|&p| inside_q(p))
+}
+
+/// Whether the convex quad `q` lies strictly inside `region`: corners inside, no region
+/// vertex inside or on the quad, no crossing.
+fn rect_inside(region: &Polygon, q: &[DVec2; 4]) -> bool {
+    if !corners_clear(region, q) {
         return false;
     }
     (0..4).all(|i| {
@@ -369,7 +375,7 @@ mod tests {
         );
     }
 
-    fn l_shape() -> Polygon {
+    pub(super) fn l_shape() -> Polygon {
         Polygon::new(vec![
             DVec2::new(0.0, 0.0),
             DVec2::new(30.0, 0.0),
@@ -555,12 +561,7 @@ mod tests {
     /// `rect_inside` before its box pre-test: every edge pair through
     /// `segment_intersection`.
     fn rect_inside_reference(region: &Polygon, q: &[DVec2; 4]) -> bool {
-        if !q.iter().all(|&p| region.contains(p)) {
-            return false;
-        }
-        let inside_q =
-            |p: DVec2| (0..4).all(|i| orient2d(q[i], q[(i + 1) % 4], p) != Orientation::Clockwise);
-        if region.points().iter().any(|&p| inside_q(p)) {
+        if !corners_clear(region, q) {
             return false;
         }
         (0..4).all(|i| {

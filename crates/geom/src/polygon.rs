@@ -486,6 +486,19 @@ fn validate_ring_alone(points: &[DVec2]) -> Result<(), GeomError> {
 /// An edge of a ring being validated: (ring index, edge index, start, end).
 type RingEdge = (usize, usize, DVec2, DVec2);
 
+/// Every edge of the rings, ring by ring.
+fn ring_edge_list(rings: &[(&[DVec2], Ring)]) -> Vec<RingEdge> {
+    rings
+        .iter()
+        .enumerate()
+        .flat_map(|(r, (pts, _))| {
+            ring_edges(pts)
+                .enumerate()
+                .map(move |(e, (a, b))| (r, e, a, b))
+        })
+        .collect()
+}
+
 /// The forbidden contact between edges `i` and `j`, if any: any contact between different
 /// rings or non-consecutive edges of one ring, or consecutive edges that fold back onto
 /// each other.
@@ -537,16 +550,7 @@ fn find_intersection_with(
     rings: &[(&[DVec2], Ring)],
     brute_force_edges: usize,
 ) -> Option<GeomError> {
-    // (ring index, edge index, a, b)
-    let edges: Vec<RingEdge> = rings
-        .iter()
-        .enumerate()
-        .flat_map(|(r, (pts, _))| {
-            ring_edges(pts)
-                .enumerate()
-                .map(move |(e, (a, b))| (r, e, a, b))
-        })
-        .collect();
+    let edges = ring_edge_list(rings);
     let check = |i: usize, j: usize| contact(rings, &edges, i, j);
     if edges.len() <= brute_force_edges {
         // Pairs that cannot meet are skipped before the exact classification: edges
@@ -805,15 +809,7 @@ mod tests {
     /// Every pair of edges in order, with no pruning: the reference of the small-input pass
     /// of `find_intersection_with`.
     fn every_pair(rings: &[(&[DVec2], Ring)]) -> Option<GeomError> {
-        let edges: Vec<RingEdge> = rings
-            .iter()
-            .enumerate()
-            .flat_map(|(r, (pts, _))| {
-                ring_edges(pts)
-                    .enumerate()
-                    .map(move |(e, (a, b))| (r, e, a, b))
-            })
-            .collect();
+        let edges = ring_edge_list(rings);
         (0..edges.len())
             .flat_map(|i| (i + 1..edges.len()).map(move |j| (i, j)))
             .find_map(|(i, j)| contact(rings, &edges, i, j))

@@ -255,15 +255,32 @@ fn rectangle_in(work: &mut RectangleWork, region: &Polygon, dir: DVec2) -> Optio
         }
         r *= 0.25;
     }
-    // Back to the layout with a tiny safety margin, checked exactly.
+    placed(
+        region,
+        (x, y),
+        [best.u0, best.u1, best.v0, best.v1],
+        (lo, hi),
+    )
+}
+
+/// The rectangle `[u0, u1] × [v0, v1]` of the frame with axes `x`, `y` (whose points span
+/// `lo`–`hi`) back in the layout, shrunk by a tiny margin and checked exactly to lie
+/// inside `region`; the margin grows a few times before giving up.
+fn placed(
+    region: &Polygon,
+    (x, y): (DVec2, DVec2),
+    [bu0, bu1, bv0, bv1]: [f64; 4],
+    (lo, hi): (DVec2, DVec2),
+) -> Option<Polygon> {
+    let (w, h) = (hi.x - lo.x, hi.y - lo.y);
     let scale = w
         .max(h)
         .max(lo.abs().max_element())
         .max(hi.abs().max_element());
     let mut margin = 1e-9 * scale;
     for _ in 0..6 {
-        let (u0, u1) = (best.u0 + margin, best.u1 - margin);
-        let (v0, v1) = (best.v0 + margin, best.v1 - margin);
+        let (u0, u1) = (bu0 + margin, bu1 - margin);
+        let (v0, v1) = (bv0 + margin, bv1 - margin);
         if !(u1 > u0 && v1 > v0) {
             return None;
         }
@@ -393,7 +410,7 @@ mod tests {
     /// per-edge modulo and ordering, a full sort of the candidates), kept as the
     /// reference the pruned sweep must equal bit for bit.
     mod reference {
-        use super::super::{RECTANGLE_GRID_STEPS, RECTANGLE_REFINE_ROUNDS, rect_inside};
+        use super::super::{RECTANGLE_GRID_STEPS, RECTANGLE_REFINE_ROUNDS};
         use polis_geom::{DVec2, Polygon};
 
         pub fn largest(region: &Polygon, dir: DVec2) -> Option<Polygon> {
@@ -475,30 +492,12 @@ mod tests {
                 }
                 r *= 0.25;
             }
-            let scale = w
-                .max(h)
-                .max(lo.abs().max_element())
-                .max(hi.abs().max_element());
-            let mut margin = 1e-9 * scale;
-            for _ in 0..6 {
-                let (u0, u1) = (best.u0 + margin, best.u1 - margin);
-                let (v0, v1) = (best.v0 + margin, best.v1 - margin);
-                if !(u1 > u0 && v1 > v0) {
-                    return None;
-                }
-                let corners = [
-                    x * u0 + y * v0,
-                    x * u1 + y * v0,
-                    x * u1 + y * v1,
-                    x * u0 + y * v1,
-                ];
-                if rect_inside(region, &corners) {
-                    let r = Polygon::new(corners.to_vec());
-                    return (r.area() > 0.0 && r.is_ccw()).then_some(r);
-                }
-                margin *= 16.0;
-            }
-            None
+            super::placed(
+                region,
+                (x, y),
+                [best.u0, best.u1, best.v0, best.v1],
+                (lo, hi),
+            )
         }
 
         #[derive(Default)]
@@ -712,14 +711,7 @@ mod tests {
     #[test]
     fn pruned_sweep_equals_the_plain_sweep_on_known_shapes() {
         let shapes = [
-            vec![
-                DVec2::new(0.0, 0.0),
-                DVec2::new(30.0, 0.0),
-                DVec2::new(30.0, 10.0),
-                DVec2::new(10.0, 10.0),
-                DVec2::new(10.0, 30.0),
-                DVec2::new(0.0, 30.0),
-            ],
+            super::super::tests::l_shape().points().to_vec(),
             vec![
                 DVec2::new(0.0, 0.0),
                 DVec2::new(16.0, 0.0),
