@@ -447,6 +447,20 @@ impl Pipeline {
                 Ok(Ok((id, lots?)))
             })
             .collect();
+        // Exact room for what the cells made (growing by doubling would leave up to half
+        // of each vector unused and copy it on the way).
+        let made = per_cell
+            .iter()
+            .filter_map(|r| r.as_ref().ok()?.as_ref().ok());
+        let (mut n_blocks, mut n_green, mut n_lots) = (0, 0, 0);
+        for (_, lots) in made {
+            n_blocks += lots.blocks.len();
+            n_green += lots.green_spaces.len();
+            n_lots += lots.lots.len();
+        }
+        out.blocks.reserve_exact(n_blocks);
+        out.green_spaces.reserve_exact(n_green);
+        out.lots.reserve_exact(n_lots);
         for result in per_cell {
             let (cell, lots) = match result? {
                 Ok(done) => done,
@@ -509,6 +523,9 @@ impl Pipeline {
                 r
             })
             .collect();
+        let n_built = built.iter().filter(|b| matches!(b, Ok(Some(_)))).count();
+        out.buildings.reserve_exact(n_built);
+        out.building_cells.reserve_exact(n_built);
         for (l, b) in out.lots.iter().zip(built) {
             match b {
                 Ok(Some(b)) => {

@@ -202,12 +202,21 @@ pub fn road_surfaces_with_report(
     check_roads(roads)?;
     let plan = junctions::plan(roads, options);
     let drape = Drape::new(roads, &plan, elevation, options)?;
+    // Room for everything below (an upper bound: degenerate pieces are skipped), so the
+    // one large mesh never grows by doubling.
+    let ribbons = || plan.edges.iter().filter(|e| !e.dropped && !e.internal);
+    let pieces: usize = ribbons().map(|e| ribbon_pieces(e, options)).sum();
     let mut mesh = Mesh::with_capacity(
         material,
-        4 * plan.edges.len() + 8 * plan.junctions.len(),
-        2 * plan.edges.len() + 6 * plan.junctions.len(),
+        4 * pieces + plan.junctions.iter().map(|j| j.ring.len()).sum::<usize>(),
+        2 * pieces
+            + plan
+                .junctions
+                .iter()
+                .map(|j| j.triangles.len())
+                .sum::<usize>(),
     );
-    for e in plan.edges.iter().filter(|e| !e.dropped && !e.internal) {
+    for e in ribbons() {
         add_ribbon(&mut mesh, roads, e, &drape, options)?;
     }
     let mut report = plan.report.clone();
@@ -424,6 +433,17 @@ fn bridge_height(
     Ok(h0 + (h1 - h0) * f)
 }
 
+/// The quads of an edge's ribbon: its length between the junction cuts in pieces of at
+/// most `max_segment_m` (none when the cuts leave nothing).
+fn ribbon_pieces(e: &junctions::PlanEdge, o: &RoadSurfaceOptions) -> usize {
+    let inner = e.len - e.trim[0] - e.trim[1];
+    if inner <= e.len * 1e-12 {
+        0
+    } else {
+        (inner / o.max_segment_m).ceil().max(1.0) as usize
+    }
+}
+
 fn add_ribbon(
     mesh: &mut Mesh,
     roads: &[MapRoad],
@@ -433,7 +453,8 @@ fn add_ribbon(
 ) -> Result<(), ExportError> {
     let road = &roads[e.road];
     let inner = e.len - e.trim[0] - e.trim[1];
-    if inner <= e.len * 1e-12 {
+    let pieces = ribbon_pieces(e, o);
+    if pieces == 0 {
         return Ok(());
     }
     let lift = o.lift_m + o.class_lift_m * f64::from(road.class.rank());
@@ -443,7 +464,6 @@ fn add_ribbon(
         [drape.at_node(e.a, ra)?, drape.at_node(e.a, la)?],
         [drape.at_node(e.b, rb)?, drape.at_node(e.b, lb)?],
     ];
-    let pieces = (inner / o.max_segment_m).ceil().max(1.0) as usize;
     let station = |j: usize| -> Result<(DVec3, DVec3, f64), ExportError> {
         let t = j as f64 / pieces as f64;
         let (r, l) = (ra.lerp(rb, t), la.lerp(lb, t));

@@ -191,6 +191,10 @@ impl Mesh {
     ) -> Result<(), GeomError> {
         let poly = normalized_for_walls(polygon, bottom, top)?;
         let triangles = triangulate(&poly)?;
+        // Four vertices and two triangles per wall, one vertex per corner and the cap's
+        // triangles on each cap.
+        let corners: usize = poly.rings().map(|(_, r)| r.len()).sum();
+        self.reserve(6 * corners, 2 * corners + 2 * triangles.len());
         let mark = self.mark();
         let first_triangle = self.triangle_count();
         self.push_walls(&poly, bottom, top);

@@ -223,6 +223,16 @@ impl Mesh {
         self.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]])
     }
 
+    /// Makes room for `vertices` more vertices and `triangles` more triangles (as
+    /// `Vec::reserve`: an empty mesh gets exactly that, a growing one keeps doubling), so a
+    /// mesh built in known steps is allocated once.
+    pub fn reserve(&mut self, vertices: usize, triangles: usize) {
+        self.positions.reserve(vertices);
+        self.normals.reserve(vertices);
+        self.uvs.reserve(vertices);
+        self.indices.reserve(3 * triangles);
+    }
+
     /// Appends one vertex and returns its index.
     ///
     /// The values are taken as given (rounded to `f32`); [`validate`](Self::validate)
