@@ -361,28 +361,30 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         )?))
     };
     // Each building's node (name, placement, metadata) and meshes.
-    let buildings_job = || -> Vec<Result<(Node, Vec<Mesh>)>> {
+    let buildings_job = || -> Vec<Leaf> {
         inp.buildings
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
                 let meshes = building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal)?;
                 let base = ground(elevation, b.footprint.points());
-                let mut node = Node::new(format!("building {}", b.id));
-                node.transform = Transform::from_translation(to_world(b.origin, base));
-                node.metadata = Metadata::from([
-                    ("kind", MetaValue::from_static(b.kind.name())),
-                    ("height", MetaValue::from(b.height)),
-                    ("floors", MetaValue::from(f64::from(b.floors))),
-                    ("lot", MetaValue::from(b.lot_id as f64)),
-                ]);
+                let node = LeafNode {
+                    name: format!("building {}", b.id),
+                    translation: to_world(b.origin, base),
+                    metadata: Metadata::from([
+                        ("kind", MetaValue::from_static(b.kind.name())),
+                        ("height", MetaValue::from(b.height)),
+                        ("floors", MetaValue::from(f64::from(b.floors))),
+                        ("lot", MetaValue::from(b.lot_id as f64)),
+                    ]),
+                };
                 Ok((node, meshes))
             })
             .collect()
     };
     // Each block's node and kerb-high plinth.
     let kerb = inp.config.scene.kerb_height_m;
-    let blocks_job = || -> Vec<Result<(Node, Vec<Mesh>)>> {
+    let blocks_job = || -> Vec<Leaf> {
         if kerb <= 0.0 {
             return Vec::new();
         }
@@ -392,7 +394,12 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                 let base = ground(elevation, block.polygon.outer.points());
                 let plinth =
                     polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?;
-                Ok((Node::new(format!("block {}", block.id())), vec![plinth]))
+                let node = LeafNode {
+                    name: format!("block {}", block.id()),
+                    translation: DVec3::ZERO,
+                    metadata: Metadata::new(),
+                };
+                Ok((node, vec![plinth]))
             })
             .collect()
     };
@@ -443,8 +450,18 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     Ok(scene)
 }
 
-/// A leaf made in parallel: its node (meshes not attached yet) and its meshes.
-type Leaf = Result<(Node, Vec<Mesh>)>;
+/// What a leaf node of the scene (a block, a building) is made of before it joins the
+/// scene: kept small, as there is one per building until the scene takes them.
+#[derive(Default)]
+struct LeafNode {
+    name: String,
+    /// Placement relative to the cell node.
+    translation: DVec3,
+    metadata: Metadata,
+}
+
+/// A leaf made in parallel: its node's parts and its meshes.
+type Leaf = Result<(LeafNode, Vec<Mesh>)>;
 
 /// Appends `made` (in order) as children of `parents`: node ids, mesh ids and the
 /// parents' child lists are assigned serially, which is cheap; the nodes and meshes are
@@ -472,13 +489,16 @@ fn insert_leaves(scene: &mut Scene, made: &mut [Leaf], parents: &[NodeId]) -> Re
         made.par_iter_mut()
             .zip(first_mesh.par_iter())
             .map(|(m, &first)| {
-                let (node, len) = m
+                let (leaf, len) = m
                     .as_mut()
-                    .map(|(node, meshes)| (std::mem::take(node), meshes.len()))
+                    .map(|(leaf, meshes)| (std::mem::take(leaf), meshes.len()))
                     .unwrap_or_default();
                 Node {
+                    name: leaf.name,
+                    transform: Transform::from_translation(leaf.translation),
                     meshes: (first..first + len).map(|i| MeshId(i as u32)).collect(),
-                    ..node
+                    children: Vec::new(),
+                    metadata: leaf.metadata,
                 }
             }),
     );
