@@ -16,6 +16,7 @@
 //! | [`field`] | [`Field`]: input maps (population, water, elevation …) — constants, closures, PNG rasters, seeded simplex/fBm noise, the slides' `populationAt`, combinators, serde [`field::FieldSpec`] |
 //! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks |
 //! | [`scene`] | [`Scene`]: node tree, materials, textures, images — the contract between generators and exporters |
+//! | [`metadata`] | [`Metadata`](metadata::Metadata): a node's small ordered map of [`MetaValue`]s (glTF `extras`, GeoJSON properties) |
 //!
 //! ## Numeric policy
 //!
