@@ -28,6 +28,7 @@ impl Aabb2 {
     };
 
     /// The box spanned by two corners (in any order).
+    #[inline]
     pub fn new(a: DVec2, b: DVec2) -> Self {
         Aabb2 {
             min: a.min(b),
@@ -45,17 +46,20 @@ impl Aabb2 {
     }
 
     /// Whether the box contains no point.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         !(self.min.x <= self.max.x && self.min.y <= self.max.y)
     }
 
     /// Grows the box to contain `p`.
+    #[inline]
     pub fn extend(&mut self, p: DVec2) {
         self.min = self.min.min(p);
         self.max = self.max.max(p);
     }
 
     /// The smallest box containing both.
+    #[inline]
     pub fn union(&self, other: &Aabb2) -> Aabb2 {
         Aabb2 {
             min: self.min.min(other.min),
@@ -64,6 +68,7 @@ impl Aabb2 {
     }
 
     /// The overlap of both boxes (possibly empty).
+    #[inline]
     pub fn intersection(&self, other: &Aabb2) -> Aabb2 {
         Aabb2 {
             min: self.min.max(other.min),
@@ -72,11 +77,13 @@ impl Aabb2 {
     }
 
     /// Whether `p` lies in the closed box.
+    #[inline]
     pub fn contains(&self, p: DVec2) -> bool {
         p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
     }
 
     /// Whether the closed boxes share a point.
+    #[inline]
     pub fn intersects(&self, other: &Aabb2) -> bool {
         self.min.x <= other.max.x
             && other.min.x <= self.max.x
@@ -85,6 +92,7 @@ impl Aabb2 {
     }
 
     /// The box grown by `margin` on every side (shrunk for negative margins).
+    #[inline]
     pub fn expanded(&self, margin: f64) -> Aabb2 {
         Aabb2 {
             min: self.min - DVec2::splat(margin),
@@ -93,6 +101,7 @@ impl Aabb2 {
     }
 
     /// Width and height (zero for an empty box).
+    #[inline]
     pub fn size(&self) -> DVec2 {
         if self.is_empty() {
             DVec2::ZERO
@@ -102,21 +111,25 @@ impl Aabb2 {
     }
 
     /// Width (x extent).
+    #[inline]
     pub fn width(&self) -> f64 {
         self.size().x
     }
 
     /// Height (y extent).
+    #[inline]
     pub fn height(&self) -> f64 {
         self.size().y
     }
 
     /// The centre point.
+    #[inline]
     pub fn center(&self) -> DVec2 {
         (self.min + self.max) * 0.5
     }
 
     /// Area in square metres (zero for an empty box).
+    #[inline]
     pub fn area(&self) -> f64 {
         let s = self.size();
         s.x * s.y

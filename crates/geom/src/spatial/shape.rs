@@ -19,6 +19,7 @@ pub enum Shape {
 
 impl Shape {
     /// The bounding box.
+    #[inline]
     pub fn bbox(&self) -> Aabb2 {
         match *self {
             Shape::Point(p) => Aabb2::new(p, p),
