@@ -363,31 +363,44 @@ impl Strip<'_> {
             });
         }
         sort_by_start(self.blocked);
-        let width = u1 - u0;
-        let mid = 0.5 * (u0 + u1);
-        let mut cur = self.vmin;
-        let gaps = self
-            .blocked
-            .iter()
-            .copied()
-            .chain(std::iter::once((self.vmax, self.vmax)));
-        for (s, e) in gaps {
-            if s > cur && (s - cur) * width > best.area {
-                let m = DVec2::new(mid, 0.5 * (cur + s));
-                if polis_geom::polygon::locate_in_ring(self.ring, m)
-                    == polis_geom::PointLocation::Inside
-                {
-                    *best = Best {
-                        area: (s - cur) * width,
-                        u0,
-                        u1,
-                        v0: cur,
-                        v1: s,
-                    };
-                }
+        tallest_gap(
+            self.ring,
+            (self.vmin, self.vmax),
+            self.blocked,
+            (u0, u1),
+            best,
+        );
+    }
+}
+
+/// Walks the gaps between the sorted blocked intervals of the strip `[u0, u1]` (from
+/// `vmin` to `vmax`): a gap holds no boundary point, so one exact point-in-ring test at its
+/// middle decides whether it lies inside; an inside gap taller than `best` replaces it.
+fn tallest_gap(
+    ring: &[DVec2],
+    (vmin, vmax): (f64, f64),
+    blocked: &[(f64, f64)],
+    (u0, u1): (f64, f64),
+    best: &mut Best,
+) {
+    let width = u1 - u0;
+    let mid = 0.5 * (u0 + u1);
+    let mut cur = vmin;
+    let gaps = blocked.iter().copied().chain(std::iter::once((vmax, vmax)));
+    for (s, e) in gaps {
+        if s > cur && (s - cur) * width > best.area {
+            let m = DVec2::new(mid, 0.5 * (cur + s));
+            if polis_geom::polygon::locate_in_ring(ring, m) == polis_geom::PointLocation::Inside {
+                *best = Best {
+                    area: (s - cur) * width,
+                    u0,
+                    u1,
+                    v0: cur,
+                    v1: s,
+                };
             }
-            cur = cur.max(e);
         }
+        cur = cur.max(e);
     }
 }
 
@@ -410,7 +423,7 @@ mod tests {
     /// per-edge modulo and ordering, a full sort of the candidates), kept as the
     /// reference the pruned sweep must equal bit for bit.
     mod reference {
-        use super::super::{RECTANGLE_GRID_STEPS, RECTANGLE_REFINE_ROUNDS};
+        use super::super::{Best, RECTANGLE_GRID_STEPS, RECTANGLE_REFINE_ROUNDS};
         use polis_geom::{DVec2, Polygon};
 
         pub fn largest(region: &Polygon, dir: DVec2) -> Option<Polygon> {
@@ -500,15 +513,6 @@ mod tests {
             )
         }
 
-        #[derive(Default)]
-        struct Best {
-            area: f64,
-            u0: f64,
-            u1: f64,
-            v0: f64,
-            v1: f64,
-        }
-
         struct Strip<'a> {
             ring: &'a [DVec2],
             vmin: f64,
@@ -559,31 +563,13 @@ mod tests {
                     self.blocked.push((va.min(vb), va.max(vb)));
                 }
                 self.blocked.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let width = u1 - u0;
-                let mid = 0.5 * (u0 + u1);
-                let mut cur = self.vmin;
-                let gaps = self
-                    .blocked
-                    .iter()
-                    .map(|&(s, e)| (s, e))
-                    .chain(std::iter::once((self.vmax, self.vmax)));
-                for (s, e) in gaps {
-                    if s > cur && (s - cur) * width > best.area {
-                        let m = DVec2::new(mid, 0.5 * (cur + s));
-                        if polis_geom::polygon::locate_in_ring(self.ring, m)
-                            == polis_geom::PointLocation::Inside
-                        {
-                            *best = Best {
-                                area: (s - cur) * width,
-                                u0,
-                                u1,
-                                v0: cur,
-                                v1: s,
-                            };
-                        }
-                    }
-                    cur = cur.max(e);
-                }
+                super::super::tallest_gap(
+                    self.ring,
+                    (self.vmin, self.vmax),
+                    self.blocked,
+                    (u0, u1),
+                    best,
+                );
             }
         }
     }
