@@ -378,15 +378,13 @@ impl SkinQuad {
     /// (glTF convention: the tile's top edge at `v = 0`, the quad's bottom at
     /// `v = ⌈repeats up⌉`).
     pub fn uvs(&self) -> [DVec2; 4] {
-        let [ru, rv] = self.repeats.map(f64::from);
-        let bottom = rv.ceil();
-        let top = bottom - rv;
-        [
-            DVec2::new(0.0, bottom),
-            DVec2::new(ru, bottom),
-            DVec2::new(ru, top),
-            DVec2::new(0.0, top),
-        ]
+        let [s0, t0, s1, t1] = self.rect;
+        let tile = TileQuad {
+            rect: polis_geom::Aabb2::new(DVec2::new(s0, t0), DVec2::new(s1, t1)),
+            tile: self.tile as usize,
+            repeats: self.repeats.map(f64::from),
+        };
+        [(s0, t0), (s1, t0), (s1, t1), (s0, t1)].map(|(s, t)| DVec2::from(tile.uv_at(s, t)))
     }
 }
 
