@@ -48,8 +48,9 @@
 //!   out-of-range indices, broken trees, short rings) before the first byte; options are
 //!   checked too. The error is a typed [`ExportError`].
 //! * **Streaming.** Every writer writes through `impl Write` as it goes; no writer builds
-//!   the whole file as a string or buffer (the glTF JSON chunk, PNG encodings and
-//!   batched meshes are the only things assembled first).
+//!   the whole file as a string or buffer (the glTF JSON chunk, PNG encodings, batched
+//!   meshes and the OBJ text of about 256 Ki vertices at a time, formatted in parallel,
+//!   are the only things assembled first).
 //! * **Deterministic.** Identical input and options give identical bytes: array order
 //!   everywhere, ordered maps only, fixed or shortest-round-trip number formatting.
 //! * **Checked by real readers** in the tests: `gltf` (with validation) and a hand decoder
@@ -85,6 +86,7 @@ pub mod obj;
 pub mod sink;
 pub mod surfaces;
 pub mod svg;
+mod text;
 
 pub use error::ExportError;
 

@@ -22,8 +22,11 @@
 //!   and normal textures. Meshes without a material use `polis_default` (white).
 //! * `<stem>_<image index>_<name>.png` per image a material uses.
 //!
-//! Numbers use Rust's shortest round-trip formatting, so output is byte-identical for
-//! identical scenes, and `f32` values read back exactly.
+//! Numbers are written exactly as Rust's `Display` writes them (shortest round-trip digits,
+//! plain notation), so output is byte-identical for identical scenes, and `f32` values
+//! read back exactly. The text is formatted node by node on rayon's thread pool, a batch
+//! of about 256 Ki vertices at a time while the previous batch is written, and written in
+//! node order: the bytes do not depend on the number of threads.
 //!
 //! ## Limitations
 //!
@@ -34,13 +37,15 @@
 use std::io::Write;
 
 use polis_geom::Mesh;
-use polis_geom::glam::{DMat3, DMat4, Vec2, Vec3};
+use polis_geom::glam::{DMat3, DMat4};
 use polis_geom::scene::{Material, Scene};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 use crate::images::{png_bytes, sanitize};
 use crate::sink::FileSink;
+use crate::text::{push_f32, push_u64};
 
 /// Options of [`write_obj`].
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -100,8 +105,23 @@ pub const DEFAULT_MATERIAL: &str = "polis_default";
 pub fn write_obj<W: Write, S: FileSink>(
     scene: &Scene,
     options: &ObjOptions,
+    obj: W,
+    sink: &mut S,
+) -> Result<ObjReport, ExportError> {
+    write_obj_in_batches(scene, options, obj, sink, BATCH_VERTICES)
+}
+
+/// About how many vertices' text [`write_obj`] formats at a time.
+const BATCH_VERTICES: u64 = 1 << 18;
+
+/// [`write_obj`] with batches of about `batch_vertices` vertices (the tests vary it: the
+/// bytes must not depend on it).
+pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
+    scene: &Scene,
+    options: &ObjOptions,
     mut obj: W,
     sink: &mut S,
+    batch_vertices: u64,
 ) -> Result<ObjReport, ExportError> {
     scene.validate()?;
     let stem = &options.stem;
@@ -120,6 +140,8 @@ pub fn write_obj<W: Write, S: FileSink>(
     let mut report = ObjReport::default();
 
     // --- OBJ ---
+    // Each node's text is formatted on its own (in parallel, in batches of bounded size)
+    // and the batches are written in node order, so the bytes are those of a serial pass.
     let worlds = scene.world_matrices();
     let uses_default = scene
         .nodes
@@ -127,44 +149,95 @@ pub fn write_obj<W: Write, S: FileSink>(
         .flat_map(|n| &n.meshes)
         .map(|m| &scene.meshes[m.index()])
         .any(|m| m.material.is_none() && !m.is_empty());
-    let mut w = Counted::new(&mut obj);
-    let io = ExportError::io("obj");
+    let material_names: Vec<String> = (0..scene.materials.len())
+        .map(|i| material_name(i, scene))
+        .collect();
+    let drawn_meshes = |i: usize| {
+        scene.nodes[i]
+            .meshes
+            .iter()
+            .map(|m| &scene.meshes[m.index()])
+            .filter(|m| !m.is_empty())
+    };
+    // The nodes that draw geometry, with the OBJ index of their first vertex.
+    let mut drawn: Vec<(usize, u64)> = Vec::new();
+    let mut base: u64 = 1;
+    for i in 0..scene.nodes.len() {
+        let first = base;
+        for m in drawn_meshes(i) {
+            report.vertices += m.vertex_count();
+            report.triangles += m.triangle_count();
+            base += m.vertex_count() as u64;
+        }
+        if drawn_meshes(i).next().is_some() {
+            drawn.push((i, first));
+        }
+    }
+    report.groups = drawn.len();
+    let mut header = Vec::new();
     (|| -> std::io::Result<()> {
-        writeln!(w, "# polis-export {}", env!("CARGO_PKG_VERSION"))?;
+        writeln!(header, "# polis-export {}", env!("CARGO_PKG_VERSION"))?;
         writeln!(
-            w,
+            header,
             "# metres; +Y up, right-handed (glTF axes); triangles counter-clockwise from the front"
         )?;
-        writeln!(w, "mtllib {mtl_name}")?;
-        let mut base: u64 = 1;
-        for (i, node) in scene.nodes.iter().enumerate() {
-            let meshes: Vec<&Mesh> = node
-                .meshes
-                .iter()
-                .map(|m| &scene.meshes[m.index()])
-                .filter(|m| !m.is_empty())
-                .collect();
-            if meshes.is_empty() {
-                continue;
-            }
-            report.groups += 1;
-            writeln!(w, "g {}_{i}", sanitize(&node.name, "node"))?;
-            let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
-            for m in meshes {
-                match m.material {
-                    Some(id) => writeln!(w, "usemtl {}", material_name(id.index(), scene))?,
-                    None => writeln!(w, "usemtl {DEFAULT_MATERIAL}")?,
-                }
-                write_mesh(&mut w, m, &world, base)?;
-                base += m.vertex_count() as u64;
-                report.vertices += m.vertex_count();
-                report.triangles += m.triangle_count();
-            }
-        }
-        w.flush()
+        writeln!(header, "mtllib {mtl_name}")
     })()
-    .map_err(io)?;
-    report.bytes = w.written;
+    .map_err(ExportError::io("obj"))?;
+    obj.write_all(&header).map_err(ExportError::io("obj"))?;
+    let mut bytes = header.len() as u64;
+    let node_text = |&(i, first): &(usize, u64)| -> Vec<u8> {
+        let vertices: usize = drawn_meshes(i).map(|m| m.vertex_count()).sum();
+        let triangles: usize = drawn_meshes(i).map(|m| m.triangle_count()).sum();
+        // Vertex lines (v, vt, vn) take about 80 bytes a vertex, face lines about 40.
+        let mut out = Vec::with_capacity(64 + vertices * 80 + triangles * 40);
+        out.extend_from_slice(b"g ");
+        out.extend_from_slice(sanitize(&scene.nodes[i].name, "node").as_bytes());
+        out.push(b'_');
+        push_u64(&mut out, i as u64);
+        out.push(b'\n');
+        let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
+        let mut base = first;
+        for m in drawn_meshes(i) {
+            out.extend_from_slice(b"usemtl ");
+            match m.material.and_then(|id| material_names.get(id.index())) {
+                Some(name) => out.extend_from_slice(name.as_bytes()),
+                None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
+            }
+            out.push(b'\n');
+            push_mesh(&mut out, m, &world, base);
+            base += m.vertex_count() as u64;
+        }
+        out
+    };
+    // Batches of about 256 Ki vertices (some tens of MiB of text): the next batch is
+    // formatted on the thread pool while this thread writes the last one.
+    let batches = batch_bounds(&drawn, batch_vertices);
+    let format = |range: &std::ops::Range<usize>| -> Vec<Vec<u8>> {
+        drawn
+            .get(range.clone())
+            .unwrap_or_default()
+            .par_iter()
+            .map(node_text)
+            .collect()
+    };
+    let mut ready = batches.first().map(&format).unwrap_or_default();
+    for k in 0..batches.len() {
+        let mut next = None;
+        let written = rayon::in_place_scope(|s| {
+            if let Some(range) = batches.get(k + 1) {
+                s.spawn(|_| next = Some(format(range)));
+            }
+            ready.iter().try_for_each(|text| {
+                bytes += text.len() as u64;
+                obj.write_all(text)
+            })
+        });
+        written.map_err(ExportError::io("obj"))?;
+        ready = next.unwrap_or_default();
+    }
+    obj.flush().map_err(ExportError::io("obj"))?;
+    report.bytes = bytes;
 
     // --- MTL and textures ---
     let mut texture_files: Vec<Option<String>> = vec![None; scene.images.len()];
@@ -248,9 +321,26 @@ fn write_material(
     Ok(())
 }
 
-/// Writes one mesh's vertices and faces in world coordinates; `base` is the OBJ index of
+/// Splits the drawn nodes (node, first vertex) into runs of consecutive nodes of about
+/// `vertices` vertices each (a node is never split).
+fn batch_bounds(drawn: &[(usize, u64)], vertices: u64) -> Vec<std::ops::Range<usize>> {
+    let mut bounds = Vec::new();
+    let mut start = 0;
+    while let Some(&(_, first)) = drawn.get(start) {
+        let end = drawn
+            .iter()
+            .skip(start + 1)
+            .position(|&(_, f)| f - first >= vertices)
+            .map_or(drawn.len(), |k| start + 1 + k);
+        bounds.push(start..end);
+        start = end;
+    }
+    bounds
+}
+
+/// Appends one mesh's vertices and faces in world coordinates; `base` is the OBJ index of
 /// its first vertex.
-fn write_mesh<W: Write>(w: &mut W, m: &Mesh, world: &DMat4, base: u64) -> std::io::Result<()> {
+fn push_mesh(out: &mut Vec<u8>, m: &Mesh, world: &DMat4, base: u64) {
     let identity = *world == DMat4::IDENTITY;
     let linear = DMat3::from_mat4(*world);
     let mirror = linear.determinant() < 0.0;
@@ -261,10 +351,10 @@ fn write_mesh<W: Write>(w: &mut W, m: &Mesh, world: &DMat4, base: u64) -> std::i
         } else {
             world.transform_point3(p.as_dvec3()).as_vec3()
         };
-        write_v3(w, "v ", p)?;
+        push_vector(out, b"v ", &p.to_array());
     }
     for t in &m.uvs {
-        write_v2(w, "vt ", Vec2::new(t.x, 1.0 - t.y))?;
+        push_vector(out, b"vt ", &[t.x, 1.0 - t.y]);
     }
     for n in &m.normals {
         let n = if identity {
@@ -272,54 +362,34 @@ fn write_mesh<W: Write>(w: &mut W, m: &Mesh, world: &DMat4, base: u64) -> std::i
         } else {
             (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()
         };
-        write_v3(w, "vn ", n)?;
+        push_vector(out, b"vn ", &n.to_array());
     }
     for [a, b, c] in m.triangles() {
-        let (a, b, c) = (
-            base + u64::from(a),
-            base + u64::from(b),
-            base + u64::from(c),
-        );
         let (b, c) = if mirror { (c, b) } else { (b, c) };
-        writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
-    }
-    Ok(())
-}
-
-fn write_v3<W: Write>(w: &mut W, tag: &str, v: Vec3) -> std::io::Result<()> {
-    writeln!(w, "{tag}{} {} {}", v.x, v.y, v.z)
-}
-
-fn write_v2<W: Write>(w: &mut W, tag: &str, v: Vec2) -> std::io::Result<()> {
-    writeln!(w, "{tag}{} {}", v.x, v.y)
-}
-
-/// A buffered writer that counts bytes (so the report knows the size without seeking).
-struct Counted<'w, W: Write> {
-    inner: std::io::BufWriter<&'w mut W>,
-    written: u64,
-}
-
-impl<'w, W: Write> Counted<'w, W> {
-    fn new(out: &'w mut W) -> Self {
-        Counted {
-            inner: std::io::BufWriter::with_capacity(1 << 16, out),
-            written: 0,
+        out.push(b'f');
+        for k in [a, b, c] {
+            let k = base + u64::from(k);
+            out.push(b' ');
+            push_u64(out, k);
+            out.push(b'/');
+            push_u64(out, k);
+            out.push(b'/');
+            push_u64(out, k);
         }
+        out.push(b'\n');
     }
 }
 
-impl<W: Write> Write for Counted<'_, W> {
-    #[inline]
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let n = self.inner.write(buf)?;
-        self.written += n as u64;
-        Ok(n)
+/// Appends `tag`, the components separated by spaces, and a newline.
+fn push_vector(out: &mut Vec<u8>, tag: &[u8], v: &[f32]) {
+    out.extend_from_slice(tag);
+    for (k, &x) in v.iter().enumerate() {
+        if k > 0 {
+            out.push(b' ');
+        }
+        push_f32(out, x);
     }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.inner.flush()
-    }
+    out.push(b'\n');
 }
 
 #[cfg(test)]

@@ -238,6 +238,12 @@ proptest! {
         let mut files = MemorySink::new();
         let report = write_obj(&scene, &ObjOptions::default(), &mut obj, &mut files).unwrap();
         prop_assert_eq!(report.triangles, drawn);
+        // Byte for byte the serial `writeln!` writer, with any batch size.
+        let reference = crate::obj::tests::reference_obj(&scene, &ObjOptions::default().stem);
+        prop_assert_eq!(&obj, &reference);
+        let mut small = Vec::new();
+        crate::obj::write_obj_in_batches(&scene, &ObjOptions::default(), &mut small, &mut MemorySink::new(), 3).unwrap();
+        prop_assert_eq!(&small, &reference);
         if drawn > 0 {
             let (models, _) = crate::obj::tests::load(&obj, &files);
             let tris: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();

@@ -1,6 +1,7 @@
 use super::*;
 use crate::sink::MemorySink;
-use crate::testing::{drawn_triangles, sample_scene};
+use crate::testing::{drawn_triangles, grid_scene, sample_scene};
+use polis_geom::glam::Vec3;
 
 /// Reads an OBJ and its MTL with `tobj`, the MTL from the sink.
 pub(crate) fn load(obj: &[u8], files: &MemorySink) -> (Vec<tobj::Model>, Vec<tobj::Material>) {
@@ -222,4 +223,100 @@ fn default_material_only_when_drawn_and_dir_sink_writes_files() {
     assert_eq!(models.len(), 7);
     assert_eq!(mats.len(), 3);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The OBJ text of `scene` as the first writer made it, one `writeln!` at a time with
+/// `core`'s number formatting: the reference the batched, parallel writer must match byte
+/// for byte.
+pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
+    use std::io::Write as _;
+    let mut w = Vec::new();
+    let _ = writeln!(w, "# polis-export {}", env!("CARGO_PKG_VERSION"));
+    let _ = writeln!(
+        w,
+        "# metres; +Y up, right-handed (glTF axes); triangles counter-clockwise from the front"
+    );
+    let _ = writeln!(w, "mtllib {stem}.mtl");
+    let worlds = scene.world_matrices();
+    let mut base: u64 = 1;
+    for (i, node) in scene.nodes.iter().enumerate() {
+        let meshes: Vec<&Mesh> = node
+            .meshes
+            .iter()
+            .map(|m| &scene.meshes[m.index()])
+            .filter(|m| !m.is_empty())
+            .collect();
+        if meshes.is_empty() {
+            continue;
+        }
+        let _ = writeln!(w, "g {}_{i}", sanitize(&node.name, "node"));
+        let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
+        let identity = world == DMat4::IDENTITY;
+        let linear = DMat3::from_mat4(world);
+        let mirror = linear.determinant() < 0.0;
+        let normal_matrix = linear.inverse().transpose();
+        for m in meshes {
+            match m.material {
+                Some(id) => {
+                    let _ = writeln!(w, "usemtl {}", material_name(id.index(), scene));
+                }
+                None => {
+                    let _ = writeln!(w, "usemtl {DEFAULT_MATERIAL}");
+                }
+            }
+            for p in &m.positions {
+                let p = if identity {
+                    *p
+                } else {
+                    world.transform_point3(p.as_dvec3()).as_vec3()
+                };
+                let _ = writeln!(w, "v {} {} {}", p.x, p.y, p.z);
+            }
+            for t in &m.uvs {
+                let _ = writeln!(w, "vt {} {}", t.x, 1.0 - t.y);
+            }
+            for n in &m.normals {
+                let n = if identity {
+                    n.normalize_or_zero()
+                } else {
+                    (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()
+                };
+                let _ = writeln!(w, "vn {} {} {}", n.x, n.y, n.z);
+            }
+            for [a, b, c] in m.triangles() {
+                let (a, b, c) = (
+                    base + u64::from(a),
+                    base + u64::from(b),
+                    base + u64::from(c),
+                );
+                let (b, c) = if mirror { (c, b) } else { (b, c) };
+                let _ = writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
+            }
+            base += m.vertex_count() as u64;
+        }
+    }
+    w
+}
+
+#[test]
+fn batches_and_threads_do_not_change_the_bytes() {
+    let scene = grid_scene(6);
+    let options = ObjOptions::default();
+    let write = |batch: u64| {
+        let (mut obj, mut files) = (Vec::new(), MemorySink::new());
+        let report = write_obj_in_batches(&scene, &options, &mut obj, &mut files, batch).unwrap();
+        assert_eq!(report.bytes, obj.len() as u64);
+        obj
+    };
+    let reference = reference_obj(&scene, &options.stem);
+    for batch in [1, 5, 64, BATCH_VERTICES] {
+        assert_eq!(write(batch), reference, "batch {batch}");
+    }
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        assert_eq!(pool.install(|| write(7)), reference, "{threads} threads");
+    }
 }
