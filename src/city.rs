@@ -235,30 +235,35 @@ impl City {
             path: dir.into(),
             source,
         })?;
-        let mut written = Written::default();
-        let map = self.map_layers()?;
-
-        let files = &mut written.files;
-        files.push(write_file(dir.join("city.svg"), |w| {
-            svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
-            Ok(())
-        })?);
-        files.push(write_file(dir.join("city.geojson"), |w| {
-            geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), w)?;
-            Ok(())
-        })?);
-        files.push(write_file(dir.join("city.glb"), |w| {
-            self.write_glb(w).map(|_| ())
-        })?);
-        files.push(write_file(dir.join("city.obj"), |w| {
-            let options = obj::ObjOptions {
-                stem: "city".into(),
-            };
-            obj::write_obj(&self.scene, &options, w, &mut DirSink::new(dir))?;
-            Ok(())
-        })?);
-        written.files.push(dir.join("city.mtl"));
-        Ok(written)
+        // The four files are written at the same time (the OBJ text is also formatted in
+        // parallel); the first error in the order below is returned.
+        let maps = || -> Result<(PathBuf, PathBuf)> {
+            let map = self.map_layers()?;
+            let svg = write_file(dir.join("city.svg"), |w| {
+                svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
+                Ok(())
+            })?;
+            let geojson = write_file(dir.join("city.geojson"), |w| {
+                geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), w)?;
+                Ok(())
+            })?;
+            Ok((svg, geojson))
+        };
+        let glb = || write_file(dir.join("city.glb"), |w| self.write_glb(w).map(|_| ()));
+        let obj = || {
+            write_file(dir.join("city.obj"), |w| {
+                let options = obj::ObjOptions {
+                    stem: "city".into(),
+                };
+                obj::write_obj(&self.scene, &options, w, &mut DirSink::new(dir))?;
+                Ok(())
+            })
+        };
+        let (maps, (glb, obj)) = rayon::join(maps, || rayon::join(glb, obj));
+        let (svg, geojson) = maps?;
+        Ok(Written {
+            files: vec![svg, geojson, glb?, obj?, dir.join("city.mtl")],
+        })
     }
 }
 
