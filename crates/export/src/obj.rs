@@ -368,13 +368,12 @@ fn push_mesh(out: &mut Vec<u8>, m: &Mesh, world: &DMat4, base: u64) {
         let (b, c) = if mirror { (c, b) } else { (b, c) };
         out.push(b'f');
         for k in [a, b, c] {
-            let k = base + u64::from(k);
-            out.push(b' ');
-            push_u64(out, k);
-            out.push(b'/');
-            push_u64(out, k);
-            out.push(b'/');
-            push_u64(out, k);
+            let mut text = itoa::Buffer::new();
+            let k = text.format(base + u64::from(k)).as_bytes();
+            for (sep, part) in [(b' ', k), (b'/', k), (b'/', k)] {
+                out.push(sep);
+                out.extend_from_slice(part);
+            }
         }
         out.push(b'\n');
     }

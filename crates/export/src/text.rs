@@ -25,58 +25,86 @@ pub(crate) fn push_f32(out: &mut Vec<u8>, x: f32) {
         Some((b'-', rest)) => (true, rest),
         _ => (false, text),
     };
-    // zmij writes `digits[.digits][e±exponent]`; read the significant digits `d` and the
-    // decimal exponent `q` of the value d × 10^q.
-    let (mantissa, exponent) = match text.iter().position(|&c| c == b'e') {
-        Some(i) => (
-            text.get(..i).unwrap_or_default(),
-            parse_exponent(text.get(i + 1..).unwrap_or_default()),
-        ),
-        None => (text, 0),
-    };
-    let mut d: u64 = 0;
-    let mut fraction_digits = 0i32;
+    // zmij writes `digits[.digits][e±exponent]`. Keep the significant digits (leading
+    // zeros dropped) and the decimal exponent `q`: the value is digits × 10^q.
+    let mut digits = [0u8; 24];
+    let mut n = 0;
+    let mut q = 0i32;
     let mut after_point = false;
-    for &c in mantissa {
-        if c == b'.' {
-            after_point = true;
-        } else {
-            d = d * 10 + u64::from(c.wrapping_sub(b'0'));
-            fraction_digits += i32::from(after_point);
+    for (i, &c) in text.iter().enumerate() {
+        match c {
+            b'.' => after_point = true,
+            b'e' => {
+                q += parse_exponent(text.get(i + 1..).unwrap_or_default());
+                break;
+            }
+            _ => {
+                if (n > 0 || c != b'0')
+                    && let Some(slot) = digits.get_mut(n)
+                {
+                    *slot = c;
+                    n += 1;
+                }
+                q -= i32::from(after_point);
+            }
         }
     }
-    let mut q = exponent - fraction_digits;
+    while n > 0 && digits.get(n - 1) == Some(&b'0') {
+        n -= 1;
+        q += 1;
+    }
+    out.reserve(64);
     if negative {
         out.push(b'-');
     }
-    if d == 0 {
+    let digits = digits.get(..n).unwrap_or_default();
+    if digits.is_empty() {
         out.push(b'0');
         return;
     }
-    strip_zeros(&mut d, &mut q);
     // A value exactly halfway between two shortest candidates: zmij rounds to the even
     // one, `core` away from zero. Both read back to `x`.
-    if is_midpoint_above(d, q, x) {
-        d += 1;
-        strip_zeros(&mut d, &mut q);
+    if is_midpoint_above(digits, q, x) {
+        let mut up = digits
+            .iter()
+            .fold(0u64, |d, &c| d * 10 + u64::from(c.wrapping_sub(b'0')))
+            + 1;
+        strip_zeros(&mut up, &mut q);
+        let mut text = itoa::Buffer::new();
+        push_plain(out, text.format(up).as_bytes(), q);
+    } else {
+        push_plain(out, digits, q);
     }
-    let mut digits = itoa::Buffer::new();
-    let digits = digits.format(d).as_bytes();
+}
+
+/// Appends digits × 10^q in plain notation, as `core` lays out a shortest `Display`.
+fn push_plain(out: &mut Vec<u8>, digits: &[u8], q: i32) {
     let n = digits.len() as i32;
     // The value is 0.digits × 10^k.
     let k = n + q;
+    let zeros = |out: &mut Vec<u8>, count: i32| {
+        for _ in 0..count {
+            out.push(b'0');
+        }
+    };
+    let push_all = |out: &mut Vec<u8>, bytes: &[u8]| {
+        for &c in bytes {
+            out.push(c);
+        }
+    };
     if k <= 0 {
-        out.extend_from_slice(b"0.");
-        out.resize(out.len() + (-k) as usize, b'0');
-        out.extend_from_slice(digits);
+        out.push(b'0');
+        out.push(b'.');
+        zeros(out, -k);
+        push_all(out, digits);
     } else if k < n {
         let (whole, fraction) = digits.split_at(k as usize);
-        out.extend_from_slice(whole);
+        push_all(out, whole);
         out.push(b'.');
-        out.extend_from_slice(fraction);
+        push_all(out, fraction);
     } else {
-        out.extend_from_slice(digits);
-        out.resize(out.len() + (k - n) as usize, b'0');
+        push_all(out, digits);
+        zeros(out, k - n);
     }
 }
 
@@ -105,12 +133,14 @@ fn parse_exponent(text: &[u8]) -> i32 {
         .fold(0i32, |e, &c| e * 10 + i32::from(c.wrapping_sub(b'0')))
 }
 
-/// Whether |x| is exactly (d + ½) × 10^q, in exact integer arithmetic.
+/// Whether |x| is exactly (d + ½) × 10^q, where d is the number `digits` spell, in exact
+/// integer arithmetic.
 ///
 /// |x| = m × 2^e. The equation (2d + 1) × 10^q = m × 2^(e+1) holds exactly when both
-/// sides have the same part prime to 10 and the same powers of 2 and of 5; 2d + 1 is odd,
-/// so its powers of 2 come from 10^q alone.
-fn is_midpoint_above(d: u64, q: i32, x: f32) -> bool {
+/// sides have the same powers of 2 and of 5 and the same part prime to 10; 2d + 1 is odd,
+/// so its power of 2 comes from 10^q alone, which is checked first and rules out almost
+/// every value.
+fn is_midpoint_above(digits: &[u8], q: i32, x: f32) -> bool {
     let bits = x.to_bits() & 0x7fff_ffff;
     let (mut m, mut e) = (u64::from(bits & 0x7f_ffff), (bits >> 23) as i32);
     if e == 0 {
@@ -122,13 +152,16 @@ fn is_midpoint_above(d: u64, q: i32, x: f32) -> bool {
     if m == 0 {
         return false;
     }
-    let Some(lhs) = d.checked_mul(2).and_then(|v| v.checked_add(1)) else {
-        return false;
-    };
-    let (a, fives_a) = without_fives(lhs);
     let twos_m = m.trailing_zeros() as i32;
+    if q != e + 1 + twos_m || digits.len() > 18 {
+        return false;
+    }
+    let d = digits
+        .iter()
+        .fold(0u64, |d, &c| d * 10 + u64::from(c.wrapping_sub(b'0')));
+    let (a, fives_a) = without_fives(2 * d + 1);
     let (b, fives_m) = without_fives(m >> twos_m);
-    a == b && q == e + 1 + twos_m && q + fives_a == fives_m
+    a == b && q + fives_a == fives_m
 }
 
 /// `v` without its factors of 5, and how many there were.
