@@ -143,12 +143,6 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     // Each node's text is formatted on its own (in parallel, in batches of bounded size)
     // and the batches are written in node order, so the bytes are those of a serial pass.
     let worlds = scene.world_matrices();
-    let uses_default = scene
-        .nodes
-        .iter()
-        .flat_map(|n| &n.meshes)
-        .map(|m| &scene.meshes[m.index()])
-        .any(|m| m.material.is_none() && !m.is_empty());
     let material_names: Vec<String> = (0..scene.materials.len())
         .map(|i| material_name(i, scene))
         .collect();
@@ -159,12 +153,15 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
             .map(|m| &scene.meshes[m.index()])
             .filter(|m| !m.is_empty())
     };
-    // The nodes that draw geometry, with the OBJ index of their first vertex.
+    // The nodes that draw geometry, with the OBJ index of their first vertex; whether a
+    // drawn mesh has no material (the MTL then needs the default one).
     let mut drawn: Vec<(usize, u64)> = Vec::new();
     let mut base: u64 = 1;
+    let mut uses_default = false;
     for i in 0..scene.nodes.len() {
         let first = base;
         for m in drawn_meshes(i) {
+            uses_default |= m.material.is_none();
             report.vertices += m.vertex_count();
             report.triangles += m.triangle_count();
             base += m.vertex_count() as u64;

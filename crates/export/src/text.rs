@@ -5,7 +5,7 @@
 //! `format!("{x}")` writes, several times faster: it takes the shortest round-trip digits
 //! from `zmij` (Schubfach), breaks ties the way `core` does, and lays them out in plain
 //! notation. That it matches `core` for every one of the 2³² `f32` bit patterns is checked
-//! by the ignored test `f32_text_matches_display_for_every_f32` (about six minutes on
+//! by the ignored test `f32_text_matches_display_for_every_f32` (about five minutes on
 //! two cores); a property test samples it on every run.
 
 /// Appends `x` exactly as `format!("{x}")` would: the shortest decimal that reads back to
@@ -65,10 +65,7 @@ pub(crate) fn push_f32(out: &mut Vec<u8>, x: f32) {
     // A value exactly halfway between two shortest candidates: zmij rounds to the even
     // one, `core` away from zero. Both read back to `x`.
     if is_midpoint_above(digits, q, x) {
-        let mut up = digits
-            .iter()
-            .fold(0u64, |d, &c| d * 10 + u64::from(c.wrapping_sub(b'0')))
-            + 1;
+        let mut up = value(digits) + 1;
         strip_zeros(&mut up, &mut q);
         let mut text = itoa::Buffer::new();
         push_plain(out, text.format(up).as_bytes(), q);
@@ -106,6 +103,13 @@ fn push_plain(out: &mut Vec<u8>, digits: &[u8], q: i32) {
         push_all(out, digits);
         zeros(out, k - n);
     }
+}
+
+/// The number decimal `digits` spell (at most 18 of them, so it fits).
+fn value(digits: &[u8]) -> u64 {
+    digits
+        .iter()
+        .fold(0u64, |d, &c| d * 10 + u64::from(c.wrapping_sub(b'0')))
 }
 
 /// Moves trailing zeros of `d` (non-zero) into the exponent `q`.
@@ -156,10 +160,7 @@ fn is_midpoint_above(digits: &[u8], q: i32, x: f32) -> bool {
     if q != e + 1 + twos_m || digits.len() > 18 {
         return false;
     }
-    let d = digits
-        .iter()
-        .fold(0u64, |d, &c| d * 10 + u64::from(c.wrapping_sub(b'0')));
-    let (a, fives_a) = without_fives(2 * d + 1);
+    let (a, fives_a) = without_fives(2 * value(digits) + 1);
     let (b, fives_m) = without_fives(m >> twos_m);
     a == b && q + fives_a == fives_m
 }
@@ -252,7 +253,7 @@ mod tests {
         }
     }
 
-    /// Every `f32` bit pattern (about six minutes on two cores in release mode):
+    /// Every `f32` bit pattern (about five minutes on two cores in release mode):
     /// `cargo test -p polis-export --release -- --ignored f32_text_matches_display`.
     #[test]
     #[ignore]
