@@ -828,3 +828,88 @@ fn encode(image: &[Vec3], width: usize, height: usize) -> BoxResult<Vec<u8>> {
     encoder.write_header()?.write_image_data(&rgb)?;
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles sharing a diagonal cover every pixel centre of their square, and
+    /// none outside it.
+    #[test]
+    fn raster_covers_a_square_without_gaps() {
+        let (a, b, c, d) = (
+            Vec3::new(2.0, 3.0, 1.0),
+            Vec3::new(12.0, 3.0, 1.0),
+            Vec3::new(12.0, 9.0, 1.0),
+            Vec3::new(2.0, 9.0, 1.0),
+        );
+        let mut hits = vec![0u32; 16 * 16];
+        for tri in [[a, b, c], [a, c, d]] {
+            raster(tri, 16, 16, |x, y, z| {
+                assert!((z - 1.0).abs() < 1e-5);
+                hits[y * 16 + x] += 1;
+            });
+        }
+        for y in 0..16 {
+            for x in 0..16 {
+                let inside = (2..12).contains(&x) && (3..9).contains(&y);
+                assert_eq!(hits[y * 16 + x] > 0, inside, "pixel ({x}, {y})");
+            }
+        }
+    }
+
+    /// Clipping keeps the part in front of the near plane: a triangle crossing it becomes
+    /// a quadrilateral with two vertices on the plane.
+    #[test]
+    fn near_clipping_keeps_the_front() {
+        let v = [
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, 2.0),
+            DVec3::new(0.0, 1.0, 2.0),
+        ];
+        let poly = clip_near(v);
+        assert_eq!(poly.len(), 4);
+        assert!(poly.iter().all(|p| p.z >= NEAR - 1e-12));
+        assert_eq!(
+            poly.iter().filter(|p| (p.z - NEAR).abs() < 1e-12).count(),
+            2
+        );
+        assert!(clip_near(v.map(|p| p - DVec3::Z * 5.0)).is_empty());
+    }
+
+    /// Each mip level averages the one above it, down to one texel.
+    #[test]
+    fn mips_keep_the_mean_colour() {
+        let rgba: Vec<u8> = (0..8 * 4)
+            .flat_map(|i| [(i * 8) as u8, 255 - (i * 8) as u8, 128, 255])
+            .collect();
+        let mips = Mips::new(8, 4, &rgba).unwrap();
+        assert_eq!(mips.levels.len(), 4);
+        let mean = |l: &Level| l.texels.iter().sum::<Vec3>() / l.texels.len() as f32;
+        let first = mean(&mips.levels[0]);
+        for l in &mips.levels {
+            assert!((mean(l) - first).abs().max_element() < 1e-5);
+        }
+        assert!(Mips::new(8, 4, &rgba[..10]).is_none());
+    }
+
+    /// The ray through a pixel meets its triangle at the barycentrics of the hit point.
+    #[test]
+    fn hit_finds_the_point_on_the_triangle() {
+        let t = Tri {
+            p: [
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(4.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -4.0),
+            ],
+            uv: [Vec2::ZERO, Vec2::X, Vec2::Y],
+            material: 0,
+        };
+        let eye = Vec3::new(1.0, 10.0, -1.0);
+        let (s, b) = hit(&t, eye, Vec3::new(0.0, -2.0, 0.0)).unwrap();
+        assert!((s - 5.0).abs() < 1e-6);
+        assert!((b - Vec3::new(0.5, 0.25, 0.25)).abs().max_element() < 1e-6);
+        assert!((uv_at(&t, b) - Vec2::new(0.25, 0.25)).abs().max_element() < 1e-6);
+        assert!(hit(&t, eye, Vec3::X).is_none());
+    }
+}
