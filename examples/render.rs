@@ -231,9 +231,7 @@ struct World {
     tris: Vec<Tri>,
     surfaces: Vec<Surface>,
     textures: Vec<Mips>,
-    /// Lowest point of the scene (the ground plane), world `y`.
-    ground: f32,
-    /// Scene bounds (world).
+    /// Scene bounds (world); the ground plane is at `min.y`.
     min: Vec3,
     max: Vec3,
 }
@@ -375,25 +373,18 @@ impl World {
                 let material = material.min(default_material);
                 for t in mesh.triangles() {
                     let k = t.map(|k| k as usize);
-                    let (Some(p), Some(uv)) = (
-                        k.iter()
-                            .map(|&k| mesh.positions.get(k))
-                            .collect::<Option<Vec<_>>>(),
-                        k.iter()
-                            .map(|&k| mesh.uvs.get(k).copied())
-                            .collect::<Option<Vec<_>>>(),
+                    let ([Some(p0), Some(p1), Some(p2)], [Some(t0), Some(t1), Some(t2)]) = (
+                        k.map(|k| mesh.positions.get(k).copied()),
+                        k.map(|k| mesh.uvs.get(k).copied()),
                     ) else {
                         continue;
                     };
-                    let p = [0, 1, 2].map(|i| m.transform_point3(p[i].as_dvec3()).as_vec3());
+                    let p = [p0, p1, p2].map(|v| m.transform_point3(v.as_dvec3()).as_vec3());
+                    let uv = [t0, t1, t2];
                     if p.iter().any(|v| !v.is_finite()) {
                         continue;
                     }
-                    tris.push(Tri {
-                        p,
-                        uv: [uv[0], uv[1], uv[2]],
-                        material,
-                    });
+                    tris.push(Tri { p, uv, material });
                 }
             }
         }
@@ -408,7 +399,6 @@ impl World {
             tris,
             surfaces,
             textures,
-            ground: min.y,
             min,
             max,
         })
@@ -797,7 +787,7 @@ fn shade(
 
 fn background(world: &World, camera: &Camera, sun: &Sun, dir: Vec3) -> Vec3 {
     if dir.y < 0.0 {
-        let s = (world.ground - camera.eye.y) / dir.y;
+        let s = (world.min.y - camera.eye.y) / dir.y;
         let p = camera.eye + dir * s;
         return lit(sun, GROUND_COLOR, p, Vec3::Y, s * dir.length(), dir);
     }
