@@ -27,6 +27,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use polis::geom::field::decode_png_rgba8;
 use polis::geom::glam::{DVec3, Vec2, Vec3};
 use polis::geom::scene::{ImageData, Scene};
 use polis::{CityConfig, Pipeline};
@@ -335,9 +336,9 @@ impl World {
                     height,
                     pixels,
                 } => Mips::new(*width as usize, *height as usize, pixels),
-                ImageData::Png(bytes) => {
-                    decode_png(bytes).and_then(|(w, h, rgba)| Mips::new(w, h, &rgba))
-                }
+                ImageData::Png(bytes) => decode_png_rgba8(bytes)
+                    .ok()
+                    .and_then(|(w, h, rgba)| Mips::new(w as usize, h as usize, &rgba)),
             };
             if let Some(m) = mips {
                 texture_of_image[i] = Some(textures.len());
@@ -403,29 +404,6 @@ impl World {
             max,
         })
     }
-}
-
-fn decode_png(bytes: &[u8]) -> Option<(usize, usize, Vec<u8>)> {
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder.read_info().ok()?;
-    let mut buf = vec![0; reader.output_buffer_size()?];
-    let info = reader.next_frame(&mut buf).ok()?;
-    let (w, h) = (info.width as usize, info.height as usize);
-    let rgba = match info.color_type {
-        png::ColorType::Rgba => buf,
-        png::ColorType::Rgb => buf
-            .chunks_exact(3)
-            .flat_map(|p| [p[0], p[1], p[2], 255])
-            .collect(),
-        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
-        png::ColorType::GrayscaleAlpha => buf
-            .chunks_exact(2)
-            .flat_map(|p| [p[0], p[0], p[0], p[1]])
-            .collect(),
-        png::ColorType::Indexed => return None,
-    };
-    Some((w, h, rgba))
 }
 
 // ---------------------------------------------------------------------------------------

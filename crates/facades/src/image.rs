@@ -102,41 +102,17 @@ impl MaterialImage {
         MaterialImage::new(width, height, texels)
     }
 
-    /// Decodes an 8-bit RGB or RGBA PNG (e.g. a scanned window) into an image.
+    /// Decodes a PNG (e.g. a scanned window) into an image, through
+    /// [`decode_png_rgba8`](polis_geom::field::decode_png_rgba8).
     ///
     /// # Errors
-    /// [`FacadeError::Png`] for undecodable data or unsupported pixel formats.
+    /// [`FacadeError::Png`] for undecodable data or images too large to decode.
     pub fn from_png(bytes: &[u8], base: FacadeSample) -> Result<Self> {
-        let png_err = |e: png::DecodingError| FacadeError::Png(e.to_string());
-        let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-        decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-        let mut reader = decoder.read_info().map_err(png_err)?;
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| FacadeError::Png("image too large".into()))?;
-        let mut buf = vec![0; size];
-        let info = reader.next_frame(&mut buf).map_err(png_err)?;
-        let (w, h) = (info.width as usize, info.height as usize);
-        let data = buf
-            .get(..info.buffer_size())
-            .ok_or_else(|| FacadeError::Png("decoded frame is shorter than announced".into()))?;
-        let rgba: Vec<u8> = match info.color_type {
-            png::ColorType::Rgba => data.to_vec(),
-            png::ColorType::Rgb => data
-                .chunks_exact(3)
-                .flat_map(|p| [p[0], p[1], p[2], 255])
-                .collect(),
-            png::ColorType::Grayscale => data.iter().flat_map(|&g| [g, g, g, 255]).collect(),
-            png::ColorType::GrayscaleAlpha => data
-                .chunks_exact(2)
-                .flat_map(|p| [p[0], p[0], p[0], p[1]])
-                .collect(),
-            other => {
-                return Err(FacadeError::Png(format!(
-                    "unsupported PNG colour type {other:?}"
-                )));
-            }
-        };
+        let (w, h, rgba) = polis_geom::field::decode_png_rgba8(bytes).map_err(|e| match e {
+            polis_geom::GeomError::Image(message) => FacadeError::Png(message),
+            other => FacadeError::Png(other.to_string()),
+        })?;
+        let (w, h) = (w as usize, h as usize);
         MaterialImage::from_rgba8(w, h, &rgba, base)
     }
 }

@@ -19,6 +19,80 @@ fn png_error(e: png::DecodingError) -> GeomError {
     ))
 }
 
+/// Decodes the first frame of a PNG with `transformations`, refusing images that would
+/// decode to more than [`MAX_PNG_DECODED_BYTES`].
+fn read_png(
+    bytes: &[u8],
+    transformations: png::Transformations,
+) -> Result<(Vec<u8>, png::OutputInfo), GeomError> {
+    let mut decoder = png::Decoder::new(Cursor::new(bytes));
+    decoder.set_transformations(transformations);
+    let mut reader = decoder.read_info().map_err(png_error)?;
+    let size = reader
+        .output_buffer_size()
+        .filter(|&s| s <= MAX_PNG_DECODED_BYTES)
+        .ok_or_else(|| {
+            let info = reader.info();
+            GeomError::Image(format!(
+                "the PNG is {} × {} pixels, more than the {} MiB this loader accepts; downscale it",
+                info.width,
+                info.height,
+                MAX_PNG_DECODED_BYTES >> 20
+            ))
+        })?;
+    let mut buf = vec![0u8; size];
+    let out = reader.next_frame(&mut buf).map_err(png_error)?;
+    buf.truncate(out.buffer_size());
+    Ok((buf, out))
+}
+
+/// Decodes a PNG (any colour type and bit depth) to 8-bit RGBA pixels, row by row from
+/// the top: `(width, height, 4 · width · height bytes)`. Grey is spread to R, G and B,
+/// palettes are expanded, 16-bit samples keep their high byte, and a missing alpha
+/// channel is opaque.
+///
+/// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG or decode to more
+/// than [`MAX_PNG_DECODED_BYTES`].
+///
+/// ```
+/// # use polis_geom::field::decode_png_rgba8;
+/// assert!(decode_png_rgba8(b"not a png").is_err());
+/// ```
+pub fn decode_png_rgba8(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), GeomError> {
+    let (buf, out) = read_png(
+        bytes,
+        png::Transformations::EXPAND | png::Transformations::STRIP_16,
+    )?;
+    let rgba: Vec<u8> = match out.color_type {
+        png::ColorType::Rgba => buf,
+        png::ColorType::Rgb => buf
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
+        png::ColorType::GrayscaleAlpha => buf
+            .chunks_exact(2)
+            .flat_map(|p| [p[0], p[0], p[0], p[1]])
+            .collect(),
+        png::ColorType::Indexed => {
+            return Err(GeomError::Image(
+                "the PNG palette could not be expanded".into(),
+            ));
+        }
+    };
+    let expected = (out.width as usize)
+        .saturating_mul(out.height as usize)
+        .saturating_mul(4);
+    if rgba.len() != expected {
+        return Err(GeomError::Image(format!(
+            "the PNG decoded to {} of {} bytes; the file is truncated",
+            rgba.len(),
+            expected
+        )));
+    }
+    Ok((out.width, out.height, rgba))
+}
+
 impl Raster {
     /// Decodes a PNG image into a raster over `extent` (metres), values in `[0, 1]`.
     ///
@@ -32,23 +106,7 @@ impl Raster {
     /// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG or decode to more
     /// than [`MAX_PNG_DECODED_BYTES`]; the errors of [`Raster::new`] for a bad `extent`.
     pub fn from_png_bytes(bytes: &[u8], extent: Aabb2) -> Result<Raster, GeomError> {
-        let mut decoder = png::Decoder::new(Cursor::new(bytes));
-        decoder.set_transformations(png::Transformations::EXPAND);
-        let mut reader = decoder.read_info().map_err(png_error)?;
-        let size = reader
-            .output_buffer_size()
-            .filter(|&s| s <= MAX_PNG_DECODED_BYTES)
-            .ok_or_else(|| {
-                let info = reader.info();
-                GeomError::Image(format!(
-                    "the PNG is {} × {} pixels, more than the {} MiB this loader accepts; downscale it",
-                    info.width,
-                    info.height,
-                    MAX_PNG_DECODED_BYTES >> 20
-                ))
-            })?;
-        let mut buf = vec![0u8; size];
-        let out = reader.next_frame(&mut buf).map_err(png_error)?;
+        let (buf, out) = read_png(bytes, png::Transformations::EXPAND)?;
         let channels = match out.color_type {
             png::ColorType::Grayscale => 1,
             png::ColorType::GrayscaleAlpha => 2,
@@ -272,6 +330,60 @@ mod tests {
         );
         let r = Raster::from_png_bytes(&rgba, extent()).unwrap();
         assert!((r.data()[0] - 0.0722).abs() < 1e-6);
+    }
+
+    /// Every colour type and bit depth decodes to the same RGBA pixels.
+    #[test]
+    fn rgba8_from_every_colour_type() {
+        use png::{BitDepth, ColorType};
+        let cases: [(ColorType, BitDepth, Vec<u8>, [u8; 8]); 5] = [
+            (
+                ColorType::Rgba,
+                BitDepth::Eight,
+                vec![1, 2, 3, 4, 5, 6, 7, 8],
+                [1, 2, 3, 4, 5, 6, 7, 8],
+            ),
+            (
+                ColorType::Rgb,
+                BitDepth::Eight,
+                vec![1, 2, 3, 5, 6, 7],
+                [1, 2, 3, 255, 5, 6, 7, 255],
+            ),
+            (
+                ColorType::Grayscale,
+                BitDepth::Eight,
+                vec![9, 200],
+                [9, 9, 9, 255, 200, 200, 200, 255],
+            ),
+            (
+                ColorType::GrayscaleAlpha,
+                BitDepth::Eight,
+                vec![9, 10, 200, 20],
+                [9, 9, 9, 10, 200, 200, 200, 20],
+            ),
+            // 16-bit samples keep their high byte.
+            (
+                ColorType::Grayscale,
+                BitDepth::Sixteen,
+                vec![9, 99, 200, 1],
+                [9, 9, 9, 255, 200, 200, 200, 255],
+            ),
+        ];
+        for (color, depth, data, want) in cases {
+            let (w, h, rgba) = decode_png_rgba8(&encode(2, 1, color, depth, &data)).unwrap();
+            assert_eq!(
+                (w, h, rgba.as_slice()),
+                (2, 1, &want[..]),
+                "{color:?} {depth:?}"
+            );
+        }
+        let good = encode(2, 1, ColorType::Rgb, BitDepth::Eight, &[1, 2, 3, 5, 6, 7]);
+        for cut in [0, 1, 8, 20, 33, good.len() - 13] {
+            assert!(
+                matches!(decode_png_rgba8(&good[..cut]), Err(GeomError::Image(_))),
+                "cut at {cut}"
+            );
+        }
     }
 
     #[test]

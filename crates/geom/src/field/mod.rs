@@ -18,6 +18,9 @@
 //! | [`combinators`] | scale, offset, sum, product, threshold, min, max, clamp, mask, blend, domain transform |
 //! | [`FieldSpec`] | any of the above described as data (serde), built into a `Box<dyn Field>` |
 //!
+//! The PNG loader behind [`Raster::from_png_bytes`] also decodes colour images for
+//! textures: `decode_png_rgba8` (feature `png`) turns any PNG into 8-bit RGBA pixels.
+//!
 //! [`FieldExt`] chains the combinators: `noise.scaled(0.5).offset(0.5).clamped(0.0, 1.0)`.
 //! Fields are used as trait objects (`Box<dyn Field>`, `Arc<dyn Field>`), and `&F`,
 //! `Box<F>`, `Arc<F>` are fields themselves.
@@ -92,7 +95,7 @@ pub use combinators::{
     Blend, Clamp, DomainTransform, Mask, Max, Min, Offset, Product, Scaled, Sum, Threshold,
 };
 #[cfg(feature = "png")]
-pub use image::MAX_PNG_DECODED_BYTES;
+pub use image::{MAX_PNG_DECODED_BYTES, decode_png_rgba8};
 pub use noise::{Fbm, FbmParams, MAX_OCTAVES, SimplexNoise};
 pub use population::{Population, PopulationParams};
 pub use raster::Raster;
