@@ -81,7 +81,7 @@
 //!   index of the lines by direction and offset (from 256 edges on) that visits only the
 //!   lines that can come first; the worst case is still O(n) per reflex vertex (the
 //!   Felkel–Obdržálek bound, O(n·r) in all), met by vertices that cross a region where
-//!   many lines pass (see `BENCHMARKS.md` for the growth on stars and combs).
+//!   many lines pass (see the polis repository's `BENCHMARKS.md` for the growth on stars and combs).
 //! * Consecutive parallel edges with different weights meet in a perpendicular step (a
 //!   virtual edge of weight 0), the convention for this case, which has no bisector. An arc
 //!   along a step lies on the offset line of one of the two input edges it names, not both

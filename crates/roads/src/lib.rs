@@ -58,7 +58,7 @@
 //! * Roads stop where a proposal fails (illegal with no prune/rotate/bridge variant, or
 //!   below the minimum angle), so dead ends remain at the fringe of the city, as in the
 //!   paper's figures; there is no pass that removes or reconnects them.
-//! * Speed (see `BENCHMARKS.md`): 15,000 segments take about 100 ms of CPU with the
+//! * Speed (see the polis repository's `BENCHMARKS.md`): 15,000 segments take about 100 ms of CPU with the
 //!   procedural maps, whose coastline and hills are sampled on lazily cached 40 m
 //!   [`LazyLattice`]s. Maps given as other fields are sampled as they are, at every
 //!   legality sample (a few hundred thousand for 15,000 segments): an expensive water or

@@ -20,7 +20,7 @@
 //!
 //! # Why a grid
 //!
-//! Measured on 100,000 random segments of 5–50 m in a 10 km square (`BENCHMARKS.md`,
+//! Measured on 100,000 random segments of 5–50 m in a 10 km square (the polis repository's `BENCHMARKS.md`,
 //! `cargo bench -p polis-geom --bench spatial`): with 64 m cells the grid inserts about
 //! 3× and removes about 4× faster than the R*-tree, and answers small-radius nearest and
 //! segment-crossing queries 2–3× faster; the bulk-loaded R*-tree is about 1.3× faster on
