@@ -96,6 +96,11 @@
 //! *Procedural Modeling of Cities* (2001) §4.1.
 
 pub use polis_geom as geom;
+/// The random-number crates of this crate's public signatures (`Rng` bounds, `Pcg64Mcg`),
+/// re-exported so callers never match their versions by hand.
+pub use rand;
+#[doc(no_inline)]
+pub use rand_pcg;
 
 pub mod block;
 mod error;
