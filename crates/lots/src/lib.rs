@@ -16,7 +16,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`skeleton`] | [`StraightSkeleton`]: nodes with times, arcs, the face each input edge sweeps |
-//! | [`inset`](mod@inset) | [`inset`], [`inset_weighted`], [`inset_shapes`], [`Inset`]: the wavefront at a time |
+//! | [`inset`](mod@inset) | [`inset`](fn@inset), [`inset_weighted`], [`inset_shapes`], [`Inset`]: the wavefront at a time |
 //! | [`block`] | [`Cell`] → [`Block`]s with [`Footpath`]s and parcels ([`blocks`]) |
 //! | [`subdivision`] | [`subdivide`], [`subdivide_block`], [`Subdivider`]: [`Lot`]s ([`LotParams`]) |
 //! | [`polygon_split`] | [`split_by_line`]: a region cut by a line into all its pieces |
