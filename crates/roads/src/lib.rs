@@ -85,6 +85,7 @@ pub mod legality;
 pub mod modules;
 pub mod network;
 pub mod params;
+pub mod primary;
 pub mod smooth;
 pub mod snap;
 
@@ -99,3 +100,4 @@ pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};
+pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};
