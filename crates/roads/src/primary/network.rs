@@ -6,7 +6,8 @@
 //! restores the whole state, id counters included (see [`crate::primary::EditLog`]).
 //!
 //! Invariants ([`PrimaryNetwork::check_invariants`]): every road joins two distinct live
-//! nodes, at most one road per pair; each path starts and ends exactly at its nodes, has
+//! nodes (two nodes may be joined by several roads with different paths, e.g. where a
+//! new road crosses an old one twice); each path starts and ends exactly at its nodes, has
 //! no repeated consecutive vertices and lists its plot points; no two nodes coincide; and
 //! the low-level paths form a planar embedding of the high-level graph: two paths meet
 //! only at a node they share, at their ends, and no path touches itself or passes through
@@ -353,7 +354,6 @@ impl PrimaryNetwork {
                 return bad(format!("nodes {id} and {} coincide", other.key));
             }
         }
-        let mut pairs = BTreeMap::new();
         for (&id, r) in &self.roads {
             if id.0 >= self.next_road {
                 return bad(format!(
@@ -366,9 +366,6 @@ impl PrimaryNetwork {
             };
             if r.a == r.b {
                 return bad(format!("road {id} is a loop"));
-            }
-            if let Some(prev) = pairs.insert((r.a.min(r.b), r.a.max(r.b)), id) {
-                return bad(format!("roads {prev} and {id} join the same nodes"));
             }
             let p = &r.path;
             let n = p.points.len();

@@ -254,7 +254,8 @@ fn plot_inner(
             if n == 1 {
                 0.0
             } else {
-                -theta + 2.0 * theta * i as f64 / (n - 1) as f64
+                // Symmetric about 0 bit for bit: the middle sample is exactly straight.
+                theta * (2.0 * i as f64 - (n - 1) as f64) / (n - 1) as f64
             }
         })
         .collect();
