@@ -133,7 +133,10 @@ proptest! {
                 let n = pl.points.len();
                 prop_assert_eq!(pl.bridge.len(), n - 1);
                 let max_bound = p.sample_size_m.max(p.snap_m) * (1.0 + 1e-9);
-                prop_assert!(pl.points.windows(2).all(|w| w[0].distance(w[1]) <= max_bound));
+                // Every step is d_sample long; only the join may be longer (heads that turned
+                // away are dropped before it).
+                let long = pl.points.windows(2).filter(|w| w[0].distance(w[1]) > max_bound).count();
+                prop_assert!(long <= 1, "{long} long steps");
                 if let Ok(path) = path_from_plot(&pl, p.segment_draw_size_m, &t) {
                     let mut distinct = pl.points.clone();
                     distinct.dedup();
@@ -743,7 +746,7 @@ fn even_elevation_difference_has_the_gentler_steepest_grade() {
     );
     println!("max grade: even {even:.4}, least difference {least:.4}, straight {straight:.4}");
     assert!(even < least, "even {even} least {least}");
-    // Pinned (measured 0.0840, 0.1182, 0.0989 on x86-64), with room for libm differences.
+    // Pinned (measured 0.0842, 0.1200, 0.0989 on x86-64), with room for libm differences.
     assert!((0.080..0.088).contains(&even), "{even}");
     assert!((0.112..0.124).contains(&least), "{least}");
 }

@@ -10,7 +10,9 @@
 //! a bridge), and moves to the one its [`Strategy`] prefers (ties: the first sample of
 //! the fan, counter-clockwise order). Plotting ends when the heads are within `d_snap`;
 //! they are joined, and the plot points are the first front's points followed by the
-//! second's, reversed.
+//! second's, reversed. A head whose last step points away from the other head (the
+//! fronts met side by side) is dropped before the join, so the road never turns back on
+//! itself there.
 //!
 //! *Termination.* While the heads are `D > d_snap > d·cos θ` apart, a step toward a
 //! fixed target at most `θ < 45°` off brings the front closer by at least
@@ -404,8 +406,24 @@ fn plot_inner(
         }
         side = 1 - side;
     }
-    // Join the heads.
-    let [f0, mut f1] = fronts;
+    // Join the heads. Side by side, the last step of a front can point away from the
+    // other head, so the join would turn back on it (a hairpin): drop such heads first.
+    let [mut f0, mut f1] = fronts;
+    loop {
+        let (h0, h1) = (head(&f0), head(&f1));
+        let back = |f: &Front, from: DVec2, to: DVec2| {
+            f.points.len() > 1 && (from - f.points[f.points.len() - 2]).dot(to - from) < 0.0
+        };
+        if back(&f0, h0, h1) {
+            f0.points.pop();
+            f0.bridge.pop();
+        } else if back(&f1, h1, h0) {
+            f1.points.pop();
+            f1.bridge.pop();
+        } else {
+            break;
+        }
+    }
     let (h0, h1) = (head(&f0), head(&f1));
     let join_bridge = match terrain.step(h0, h1) {
         Ground::Legal => false,
