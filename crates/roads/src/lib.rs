@@ -23,6 +23,7 @@
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
+//! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
 //!
 //! ## Example
 //!
