@@ -626,8 +626,15 @@ impl<'a> Draft<'a> {
                 End::OnRoad(r, seg, c) => {
                     let rp = &self.road(r)?.path.points;
                     let seg = normalize_cut(&self.road(r)?.path, seg, c);
-                    let before = if rp[seg] == c { rp[seg - 1] } else { rp[seg] };
-                    let after = rp[seg + 1];
+                    // The road's directions away from the junction: the vertices around it.
+                    let before = if rp.get(seg) == Some(&c) {
+                        seg.checked_sub(1).and_then(|k| rp.get(k))
+                    } else {
+                        rp.get(seg)
+                    };
+                    let (Some(&before), Some(&after)) = (before, rp.get(seg + 1)) else {
+                        return Err(PrimaryError::CrossingNearNode { at: c, road: r });
+                    };
                     self.check_angle(c, leave, [before, after])?;
                 }
                 End::Free(_) => {}

@@ -365,10 +365,11 @@ impl PrimaryNetwork {
         let mut edge_road = Vec::new();
         for (id, r) in self.roads() {
             let pts = &r.path.points;
-            let mut prev = of_control[&r.a];
+            let corrupt = || PrimaryError::BadData(format!("road {id} is inconsistent"));
+            let mut prev = *of_control.get(&r.a).ok_or_else(corrupt)?;
             for (i, &p) in pts.iter().enumerate().skip(1) {
                 let v = if i + 1 == pts.len() {
-                    of_control[&r.b]
+                    *of_control.get(&r.b).ok_or_else(corrupt)?
                 } else {
                     node_control.push(None);
                     g.add_node(p, Junction::default())?
@@ -376,7 +377,7 @@ impl PrimaryNetwork {
                 let road = Road {
                     class: RoadClass::Highway,
                     width: r.spec.width_m,
-                    bridge: r.path.bridge[i - 1],
+                    bridge: r.path.bridge.get(i - 1).copied().unwrap_or(false),
                     step: 0,
                 };
                 let e = g.add_edge(prev, v, road)?;

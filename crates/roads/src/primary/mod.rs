@@ -14,7 +14,7 @@
 //! | [`PrimaryNetwork`] | the two graphs: [`ControlNode`]s, [`PrimaryRoad`]s with their [`RoadPath`]s; serde, invariants |
 //! | [`AdaptiveParams`], [`Strategy`], [`RoadPreset`], [`RoadSpec`] | how a road is plotted; §6.2's presets |
 //! | [`Terrain`] | elevation + legality maps the roads are plotted on |
-//! | [`plot`], [`plot_traced`], [`plot_path`] | bidirectional plotting, with the fans for debugging |
+//! | [`plot()`], [`plot_traced`], [`plot_path`] | bidirectional plotting, with the fans for debugging |
 //! | [`Edit`], [`Preview`], [`ChangeSet`], [`Correction`] | propose → preview → commit (§5.3.2) |
 //! | [`PrimaryEditor`], [`EditLog`] | an editing session with undo / redo / replay |
 //! | [`PrimarySpec`], [`PrimaryNetwork::from_geojson`], [`PrimaryNetwork::from_highways`] | sources |
@@ -48,7 +48,7 @@
 //! # Guarantees
 //!
 //! * Plotting terminates for every accepted parameter set on any terrain, and is
-//!   commutative: `plot(b → a)` is `plot(a → b)` reversed, bit for bit ([`plot`]).
+//!   commutative: `plot(b → a)` is `plot(a → b)` reversed, bit for bit ([`plot()`]).
 //! * The spline passes through every plot point exactly ([`spline`]).
 //! * Both graphs are planar after every commit: a path meets another only at a shared
 //!   node ([`PrimaryNetwork::check_invariants`]).
@@ -60,8 +60,9 @@
 //!
 //! * Moves and parameter changes refuse to cross other roads instead of inserting
 //!   junctions ([`edit`] explains why).
-//! * Legality is sampled every [`Terrain::legality_step_m`] along each step; thinner
-//!   obstacles can be missed. Bridges are flagged on the path and draped on the ground
+//! * Legality is sampled every [`Terrain::legality_step_m`] along each plot step; thinner
+//!   obstacles can be missed, and the spline between two plot points (a few metres off
+//!   their chord at sharp turns) is not tested again. Bridges are flagged on the path and draped on the ground
 //!   like the rest (no deck profile).
 //! * A split road keeps its piece of the old path; its spec applies again only when it
 //!   is re-plotted (an end moves, or its spec changes).

@@ -429,7 +429,12 @@ impl PrimaryNetwork {
         }
         for (&id, n) in &self.nodes {
             for s in self.path_index.segments_within(n.pos, 0.0) {
-                let r = &self.roads[&s.key.0];
+                let Some(r) = self.roads.get(&s.key.0) else {
+                    return Err(PrimaryError::BadData(format!(
+                        "index names dead road {}",
+                        s.key.0
+                    )));
+                };
                 let last = r.path.points.len().saturating_sub(2) as u32;
                 let at_end = (r.a == id && s.key.1 == 0) || (r.b == id && s.key.1 == last);
                 if !at_end {
