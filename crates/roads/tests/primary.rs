@@ -256,6 +256,13 @@ proptest! {
                 Ok(p) => {
                     let changes = ed.commit(&p).unwrap();
                     prop_assert_eq!(&changes, p.changes());
+                    // The commit wrote exactly the preview.
+                    for (id, road) in p.roads() {
+                        prop_assert_eq!(ed.network().road(*id).ok(), road.as_ref());
+                    }
+                    for (id, node) in p.nodes() {
+                        prop_assert_eq!(ed.network().node(*id).ok(), node.as_ref());
+                    }
                     states.push(ed.network().to_json().unwrap());
                 }
                 Err(_) => prop_assert_eq!(ed.network().to_json().unwrap(), before),

@@ -58,7 +58,8 @@ pub struct Fan {
     pub from: DVec2,
     /// The other front's head it aimed at.
     pub toward: DVec2,
-    /// The samples, counter-clockwise.
+    /// The samples, counter-clockwise (with [`Strategy::Straight`] and an even
+    /// `n_sample`, the straight-ahead step is added last).
     pub samples: Vec<DVec2>,
     /// What each sample's step crosses.
     pub ground: Vec<Ground>,
