@@ -23,6 +23,7 @@
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
+//! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
 //!
 //! ## Example
 //!
@@ -85,6 +86,7 @@ pub mod legality;
 pub mod modules;
 pub mod network;
 pub mod params;
+pub mod primary;
 pub mod smooth;
 pub mod snap;
 
@@ -99,3 +101,4 @@ pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};
+pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};
