@@ -23,6 +23,7 @@
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
+//! | [`grid_builders`]: [`GridBuilderGrowth`], [`grow_grid_roads`], [`GridRules`], [`GridParams`] | the course report's grid road builders in one cell (rules from JSON; Downtown, Residential) |
 //!
 //! ## Example
 //!
@@ -79,6 +80,7 @@ pub mod constraints;
 pub mod error;
 pub mod generator;
 pub mod goals;
+pub mod grid_builders;
 pub mod inputs;
 pub mod lattice;
 pub mod legality;
@@ -94,6 +96,7 @@ pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };
 pub use goals::{DefaultGoals, GlobalGoals};
+pub use grid_builders::{GridBuilderGrowth, GridParams, GridRoads, GridRules, grow_grid_roads};
 pub use inputs::{RoadInputs, procedural_lattice_m};
 pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};

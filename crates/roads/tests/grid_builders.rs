@@ -1,0 +1,529 @@
+//! The course report's grid road builders: invariants on fixed and random cells,
+//! Downtown vs Residential statistics, determinism, and typed errors for bad rules.
+
+#![allow(clippy::unwrap_used)]
+
+use std::sync::Arc;
+
+use polis_roads::RoadInputs;
+use polis_roads::geom::field::{Constant, FnField};
+use polis_roads::geom::predicates::{distance_to_segment, segments_intersect};
+use polis_roads::geom::{DVec2, PointLocation, Polygon, PolygonWithHoles};
+use polis_roads::grid_builders::{
+    DOWNTOWN_JSON, GridBuilderGrowth, GridError, GridParams, GridRoads, GridRules,
+    RESIDENTIAL_JSON, StreetStats, grow_grid_roads, street_stats,
+};
+use proptest::prelude::*;
+
+fn flat() -> RoadInputs {
+    RoadInputs::flat(Arc::new(Constant(1.0)))
+}
+
+/// Segments of the cell's rings plus `filaments`.
+fn obstacles(cell: &PolygonWithHoles, filaments: &[(DVec2, DVec2)]) -> Vec<(DVec2, DVec2)> {
+    let mut out: Vec<_> = cell.rings().flat_map(|(_, r)| r.edges()).collect();
+    out.extend_from_slice(filaments);
+    out
+}
+
+/// Every invariant the module promises, for one grown cell.
+fn check(
+    roads: &GridRoads,
+    cell: &PolygonWithHoles,
+    filaments: &[(DVec2, DVec2)],
+    maps: &RoadInputs,
+    params: &GridParams,
+) {
+    let g = &roads.network;
+    g.check_invariants().unwrap();
+    assert!(g.is_planar_by_construction());
+    let walls = obstacles(cell, filaments);
+    let scale = cell
+        .bbox()
+        .max
+        .abs()
+        .max(cell.bbox().min.abs())
+        .max_element()
+        .max(1.0);
+    let on_wall = |p: DVec2| {
+        walls
+            .iter()
+            .map(|&(a, b)| distance_to_segment(p, a, b))
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Nodes: boundary nodes on a wall, the others strictly inside and clear of walls.
+    let clearance = params.boundary_clearance * params.grid_size_m;
+    for (n, p, _) in g.nodes() {
+        if roads.boundary_nodes.binary_search(&n).is_ok() {
+            assert!(
+                on_wall(p) <= 1e-9 * scale,
+                "boundary node {p} off the boundary"
+            );
+        } else {
+            assert_eq!(cell.locate(p), PointLocation::Inside, "node {p} outside");
+            assert!(
+                on_wall(p) >= clearance * (1.0 - 1e-9),
+                "node {p} too near a wall: {} < {clearance}, degree {}",
+                on_wall(p),
+                g.degree(n).unwrap()
+            );
+        }
+    }
+    // Edges: inside the cell, crossing no wall, out of water and parks.
+    for (e, a, b, road) in g.edges() {
+        let (p, q) = g.segment(e).unwrap();
+        let (p0, q0) = (p.lerp(q, 1e-6), p.lerp(q, 1.0 - 1e-6));
+        for &(w0, w1) in &walls {
+            assert!(
+                !segments_intersect(p0, q0, w0, w1),
+                "street {p}–{q} crosses the wall {w0}–{w1}"
+            );
+        }
+        assert_eq!(cell.locate(p.midpoint(q)), PointLocation::Inside);
+        for k in 0..=20 {
+            let s = p.lerp(q, k as f64 / 20.0);
+            assert!(maps.water.sample(s) < 0.5, "street in water at {s}");
+            assert!(maps.parks.sample(s) < 0.5, "street in a park at {s}");
+        }
+        assert_eq!(road.width, params.street_width_m);
+        assert_ne!(a, b);
+    }
+    // Every component reaches the boundary.
+    for comp in g.connected_components() {
+        assert!(
+            comp.iter()
+                .any(|n| roads.boundary_nodes.binary_search(n).is_ok()),
+            "a component of {} nodes does not reach the boundary",
+            comp.len()
+        );
+    }
+    // The no-dead-end rule.
+    if params.rules.dead_end_probability() == 0.0 {
+        let stats = street_stats(g, &roads.boundary_nodes, cell).unwrap();
+        assert_eq!(stats.dead_ends, 0, "a dead end where the rules forbid them");
+    }
+}
+
+fn square(side: f64) -> PolygonWithHoles {
+    PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::splat(side)))
+}
+
+/// The fixed cells of the statistics test: a square, a concave cell with a notch, a
+/// rotated heptagon, a cell with a hole.
+fn fixed_cells() -> Vec<PolygonWithHoles> {
+    let notch = Polygon::new(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(520.0, 20.0),
+        DVec2::new(500.0, 210.0),
+        DVec2::new(380.0, 250.0),
+        DVec2::new(510.0, 300.0),
+        DVec2::new(480.0, 500.0),
+        DVec2::new(30.0, 480.0),
+    ]);
+    let hole = Polygon::new(vec![
+        DVec2::new(200.0, 200.0),
+        DVec2::new(300.0, 200.0),
+        DVec2::new(300.0, 280.0),
+        DVec2::new(200.0, 280.0),
+    ]);
+    vec![
+        square(500.0),
+        notch.into(),
+        Polygon::regular(7, DVec2::new(100.0, 50.0), 300.0).into(),
+        PolygonWithHoles::new(
+            Polygon::rect(DVec2::ZERO, DVec2::new(500.0, 480.0)),
+            vec![hole],
+        ),
+    ]
+}
+
+/// Mean statistics over the fixed cells and seeds 0..20, checking every run.
+fn mean_stats(params: &GridParams) -> StreetStats {
+    let maps = flat();
+    let mut sum = StreetStats::default();
+    let mut n = 0.0;
+    for cell in fixed_cells() {
+        for seed in 0..20 {
+            let roads = grow_grid_roads(&cell, &maps, params, seed).unwrap();
+            check(&roads, &cell, &[], &maps, params);
+            let s = street_stats(&roads.network, &roads.boundary_nodes, &cell).unwrap();
+            sum.four_way_share += s.four_way_share;
+            sum.dead_end_share += s.dead_end_share;
+            sum.mean_block_area_m2 += s.mean_block_area_m2;
+            sum.density_km_per_km2 += s.density_km_per_km2;
+            n += 1.0;
+        }
+    }
+    StreetStats {
+        four_way_share: sum.four_way_share / n,
+        dead_end_share: sum.dead_end_share / n,
+        mean_block_area_m2: sum.mean_block_area_m2 / n,
+        density_km_per_km2: sum.density_km_per_km2 / n,
+        ..StreetStats::default()
+    }
+}
+
+#[test]
+fn downtown_is_denser_and_more_gridded_than_residential() {
+    let d = mean_stats(&GridParams::downtown());
+    let r = mean_stats(&GridParams::residential());
+    eprintln!("downtown {d:?}\nresidential {r:?}");
+    // Denser: more street per area, smaller blocks.
+    assert!(d.density_km_per_km2 > 1.25 * r.density_km_per_km2);
+    assert!(d.mean_block_area_m2 < 0.7 * r.mean_block_area_m2);
+    // More gridded: more cross junctions, no dead ends.
+    assert!(d.four_way_share > 1.4 * r.four_way_share);
+    assert_eq!(d.dead_end_share, 0.0);
+    assert!(r.dead_end_share > 0.05);
+    // Pinned bands around the measured means (Downtown 4-way 0.162, 20.9 km/km²,
+    // 6,900 m² blocks; Residential 4-way 0.088, dead ends 0.098, 15.1 km/km², 12,500 m²).
+    assert!((0.12..=0.21).contains(&d.four_way_share), "{d:?}");
+    assert!((17.0..=25.0).contains(&d.density_km_per_km2), "{d:?}");
+    assert!((5_000.0..=9_000.0).contains(&d.mean_block_area_m2), "{d:?}");
+    assert!((0.05..=0.13).contains(&r.four_way_share), "{r:?}");
+    assert!((0.06..=0.14).contains(&r.dead_end_share), "{r:?}");
+    assert!((12.0..=18.5).contains(&r.density_km_per_km2), "{r:?}");
+    assert!(
+        (9_500.0..=16_500.0).contains(&r.mean_block_area_m2),
+        "{r:?}"
+    );
+}
+
+#[test]
+fn same_seed_same_graph_other_seed_other_graph() {
+    let cell = fixed_cells().swap_remove(1);
+    let maps = flat();
+    let edges = |seed| {
+        let r = grow_grid_roads(&cell, &maps, &GridParams::downtown(), seed).unwrap();
+        r.network
+            .edges()
+            .map(|(e, a, b, _)| (e, a, b, r.network.segment(e).unwrap()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(format!("{:?}", edges(11)), format!("{:?}", edges(11)));
+    assert_ne!(format!("{:?}", edges(11)), format!("{:?}", edges(12)));
+    // A reused worker gives the same result as a fresh one.
+    let mut worker = GridBuilderGrowth::new();
+    let params = GridParams::residential();
+    let other = square(300.0);
+    let _ = worker.grow(&other, &[], &maps, &params, 1).unwrap();
+    let a = worker.grow(&cell, &[], &maps, &params, 5).unwrap();
+    let b = grow_grid_roads(&cell, &maps, &params, 5).unwrap();
+    assert_eq!(format!("{:?}", a.network), format!("{:?}", b.network));
+    assert_eq!(a.report, b.report);
+}
+
+#[test]
+fn streets_keep_out_of_water_parks_and_filaments() {
+    let cell = square(600.0);
+    let mut maps = flat();
+    maps.water = Arc::new(FnField(|p: DVec2| {
+        if p.distance(DVec2::new(400.0, 400.0)) < 110.0 {
+            1.0
+        } else {
+            0.0
+        }
+    }));
+    maps.parks = Arc::new(FnField(|p: DVec2| {
+        if (80.0..200.0).contains(&p.x) && (350.0..520.0).contains(&p.y) {
+            1.0
+        } else {
+            0.0
+        }
+    }));
+    let filaments = [
+        (DVec2::new(0.0, 300.0), DVec2::new(260.0, 300.0)),
+        (DVec2::new(260.0, 300.0), DVec2::new(260.0, 180.0)),
+    ];
+    for params in [GridParams::downtown(), GridParams::residential()] {
+        for seed in 0..8 {
+            let roads = GridBuilderGrowth::new()
+                .grow(&cell, &filaments, &maps, &params, seed)
+                .unwrap();
+            check(&roads, &cell, &filaments, &maps, &params);
+        }
+    }
+}
+
+#[test]
+fn orientation_can_be_given() {
+    let cell = square(400.0);
+    let params = GridParams {
+        orientation_deg: Some(30.0),
+        ..GridParams::downtown()
+    };
+    let roads = grow_grid_roads(&cell, &flat(), &params, 2).unwrap();
+    check(&roads, &cell, &[], &flat(), &params);
+    // Every street not ending on the boundary runs at 30° or 120°.
+    let (u, v) = (
+        DVec2::from_angle(30f64.to_radians()),
+        DVec2::from_angle(120f64.to_radians()),
+    );
+    let mut grid_edges = 0;
+    for (e, a, b, _) in roads.network.edges() {
+        if roads.boundary_nodes.contains(&a) || roads.boundary_nodes.contains(&b) {
+            continue;
+        }
+        let (p, q) = roads.network.segment(e).unwrap();
+        let d = (q - p).normalize();
+        assert!(d.dot(u).abs() > 1.0 - 1e-9 || d.dot(v).abs() > 1.0 - 1e-9);
+        grid_edges += 1;
+    }
+    assert!(grid_edges > 5);
+}
+
+#[test]
+fn bad_rules_are_typed_errors() {
+    let bad = |from: &str, to: &str| DOWNTOWN_JSON.replacen(from, to, 1);
+    assert!(matches!(GridRules::from_json("{"), Err(GridError::Json(_))));
+    assert!(matches!(
+        GridRules::from_json("[]"),
+        Err(GridError::Json(_))
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("\"CS\"", "\"JUMP\"")),
+        Err(GridError::Json(_))
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("\"deadEndRules\"", "\"deadEndRule\"")),
+        Err(GridError::Json(_))
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("0.8", "1.5")),
+        Err(GridError::InvalidProbability {
+            group: "movementActionRules",
+            action: "CS",
+            ..
+        })
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("0.8", "-0.2")),
+        Err(GridError::InvalidProbability { .. })
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("0.8", "0.7")),
+        Err(GridError::ProbabilitySum {
+            group: "movementActionRules",
+            ..
+        })
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad(
+            "\"doBranchOut\", \"probability\": 0.2",
+            "\"doBranchOut\", \"probability\": 0.3"
+        )),
+        Err(GridError::ProbabilitySum {
+            group: "branchOutRules",
+            ..
+        })
+    ));
+    assert!(matches!(
+        GridRules::from_json(&bad("\"TL\"", "\"TR\"")),
+        Err(GridError::DuplicateAction { action: "TR", .. })
+    ));
+    let mut rules = GridRules::downtown();
+    rules.cross_intersection_rules.pop();
+    assert!(matches!(
+        rules.validate(),
+        Err(GridError::MissingAction {
+            action: "doNotCrossIntersection",
+            ..
+        })
+    ));
+    let mut rules = GridRules::residential();
+    rules.dead_end_rules[0].probability = f64::NAN;
+    assert!(matches!(
+        rules.validate(),
+        Err(GridError::InvalidProbability { .. })
+    ));
+    // The report's file: an array of both sets.
+    let file = format!("[{DOWNTOWN_JSON},{RESIDENTIAL_JSON}]");
+    let list = GridRules::list_from_json(&file).unwrap();
+    assert_eq!(
+        GridRules::find(&list, "residential").unwrap(),
+        &GridRules::residential()
+    );
+    assert!(matches!(
+        GridRules::find(&list, "Suburbia"),
+        Err(GridError::UnknownRuleSet { .. })
+    ));
+    // A bad rule set inside parameters is refused before growth.
+    let params = GridParams {
+        rules,
+        ..GridParams::residential()
+    };
+    assert!(matches!(
+        grow_grid_roads(&square(300.0), &flat(), &params, 0),
+        Err(GridError::InvalidProbability { .. })
+    ));
+}
+
+#[test]
+fn bad_parameters_and_cells_are_typed_errors() {
+    let cell = square(400.0);
+    let maps = flat();
+    let with = |f: &dyn Fn(&mut GridParams)| {
+        let mut p = GridParams::downtown();
+        f(&mut p);
+        grow_grid_roads(&cell, &maps, &p, 0)
+    };
+    for g in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            with(&|p| p.grid_size_m = g),
+            Err(GridError::InvalidParameter {
+                name: "grid_size_m",
+                ..
+            })
+        ));
+    }
+    assert!(matches!(
+        with(&|p| p.street_width_m = f64::NAN),
+        Err(GridError::InvalidParameter {
+            name: "street_width_m",
+            ..
+        })
+    ));
+    assert!(matches!(
+        with(&|p| p.legality_step_m = 0.0),
+        Err(GridError::InvalidParameter {
+            name: "legality_step_m",
+            ..
+        })
+    ));
+    assert!(matches!(
+        with(&|p| p.starts = 0),
+        Err(GridError::InvalidParameter { name: "starts", .. })
+    ));
+    assert!(matches!(
+        with(&|p| p.boundary_clearance = 0.0),
+        Err(GridError::InvalidParameter {
+            name: "boundary_clearance",
+            ..
+        })
+    ));
+    assert!(matches!(
+        with(&|p| p.orientation_deg = Some(f64::NAN)),
+        Err(GridError::InvalidParameter {
+            name: "orientation_deg",
+            ..
+        })
+    ));
+    assert!(matches!(
+        with(&|p| p.grid_size_m = 0.01),
+        Err(GridError::TooManyLatticePoints { .. })
+    ));
+    // A bow tie, a NaN vertex, a cell too small for one step, a cell under water.
+    let bow = PolygonWithHoles::from(Polygon::new(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(100.0, 100.0),
+        DVec2::new(100.0, 0.0),
+        DVec2::new(0.0, 100.0),
+    ]));
+    let p = GridParams::downtown();
+    assert!(matches!(
+        grow_grid_roads(&bow, &maps, &p, 0),
+        Err(GridError::InvalidCell(_))
+    ));
+    let nan = PolygonWithHoles::from(Polygon::new(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(f64::NAN, 0.0),
+        DVec2::new(0.0, 100.0),
+    ]));
+    assert!(matches!(
+        grow_grid_roads(&nan, &maps, &p, 0),
+        Err(GridError::InvalidCell(_))
+    ));
+    assert!(matches!(
+        grow_grid_roads(&square(20.0), &maps, &p, 0),
+        Err(GridError::NoStart { .. })
+    ));
+    let mut wet = flat();
+    wet.water = Arc::new(Constant(1.0));
+    assert!(matches!(
+        grow_grid_roads(&cell, &wet, &p, 0),
+        Err(GridError::NoStart { .. })
+    ));
+    let bad_filament = [(DVec2::new(10.0, 10.0), DVec2::new(f64::INFINITY, 10.0))];
+    assert!(matches!(
+        GridBuilderGrowth::new().grow(&cell, &bad_filament, &maps, &p, 0),
+        Err(GridError::InvalidCell(_))
+    ));
+}
+
+/// A star-shaped (often concave) cell around `c`, with an optional square hole.
+fn star_cell(radii: &[f64], phase: f64, hole: bool) -> PolygonWithHoles {
+    let n = radii.len();
+    let pts = radii
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| DVec2::from_angle(phase + i as f64 * std::f64::consts::TAU / n as f64) * r)
+        .collect();
+    let holes = if hole {
+        vec![Polygon::rect(DVec2::splat(-30.0), DVec2::splat(30.0))]
+    } else {
+        Vec::new()
+    };
+    PolygonWithHoles::new(Polygon::new(pts), holes)
+}
+
+/// Probabilities of a random rule group of `n` actions, adding up to 1.
+fn split(weights: &[u32]) -> Vec<f64> {
+    let total: u32 = weights.iter().sum::<u32>().max(1);
+    let mut p: Vec<f64> = weights.iter().map(|&w| w as f64 / total as f64).collect();
+    if weights.iter().all(|&w| w == 0) {
+        p[0] = 1.0;
+    }
+    p
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_concave_cells_keep_every_invariant(
+        radii in prop::collection::vec(120.0f64..380.0, 5..11),
+        phase in 0.0f64..6.3,
+        hole in any::<bool>(),
+        grid in 18.0f64..50.0,
+        orientation in prop::option::of(-180.0f64..180.0),
+        residential in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        let cell = star_cell(&radii, phase, hole);
+        let base = if residential { GridParams::residential() } else { GridParams::downtown() };
+        let params = GridParams { grid_size_m: grid, orientation_deg: orientation, ..base };
+        match grow_grid_roads(&cell, &flat(), &params, seed) {
+            Ok(roads) => check(&roads, &cell, &[], &flat(), &params),
+            // A start may find no room in a spiky cell; never any other error.
+            Err(GridError::NoStart { .. }) => {}
+            Err(e) => prop_assert!(false, "{e}"),
+        }
+    }
+
+    #[test]
+    fn random_rule_sets_keep_every_invariant(
+        movement in prop::collection::vec(0u32..10, 4),
+        branch in 0u32..10,
+        cross in 0u32..10,
+        dead in 0u32..3,
+        seed in any::<u64>(),
+    ) {
+        let mut rules = GridRules::downtown();
+        for (r, p) in rules.movement_action_rules.iter_mut().zip(split(&movement)) {
+            r.probability = p;
+        }
+        let b = branch as f64 / 10.0;
+        rules.branch_out_rules[0].probability = b;
+        rules.branch_out_rules[1].probability = 1.0 - b;
+        let c = cross as f64 / 10.0;
+        rules.cross_intersection_rules[0].probability = c;
+        rules.cross_intersection_rules[1].probability = 1.0 - c;
+        let d = dead as f64 / 2.0;
+        rules.dead_end_rules[0].probability = d;
+        rules.dead_end_rules[1].probability = 1.0 - d;
+        let params = GridParams { rules, ..GridParams::downtown() };
+        let cell = fixed_cells().swap_remove(1);
+        let roads = grow_grid_roads(&cell, &flat(), &params, seed).unwrap();
+        check(&roads, &cell, &[], &flat(), &params);
+    }
+}
