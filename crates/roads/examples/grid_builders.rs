@@ -2,12 +2,13 @@
 //! side by side, as SVG (the report's Images 4.1 and 4.2, seen from above).
 //!
 //! ```text
-//! cargo run --release -p polis-roads --example grid_builders -- [out.svg] [seed]
+//! cargo run --release -p polis-roads --example grid_builders -- [out.svg] [seed] [grid m] [starts]
 //! ```
 //!
-//! The cell is concave (a notch on its east side), has a hole (a block ringed by
-//! primary roads), a lake (water) and a park; streets keep out of all three. Each panel
-//! prints its street statistics.
+//! The cell is concave (a notch cut into its north side), has a hole (a block ringed by
+//! primary roads), a lake (water) and a park; streets keep out of all three. For each
+//! rule set the program prints the street statistics and the street map as the
+//! report's console print (Images 2.1 and 2.2: `*` streets, `J` joined to the boundary).
 
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -15,7 +16,7 @@ use std::sync::Arc;
 use polis_roads::RoadInputs;
 use polis_roads::geom::field::{Constant, FnField};
 use polis_roads::geom::{DVec2, Polygon, PolygonWithHoles};
-use polis_roads::grid_builders::{GridParams, GridRoads, grow_grid_roads, street_stats};
+use polis_roads::grid_builders::{GridBuilderGrowth, GridParams, GridRoads, street_stats};
 
 const LAKE: (DVec2, f64) = (DVec2::new(170.0, 170.0), 70.0);
 const PARK: (DVec2, DVec2) = (DVec2::new(420.0, 330.0), DVec2::new(540.0, 440.0));
@@ -130,7 +131,7 @@ fn panel(svg: &mut String, title: &str, roads: &GridRoads, cell: &PolygonWithHol
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let path = args.next().unwrap_or_else(|| "grid_builders.svg".into());
-    let seed: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(3);
+    let seed: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(4);
     let grid: Option<f64> = args.next().map(|s| s.parse()).transpose()?;
     let starts: Option<u32> = args.next().map(|s| s.parse()).transpose()?;
     let cell = cell();
@@ -147,7 +148,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         params.grid_size_m = grid.unwrap_or(params.grid_size_m);
         params.starts = starts.unwrap_or(params.starts);
         let params = &params;
-        let roads = grow_grid_roads(&cell, &maps, params, seed)?;
+        let mut worker = GridBuilderGrowth::new();
+        let roads = worker.grow(&cell, &[], &maps, params, seed)?;
         let s = street_stats(&roads.network, &roads.boundary_nodes, &cell)?;
         println!(
             "{:<12} streets {:>6.0} m  junctions {:>3}  4-way {:>4.2}  dead ends {:>4.2}  \
@@ -162,7 +164,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             roads.report.builders,
             roads.report.steps
         );
-        println!("  {:?}", roads.report);
+        print!("{}", worker.street_map());
         let title = format!(
             "{}: {} blocks, {:.0}% 4-way, {:.0}% dead ends",
             params.rules.name,

@@ -211,6 +211,14 @@ fn same_seed_same_graph_other_seed_other_graph() {
     let b = grow_grid_roads(&cell, &maps, &params, 5).unwrap();
     assert_eq!(format!("{:?}", a.network), format!("{:?}", b.network));
     assert_eq!(a.report, b.report);
+    // The report's console print: one row per grid row, a `J` for every start.
+    let map = worker.street_map();
+    let rows: Vec<&str> = map.lines().collect();
+    assert_eq!(rows.len() * rows[0].len(), a.report.grid_points);
+    assert!(rows.iter().all(|r| r.len() == rows[0].len()));
+    assert!(map.matches('J').count() >= a.report.starts as usize);
+    assert!(map.contains('*'));
+    assert!(GridBuilderGrowth::new().street_map().is_empty());
 }
 
 #[test]

@@ -215,6 +215,26 @@ impl GridBuilderGrowth {
         Self::default()
     }
 
+    /// The last grown cell's street map as text, north (the grid's second axis) up, one
+    /// character per grid point: `*` a street, `J` a street joined to the boundary, `.`
+    /// anything else — the report's console print of a layout (its Images 2.1 and 2.2).
+    /// Empty before the first [`grow`](Self::grow).
+    pub fn street_map(&self) -> String {
+        let mut out = String::new();
+        if self.width == 0 {
+            return out;
+        }
+        for row in self.sites.chunks(self.width).rev() {
+            out.extend(row.iter().map(|s| match (s.street, s.joined) {
+                (false, _) => '.',
+                (true, false) => '*',
+                (true, true) => 'J',
+            }));
+            out.push('\n');
+        }
+        out
+    }
+
     /// Grows the streets of `cell` (see [`grow_grid_roads`]); `filaments` are road
     /// segments inside the cell (dead-end roads of the graph the cell came from), which
     /// the builders treat like the boundary: they join them and keep clear of them.
@@ -406,24 +426,6 @@ mod tests {
     use polis_geom::field::Constant;
     use std::sync::Arc;
 
-    /// The report's console picture of the street map (`*` street, `J` joined to the
-    /// boundary), north up.
-    fn picture(w: &GridBuilderGrowth) -> String {
-        let rows = w.sites.len() / w.width;
-        let mut out = String::new();
-        for y in (0..rows).rev() {
-            for s in &w.sites[y * w.width..(y + 1) * w.width] {
-                out.push(match (s.street, s.joined) {
-                    (false, _) => '.',
-                    (true, false) => '*',
-                    (true, true) => 'J',
-                });
-            }
-            out.push('\n');
-        }
-        out
-    }
-
     #[test]
     fn street_map_links_are_symmetric_and_downtown_has_no_dead_end_points() {
         let cell = PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::new(500.0, 400.0)));
@@ -447,19 +449,19 @@ mod tests {
                         if s.links & d.bit() != 0 {
                             let (dx, dy) = d.delta();
                             let n = at(x + dx, y + dy).unwrap();
-                            assert!(s.street && n.street, "{}", picture(&w));
-                            assert!(n.links & d.opposite().bit() != 0, "{}", picture(&w));
+                            assert!(s.street && n.street, "{}", w.street_map());
+                            assert!(n.links & d.opposite().bit() != 0, "{}", w.street_map());
                         }
                     }
                     if s.street {
                         streets += 1;
-                        assert!(s.degree() >= 1, "isolated street point\n{}", picture(&w));
+                        assert!(s.degree() >= 1, "isolated street point\n{}", w.street_map());
                         if !dead_ends_allowed {
-                            assert!(s.degree() >= 2, "dead end\n{}", picture(&w));
+                            assert!(s.degree() >= 2, "dead end\n{}", w.street_map());
                         }
                     }
                 }
-                assert!(streets > 10, "{}", picture(&w));
+                assert!(streets > 10, "{}", w.street_map());
                 assert_eq!(r.report.grid_points, w.sites.len());
             }
         }

@@ -1,0 +1,62 @@
+//! The course report's grid road builders in one 500 m × 500 m cell, per shipped rule
+//! set (Downtown, Residential), on flat dry land: the whole call (validation, grid,
+//! builders, planar graph) with a reused worker, over a few seeds.
+//!
+//! `cargo bench -p polis-roads --bench grid_builders`; divan reports the time per cell
+//! (and cells/s as item throughput).
+
+#![allow(clippy::unwrap_used)]
+
+use std::sync::Arc;
+
+use divan::counter::ItemsCount;
+use polis_geom::field::Constant;
+use polis_geom::{DVec2, Polygon, PolygonWithHoles};
+use polis_roads::RoadInputs;
+use polis_roads::grid_builders::{GridBuilderGrowth, GridParams};
+
+fn main() {
+    // Per-seed table first: the time of one cell varies with how far the builders get.
+    let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+    let mut worker = GridBuilderGrowth::new();
+    for params in [GridParams::downtown(), GridParams::residential()] {
+        for seed in 1..16 {
+            let t = std::time::Instant::now();
+            let roads = worker.grow(&cell(), &[], &maps, &params, seed).unwrap();
+            eprintln!(
+                "{:<12} seed {seed:>2}: {:>8.1} µs, {} edges, {} steps",
+                params.rules.name,
+                t.elapsed().as_secs_f64() * 1e6,
+                roads.network.edge_count(),
+                roads.report.steps
+            );
+        }
+    }
+    divan::main();
+}
+
+fn cell() -> PolygonWithHoles {
+    Polygon::rect(DVec2::ZERO, DVec2::splat(500.0)).into()
+}
+
+fn run(params: &GridParams, bencher: divan::Bencher<'_, '_>) {
+    let cell = cell();
+    let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+    let mut worker = GridBuilderGrowth::new();
+    let mut seed = 0u64;
+    bencher.counter(ItemsCount::new(1usize)).bench_local(|| {
+        seed = seed.wrapping_add(1) % 16;
+        let roads = worker.grow(&cell, &[], &maps, params, seed).unwrap();
+        divan::black_box(roads.network.edge_count())
+    });
+}
+
+#[divan::bench]
+fn downtown_500m(bencher: divan::Bencher<'_, '_>) {
+    run(&GridParams::downtown(), bencher);
+}
+
+#[divan::bench]
+fn residential_500m(bencher: divan::Bencher<'_, '_>) {
+    run(&GridParams::residential(), bencher);
+}
