@@ -459,15 +459,17 @@ fn bad_parameters_and_cells_are_typed_errors() {
 }
 
 /// A star-shaped (often concave) cell around `c`, with an optional square hole.
-fn star_cell(radii: &[f64], phase: f64, hole: bool) -> PolygonWithHoles {
+fn star_cell(c: DVec2, radii: &[f64], phase: f64, hole: bool) -> PolygonWithHoles {
     let n = radii.len();
     let pts = radii
         .iter()
         .enumerate()
-        .map(|(i, &r)| DVec2::from_angle(phase + i as f64 * std::f64::consts::TAU / n as f64) * r)
+        .map(|(i, &r)| {
+            c + DVec2::from_angle(phase + i as f64 * std::f64::consts::TAU / n as f64) * r
+        })
         .collect();
     let holes = if hole {
-        vec![Polygon::rect(DVec2::splat(-30.0), DVec2::splat(30.0))]
+        vec![Polygon::rect(c - 30.0, c + 30.0)]
     } else {
         Vec::new()
     };
@@ -495,9 +497,12 @@ proptest! {
         grid in 18.0f64..50.0,
         orientation in prop::option::of(-180.0f64..180.0),
         residential in any::<bool>(),
+        far in any::<bool>(),
         seed in any::<u64>(),
     ) {
-        let cell = star_cell(&radii, phase, hole);
+        // Near the origin, or far from it (where coordinates carry less precision).
+        let centre = if far { DVec2::new(734_512.25, -2_104_377.5) } else { DVec2::ZERO };
+        let cell = star_cell(centre, &radii, phase, hole);
         let base = if residential { GridParams::residential() } else { GridParams::downtown() };
         let params = GridParams { grid_size_m: grid, orientation_deg: orientation, ..base };
         match grow_grid_roads(&cell, &flat(), &params, seed) {

@@ -39,6 +39,7 @@ pub(crate) struct Counts {
     pub(crate) dead_ends_allowed: u32,
     pub(crate) dead_ends_pruned: u32,
     pub(crate) pruned_points: u32,
+    pub(crate) truncated: bool,
 }
 
 /// A road builder: a grid point and the direction it last moved in (the report's
@@ -99,6 +100,8 @@ pub(crate) struct Growth<'g, 'a> {
     pub(crate) rng: Pcg64Mcg,
     pub(crate) clearance: f64,
     pub(crate) queue: &'g mut VecDeque<Builder>,
+    /// Queue pops after which the remaining builders are ended (a guard: see `run`).
+    pub(crate) max_pops: u32,
     pub(crate) counts: Counts,
 }
 
@@ -130,7 +133,7 @@ impl Growth<'_, '_> {
     /// position; if so, the sides at which a street ends pointing at it.
     pub(crate) fn fresh(&self, q: usize, d: Dir, from: DVec2) -> Option<[Option<Dir>; 2]> {
         let s = self.site(q);
-        if s.street {
+        if s.street || s.passed {
             return None;
         }
         let qw = self.frame.position(q);
@@ -299,10 +302,19 @@ impl Growth<'_, '_> {
     }
 
     /// The build loop: pops builders until the queue is empty.
+    ///
+    /// Every pop either makes a new street point or ends a builder, but pruning frees
+    /// points again, so termination is only almost sure; after `max_pops` pops the
+    /// builders still queued end where they are, under the dead-end rule.
     pub(crate) fn run(&mut self) {
         while let Some(b) = self.queue.pop_front() {
             if !self.site(b.site).street {
                 continue; // its street was pruned away
+            }
+            if self.counts.pops >= self.max_pops {
+                self.counts.truncated = true;
+                self.end_stopped(b);
+                continue;
             }
             self.counts.pops += 1;
             let m = self.rules.movement(&mut self.rng);
@@ -359,6 +371,19 @@ impl Growth<'_, '_> {
             }
         }
         self.prune(b.site);
+    }
+
+    /// Ends a builder without moving it (after the guard): a dead end stays only if the
+    /// rules allow it.
+    fn end_stopped(&mut self, b: Builder) {
+        if self.site(b.site).degree() >= 2 {
+            return;
+        }
+        if self.rules.allow_dead_end(&mut self.rng) {
+            self.counts.dead_ends_allowed += 1;
+        } else {
+            self.prune(b.site);
+        }
     }
 
     /// Removes the dead-end street ending at `k`, back to the nearest junction.

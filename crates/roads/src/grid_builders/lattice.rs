@@ -64,15 +64,14 @@ pub(crate) struct Frame {
 }
 
 impl Frame {
-    /// The grid with first axis at `angle` (radians) through `origin`, covering `cell`.
+    /// The grid with first axis `u` (a unit vector) through `origin`, covering `cell`.
     pub(crate) fn covering(
         cell: &PolygonWithHoles,
         origin: DVec2,
-        angle: f64,
+        u: DVec2,
         step: f64,
         max_points: u64,
     ) -> Result<Frame> {
-        let u = DVec2::new(angle.cos(), angle.sin());
         let v = u.perp();
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for p in cell.outer.points() {

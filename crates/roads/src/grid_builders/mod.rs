@@ -167,7 +167,15 @@ pub struct GridReport {
     pub dead_ends_pruned: u32,
     /// Grid points those removals cleared.
     pub pruned_points: u32,
+    /// The growth hit its guard of [`MAX_POPS_PER_POINT`] queue pops per grid point and
+    /// ended the builders still queued (never seen in practice; see the module docs).
+    pub truncated: bool,
 }
+
+/// The growth guard: at most this many queue pops per grid point. Every pop makes a
+/// street point or ends a builder, but pruned points can be built again, so the loop is
+/// bounded explicitly; real runs use about one pop per street point.
+pub const MAX_POPS_PER_POINT: usize = 16;
 
 /// The grid builders' result for one cell.
 #[derive(Debug, Clone)]
@@ -252,6 +260,20 @@ impl GridBuilderGrowth {
         params: &GridParams,
         seed: u64,
     ) -> Result<GridRoads> {
+        self.grow_guarded(cell, filaments, inputs, params, seed, None)
+    }
+
+    /// [`grow`](Self::grow) with the pop guard `max_pops` (`None`: [`MAX_POPS_PER_POINT`]
+    /// per grid point).
+    fn grow_guarded(
+        &mut self,
+        cell: &PolygonWithHoles,
+        filaments: &[(DVec2, DVec2)],
+        inputs: &RoadInputs,
+        params: &GridParams,
+        seed: u64,
+        max_pops: Option<u32>,
+    ) -> Result<GridRoads> {
         params.validate()?;
         let mut cell = cell.clone();
         cell.normalize();
@@ -262,14 +284,15 @@ impl GridBuilderGrowth {
                 grid_size_m: params.grid_size_m,
             });
         };
-        let angle = match params.orientation_deg {
-            Some(deg) => deg.to_radians(),
-            None => (b - a).y.atan2((b - a).x),
+        // The first axis: along the longest edge (no trigonometry), or the given angle.
+        let axis = match params.orientation_deg {
+            Some(deg) => DVec2::from_angle(deg.to_radians()),
+            None => (b - a).normalize(),
         };
         let frame = Frame::covering(
             &cell,
             a.midpoint(b),
-            angle,
+            axis,
             params.grid_size_m,
             params.max_lattice_points,
         )?;
@@ -288,6 +311,9 @@ impl GridBuilderGrowth {
             rng: Pcg64Mcg::seed_from_u64(seed),
             clearance: params.boundary_clearance * params.grid_size_m,
             queue: &mut self.queue,
+            max_pops: max_pops.unwrap_or_else(|| {
+                u32::try_from(frame.len().saturating_mul(MAX_POPS_PER_POINT)).unwrap_or(u32::MAX)
+            }),
             counts: Counts::default(),
         };
         let mut starts = 0;
@@ -323,6 +349,7 @@ impl GridBuilderGrowth {
                 dead_ends_allowed: c.dead_ends_allowed,
                 dead_ends_pruned: c.dead_ends_pruned,
                 pruned_points: c.pruned_points,
+                truncated: c.truncated,
             },
         })
     }
@@ -425,6 +452,31 @@ mod tests {
     use polis_geom::Polygon;
     use polis_geom::field::Constant;
     use std::sync::Arc;
+
+    #[test]
+    fn the_pop_guard_ends_builders_under_the_dead_end_rule() {
+        let cell = PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::new(500.0, 400.0)));
+        let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+        let params = GridParams::downtown();
+        for seed in 0..10 {
+            let mut w = GridBuilderGrowth::new();
+            let full = w.grow(&cell, &[], &maps, &params, seed).unwrap();
+            assert!(!full.report.truncated);
+            let cut = w
+                .grow_guarded(&cell, &[], &maps, &params, seed, Some(25))
+                .unwrap();
+            assert!(cut.report.truncated, "{}", w.street_map());
+            assert_eq!(cut.report.steps, 25);
+            cut.network.check_invariants().unwrap();
+            for s in w.sites.iter().filter(|s| s.street) {
+                assert!(
+                    s.degree() >= 2,
+                    "dead end after the guard\n{}",
+                    w.street_map()
+                );
+            }
+        }
+    }
 
     #[test]
     fn street_map_links_are_symmetric_and_downtown_has_no_dead_end_points() {
