@@ -7,17 +7,13 @@
 
 #![allow(clippy::unwrap_used)]
 
-use std::sync::Arc;
-
 use divan::counter::ItemsCount;
-use polis_geom::field::Constant;
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
-use polis_roads::RoadInputs;
-use polis_roads::grid_builders::{GridBuilderGrowth, GridParams};
+use polis_roads::grid_builders::{GridBuilderGrowth, GridMaps, GridParams};
 
 fn main() {
     // Per-seed table first: the time of one cell varies with how far the builders get.
-    let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+    let maps = GridMaps::none();
     let mut worker = GridBuilderGrowth::new();
     for params in [GridParams::downtown(), GridParams::residential()] {
         for seed in 1..16 {
@@ -41,7 +37,7 @@ fn cell() -> PolygonWithHoles {
 
 fn run(params: &GridParams, bencher: divan::Bencher<'_, '_>) {
     let cell = cell();
-    let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+    let maps = GridMaps::none();
     let mut worker = GridBuilderGrowth::new();
     let mut seed = 0u64;
     bencher.counter(ItemsCount::new(1usize)).bench_local(|| {

@@ -16,7 +16,9 @@ use std::sync::Arc;
 use polis_roads::RoadInputs;
 use polis_roads::geom::field::{Constant, FnField};
 use polis_roads::geom::{DVec2, Polygon, PolygonWithHoles};
-use polis_roads::grid_builders::{GridBuilderGrowth, GridParams, GridRoads, street_stats};
+use polis_roads::grid_builders::{
+    GridBuilderGrowth, GridMaps, GridParams, GridRoads, street_stats,
+};
 
 const LAKE: (DVec2, f64) = (DVec2::new(170.0, 170.0), 70.0);
 const PARK: (DVec2, DVec2) = (DVec2::new(420.0, 330.0), DVec2::new(540.0, 440.0));
@@ -149,7 +151,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         params.starts = starts.unwrap_or(params.starts);
         let params = &params;
         let mut worker = GridBuilderGrowth::new();
-        let roads = worker.grow(&cell, &[], &maps, params, seed)?;
+        let roads = worker.grow(&cell, &[], &GridMaps::from(&maps), params, seed)?;
         let s = street_stats(&roads.network, &roads.boundary_nodes, &cell)?;
         println!(
             "{:<12} streets {:>6.0} m  junctions {:>3}  4-way {:>4.2}  dead ends {:>4.2}  \

@@ -3,20 +3,18 @@
 
 #![allow(clippy::unwrap_used)]
 
-use std::sync::Arc;
-
-use polis_roads::RoadInputs;
+use polis_roads::RoadClass;
 use polis_roads::geom::field::{Constant, FnField};
 use polis_roads::geom::predicates::{distance_to_segment, segments_intersect};
 use polis_roads::geom::{DVec2, PointLocation, Polygon, PolygonWithHoles};
 use polis_roads::grid_builders::{
-    DOWNTOWN_JSON, GridBuilderGrowth, GridError, GridParams, GridRoads, GridRules,
+    DOWNTOWN_JSON, GridBuilderGrowth, GridError, GridMaps, GridParams, GridRoads, GridRules,
     RESIDENTIAL_JSON, StreetStats, grow_grid_roads, street_stats,
 };
 use proptest::prelude::*;
 
-fn flat() -> RoadInputs {
-    RoadInputs::flat(Arc::new(Constant(1.0)))
+fn flat() -> GridMaps<'static> {
+    GridMaps::none()
 }
 
 /// Segments of the cell's rings plus `filaments`.
@@ -31,7 +29,7 @@ fn check(
     roads: &GridRoads,
     cell: &PolygonWithHoles,
     filaments: &[(DVec2, DVec2)],
-    maps: &RoadInputs,
+    maps: &GridMaps<'_>,
     params: &GridParams,
 ) {
     let g = &roads.network;
@@ -82,8 +80,7 @@ fn check(
         assert_eq!(cell.locate(p.midpoint(q)), PointLocation::Inside);
         for k in 0..=20 {
             let s = p.lerp(q, k as f64 / 20.0);
-            assert!(maps.water.sample(s) < 0.5, "street in water at {s}");
-            assert!(maps.parks.sample(s) < 0.5, "street in a park at {s}");
+            assert!(!maps.blocked_at(s), "street in water or a park at {s}");
         }
         assert_eq!(road.width, params.street_width_m);
         assert_ne!(a, b);
@@ -97,6 +94,16 @@ fn check(
             comp.len()
         );
     }
+    // The cell's private graph (Kelly's shape): planar, the streets unchanged, boundary
+    // and filaments as highways.
+    let whole = roads.cell_graph(cell, filaments).unwrap();
+    whole.check_invariants().unwrap();
+    let streets = whole
+        .edges()
+        .filter(|(.., r)| r.class == RoadClass::Street)
+        .count();
+    assert_eq!(streets, g.edge_count());
+    assert!(whole.edge_count() > g.edge_count());
     // The no-dead-end rule.
     if params.rules.dead_end_probability() == 0.0 {
         let stats = street_stats(g, &roads.boundary_nodes, cell).unwrap();
@@ -224,21 +231,24 @@ fn same_seed_same_graph_other_seed_other_graph() {
 #[test]
 fn streets_keep_out_of_water_parks_and_filaments() {
     let cell = square(600.0);
-    let mut maps = flat();
-    maps.water = Arc::new(FnField(|p: DVec2| {
+    let water = FnField(|p: DVec2| {
         if p.distance(DVec2::new(400.0, 400.0)) < 110.0 {
             1.0
         } else {
             0.0
         }
-    }));
-    maps.parks = Arc::new(FnField(|p: DVec2| {
+    });
+    let parks = FnField(|p: DVec2| {
         if (80.0..200.0).contains(&p.x) && (350.0..520.0).contains(&p.y) {
             1.0
         } else {
             0.0
         }
-    }));
+    });
+    let maps = GridMaps {
+        water: Some(&water),
+        parks: Some(&parks),
+    };
     let filaments = [
         (DVec2::new(0.0, 300.0), DVec2::new(260.0, 300.0)),
         (DVec2::new(260.0, 300.0), DVec2::new(260.0, 180.0)),
@@ -445,8 +455,11 @@ fn bad_parameters_and_cells_are_typed_errors() {
         grow_grid_roads(&square(20.0), &maps, &p, 0),
         Err(GridError::NoStart { .. })
     ));
-    let mut wet = flat();
-    wet.water = Arc::new(Constant(1.0));
+    let sea = Constant(1.0);
+    let wet = GridMaps {
+        water: Some(&sea),
+        ..GridMaps::none()
+    };
     assert!(matches!(
         grow_grid_roads(&cell, &wet, &p, 0),
         Err(GridError::NoStart { .. })

@@ -10,9 +10,56 @@
 use polis_geom::graph::SnapOptions;
 use polis_geom::{DVec2, NodeId};
 
-use super::error::Result;
+use polis_geom::PolygonWithHoles;
+
+use super::GridRoads;
+use super::error::{GridError, Result};
 use super::lattice::{Dir, Frame, Site};
 use crate::network::{Junction, Road, RoadClass, RoadNetwork};
+
+/// The payload of boundary and filament edges in [`GridRoads::cell_graph`]: the roads
+/// around the cell, which are not the builders' to size.
+pub const BOUNDARY_ROAD: Road = Road {
+    class: RoadClass::Highway,
+    width: 0.0,
+    bridge: false,
+    step: 0,
+};
+
+impl GridRoads {
+    /// The cell's whole road graph: the streets plus the cell's rings and `filaments` as
+    /// [`BOUNDARY_ROAD`] edges ([`RoadClass::Highway`], width 0), inserted with exact
+    /// predicates, so boundary edges are split where streets join them. This is the shape
+    /// of a cell's private graph in Kelly's secondary growth (boundary and filaments as
+    /// highways, new roads as streets). Planar.
+    ///
+    /// # Errors
+    /// [`GridError::InvalidCell`] when a ring or filament has bad coordinates.
+    pub fn cell_graph(
+        &self,
+        cell: &PolygonWithHoles,
+        filaments: &[(DVec2, DVec2)],
+    ) -> Result<RoadNetwork> {
+        with_boundary(&self.network, cell, filaments)
+    }
+}
+
+/// `network` plus the rings of `cell` and `filaments` as [`BOUNDARY_ROAD`] edges.
+pub(crate) fn with_boundary(
+    network: &RoadNetwork,
+    cell: &PolygonWithHoles,
+    filaments: &[(DVec2, DVec2)],
+) -> Result<RoadNetwork> {
+    let mut whole = network.clone();
+    let opts = SnapOptions::default();
+    let rings = cell.rings().flat_map(|(_, ring)| ring.edges());
+    for (a, b) in rings.chain(filaments.iter().copied()) {
+        whole
+            .insert_segment(a, b, BOUNDARY_ROAD, &opts)
+            .map_err(GridError::InvalidCell)?;
+    }
+    Ok(whole)
+}
 
 /// Snap distance of the conversion as a fraction of the grid step (capped at 1 cm): far
 /// below the smallest distance between distinct points the builders make (5 % of a step).

@@ -6,7 +6,7 @@ use polis_geom::spatial::{SegmentIndex, SpatialIndex};
 use polis_geom::{DVec2, PointLocation, PolygonWithHoles};
 
 use super::error::{GridError, Result};
-use crate::inputs::RoadInputs;
+use super::maps::GridMaps;
 
 /// A grid direction. `East` runs along the grid's first axis `u`, `North` along `v`
 /// (`u` turned 90° counter-clockwise), so turning left is `+1` and right is `-1`.
@@ -186,7 +186,7 @@ pub(crate) struct Ground<'a> {
     cell: &'a PolygonWithHoles,
     /// Every boundary and filament segment.
     index: SegmentIndex<u32>,
-    inputs: &'a RoadInputs,
+    maps: GridMaps<'a>,
     legality_step: f64,
 }
 
@@ -194,7 +194,7 @@ impl<'a> Ground<'a> {
     pub(crate) fn new(
         cell: &'a PolygonWithHoles,
         filaments: &[(DVec2, DVec2)],
-        inputs: &'a RoadInputs,
+        maps: GridMaps<'a>,
         legality_step: f64,
     ) -> Result<Ground<'a>> {
         let mut index = SegmentIndex::default();
@@ -207,7 +207,7 @@ impl<'a> Ground<'a> {
         Ok(Ground {
             cell,
             index,
-            inputs,
+            maps,
             legality_step,
         })
     }
@@ -234,9 +234,9 @@ impl<'a> Ground<'a> {
     /// (NaN counts as illegal).
     pub(crate) fn legal(&self, a: DVec2, b: DVec2) -> bool {
         let n = ((a.distance(b) / self.legality_step).ceil() as usize).max(1);
-        (0..=n).all(|k| {
-            let p = a.lerp(b, k as f64 / n as f64);
-            self.inputs.water.sample(p) < 0.5 && self.inputs.parks.sample(p) < 0.5
-        })
+        if self.maps.water.is_none() && self.maps.parks.is_none() {
+            return true;
+        }
+        (0..=n).all(|k| !self.maps.blocked_at(a.lerp(b, k as f64 / n as f64)))
     }
 }

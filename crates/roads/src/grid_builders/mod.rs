@@ -41,14 +41,14 @@
 //! ## Example
 //!
 //! ```
-//! use polis_roads::grid_builders::{GridParams, grow_grid_roads, street_stats};
+//! use polis_roads::grid_builders::{GridMaps, GridParams, grow_grid_roads, street_stats};
 //! use polis_roads::geom::{DVec2, Polygon, PolygonWithHoles};
-//! use polis_roads::RoadInputs;
-//! use polis_roads::geom::field::Constant;
-//! use std::sync::Arc;
+//! use polis_roads::geom::field::FnField;
 //!
 //! let cell = PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::new(300.0, 240.0)));
-//! let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+//! // A pond in one corner: 1 = water.
+//! let pond = FnField(|p: DVec2| if p.distance(DVec2::new(250.0, 200.0)) < 40.0 { 1.0 } else { 0.0 });
+//! let maps = GridMaps { water: Some(&pond), ..GridMaps::none() };
 //! let roads = grow_grid_roads(&cell, &maps, &GridParams::downtown(), 7)?;
 //! roads.network.check_invariants()?; // planar
 //! let stats = street_stats(&roads.network, &roads.boundary_nodes, &cell)?;
@@ -111,6 +111,7 @@ mod error;
 mod graph;
 mod growth;
 mod lattice;
+mod maps;
 mod params;
 pub mod rules;
 mod stats;
@@ -123,6 +124,8 @@ use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
 pub use error::{GridError, Result};
+pub use graph::BOUNDARY_ROAD;
+pub use maps::GridMaps;
 pub use params::GridParams;
 pub use rules::{
     BranchOut, CrossIntersection, DOWNTOWN_JSON, DeadEnd, GridRules, Movement,
@@ -133,7 +136,6 @@ pub use stats::{StreetStats, street_stats};
 use growth::{Builder, Counts, Growth};
 use lattice::{Dir, Frame, Ground, Site};
 
-use crate::inputs::RoadInputs;
 use crate::network::RoadNetwork;
 
 /// What the builders did in one cell.
@@ -256,11 +258,11 @@ impl GridBuilderGrowth {
         &mut self,
         cell: &PolygonWithHoles,
         filaments: &[(DVec2, DVec2)],
-        inputs: &RoadInputs,
+        maps: &GridMaps<'_>,
         params: &GridParams,
         seed: u64,
     ) -> Result<GridRoads> {
-        self.grow_guarded(cell, filaments, inputs, params, seed, None)
+        self.grow_guarded(cell, filaments, maps, params, seed, None)
     }
 
     /// [`grow`](Self::grow) with the pop guard `max_pops` (`None`: [`MAX_POPS_PER_POINT`]
@@ -269,7 +271,7 @@ impl GridBuilderGrowth {
         &mut self,
         cell: &PolygonWithHoles,
         filaments: &[(DVec2, DVec2)],
-        inputs: &RoadInputs,
+        maps: &GridMaps<'_>,
         params: &GridParams,
         seed: u64,
         max_pops: Option<u32>,
@@ -296,7 +298,7 @@ impl GridBuilderGrowth {
             params.grid_size_m,
             params.max_lattice_points,
         )?;
-        let ground = Ground::new(&cell, filaments, inputs, params.legality_step_m)?;
+        let ground = Ground::new(&cell, filaments, *maps, params.legality_step_m)?;
         self.sites.clear();
         self.sites.resize(frame.len(), Site::default());
         self.width = frame.width;
@@ -430,8 +432,7 @@ fn place_start(growth: &mut Growth<'_, '_>, a: DVec2, b: DVec2) -> bool {
 }
 
 /// Grows the course report's grid streets in one `cell` (a polygon with holes; any
-/// orientation, possibly concave), keeping out of water and parks (`inputs.water`,
-/// `inputs.parks` ≥ 0.5), with `params`' rules, seeded by `seed` (the caller derives it
+/// orientation, possibly concave), keeping out of water and parks (`maps`), with `params`' rules, seeded by `seed` (the caller derives it
 /// from the city seed and the cell's stable id). The one-call form of
 /// [`GridBuilderGrowth::grow`] without filaments.
 ///
@@ -439,24 +440,22 @@ fn place_start(growth: &mut Growth<'_, '_>, a: DVec2, b: DVec2) -> bool {
 /// See [`GridBuilderGrowth::grow`].
 pub fn grow_grid_roads(
     cell: &PolygonWithHoles,
-    inputs: &RoadInputs,
+    maps: &GridMaps<'_>,
     params: &GridParams,
     seed: u64,
 ) -> Result<GridRoads> {
-    GridBuilderGrowth::new().grow(cell, &[], inputs, params, seed)
+    GridBuilderGrowth::new().grow(cell, &[], maps, params, seed)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use polis_geom::Polygon;
-    use polis_geom::field::Constant;
-    use std::sync::Arc;
 
     #[test]
     fn the_pop_guard_ends_builders_under_the_dead_end_rule() {
         let cell = PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::new(500.0, 400.0)));
-        let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+        let maps = GridMaps::none();
         let params = GridParams::downtown();
         for seed in 0..10 {
             let mut w = GridBuilderGrowth::new();
@@ -481,7 +480,7 @@ mod tests {
     #[test]
     fn street_map_links_are_symmetric_and_downtown_has_no_dead_end_points() {
         let cell = PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::new(500.0, 400.0)));
-        let maps = RoadInputs::flat(Arc::new(Constant(1.0)));
+        let maps = GridMaps::none();
         for (params, dead_ends_allowed) in [
             (GridParams::downtown(), false),
             (GridParams::residential(), true),

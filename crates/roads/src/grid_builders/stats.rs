@@ -1,11 +1,11 @@
 //! [`StreetStats`]: how gridded and how dense a cell's streets are.
 
-use polis_geom::graph::SnapOptions;
 use polis_geom::{NodeId, PolygonWithHoles};
 use serde::{Deserialize, Serialize};
 
-use super::error::{GridError, Result};
-use crate::network::{Road, RoadClass, RoadNetwork};
+use super::error::Result;
+use super::graph::with_boundary;
+use crate::network::RoadNetwork;
 
 /// Street statistics of one cell's road graph (streets only, with the nodes where they
 /// meet the cell boundary).
@@ -50,7 +50,7 @@ fn share(n: usize, d: usize) -> f64 {
 /// (inserted with exact predicates): bounded faces `E − V + C`, less one per hole.
 ///
 /// # Errors
-/// [`GridError::InvalidCell`] when the cell's rings cannot be added to the graph (bad
+/// [`GridError::InvalidCell`](super::GridError::InvalidCell) when the cell's rings cannot be added to the graph (bad
 /// coordinates).
 pub fn street_stats(
     network: &RoadNetwork,
@@ -79,21 +79,7 @@ pub fn street_stats(
     s.dead_end_share = share(s.dead_ends, ends);
     s.four_way_or_boundary_share = share(s.four_way + s.boundary_joins, ends);
 
-    let mut whole = network.clone();
-    let ring_road = Road {
-        class: RoadClass::Highway,
-        width: 0.0,
-        bridge: false,
-        step: 0,
-    };
-    let opts = SnapOptions::default();
-    for (_, ring) in cell.rings() {
-        for (a, b) in ring.edges() {
-            whole
-                .insert_segment(a, b, ring_road, &opts)
-                .map_err(GridError::InvalidCell)?;
-        }
-    }
+    let whole = with_boundary(network, cell, &[])?;
     let components = whole.connected_components().len();
     let bounded = (whole.edge_count() + components).saturating_sub(whole.node_count());
     s.blocks = bounded.saturating_sub(cell.holes.len());
