@@ -18,9 +18,9 @@ fn flat() -> GridMaps<'static> {
 }
 
 /// Segments of the cell's rings plus `filaments`.
-fn obstacles(cell: &PolygonWithHoles, filaments: &[(DVec2, DVec2)]) -> Vec<(DVec2, DVec2)> {
+fn obstacles(cell: &PolygonWithHoles, filaments: &[[DVec2; 2]]) -> Vec<(DVec2, DVec2)> {
     let mut out: Vec<_> = cell.rings().flat_map(|(_, r)| r.edges()).collect();
-    out.extend_from_slice(filaments);
+    out.extend(filaments.iter().map(|&[a, b]| (a, b)));
     out
 }
 
@@ -28,7 +28,7 @@ fn obstacles(cell: &PolygonWithHoles, filaments: &[(DVec2, DVec2)]) -> Vec<(DVec
 fn check(
     roads: &GridRoads,
     cell: &PolygonWithHoles,
-    filaments: &[(DVec2, DVec2)],
+    filaments: &[[DVec2; 2]],
     maps: &GridMaps<'_>,
     params: &GridParams,
 ) {
@@ -250,8 +250,8 @@ fn streets_keep_out_of_water_parks_and_filaments() {
         parks: Some(&parks),
     };
     let filaments = [
-        (DVec2::new(0.0, 300.0), DVec2::new(260.0, 300.0)),
-        (DVec2::new(260.0, 300.0), DVec2::new(260.0, 180.0)),
+        [DVec2::new(0.0, 300.0), DVec2::new(260.0, 300.0)],
+        [DVec2::new(260.0, 300.0), DVec2::new(260.0, 180.0)],
     ];
     for params in [GridParams::downtown(), GridParams::residential()] {
         for seed in 0..8 {
@@ -464,7 +464,7 @@ fn bad_parameters_and_cells_are_typed_errors() {
         grow_grid_roads(&cell, &wet, &p, 0),
         Err(GridError::NoStart { .. })
     ));
-    let bad_filament = [(DVec2::new(10.0, 10.0), DVec2::new(f64::INFINITY, 10.0))];
+    let bad_filament = [[DVec2::new(10.0, 10.0), DVec2::new(f64::INFINITY, 10.0)]];
     assert!(matches!(
         GridBuilderGrowth::new().grow(&cell, &bad_filament, &maps, &p, 0),
         Err(GridError::InvalidCell(_))
@@ -500,7 +500,7 @@ fn split(weights: &[u32]) -> Vec<f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
 
     #[test]
     fn random_concave_cells_keep_every_invariant(
@@ -511,15 +511,19 @@ proptest! {
         orientation in prop::option::of(-180.0f64..180.0),
         residential in any::<bool>(),
         far in any::<bool>(),
+        filament in any::<bool>(),
         seed in any::<u64>(),
     ) {
         // Near the origin, or far from it (where coordinates carry less precision).
         let centre = if far { DVec2::new(734_512.25, -2_104_377.5) } else { DVec2::ZERO };
         let cell = star_cell(centre, &radii, phase, hole);
+        // A dead-end road from the first vertex a third of the way to the centre.
+        let v0 = cell.outer.points()[0];
+        let filaments = if filament { vec![[v0, v0.lerp(centre, 0.35)]] } else { Vec::new() };
         let base = if residential { GridParams::residential() } else { GridParams::downtown() };
         let params = GridParams { grid_size_m: grid, orientation_deg: orientation, ..base };
-        match grow_grid_roads(&cell, &flat(), &params, seed) {
-            Ok(roads) => check(&roads, &cell, &[], &flat(), &params),
+        match GridBuilderGrowth::new().grow(&cell, &filaments, &flat(), &params, seed) {
+            Ok(roads) => check(&roads, &cell, &filaments, &flat(), &params),
             // A start may find no room in a spiky cell; never any other error.
             Err(GridError::NoStart { .. }) => {}
             Err(e) => prop_assert!(false, "{e}"),
@@ -552,4 +556,114 @@ proptest! {
         let roads = grow_grid_roads(&cell, &flat(), &params, seed).unwrap();
         check(&roads, &cell, &[], &flat(), &params);
     }
+}
+
+#[test]
+fn cells_grown_on_several_threads_equal_serial_ones() {
+    let cells = fixed_cells();
+    let params = GridParams::residential();
+    let grow = |i: usize| {
+        let r = grow_grid_roads(&cells[i % cells.len()], &flat(), &params, i as u64).unwrap();
+        format!("{:?}", r.network)
+    };
+    let serial: Vec<String> = (0..8).map(grow).collect();
+    let parallel: Vec<String> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..8).map(|i| s.spawn(move || grow(i))).collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(serial, parallel);
+}
+
+#[test]
+fn value_stability() {
+    // Pins exact outputs: a change here changes every city grown with grid builders.
+    // (nodes, edges, boundary nodes, street length in metres)
+    let pinned = [
+        (GridParams::downtown(), 4, 0, (108, 132, 17, 5875.0)),
+        (GridParams::residential(), 4, 0, (68, 83, 12, 4575.0)),
+        (
+            GridParams::downtown(),
+            9,
+            1,
+            (74, 86, 15, 4085.894240486251),
+        ),
+        (
+            GridParams::residential(),
+            9,
+            1,
+            (66, 76, 16, 4099.988324106887),
+        ),
+    ];
+    for (params, seed, cell, (nodes, edges, boundary, length)) in pinned {
+        let roads = grow_grid_roads(&fixed_cells()[cell], &flat(), &params, seed).unwrap();
+        let g = &roads.network;
+        let total: f64 = g.edge_ids().map(|e| g.edge_length(e).unwrap()).sum();
+        assert_eq!(
+            (g.node_count(), g.edge_count(), roads.boundary_nodes.len()),
+            (nodes, edges, boundary),
+            "{} seed {seed}",
+            params.rules.name
+        );
+        assert!((total - length).abs() < 1e-6, "{total} != {length}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 500, ..ProptestConfig::default() })]
+
+    #[test]
+    fn damaged_rule_text_is_a_typed_error(cut in 0usize..600, byte in 0usize..600, with in any::<char>()) {
+        // Truncated text.
+        let text = DOWNTOWN_JSON.trim_end();
+        let cut = cut.min(text.len() - 1);
+        if text.is_char_boundary(cut) {
+            prop_assert!(matches!(GridRules::from_json(&text[..cut]), Err(GridError::Json(_))));
+        }
+        // One character replaced: a typed error or the same rules; never a panic.
+        let byte = byte.min(text.len() - 1);
+        if text.is_char_boundary(byte) && text.is_char_boundary(byte + 1) {
+            let mut damaged = text.to_owned();
+            damaged.replace_range(byte..byte + 1, with.encode_utf8(&mut [0; 4]));
+            // Parsed only if no probability changed (a single character cannot change
+            // one and keep every group summing to 1); the name may have.
+            if let Ok(rules) = GridRules::from_json(&damaged) {
+                let d = GridRules::downtown();
+                prop_assert_eq!(rules.movement_action_rules, d.movement_action_rules);
+                prop_assert_eq!(rules.branch_out_rules, d.branch_out_rules);
+                prop_assert_eq!(rules.cross_intersection_rules, d.cross_intersection_rules);
+                prop_assert_eq!(rules.dead_end_rules, d.dead_end_rules);
+            }
+        }
+    }
+}
+
+/// A proptest failure, pinned: the grid's first row runs along the longest edge and on
+/// into the cell past a reflex corner, so a builder on that row heads along the edge's
+/// line towards the corner (far from the origin, where rounding decides the hit).
+#[test]
+fn regression_grid_row_through_a_reflex_corner() {
+    let radii = [
+        130.6625652666858,
+        120.0,
+        120.0,
+        120.0,
+        184.28948922911687,
+        296.1184015592105,
+        278.41393848922985,
+        120.15976021444133,
+        295.5066028122711,
+        195.88558600819144,
+    ];
+    let cell = star_cell(
+        DVec2::new(734_512.25, -2_104_377.5),
+        &radii,
+        1.2382900070996226,
+        false,
+    );
+    let params = GridParams {
+        grid_size_m: 45.85428500488902,
+        ..GridParams::downtown()
+    };
+    let roads = grow_grid_roads(&cell, &flat(), &params, 5209818659525735825).unwrap();
+    check(&roads, &cell, &[], &flat(), &params);
 }

@@ -38,7 +38,7 @@ impl GridRoads {
     pub fn cell_graph(
         &self,
         cell: &PolygonWithHoles,
-        filaments: &[(DVec2, DVec2)],
+        filaments: &[[DVec2; 2]],
     ) -> Result<RoadNetwork> {
         with_boundary(&self.network, cell, filaments)
     }
@@ -48,12 +48,12 @@ impl GridRoads {
 pub(crate) fn with_boundary(
     network: &RoadNetwork,
     cell: &PolygonWithHoles,
-    filaments: &[(DVec2, DVec2)],
+    filaments: &[[DVec2; 2]],
 ) -> Result<RoadNetwork> {
     let mut whole = network.clone();
     let opts = SnapOptions::default();
     let rings = cell.rings().flat_map(|(_, ring)| ring.edges());
-    for (a, b) in rings.chain(filaments.iter().copied()) {
+    for (a, b) in rings.chain(filaments.iter().map(|&[a, b]| (a, b))) {
         whole
             .insert_segment(a, b, BOUNDARY_ROAD, &opts)
             .map_err(GridError::InvalidCell)?;

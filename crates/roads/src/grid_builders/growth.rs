@@ -156,15 +156,15 @@ impl Growth<'_, '_> {
     }
 
     /// Whether the boundary lies within one step plus the clearance of `p` towards `d`:
-    /// `None` if not, else the join if it is legal (out of water and parks, passing no
-    /// point another join passes) or `Some(None)` if it is not.
+    /// `None` if not, else the join if it is legal (out of water and parks, steep enough,
+    /// passing no point another join passes) or `Some(None)` if it is not.
     fn boundary_ahead(&self, p: usize, d: Dir) -> Option<Option<Join>> {
         let pw = self.frame.position(p);
         let reach = self.frame.step + self.clearance;
-        let hit = self
+        let (hit, steep) = self
             .ground
             .first_hit(pw, pw + self.frame.vector(d) * reach)?;
-        if !self.ground.legal(pw, hit) {
+        if !steep || !self.ground.legal(pw, hit) {
             return Some(None);
         }
         if pw.distance(hit) < self.frame.step {

@@ -181,11 +181,20 @@ impl Site {
     }
 }
 
+/// The smallest sine of the angle at which a street may run on to the boundary (about
+/// 11.5°). A street from a grid point clear of the boundary meets it at a sine of at
+/// least `clearance / (step + clearance)` anyway; shallower hits arise only where a grid
+/// line runs into a reflex corner along one of its edges, and such a street would run
+/// along the boundary, so it is refused.
+pub(crate) const MIN_JOIN_SINE: f64 = 0.2;
+
 /// The cell's boundary rings, its filaments and the maps: where streets may go.
 pub(crate) struct Ground<'a> {
     cell: &'a PolygonWithHoles,
-    /// Every boundary and filament segment.
+    /// Every boundary and filament segment, by key.
     index: SegmentIndex<u32>,
+    /// The same segments, indexed by key.
+    walls: Vec<(DVec2, DVec2)>,
     maps: GridMaps<'a>,
     legality_step: f64,
 }
@@ -193,13 +202,16 @@ pub(crate) struct Ground<'a> {
 impl<'a> Ground<'a> {
     pub(crate) fn new(
         cell: &'a PolygonWithHoles,
-        filaments: &[(DVec2, DVec2)],
+        filaments: &[[DVec2; 2]],
         maps: GridMaps<'a>,
         legality_step: f64,
     ) -> Result<Ground<'a>> {
         let mut index = SegmentIndex::default();
         let rings = cell.rings().flat_map(|(_, ring)| ring.edges());
-        for (key, (a, b)) in (0u32..).zip(rings.chain(filaments.iter().copied())) {
+        let walls: Vec<_> = rings
+            .chain(filaments.iter().map(|&[a, b]| (a, b)))
+            .collect();
+        for (key, &(a, b)) in (0u32..).zip(&walls) {
             index
                 .insert_segment(key, a, b)
                 .map_err(GridError::InvalidCell)?;
@@ -207,6 +219,7 @@ impl<'a> Ground<'a> {
         Ok(Ground {
             cell,
             index,
+            walls,
             maps,
             legality_step,
         })
@@ -223,10 +236,16 @@ impl<'a> Ground<'a> {
     }
 
     /// The first point of the boundary or a filament on the segment `a–b` (exact
-    /// crossing decision; the point is computed afterwards).
-    pub(crate) fn first_hit(&self, a: DVec2, b: DVec2) -> Option<DVec2> {
+    /// crossing decision; the point is computed afterwards), and whether a street may
+    /// end there: not if `a–b` meets that wall at less than [`MIN_JOIN_SINE`].
+    pub(crate) fn first_hit(&self, a: DVec2, b: DVec2) -> Option<(DVec2, bool)> {
         let hit = self.index.first_crossing(a, b, |_| true)?;
-        Some(a + (b - a) * hit.t)
+        let point = a + (b - a) * hit.t;
+        let steep = self.walls.get(hit.key as usize).is_some_and(|&(w0, w1)| {
+            let (d, w) = ((b - a).normalize_or_zero(), (w1 - w0).normalize_or_zero());
+            d.perp_dot(w).abs() >= MIN_JOIN_SINE
+        });
+        Some((point, steep))
     }
 
     /// Whether the straight street `a–b` stays out of water and parks: every sample,

@@ -82,6 +82,9 @@
 //!   choose.
 //! * Water and parks are sampled, not intersected: a sliver narrower than
 //!   `legality_step_m` can be crossed.
+//! * A street never runs on to the boundary at less than about 11.5° (such a join is
+//!   refused like any blocked move): where a grid line runs into a reflex corner along
+//!   one of the corner's edges, it would run along the boundary.
 //! * A region of the cell that no builder reaches (behind water, or a narrow neck of a
 //!   concave cell) stays empty; more [`GridParams::starts`] help.
 //!
@@ -257,7 +260,7 @@ impl GridBuilderGrowth {
     pub fn grow(
         &mut self,
         cell: &PolygonWithHoles,
-        filaments: &[(DVec2, DVec2)],
+        filaments: &[[DVec2; 2]],
         maps: &GridMaps<'_>,
         params: &GridParams,
         seed: u64,
@@ -270,7 +273,7 @@ impl GridBuilderGrowth {
     fn grow_guarded(
         &mut self,
         cell: &PolygonWithHoles,
-        filaments: &[(DVec2, DVec2)],
+        filaments: &[[DVec2; 2]],
         maps: &GridMaps<'_>,
         params: &GridParams,
         seed: u64,
@@ -400,7 +403,7 @@ fn place_start(growth: &mut Growth<'_, '_>, a: DVec2, b: DVec2) -> bool {
         if !growth.ground.inside(p) || !growth.ground.clear(p, growth.clearance) {
             continue;
         }
-        let Some(hit) = growth.ground.first_hit(p, p - frame.vector(dir) * reach) else {
+        let Some((hit, true)) = growth.ground.first_hit(p, p - frame.vector(dir) * reach) else {
             return false;
         };
         // The grid points the join passes: none may be a street or passed by another.
