@@ -145,7 +145,11 @@ impl Growth<'_, '_> {
             if let Some(n) = self.frame.neighbor(q, side)
                 && self.site(n).street
             {
-                if self.tip_towards(n, side.opposite()) {
+                let nw = self.frame.position(n);
+                if self.tip_towards(n, side.opposite())
+                    && self.ground.first_hit(qw, nw).is_none()
+                    && self.ground.legal(qw, nw)
+                {
                     *slot = Some(side);
                 } else {
                     return None;
