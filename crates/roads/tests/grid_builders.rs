@@ -273,6 +273,28 @@ fn streets_keep_out_of_water_parks_and_filaments() {
 }
 
 #[test]
+fn parameters_are_serde_data() {
+    let p = GridParams::residential();
+    let text = serde_json::to_string(&p).unwrap();
+    let back: GridParams = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, p);
+    // Missing fields take the defaults (Downtown); the rules are the report's shape.
+    let partial: GridParams = serde_json::from_str(&format!(
+        r#"{{"grid_size_m": 40.0, "rules": {RESIDENTIAL_JSON}}}"#
+    ))
+    .unwrap();
+    assert_eq!(
+        partial,
+        GridParams {
+            grid_size_m: 40.0,
+            rules: GridRules::residential(),
+            ..GridParams::downtown()
+        }
+    );
+    assert!(serde_json::from_str::<GridParams>(r#"{"grid_sise_m": 40.0}"#).is_err());
+}
+
+#[test]
 fn orientation_can_be_given() {
     let cell = square(400.0);
     let params = GridParams {

@@ -29,9 +29,10 @@ pub const BOUNDARY_ROAD: Road = Road {
 impl GridRoads {
     /// The cell's whole road graph: the streets plus the cell's rings and `filaments` as
     /// [`BOUNDARY_ROAD`] edges ([`RoadClass::Highway`], width 0), inserted with exact
-    /// predicates, so boundary edges are split where streets join them. This is the shape
-    /// of a cell's private graph in Kelly's secondary growth (boundary and filaments as
-    /// highways, new roads as streets). Planar.
+    /// predicates, so boundary edges are split where streets join them (and a street is
+    /// split where a boundary vertex lies within the 1 cm snap distance of it). This is
+    /// the shape of a cell's private graph in Kelly's secondary growth (boundary and
+    /// filaments as highways, new roads as streets). Planar.
     ///
     /// # Errors
     /// [`GridError::InvalidCell`] when a ring or filament has bad coordinates.
