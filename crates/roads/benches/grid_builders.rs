@@ -4,6 +4,11 @@
 //!
 //! `cargo bench -p polis-roads --bench grid_builders`; divan reports the time per cell
 //! (and cells/s as item throughput).
+//!
+//! For whole-process timings, `POLIS_GRID_CELLS=N` (optionally with
+//! `POLIS_GRID_RULES=downtown` or `residential`) grows N cells per rule set with seeds
+//! 0..N, prints the in-process time and exits without divan:
+//! `POLIS_GRID_CELLS=2000 POLIS_GRID_RULES=downtown cargo bench -p polis-roads --bench grid_builders`.
 
 #![allow(clippy::unwrap_used)]
 
@@ -11,7 +16,42 @@ use divan::counter::ItemsCount;
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 use polis_roads::grid_builders::{GridBuilderGrowth, GridMaps, GridParams};
 
+/// Grows `n` cells per selected rule set and reports the time (whole-process mode).
+fn batch(n: u64, only: Option<&str>) {
+    let maps = GridMaps::none();
+    let mut worker = GridBuilderGrowth::new();
+    for params in [GridParams::downtown(), GridParams::residential()] {
+        if only.is_some_and(|o| !params.rules.name.eq_ignore_ascii_case(o)) {
+            continue;
+        }
+        let t = std::time::Instant::now();
+        let mut edges = 0;
+        for seed in 0..n {
+            edges += worker
+                .grow(&cell(), &[], &maps, &params, seed)
+                .unwrap()
+                .network
+                .edge_count();
+        }
+        let s = t.elapsed().as_secs_f64();
+        println!(
+            "{:<12} {n} cells: {:.3} s, {:.1} µs per cell, {:.1} edges per cell",
+            params.rules.name,
+            s,
+            s * 1e6 / n as f64,
+            edges as f64 / n as f64
+        );
+    }
+}
+
 fn main() {
+    if let Some(n) = std::env::var("POLIS_GRID_CELLS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        batch(n, std::env::var("POLIS_GRID_RULES").ok().as_deref());
+        return;
+    }
     // Per-seed table first: the time of one cell varies with how far the builders get.
     let maps = GridMaps::none();
     let mut worker = GridBuilderGrowth::new();
