@@ -3,8 +3,9 @@
 //! movement by rule probabilities read from JSON, branching out to their sides, crossing
 //! or T-ing into the streets they meet, and (Downtown) refusing dead ends. One more
 //! neighbourhood pattern for a cell, beside Kelly's secondary growth: same input (the
-//! cell with holes, the maps, parameters, a seed), same output (the cell's planar
-//! streets, joined to its boundary).
+//! cell with holes and filaments, the water and park maps, parameters, a seed), same
+//! output (the cell's planar streets, joined to its boundary; [`GridRoads::cell_graph`]
+//! adds the boundary and filaments as highway edges, the shape of Kelly's cell graph).
 //!
 //! ```text
 //!  rules JSON ─▶ GridRules ─┐
@@ -35,8 +36,8 @@
 //!    street is removed back to the last junction.
 //! 5. Then, from the builder's previous position, branch out left and right, each with
 //!    the branch-out probability: a new builder takes one step sideways and is queued.
-//! 6. The street map becomes a planar graph: one segment per
-//!    straight run, one per boundary join, all through planar insertion.
+//! 6. The street map becomes a planar graph: one segment per straight run, one per
+//!    boundary join, all through planar insertion.
 //!
 //! ## Example
 //!
@@ -86,7 +87,14 @@
 //!   refused like any blocked move): where a grid line runs into a reflex corner along
 //!   one of the corner's edges, it would run along the boundary.
 //! * A region of the cell that no builder reaches (behind water, or a narrow neck of a
-//!   concave cell) stays empty; more [`GridParams::starts`] help.
+//!   concave cell) stays empty; more [`GridParams::starts`] help. With the report's
+//!   probabilities builders die out early in small cells (the report's own limitation:
+//!   "the created layout is useless" when early builders fail), so coverage varies from
+//!   seed to seed.
+//! * The loop is bounded by [`MAX_POPS_PER_POINT`] pops per grid point (pruned points
+//!   can be built again, so termination is otherwise only almost sure); a run that
+//!   reaches it ends its queued builders under the dead-end rule and says so in
+//!   [`GridReport::truncated`].
 //!
 //! ## Departures from the report
 //!
@@ -98,8 +106,14 @@
 //!   report: Downtown never stops, Residential allows every dead end.)
 //! * The report's exceptions to the side constraint are not listed; the one kept here
 //!   lets a street end that points at the new grid point join it (a T).
-//! * A branch that would step straight onto a street is dropped (it would close a block
-//!   one step wide).
+//! * The report starts one builder; here [`GridParams::starts`] (default 4) start at the
+//!   midpoints of the longest edges, as Kelly's growth does, since a cell is surrounded
+//!   by roads on every side.
+//! * A branch takes its first step at once (the report does not show
+//!   `branchOutToSide`); one that would step straight onto a street is dropped (it would
+//!   close a block one step wide).
+//! * Streets running on to the boundary may not cross one another (each reserves the
+//!   grid point it passes).
 //!
 //! ## References
 //!
