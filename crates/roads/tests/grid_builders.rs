@@ -273,6 +273,20 @@ fn streets_keep_out_of_water_parks_and_filaments() {
 }
 
 #[test]
+fn rings_in_either_orientation_are_normalised() {
+    let mut cell = fixed_cells().swap_remove(3);
+    cell.outer.reverse();
+    for h in &mut cell.holes {
+        h.reverse();
+    }
+    assert!(!cell.is_normalized());
+    let params = GridParams::downtown();
+    let roads = grow_grid_roads(&cell, &flat(), &params, 3).unwrap();
+    cell.normalize();
+    check(&roads, &cell, &[], &flat(), &params);
+}
+
+#[test]
 fn parameters_are_serde_data() {
     let p = GridParams::residential();
     let text = serde_json::to_string(&p).unwrap();
