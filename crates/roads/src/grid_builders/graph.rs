@@ -1,8 +1,9 @@
 //! The builders' street map converted to a planar road graph.
 //!
-//! Each maximal straight run of linked grid points becomes one segment (points where a
-//! street only passes straight through are not nodes), and each join becomes a segment
-//! from its grid point to its boundary point. All are added with
+//! Each straight run of linked grid points between two nodes (junctions, bends, ends,
+//! joins; points a street only passes straight through are not nodes) becomes one
+//! segment, and each join becomes a segment from its grid point to its boundary point.
+//! All are added with
 //! [`PlanarGraph::insert_segment_with`](polis_geom::PlanarGraph::insert_segment_with), which
 //! decides every touch and crossing with exact predicates and splits there, so junctions
 //! are nodes and the graph is planar by construction.
@@ -88,18 +89,21 @@ pub(crate) fn to_network(
         snap_distance: (frame.step * SNAP_FRACTION).min(0.01),
     };
     for (forward, back) in [(Dir::East, Dir::West), (Dir::North, Dir::South)] {
+        // A point the street only passes straight through is not a node.
+        let straight = forward.bit() | back.bit();
+        let through = |s: &Site| s.links == straight && !s.joined;
         for (k, s) in sites.iter().enumerate() {
-            if s.links & forward.bit() == 0 || s.links & back.bit() != 0 {
+            if s.links & forward.bit() == 0 || through(s) {
                 continue;
             }
-            // k starts a run towards `forward`: walk to its end.
+            // k is a node with a street towards `forward`: walk to the next node.
             let (mut end, mut born) = (k, s.born);
-            while sites[end].links & forward.bit() != 0 {
-                match frame.neighbor(end, forward) {
-                    Some(n) => end = n,
-                    None => break,
-                }
+            while let Some(n) = frame.neighbor(end, forward) {
+                end = n;
                 born = born.max(sites[end].born);
+                if !through(&sites[end]) {
+                    break;
+                }
             }
             let (a, b) = (frame.position(k), frame.position(end));
             g.insert_segment_with(a, b, street(width, born), &opts, |_| Junction {
