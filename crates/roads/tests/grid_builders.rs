@@ -718,3 +718,29 @@ fn regression_grid_row_through_a_reflex_corner() {
     let roads = grow_grid_roads(&cell, &flat(), &params, 5209818659525735825).unwrap();
     check(&roads, &cell, &[], &flat(), &params);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    #[test]
+    fn any_scale_is_a_result_never_a_panic(
+        radii in prop::collection::vec(0.5f64..1.0, 5..9),
+        scale in prop_oneof![Just(1e-3), Just(1.0), Just(1e3), Just(1e5), 1e-2f64..1e4],
+        grid in prop_oneof![Just(1e-6), Just(1e-2), Just(1.0), Just(1e3), 1e-3f64..1e3],
+        offset in prop_oneof![Just(0.0), Just(1e7), -1e6f64..1e6],
+        seed in any::<u64>(),
+    ) {
+        let radii: Vec<f64> = radii.iter().map(|r| r * scale).collect();
+        let cell = star_cell(DVec2::splat(offset), &radii, 0.3, false);
+        let params = GridParams {
+            grid_size_m: grid,
+            max_lattice_points: 20_000,
+            ..GridParams::downtown()
+        };
+        // Ok (a small cell may fit no start, a fine grid too many points), never a panic;
+        // a result within the grid limit keeps every invariant.
+        if let Ok(roads) = grow_grid_roads(&cell, &flat(), &params, seed) {
+            check(&roads, &cell, &[], &flat(), &params);
+        }
+    }
+}
