@@ -24,6 +24,7 @@
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
 //! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
+//! | [`grid_builders`]: [`GridBuilderGrowth`], [`grow_grid_roads`], [`GridRules`], [`GridParams`] | the course report's grid road builders in one cell (rules from JSON; Downtown, Residential) |
 //!
 //! ## Example
 //!
@@ -80,6 +81,7 @@ pub mod constraints;
 pub mod error;
 pub mod generator;
 pub mod goals;
+pub mod grid_builders;
 pub mod inputs;
 pub mod lattice;
 pub mod legality;
@@ -96,6 +98,7 @@ pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };
 pub use goals::{DefaultGoals, GlobalGoals};
+pub use grid_builders::{GridBuilderGrowth, GridParams, GridRoads, GridRules, grow_grid_roads};
 pub use inputs::{RoadInputs, procedural_lattice_m};
 pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
