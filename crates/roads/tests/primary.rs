@@ -875,3 +875,45 @@ fn a_long_session_exercises_junctions_and_refused_crossing_moves() {
         PrimaryNetwork::new().to_json().unwrap()
     );
 }
+
+fn wild() -> impl proptest::strategy::Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(-f64::INFINITY),
+        Just(1e300),
+        Just(0.0),
+        -3000.0..3000.0f64,
+        any::<f64>(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+    /// Any coordinates and parameters, NaN and infinities included: a typed answer, never
+    /// a panic, and a refused edit leaves the network as it was.
+    #[test]
+    fn wild_input_never_panics(x in wild(), y in wild(), d in wild(), dev in wild(), snap in wild(), n in 0u32..80, kind in 0u8..5) {
+        let mut ed = flat_editor();
+        ed.apply(&Edit::AddRoad { from: at(-500.0, 0.0), to: at(500.0, 0.0), spec: straight() }).unwrap();
+        let json = ed.network().to_json().unwrap();
+        let mut spec = straight();
+        spec.params.sample_size_m = d;
+        spec.params.deviation_deg = dev;
+        spec.params.snap_m = snap;
+        spec.params.samples = n;
+        let p = DVec2::new(x, y);
+        let edit = match kind {
+            0 => Edit::AddNode { at: p, label: None },
+            1 => Edit::MoveNode { node: ControlId(0), to: p },
+            2 => Edit::AddRoad { from: Endpoint::Node(ControlId(1)), to: Endpoint::At(p), spec },
+            3 => Edit::SetRoad { road: RoadId(0), spec },
+            _ => Edit::Chain { from: ControlId(0), to: p, spec: straight() },
+        };
+        if ed.propose(&edit).is_err() {
+            prop_assert_eq!(ed.network().to_json().unwrap(), json);
+        }
+        let _ = plot(DVec2::new(x, 0.0), DVec2::new(0.0, y), &spec.params, ed.terrain());
+    }
+}
