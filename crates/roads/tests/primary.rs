@@ -564,6 +564,31 @@ fn refusals_are_typed_and_change_nothing() {
         ),
         PrimaryError::ZeroLength { .. }
     ));
+    // Passing half a metre from a lone node.
+    let mut lone = flat_editor();
+    lone.apply(&Edit::AddNode {
+        at: DVec2::ZERO,
+        label: None,
+    })
+    .unwrap();
+    let e = refuse(
+        &lone,
+        Edit::AddRoad {
+            from: at(-500.0, 0.5),
+            to: at(500.0, 0.5),
+            spec: s,
+        },
+    );
+    assert!(
+        matches!(
+            e,
+            PrimaryError::PassesNode {
+                node: ControlId(0),
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     // Bad parameters name the field.
     let mut bad = s;
     bad.params.deviation_deg = 50.0;

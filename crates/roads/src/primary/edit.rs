@@ -456,7 +456,8 @@ impl<'a> Draft<'a> {
 
     /// Refuses a new node at `p` within the snap distance of an existing node.
     fn clear_of_nodes(&self, p: DVec2) -> Result<(), PrimaryError> {
-        if let Some((node, distance)) = self.net.nearest_node(p, self.opts.snap_distance_m) {
+        let r = self.opts.snap_distance_m.max(self.opts.min_road_length_m);
+        if let Some((node, distance)) = self.net.nearest_node(p, r) {
             return Err(PrimaryError::NodeTooClose {
                 point: p,
                 node,
@@ -492,6 +493,28 @@ impl<'a> Draft<'a> {
                 Ok(End::Free(p))
             }
         }
+    }
+
+    /// Refuses a path passing within the minimum road length of a node other than `ends`.
+    fn clear_path(
+        &self,
+        road: RoadId,
+        path: &RoadPath,
+        ends: &[ControlId],
+    ) -> Result<(), PrimaryError> {
+        let r = self.opts.min_road_length_m;
+        for w in path.points.windows(2) {
+            for (node, distance) in self.net.nodes_near_segment(w[0], w[1], r) {
+                if !ends.contains(&node) {
+                    return Err(PrimaryError::PassesNode {
+                        road,
+                        node,
+                        distance,
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     fn add_node(&mut self, at: DVec2, label: Option<String>) -> Result<(), PrimaryError> {
@@ -610,6 +633,14 @@ impl<'a> Draft<'a> {
             return Err(PrimaryError::SelfCrossing { at: c.point() });
         }
         let crossings = self.crossings(&path, ea, eb)?;
+        let own: Vec<ControlId> = [ea, eb]
+            .iter()
+            .filter_map(|e| match *e {
+                End::Node(id, _) => Some(id),
+                _ => None,
+            })
+            .collect();
+        self.clear_path(new_id, &path, &own)?;
         // Angles where the road meets nodes and the roads it joins.
         let n = path.points.len();
         for (end, leave) in [(ea, path.points[1]), (eb, path.points[n - 2])] {
@@ -778,7 +809,7 @@ impl<'a> Draft<'a> {
     fn move_node(&mut self, node: ControlId, to: DVec2) -> Result<(), PrimaryError> {
         let old = self.node(node)?.clone();
         check_site(to, "node", self.terrain)?;
-        let snap = self.opts.snap_distance_m;
+        let snap = self.opts.snap_distance_m.max(self.opts.min_road_length_m);
         if let Some(p) = self.net.nearest_node_except(to, snap, node) {
             return Err(PrimaryError::NodeTooClose {
                 point: to,
@@ -811,6 +842,7 @@ impl<'a> Draft<'a> {
             let (pa, pb) = (self.node(r.a)?.pos, self.node(r.b)?.pos);
             r.path = plot_path(pa, pb, &r.spec.params, self.terrain)?;
             too_short(&r.path, min)?;
+            self.clear_path(id, &r.path, &[r.a, r.b])?;
             fresh.push((id, r));
         }
         // Contacts with the roads that stay.
