@@ -17,7 +17,8 @@
 //! Zero length (a road or piece shorter than [`EditOptions::min_road_length_m`]), a road
 //! from a node to itself or between already joined nodes, collinear overlap with another
 //! path, a meeting angle below [`EditOptions::min_angle_deg`] (at a node, a T-junction or
-//! a crossing), a crossing within the snap distance of a node, a path crossing itself, a
+//! a crossing), a crossing within the snap distance of a node, a path passing within the
+//! minimum road length of a node that is not its end, a path crossing itself, a
 //! node outside the map or on water or park, unknown ids, non-finite coordinates, bad
 //! parameters, a plot that is blocked or needs too long a bridge.
 //!
