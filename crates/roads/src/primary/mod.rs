@@ -73,6 +73,7 @@
 //! adaptive roads, sampling, strategies, spline), §5.3–5.4 (node and road edits,
 //! validity checking), §6.1–6.2 (Milan, Paris; road presets).
 
+mod draft;
 pub mod edit;
 pub mod error;
 pub mod history;
