@@ -163,6 +163,7 @@ enum Op {
     DeleteNode(usize),
     DeleteRoad(usize),
     Node(DVec2),
+    Label(usize),
     Set(usize, u8),
 }
 
@@ -176,6 +177,7 @@ fn op() -> impl Strategy<Value = Op> {
         1 => any::<usize>().prop_map(Op::DeleteNode),
         1 => any::<usize>().prop_map(Op::DeleteRoad),
         1 => q().prop_map(Op::Node),
+        1 => any::<usize>().prop_map(Op::Label),
         1 => (any::<usize>(), 0u8..3).prop_map(|(i, k)| Op::Set(i, k)),
     ]
 }
@@ -219,6 +221,10 @@ fn to_edit(net: &PrimaryNetwork, op: &Op) -> Option<Edit> {
         Op::Node(at) => Edit::AddNode {
             at,
             label: Some("x".into()),
+        },
+        Op::Label(i) => Edit::SetLabel {
+            node: pick_n(i)?,
+            label: (i % 2 == 0).then(|| format!("label {i}")),
         },
         Op::Set(i, k) => Edit::SetRoad {
             road: pick_r(i)?,

@@ -67,6 +67,13 @@ pub enum Edit {
         /// Its new position.
         to: DVec2,
     },
+    /// Set or clear a node's label (Kelly's node property inspector).
+    SetLabel {
+        /// The node.
+        node: ControlId,
+        /// The new label.
+        label: Option<String>,
+    },
     /// Delete a node and its roads.
     DeleteNode {
         /// The node.
@@ -254,6 +261,12 @@ impl PrimaryNetwork {
             }
             Edit::MoveNode { node, to } => {
                 d.move_node(*node, *to)?;
+                None
+            }
+            Edit::SetLabel { node, label } => {
+                let mut n = self.node(*node)?.clone();
+                n.label.clone_from(label);
+                d.nodes.insert(*node, Some(n));
                 None
             }
             Edit::DeleteNode { node } => {
