@@ -627,6 +627,28 @@ fn refusals_are_typed_and_change_nothing() {
             ..
         }
     ));
+    // A 30 km road drawn every centimetre would have 3 million vertices: refused.
+    let big = Terrain::flat(Aabb2::new(DVec2::splat(-20_000.0), DVec2::splat(20_000.0))).unwrap();
+    let huge = PrimaryEditor::new(big, EditOptions::default()).unwrap();
+    bad = s;
+    bad.params.segment_draw_size_m = 0.01;
+    bad.params.sample_size_m = 5000.0;
+    bad.params.snap_m = 5000.0;
+    let e = refuse(
+        &huge,
+        Edit::AddRoad {
+            from: at(-15_000.0, 0.0),
+            to: at(15_000.0, 0.0),
+            spec: bad,
+        },
+    );
+    assert!(matches!(
+        e,
+        PrimaryError::InvalidParameter {
+            name: "segment_draw_size_m",
+            ..
+        }
+    ));
     assert_eq!(ed.network().to_json().unwrap(), json);
     // A stale preview is refused.
     let p = ed
