@@ -970,3 +970,40 @@ proptest! {
         let _ = plot(DVec2::new(x, 0.0), DVec2::new(0.0, y), &spec.params, ed.terrain());
     }
 }
+
+/// Loading checks every invariant: a tampered file is refused with a reason.
+#[test]
+fn loading_a_tampered_network_is_refused() {
+    let mut ed = flat_editor();
+    ed.apply(&Edit::AddRoad {
+        from: at(-500.0, 0.0),
+        to: at(500.0, 0.0),
+        spec: straight(),
+    })
+    .unwrap();
+    ed.apply(&Edit::AddRoad {
+        from: at(0.0, 100.0),
+        to: at(0.0, 500.0),
+        spec: straight(),
+    })
+    .unwrap();
+    let json = ed.network().to_json().unwrap();
+    PrimaryNetwork::from_json(&json).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    // A node moved without its roads.
+    let mut moved = v.clone();
+    moved["nodes"]["2"]["pos"] = serde_json::json!([0.0, -100.0]);
+    assert!(matches!(
+        PrimaryNetwork::from_json(&moved.to_string()),
+        Err(PrimaryError::BadData(_))
+    ));
+    // A path bent across the other road.
+    let pts = v["roads"]["1"]["path"]["points"].as_array_mut().unwrap();
+    pts[1] = serde_json::json!([0.0, -50.0]);
+    let e = PrimaryNetwork::from_json(&v.to_string()).unwrap_err();
+    assert!(matches!(e, PrimaryError::BadData(_)), "{e}");
+    // An id at or above the counter.
+    let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    v["next_node"] = serde_json::json!(1);
+    assert!(PrimaryNetwork::from_json(&v.to_string()).is_err());
+}
