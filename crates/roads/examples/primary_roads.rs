@@ -270,19 +270,21 @@ fn milan() {
         }
         rings.push(ids);
     }
-    // Radials: from each inner-ring node out past the outer ring, crossing the rings.
+    // Radials: from each inner-ring node out past the outer ring, crossing the rings. A
+    // radial refused for crossing a ring too close to a node is turned a few degrees, as
+    // a user would move the cursor.
     for (k, &node) in rings[0].iter().enumerate() {
-        let from = Endpoint::Node(node);
-        let to = Endpoint::At(polar(2300.0, 22.5 + 45.0 * k as f64));
-        try_apply(
-            &mut ed,
-            &Edit::AddRoad {
-                from,
+        for turn in [0.0, 5.0, -5.0] {
+            let to = Endpoint::At(polar(2300.0, 22.5 + 45.0 * k as f64 + turn));
+            let edit = Edit::AddRoad {
+                from: Endpoint::Node(node),
                 to,
                 spec: primary,
-            },
-            &mut refused,
-        );
+            };
+            if try_apply(&mut ed, &edit, &mut refused).is_some() {
+                break;
+            }
+        }
     }
     ed.network().check_invariants().unwrap();
     println!(

@@ -1,60 +1,23 @@
-//! The primary network (Kelly §4.2, §5.3): plotting properties, validity checking,
-//! planarity under random edits, undo byte for byte, sources and the low-level graph.
+//! The primary network (Kelly §4.2, §5.3): plotting properties (commutativity,
+//! termination, the spline through every plot point, the strategies' grades) and
+//! properties of random edit sequences (planarity, undo byte for byte, replay, wild input).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod primary_support;
+
 use std::sync::Arc;
 
-use polis_geom::field::{Constant, Fbm, FbmParams, FnField};
-use polis_geom::{Aabb2, DVec2, FieldExt};
-use polis_roads::RoadInputs;
+use polis_geom::DVec2;
+use polis_geom::field::FnField;
 use polis_roads::legality::Illegal;
 use polis_roads::primary::{
     AdaptiveParams, ControlId, Correction, Edit, EditLog, EditOptions, Endpoint, PrimaryEditor,
-    PrimaryError, PrimaryNetwork, PrimarySpec, RoadId, RoadPreset, RoadSpec, Terrain,
-    path_from_plot, plot, plot_path,
+    PrimaryError, PrimaryNetwork, RoadId, RoadPreset, RoadSpec, Terrain, path_from_plot, plot,
+    plot_path,
 };
+use primary_support::{at, bounds, check_planar, flat_editor, hills, landscape, straight};
 use proptest::prelude::*;
-
-const HALF: f64 = 2000.0;
-
-fn bounds() -> Aabb2 {
-    Aabb2::new(DVec2::splat(-HALF), DVec2::splat(HALF))
-}
-
-/// fBm hills up to about ±60 m.
-fn hills(seed: u64) -> Terrain {
-    let f = Fbm::new(FbmParams {
-        seed,
-        octaves: 4,
-        wavelength_m: 900.0,
-        ..FbmParams::default()
-    })
-    .unwrap()
-    .scaled(60.0);
-    Terrain::with_elevation(f.shared(), bounds()).unwrap()
-}
-
-/// Hills, a river along x ≈ 600 m and a park around (−900, 900).
-fn landscape(seed: u64) -> Terrain {
-    let mut inputs = RoadInputs::flat(Arc::new(Constant(1.0)));
-    inputs.elevation = Fbm::new(FbmParams {
-        seed,
-        octaves: 3,
-        wavelength_m: 800.0,
-        ..FbmParams::default()
-    })
-    .unwrap()
-    .scaled(50.0)
-    .shared();
-    inputs.water = Arc::new(FnField::new(|p: DVec2| {
-        f64::from((p.x - 600.0 - 0.05 * p.y).abs() < 40.0)
-    }));
-    inputs.parks = Arc::new(FnField::new(|p: DVec2| {
-        f64::from(p.distance(DVec2::new(-900.0, 900.0)) < 250.0)
-    }));
-    Terrain::new(&inputs, bounds()).unwrap()
-}
 
 fn strategy() -> impl proptest::strategy::Strategy<Value = polis_roads::primary::Strategy> {
     prop_oneof![
@@ -163,6 +126,7 @@ enum Op {
     DeleteNode(usize),
     DeleteRoad(usize),
     Node(DVec2),
+    Label(usize),
     Set(usize, u8),
 }
 
@@ -176,6 +140,7 @@ fn op() -> impl Strategy<Value = Op> {
         1 => any::<usize>().prop_map(Op::DeleteNode),
         1 => any::<usize>().prop_map(Op::DeleteRoad),
         1 => q().prop_map(Op::Node),
+        1 => any::<usize>().prop_map(Op::Label),
         1 => (any::<usize>(), 0u8..3).prop_map(|(i, k)| Op::Set(i, k)),
     ]
 }
@@ -220,21 +185,15 @@ fn to_edit(net: &PrimaryNetwork, op: &Op) -> Option<Edit> {
             at,
             label: Some("x".into()),
         },
+        Op::Label(i) => Edit::SetLabel {
+            node: pick_n(i)?,
+            label: (i % 2 == 0).then(|| format!("label {i}")),
+        },
         Op::Set(i, k) => Edit::SetRoad {
             road: pick_r(i)?,
             spec: spec(k),
         },
     })
-}
-
-fn check_planar(net: &PrimaryNetwork) {
-    net.check_invariants().unwrap();
-    let low = net.to_road_network().unwrap();
-    low.network.check_invariants().unwrap();
-    // Every edge maps back to a live road.
-    for (e, _, _, _) in low.network.edges() {
-        net.road(low.road_of(e).unwrap()).unwrap();
-    }
 }
 
 proptest! {
@@ -288,438 +247,6 @@ proptest! {
     }
 }
 
-fn flat_editor() -> PrimaryEditor {
-    PrimaryEditor::new(Terrain::flat(bounds()).unwrap(), EditOptions::default()).unwrap()
-}
-
-fn straight() -> RoadSpec {
-    let mut s = RoadPreset::InnerCity.spec();
-    s.params.strategy = polis_roads::primary::Strategy::Straight;
-    s
-}
-
-fn at(x: f64, y: f64) -> Endpoint {
-    Endpoint::At(DVec2::new(x, y))
-}
-
-#[test]
-fn crossings_become_junctions_on_both_roads() {
-    let mut ed = flat_editor();
-    ed.apply(&Edit::AddRoad {
-        from: at(-500.0, 0.0),
-        to: at(500.0, 0.0),
-        spec: straight(),
-    })
-    .unwrap();
-    ed.apply(&Edit::AddRoad {
-        from: at(-400.0, 300.0),
-        to: at(-400.0, -300.0),
-        spec: straight(),
-    })
-    .unwrap();
-    let p = ed
-        .propose(&Edit::AddRoad {
-            from: at(200.0, 300.0),
-            to: at(200.0, -300.0),
-            spec: straight(),
-        })
-        .unwrap();
-    // The first road was split at x = −400 by the second: its east piece is road 3.
-    assert!(
-        matches!(
-            p.corrections(),
-            [Correction::Junction {
-                road: RoadId(3),
-                ..
-            }]
-        ),
-        "{:?}",
-        p.corrections()
-    );
-    let c = ed.commit(&p).unwrap();
-    assert_eq!(c.roads_replotted, vec![RoadId(3)]);
-    assert_eq!(c.nodes_added.len(), 3);
-    assert_eq!(c.roads_added.len(), 3); // two new pieces + the split-off piece
-    let net = ed.network();
-    assert_eq!((net.node_count(), net.road_count()), (8, 7));
-    let junction = c.nodes_added[2];
-    assert_eq!(net.node(junction).unwrap().pos, DVec2::new(200.0, 0.0));
-    assert_eq!(net.roads_at(junction).len(), 4);
-    check_planar(net);
-}
-
-#[test]
-fn snaps_and_t_junctions() {
-    let mut ed = flat_editor();
-    ed.apply(&Edit::AddRoad {
-        from: at(-500.0, 0.0),
-        to: at(500.0, 0.0),
-        spec: straight(),
-    })
-    .unwrap();
-    // An end 5 m from a node snaps to it; an end 6 m from the road becomes a T-junction.
-    let p = ed
-        .propose(&Edit::AddRoad {
-            from: at(-496.0, 3.0),
-            to: at(-500.0, 400.0),
-            spec: straight(),
-        })
-        .unwrap();
-    assert!(matches!(
-        p.corrections(),
-        [Correction::SnappedToNode {
-            node: ControlId(0),
-            ..
-        }]
-    ));
-    let p = ed
-        .propose(&Edit::AddRoad {
-            from: at(0.0, 400.0),
-            to: at(10.0, 6.0),
-            spec: straight(),
-        })
-        .unwrap();
-    assert!(matches!(
-        p.corrections(),
-        [Correction::OnRoad {
-            road: RoadId(0),
-            ..
-        }]
-    ));
-    ed.commit(&p).unwrap();
-    let t = ed
-        .network()
-        .nodes()
-        .find(|(_, n)| n.pos.distance(DVec2::new(10.0, 0.0)) < 1e-9)
-        .unwrap()
-        .0;
-    assert_eq!(ed.network().roads_at(t).len(), 3);
-    check_planar(ed.network());
-    // The chain tool continues from the road's end node.
-    let p = ed
-        .propose(&Edit::Chain {
-            from: ControlId(0),
-            to: DVec2::new(-500.0, 500.0),
-            spec: straight(),
-        })
-        .unwrap();
-    let next = p.end_node().unwrap();
-    ed.commit(&p).unwrap();
-    let p = ed
-        .propose(&Edit::Chain {
-            from: next,
-            to: DVec2::new(-100.0, 700.0),
-            spec: straight(),
-        })
-        .unwrap();
-    ed.commit(&p).unwrap();
-    assert_eq!(ed.network().roads_at(next).len(), 2);
-    check_planar(ed.network());
-}
-
-#[test]
-fn refusals_are_typed_and_change_nothing() {
-    let mut ed = flat_editor();
-    ed.apply(&Edit::AddRoad {
-        from: at(-500.0, 0.0),
-        to: at(500.0, 0.0),
-        spec: straight(),
-    })
-    .unwrap();
-    let json = ed.network().to_json().unwrap();
-    let refuse = |ed: &PrimaryEditor, e: Edit| ed.propose(&e).unwrap_err();
-    let s = straight();
-    let (n0, n1) = (ControlId(0), ControlId(1));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: Endpoint::Node(n0),
-                to: Endpoint::Node(n0),
-                spec: s
-            }
-        ),
-        PrimaryError::SelfLoop(_)
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: Endpoint::Node(n0),
-                to: Endpoint::Node(n1),
-                spec: s
-            }
-        ),
-        PrimaryError::DuplicateRoad { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: at(f64::NAN, 0.0),
-                to: at(0.0, 100.0),
-                spec: s
-            }
-        ),
-        PrimaryError::BadCoordinate { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddNode {
-                at: DVec2::new(1e300, 0.0),
-                label: None
-            }
-        ),
-        PrimaryError::BadCoordinate { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddNode {
-                at: DVec2::new(3000.0, 0.0),
-                label: None
-            }
-        ),
-        PrimaryError::OutsideMap { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddNode {
-                at: DVec2::new(-505.0, 0.0),
-                label: None
-            }
-        ),
-        PrimaryError::NodeTooClose { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::MoveNode {
-                node: ControlId(9),
-                to: DVec2::ZERO
-            }
-        ),
-        PrimaryError::UnknownNode(_)
-    ));
-    assert!(matches!(
-        refuse(&ed, Edit::DeleteRoad { road: RoadId(7) }),
-        PrimaryError::UnknownRoad(_)
-    ));
-    // Along the road: overlap.
-    let e = refuse(
-        &ed,
-        Edit::AddRoad {
-            from: at(-300.0, 2.0),
-            to: at(300.0, 2.0),
-            spec: s,
-        },
-    );
-    assert!(matches!(e, PrimaryError::CollinearOverlap { .. }), "{e:?}");
-    // A shallow crossing and a shallow meeting at a node.
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: at(-300.0, -40.0),
-                to: at(300.0, 40.0),
-                spec: s
-            }
-        ),
-        PrimaryError::AngleTooSmall { .. }
-    ));
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: Endpoint::Node(n1),
-                to: at(-100.0, 40.0),
-                spec: s
-            }
-        ),
-        PrimaryError::AngleTooSmall { .. }
-    ));
-    // Crossing right next to a node.
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: at(492.0, 300.0),
-                to: at(492.0, -300.0),
-                spec: s
-            }
-        ),
-        PrimaryError::CrossingNearNode { .. }
-    ));
-    // Zero length after snapping.
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: at(100.0, 100.0),
-                to: at(100.5, 100.0),
-                spec: s
-            }
-        ),
-        PrimaryError::ZeroLength { .. }
-    ));
-    // Bad parameters name the field.
-    let mut bad = s;
-    bad.params.deviation_deg = 50.0;
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::AddRoad {
-                from: at(0.0, 100.0),
-                to: at(0.0, 400.0),
-                spec: bad
-            }
-        ),
-        PrimaryError::InvalidParameter {
-            name: "deviation_deg",
-            ..
-        }
-    ));
-    bad = s;
-    bad.width_m = -1.0;
-    assert!(matches!(
-        refuse(
-            &ed,
-            Edit::SetRoad {
-                road: RoadId(0),
-                spec: bad
-            }
-        ),
-        PrimaryError::InvalidParameter {
-            name: "width_m",
-            ..
-        }
-    ));
-    assert_eq!(ed.network().to_json().unwrap(), json);
-    // A stale preview is refused.
-    let p = ed
-        .propose(&Edit::AddNode {
-            at: DVec2::new(0.0, 300.0),
-            label: None,
-        })
-        .unwrap();
-    ed.apply(&Edit::AddNode {
-        at: DVec2::new(0.0, -300.0),
-        label: None,
-    })
-    .unwrap();
-    assert_eq!(ed.commit(&p).unwrap_err(), PrimaryError::StalePreview);
-}
-
-#[test]
-fn nodes_in_water_or_parks_and_long_bridges_are_refused() {
-    let mut ed = PrimaryEditor::new(landscape(0), EditOptions::default()).unwrap();
-    assert!(matches!(
-        ed.propose(&Edit::AddNode {
-            at: DVec2::new(600.0, 0.0),
-            label: None
-        }),
-        Err(PrimaryError::IllegalNode {
-            what: Illegal::Water,
-            ..
-        })
-    ));
-    assert!(matches!(
-        ed.propose(&Edit::AddNode {
-            at: DVec2::new(-900.0, 900.0),
-            label: None
-        }),
-        Err(PrimaryError::IllegalNode {
-            what: Illegal::Park,
-            ..
-        })
-    ));
-    // Across the river: a bridge, flagged on the path.
-    let mut s = RoadPreset::InnerCity.spec();
-    ed.apply(&Edit::AddRoad {
-        from: at(300.0, 0.0),
-        to: at(900.0, 0.0),
-        spec: s,
-    })
-    .unwrap();
-    let r = ed.network().roads().next().unwrap().1;
-    assert!(r.path.bridge.iter().any(|&b| b));
-    s.params.max_bridge_m = 20.0;
-    assert!(matches!(
-        ed.propose(&Edit::AddRoad {
-            from: at(300.0, 500.0),
-            to: at(900.0, 500.0),
-            spec: s
-        }),
-        Err(PrimaryError::BridgeTooLong { .. })
-    ));
-}
-
-#[test]
-fn a_move_that_would_cross_is_refused_and_a_clear_one_replots() {
-    let mut ed = flat_editor();
-    ed.apply(&Edit::AddRoad {
-        from: at(-500.0, 0.0),
-        to: at(500.0, 0.0),
-        spec: straight(),
-    })
-    .unwrap();
-    ed.apply(&Edit::AddRoad {
-        from: at(0.0, 100.0),
-        to: at(0.0, 500.0),
-        spec: straight(),
-    })
-    .unwrap();
-    let low = ed
-        .network()
-        .nodes()
-        .find(|(_, n)| n.pos == DVec2::new(0.0, 100.0))
-        .unwrap()
-        .0;
-    let json = ed.network().to_json().unwrap();
-    // Dragging the lower end below the first road would cross it.
-    let e = ed
-        .propose(&Edit::MoveNode {
-            node: low,
-            to: DVec2::new(0.0, -100.0),
-        })
-        .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            PrimaryError::WouldCross {
-                other: RoadId(0),
-                ..
-            }
-        ),
-        "{e}"
-    );
-    assert_eq!(ed.network().to_json().unwrap(), json);
-    // Onto the road itself.
-    assert!(matches!(
-        ed.propose(&Edit::MoveNode {
-            node: low,
-            to: DVec2::new(30.0, 4.0)
-        }),
-        Err(PrimaryError::OnRoad { .. })
-    ));
-    // A clear move re-plots the node's road and reports it.
-    let c = ed
-        .apply(&Edit::MoveNode {
-            node: low,
-            to: DVec2::new(50.0, 60.0),
-        })
-        .unwrap();
-    assert_eq!(c.nodes_moved, vec![low]);
-    assert_eq!(c.roads_replotted, vec![RoadId(1)]);
-    assert_eq!(
-        ed.network().road(RoadId(1)).unwrap().path.points[0],
-        DVec2::new(50.0, 60.0)
-    );
-    check_planar(ed.network());
-}
-
 /// On a fixed hillside, the even-elevation-difference strategy spreads the climb: its
 /// steepest grade is well below that of minimum elevation difference, which keeps both
 /// fronts level and climbs where they meet (Kelly §4.2.3.2–3). Measured and pinned.
@@ -756,70 +283,6 @@ fn even_elevation_difference_has_the_gentler_steepest_grade() {
     // Pinned (measured 0.0842, 0.1200, 0.0989 on x86-64), with room for libm differences.
     assert!((0.080..0.088).contains(&even), "{even}");
     assert!((0.112..0.124).contains(&least), "{least}");
-}
-
-#[test]
-fn specs_and_geojson_build_networks() {
-    let json = r#"{"nodes": [{"id": 10, "x": -400, "y": 0}, {"id": 11, "x": 400, "y": 0, "label": "east"},
-        {"id": 12, "x": 0, "y": -400}, {"id": 13, "x": 0, "y": 400}],
-        "roads": [{"a": 10, "b": 11, "class": "InnerCity"}, {"a": 12, "b": 13}]}"#;
-    let spec = PrimarySpec::from_json(json).unwrap();
-    let ed = spec
-        .build(Terrain::flat(bounds()).unwrap(), EditOptions::default())
-        .unwrap();
-    // The second road crosses the first: a junction node, four roads.
-    assert_eq!(ed.network().road_count(), 4);
-    assert_eq!(
-        ed.network().node(ControlId(1)).unwrap().label.as_deref(),
-        Some("east")
-    );
-    check_planar(ed.network());
-    let bad = r#"{"nodes": [{"id": 1, "x": 0, "y": 0}], "roads": [{"a": 1, "b": 2}]}"#;
-    assert!(matches!(
-        PrimarySpec::from_json(bad)
-            .unwrap()
-            .build(hills(1), EditOptions::default()),
-        Err(PrimaryError::BadData(_))
-    ));
-    let geo = r#"{"type": "FeatureCollection", "features": [
-        {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-500, -500]}, "properties": {"label": "a"}},
-        {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[-500, -500], [0, 0], [500, 500]]}, "properties": {"class": "Primary"}},
-        {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[-500, 500], [500, -500]]}}]}"#;
-    let ed = PrimaryNetwork::from_geojson(
-        geo,
-        Terrain::flat(bounds()).unwrap(),
-        EditOptions::default(),
-    )
-    .unwrap();
-    assert_eq!(ed.network().road_count(), 4);
-    check_planar(ed.network());
-    assert!(
-        PrimaryNetwork::from_geojson("{\"type\": 1}", hills(2), EditOptions::default()).is_err()
-    );
-    assert!(PrimaryNetwork::from_json("{\"next_node\": 0}").is_err());
-}
-
-#[test]
-fn highways_of_a_grown_network_become_a_primary_network() {
-    let params = polis_roads::RoadParams {
-        max_segments: 400,
-        ..polis_roads::RoadParams::default()
-    };
-    let grown = polis_roads::generate_default(&params).unwrap().network;
-    let t = Terrain::flat(params.bounds()).unwrap();
-    let net = PrimaryNetwork::from_highways(&grown, &t, RoadPreset::Primary.spec()).unwrap();
-    assert!(net.road_count() > 0);
-    check_planar(&net);
-    let hw: f64 = grown
-        .edges()
-        .filter(|e| e.3.class == polis_roads::RoadClass::Highway)
-        .map(|e| grown.edge_length(e.0).unwrap())
-        .sum();
-    let total: f64 = net.roads().map(|(_, r)| r.path.length()).sum();
-    assert!((hw - total).abs() < 1e-6 * hw.max(1.0), "{hw} {total}");
-    // Ids are stable: the same input gives the same bytes.
-    let again = PrimaryNetwork::from_highways(&grown, &t, RoadPreset::Primary.spec()).unwrap();
-    assert_eq!(net.to_json().unwrap(), again.to_json().unwrap());
 }
 
 /// A long seeded edit session on hills: the random-edit property with counts, showing
@@ -874,4 +337,46 @@ fn a_long_session_exercises_junctions_and_refused_crossing_moves() {
         ed.network().to_json().unwrap(),
         PrimaryNetwork::new().to_json().unwrap()
     );
+}
+
+fn wild() -> impl proptest::strategy::Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(-f64::INFINITY),
+        Just(1e300),
+        Just(0.0),
+        -3000.0..3000.0f64,
+        any::<f64>(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+    /// Any coordinates and parameters, NaN and infinities included: a typed answer, never
+    /// a panic, and a refused edit leaves the network as it was.
+    #[test]
+    fn wild_input_never_panics(x in wild(), y in wild(), d in wild(), dev in wild(), snap in wild(), n in 0u32..80, kind in 0u8..5) {
+        let mut ed = flat_editor();
+        ed.apply(&Edit::AddRoad { from: at(-500.0, 0.0), to: at(500.0, 0.0), spec: straight() }).unwrap();
+        let json = ed.network().to_json().unwrap();
+        let mut spec = straight();
+        spec.params.sample_size_m = d;
+        spec.params.deviation_deg = dev;
+        spec.params.snap_m = snap;
+        spec.params.samples = n;
+        let p = DVec2::new(x, y);
+        let edit = match kind {
+            0 => Edit::AddNode { at: p, label: None },
+            1 => Edit::MoveNode { node: ControlId(0), to: p },
+            2 => Edit::AddRoad { from: Endpoint::Node(ControlId(1)), to: Endpoint::At(p), spec },
+            3 => Edit::SetRoad { road: RoadId(0), spec },
+            _ => Edit::Chain { from: ControlId(0), to: p, spec: straight() },
+        };
+        if ed.propose(&edit).is_err() {
+            prop_assert_eq!(ed.network().to_json().unwrap(), json);
+        }
+        let _ = plot(DVec2::new(x, 0.0), DVec2::new(0.0, y), &spec.params, ed.terrain());
+    }
 }

@@ -132,6 +132,20 @@ pub enum PrimaryError {
         /// Where they would cross.
         at: DVec2,
     },
+    /// A path would pass within
+    /// [`EditOptions::min_road_length_m`](crate::primary::EditOptions::min_road_length_m)
+    /// of a node that is not one of its ends.
+    #[error(
+        "the path of road {road} would pass {distance:.3} m from node {node}; connect to the node or route the road elsewhere"
+    )]
+    PassesNode {
+        /// The road (`r18446744073709551615` for a road not yet added).
+        road: RoadId,
+        /// The node.
+        node: ControlId,
+        /// Their distance in metres.
+        distance: f64,
+    },
     /// A plotted path would cross itself.
     #[error(
         "the plotted path would cross itself at {at}; lower `deviation_deg` or raise `sample_size_m`"

@@ -73,6 +73,7 @@
 //! adaptive roads, sampling, strategies, spline), §5.3–5.4 (node and road edits,
 //! validity checking), §6.1–6.2 (Milan, Paris; road presets).
 
+mod draft;
 pub mod edit;
 pub mod error;
 pub mod history;
@@ -90,5 +91,7 @@ pub use history::{EditLog, LogEntry, PrimaryEditor};
 pub use io::{LowLevelGraph, NodeSpec, PrimarySpec, RoadEntry};
 pub use network::{ControlId, ControlNode, Patch, PrimaryNetwork, PrimaryRoad, RoadId};
 pub use params::{AdaptiveParams, EditOptions, MAX_PLOT_STEPS, RoadPreset, RoadSpec, Strategy};
-pub use plot::{Fan, Plot, RoadPath, path_from_plot, plot, plot_path, plot_traced};
+pub use plot::{
+    Fan, MAX_PATH_POINTS, Plot, RoadPath, path_from_plot, plot, plot_path, plot_traced,
+};
 pub use terrain::{DEFAULT_LEGALITY_STEP_M, Ground, Terrain};

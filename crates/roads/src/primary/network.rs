@@ -244,6 +244,19 @@ impl PrimaryNetwork {
             .map(|s| s.key.0)
     }
 
+    /// The nodes within `radius` of the segment `a–b`: `(node, distance)`, by id.
+    pub fn nodes_near_segment(&self, a: DVec2, b: DVec2, radius: f64) -> Vec<(ControlId, f64)> {
+        let b_box = polis_geom::Aabb2::new(a, b).expanded(radius);
+        self.node_index
+            .query_box(&b_box)
+            .into_iter()
+            .filter_map(|id| {
+                let d = polis_geom::predicates::distance_to_segment(self.nodes.get(&id)?.pos, a, b);
+                (d <= radius).then_some((id, d))
+            })
+            .collect()
+    }
+
     /// The path segments that share a point with the segment `a–b`, ordered along it:
     /// `(road, segment index, how they meet)`.
     pub fn path_hits(&self, a: DVec2, b: DVec2) -> Vec<(RoadId, u32, f64, SegmentIntersection)> {

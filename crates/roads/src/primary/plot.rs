@@ -40,6 +40,9 @@ use crate::primary::params::{AdaptiveParams, MAX_PLOT_STEPS, Strategy};
 use crate::primary::spline::catmull_rom;
 use crate::primary::terrain::{Ground, Terrain};
 
+/// The most vertices a road's low-level path may have.
+pub const MAX_PATH_POINTS: usize = 1_000_000;
+
 /// The plot points of a road, from its first end to its second.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Plot {
@@ -175,6 +178,21 @@ pub fn path_from_plot(
     draw_size_m: f64,
     terrain: &Terrain,
 ) -> Result<RoadPath, PrimaryError> {
+    // Bound the output before allocating it.
+    let pieces: f64 = plot
+        .points
+        .windows(2)
+        .map(|w| (w[0].distance(w[1]) / draw_size_m).ceil().max(1.0))
+        .sum();
+    if pieces.is_nan() || pieces > MAX_PATH_POINTS as f64 {
+        return Err(PrimaryError::InvalidParameter {
+            name: "segment_draw_size_m",
+            reason: format!(
+                "{draw_size_m} m would cut this road into {pieces} segments, more than \
+                 {MAX_PATH_POINTS}; use a larger draw size"
+            ),
+        });
+    }
     let mut path = RoadPath::default();
     catmull_rom(&plot.points, draw_size_m, &mut path.points, &mut path.plot);
     path.elevation.reserve(path.points.len());
