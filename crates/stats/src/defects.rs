@@ -18,14 +18,15 @@
 //!   to a road's centreline.
 
 use polis_geom::measure::polygon_segment_distance;
-use polis_geom::spatial::{RTreeIndex, Shape, SpatialIndex};
-use polis_geom::{Aabb2, DVec2, PointLocation, SegmentIndex};
+use polis_geom::predicates::distance_to_segment;
+use polis_geom::{Aabb2, DVec2, PointLocation};
 use serde::{Deserialize, Serialize};
 
-use crate::error::StatsError;
+use crate::boxgrid::BoxGrid;
 use crate::input::CityInput;
 use crate::simplify::SimpleGraph;
 use crate::{StatsOptions, summary::ratio};
+use rayon::prelude::*;
 
 /// The plan-defect counters.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -57,80 +58,60 @@ pub struct PlanDefects {
 /// Spatial lookups shared by the counters.
 struct Indexes {
     /// Input street segments of positive length, by edge index.
-    roads: SegmentIndex<usize>,
+    roads: BoxGrid,
     /// Lots by bounding box.
-    lots: RTreeIndex<usize>,
+    lots: BoxGrid,
     /// Blocks by bounding box.
-    blocks: RTreeIndex<usize>,
+    blocks: BoxGrid,
     /// Widest road's half width.
     max_half_width: f64,
 }
 
-fn index_err(what: String) -> impl FnOnce(polis_geom::GeomError) -> StatsError {
-    move |_| StatsError::BadValue {
-        what: format!("{what} (beyond ±{:e} m)", polis_geom::MAX_COORDINATE),
-        value: f64::INFINITY,
-    }
-}
+/// Cell size of the lookup grids, metres (a few lots across).
+const GRID_CELL_M: f64 = 32.0;
 
-fn build_indexes(city: &CityInput<'_>) -> Result<Indexes, StatsError> {
+fn build_indexes(city: &CityInput<'_>) -> Indexes {
     let g = city.streets;
-    let mut roads = SegmentIndex::default();
-    let mut max_half_width: f64 = 0.0;
-    for (i, e) in g.edges.iter().enumerate() {
-        let (a, b) = (g.nodes[e.a], g.nodes[e.b]);
-        if a != b {
-            roads
-                .insert_segment(i, a, b)
-                .map_err(index_err(format!("street edge {i}")))?;
-            max_half_width = max_half_width.max(e.width_m * 0.5);
-        }
-    }
-    // Lots and blocks are found by bounding box: stored as their box's diagonal in an
-    // R-tree, whose candidates are exactly the entries whose box meets the query box.
-    let boxes = |items: Vec<(usize, Aabb2)>, what: &str| {
-        RTreeIndex::bulk_load(
-            items
-                .into_iter()
-                .map(|(i, b)| (i, Shape::Segment(b.min, b.max))),
-        )
-        .map_err(index_err(format!("a {what}")))
-    };
-    let lots = boxes(
-        city.lots
-            .iter()
-            .enumerate()
-            .filter(|(_, l)| !l.polygon.is_empty())
-            .map(|(i, l)| (i, l.polygon.bbox()))
-            .collect(),
-        "lot",
-    )?;
-    let blocks = boxes(
-        city.blocks
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| !b.outer.is_empty())
-            .map(|(i, b)| (i, b.bbox()))
-            .collect(),
-        "block",
-    )?;
-    Ok(Indexes {
+    let roads = g
+        .edges
+        .iter()
+        .map(|e| {
+            let (a, b) = (g.nodes[e.a], g.nodes[e.b]);
+            if a == b {
+                Aabb2::EMPTY
+            } else {
+                Aabb2::new(a, b)
+            }
+        })
+        .collect();
+    let max_half_width = g.edges.iter().map(|e| e.width_m * 0.5).fold(0.0, f64::max);
+    let lots = city.lots.iter().map(|l| l.polygon.bbox()).collect();
+    let blocks = city.blocks.iter().map(|b| b.outer.bbox()).collect();
+    let (lots, (roads, blocks)) = rayon::join(
+        || BoxGrid::new(lots, GRID_CELL_M),
+        || {
+            (
+                BoxGrid::new(roads, GRID_CELL_M),
+                BoxGrid::new(blocks, GRID_CELL_M),
+            )
+        },
+    );
+    Indexes {
         roads,
         lots,
         blocks,
         max_half_width,
-    })
+    }
 }
 
 /// Whether some lot lies within `reach` of `p`.
 fn lot_near(city: &CityInput<'_>, ix: &Indexes, p: DVec2, reach: f64) -> bool {
     let mut found = false;
-    ix.lots
-        .for_each_candidate(&Aabb2::new(p, p).expanded(reach), |i, _| {
-            if !found && polygon_segment_distance(city.lots[i].polygon, p, p) <= reach {
-                found = true;
-            }
-        });
+    ix.lots.for_each(&Aabb2::new(p, p).expanded(reach), |i| {
+        if !found && polygon_segment_distance(city.lots[i].polygon, p, p) <= reach {
+            found = true;
+        }
+    });
     found
 }
 
@@ -167,7 +148,7 @@ fn served_length(
 
 fn inside_a_block(city: &CityInput<'_>, ix: &Indexes, p: DVec2) -> bool {
     let mut inside = false;
-    ix.blocks.for_each_candidate(&Aabb2::new(p, p), |i, _| {
+    ix.blocks.for_each(&Aabb2::new(p, p), |i| {
         if !inside && city.blocks[i].locate(p) == PointLocation::Inside {
             inside = true;
         }
@@ -204,44 +185,52 @@ fn in_corridor(city: &CityInput<'_>, ix: &Indexes, opt: &StatsOptions, building:
         return false;
     }
     let bb = fp.bbox();
+    // A bounding circle of the footprint: roads farther than its radius plus their
+    // half width from its centre cannot reach the footprint.
+    let centre = (bb.min + bb.max) * 0.5;
+    let radius = fp
+        .points()
+        .iter()
+        .map(|p| p.distance(centre))
+        .fold(0.0, f64::max);
     let mut hit = false;
-    ix.roads
-        .for_each_candidate(&bb.expanded(ix.max_half_width), |i, _| {
-            if hit {
-                return;
-            }
-            let e = city.streets.edges[i];
-            let limit = e.width_m * 0.5 - opt.corridor_tolerance_m;
-            if limit <= 0.0 {
-                return;
-            }
-            let (a, b) = (city.streets.nodes[e.a], city.streets.nodes[e.b]);
-            if !Aabb2::new(a, b).expanded(limit).intersects(&bb) {
-                return;
-            }
-            hit = polygon_segment_distance(fp, a, b) < limit;
-        });
+    ix.roads.for_each(&bb.expanded(ix.max_half_width), |i| {
+        if hit {
+            return;
+        }
+        let e = city.streets.edges[i];
+        let limit = e.width_m * 0.5 - opt.corridor_tolerance_m;
+        if limit <= 0.0 {
+            return;
+        }
+        let (a, b) = (city.streets.nodes[e.a], city.streets.nodes[e.b]);
+        if !Aabb2::new(a, b).expanded(limit).intersects(&bb)
+            || distance_to_segment(centre, a, b) >= radius + limit
+        {
+            return;
+        }
+        hit = polygon_segment_distance(fp, a, b) < limit;
+    });
     hit
 }
 
 /// Counts the plan defects of a (validated) city whose simplified street graph is `s`.
-///
-/// # Errors
-/// [`StatsError::BadValue`] for coordinates beyond `MAX_COORDINATE`.
-pub fn plan_defects(
-    city: &CityInput<'_>,
-    s: &SimpleGraph,
-    opt: &StatsOptions,
-) -> Result<PlanDefects, StatsError> {
-    let ix = build_indexes(city)?;
+/// Segments and buildings are examined in parallel (rayon); the counts and sums are
+/// gathered in input order, so any thread count gives the same numbers.
+pub fn plan_defects(city: &CityInput<'_>, s: &SimpleGraph, opt: &StatsOptions) -> PlanDefects {
+    let ix = build_indexes(city);
     let g = city.streets;
     let mut d = PlanDefects::default();
-    for (i, e) in g.edges.iter().enumerate() {
-        let (a, b) = (g.nodes[e.a], g.nodes[e.b]);
-        if a == b || !inside_a_block(city, &ix, a.lerp(b, 0.5)) {
-            continue;
-        }
-        let (served, len) = served_length(city, &ix, opt, i);
+    let inside: Vec<Option<(f64, f64)>> = (0..g.edges.len())
+        .into_par_iter()
+        .map(|i| {
+            let e = g.edges[i];
+            let (a, b) = (g.nodes[e.a], g.nodes[e.b]);
+            (a != b && inside_a_block(city, &ix, a.lerp(b, 0.5)))
+                .then(|| served_length(city, &ix, opt, i))
+        })
+        .collect();
+    for (served, len) in inside.into_iter().flatten() {
         d.segments_inside_blocks += 1;
         d.length_inside_blocks_m += len;
         d.length_inside_blocks_without_lots_m += (len - served).max(0.0);
@@ -272,11 +261,12 @@ pub fn plan_defects(
         }
     }
     d.buildings_in_road_corridor = (0..city.buildings.len())
+        .into_par_iter()
         .filter(|&i| in_corridor(city, &ix, opt, i))
         .count();
     d.buildings_in_road_corridor_share = ratio(
         d.buildings_in_road_corridor as f64,
         city.buildings.len() as f64,
     );
-    Ok(d)
+    d
 }

@@ -15,9 +15,11 @@ pub enum StatsError {
         /// How many nodes there are.
         nodes: usize,
     },
-    /// A coordinate, width, height, elevation or area is NaN or infinite, or a width,
-    /// height or area is negative.
-    #[error("{what} is {value}; give a finite value (widths, heights and areas ≥ 0)")]
+    /// A coordinate, width, height, elevation or area is NaN or infinite, a coordinate
+    /// lies beyond `polis_geom::MAX_COORDINATE`, or a width, height or area is negative.
+    #[error(
+        "{what} is {value}; give a finite value (coordinates within ±1e8 m, widths, heights and areas ≥ 0)"
+    )]
     BadValue {
         /// Which value (`street node 4`, `lot 7 street edge`, `building 3 height`).
         what: String,

@@ -240,13 +240,20 @@ impl<'a> CityInput<'a> {
     }
 }
 
+/// Finite and within [`polis_geom::MAX_COORDINATE`] of the origin (the workspace's
+/// coordinate contract).
 fn finite_point(p: DVec2, what: impl FnOnce() -> String) -> Result<(), StatsError> {
-    if p.is_finite() {
+    let limit = polis_geom::MAX_COORDINATE;
+    if p.is_finite() && p.x.abs() <= limit && p.y.abs() <= limit {
         return Ok(());
     }
     Err(StatsError::BadValue {
         what: what(),
-        value: if p.x.is_finite() { p.y } else { p.x },
+        value: if p.x.is_finite() && p.x.abs() <= limit {
+            p.y
+        } else {
+            p.x
+        },
     })
 }
 

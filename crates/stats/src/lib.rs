@@ -58,6 +58,7 @@
 
 pub use polis_geom as geom;
 
+mod boxgrid;
 pub mod defects;
 mod error;
 pub mod input;
@@ -194,7 +195,7 @@ pub fn report(city: &CityInput<'_>, options: &StatsOptions) -> Result<CityReport
         blocks: parcels::block_metrics(city.blocks),
         lots: parcels::lot_metrics(city.lots),
         buildings: parcels::building_metrics(city.buildings, lot_area, land),
-        defects: defects::plan_defects(city, &simple, options)?,
+        defects: defects::plan_defects(city, &simple, options),
         realism: None,
     })
 }
