@@ -117,11 +117,12 @@ impl Histogram {
     }
 }
 
-/// `part / whole`, or 0 when `whole` is 0 (or the ratio is not finite).
+/// `part / whole`, or 0 when `whole` is 0 (or the ratio is not finite). Never −0 (an
+/// empty `f64` sum is −0 in Rust, which would print as "-0.0").
 pub fn ratio(part: f64, whole: f64) -> f64 {
     let r = part / whole;
     if whole != 0.0 && r.is_finite() {
-        r
+        r + 0.0
     } else {
         0.0
     }
@@ -158,5 +159,7 @@ mod tests {
         assert_eq!(Histogram::of(&[], true, [1.0]).total(), 0);
         assert_eq!(Histogram::of(&[3.0], true, [1.0, 3.0, 4.0]).counts, vec![2]);
         assert_eq!(ratio(1.0, 0.0), 0.0);
+        let empty: f64 = std::iter::empty::<f64>().sum();
+        assert!(ratio(empty, 3.0).is_sign_positive());
     }
 }
