@@ -15,7 +15,7 @@
 //! | [`streets`] | `H_o`, `H_w`, φ, `k̄`, node-degree shares, segment lengths, circuity, intersection density, grade |
 //! | [`parcels`] | block areas and shape factor Φ = A / (π r_c²), lot area / frontage / depth, coverage, floor-area ratio, heights, kind mix |
 //! | [`defects`] | roads inside blocks without lots, stubs in land without lots, buildings in road corridors |
-//! | [`reference`] | Boeing 2019's Table 1 (100 cities) and regional means |
+//! | [`reference`](mod@reference) | Boeing 2019's Table 1 (100 cities) and regional means |
 //! | [`realism`] | metric by metric against a reference city, in or out of band |
 //! | [`summary`] | [`Distribution`](summary::Distribution) and [`Histogram`](summary::Histogram) |
 //!
