@@ -354,3 +354,143 @@ fn realism_bands() {
     let r = polis_stats::compare(&s, &reference_city("Manhattan").unwrap());
     assert_eq!(r.row("circuity").unwrap().in_band, None);
 }
+
+/// A random city: a lattice of streets, a block per lattice cell, rectangular lots along
+/// the cell's south edge and a footprint on each lot, all jittered by the inputs.
+struct RandomCity {
+    g: StreetGraph,
+    blocks: Vec<PolygonWithHoles>,
+    lots: Vec<Polygon>,
+    footprints: Vec<Polygon>,
+}
+
+fn random_city(n: usize, spacing: f64, jitter: &[f64], lot_w: f64, setback: f64) -> RandomCity {
+    let mut g = StreetGraph::default();
+    let at = |i: usize, j: usize| j * (n + 1) + i;
+    for j in 0..=n {
+        for i in 0..=n {
+            let k = jitter[(i * 7 + j * 13) % jitter.len()];
+            g.nodes
+                .push(DVec2::new(i as f64 * spacing + k, j as f64 * spacing - k));
+        }
+    }
+    for j in 0..=n {
+        for i in 0..=n {
+            if i < n {
+                g.edges.push(street(at(i, j), at(i + 1, j), 8.0));
+            }
+            if j < n && jitter[(i + j) % jitter.len()] > -3.0 {
+                g.edges.push(street(at(i, j), at(i, j + 1), 8.0));
+            }
+        }
+    }
+    let (mut blocks, mut lots, mut footprints) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (i as f64 * spacing + 6.0, j as f64 * spacing + 6.0);
+            let side = spacing - 12.0;
+            blocks.push(PolygonWithHoles::from(rect(x, y, x + side, y + side)));
+            let mut k = 0.0;
+            while k + lot_w <= side {
+                lots.push(rect(x + k, y, x + k + lot_w, y + side * 0.4));
+                footprints.push(rect(
+                    x + k + 1.0,
+                    y - setback,
+                    x + k + lot_w - 1.0,
+                    y + side * 0.3,
+                ));
+                k += lot_w;
+            }
+        }
+    }
+    RandomCity {
+        g,
+        blocks,
+        lots,
+        footprints,
+    }
+}
+
+fn report_of(c: &RandomCity) -> polis_stats::CityReport {
+    let blocks: Vec<&PolygonWithHoles> = c.blocks.iter().collect();
+    let lots: Vec<LotInput<'_>> = c
+        .lots
+        .iter()
+        .map(|p| LotInput {
+            polygon: p,
+            street_edges: &[0],
+        })
+        .collect();
+    let buildings: Vec<BuildingInput<'_>> = c
+        .footprints
+        .iter()
+        .enumerate()
+        .map(|(i, f)| BuildingInput {
+            footprint: f,
+            height_m: 3.0 * (i % 9) as f64,
+            floors: (i % 9) as u32,
+            kind: if i % 2 == 0 { "House" } else { "Apartment" },
+        })
+        .collect();
+    let city = CityInput {
+        streets: &c.g,
+        blocks: &blocks,
+        lots: &lots,
+        buildings: &buildings,
+        bounds: None,
+        land_area_m2: None,
+        water: None,
+    };
+    polis_stats::report(&city, &StatsOptions::default()).unwrap()
+}
+
+#[test]
+fn any_thread_count_gives_the_same_report() {
+    let c = random_city(12, 90.0, &[0.0, 3.5, -2.0, 7.0, -4.0], 13.0, 5.0);
+    let pool = |n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    };
+    let one = pool(1).install(|| report_of(&c));
+    let three = pool(3).install(|| report_of(&c));
+    assert_eq!(one, three);
+    assert!(one.defects.buildings_in_road_corridor > 0);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(40))]
+
+    /// Shares stay in [0, 1], counts within their totals, every number finite.
+    #[test]
+    fn parcel_and_defect_metrics_stay_in_range(
+        n in 1usize..5,
+        spacing in 30.0f64..150.0,
+        jitter in proptest::collection::vec(-6.0f64..6.0, 1..6),
+        lot_w in 5.0f64..30.0,
+        setback in -3.0f64..8.0,
+    ) {
+        let r = report_of(&random_city(n, spacing, &jitter, lot_w, setback));
+        // serde_json writes NaN as null: only the optional parts may be null.
+        let mut v = serde_json::to_value(&r).unwrap();
+        v["streets"]["grade"] = serde_json::Value::Bool(false);
+        v["realism"] = serde_json::Value::Bool(false);
+        proptest::prop_assert!(!v.to_string().contains("null"), "{}", v);
+        proptest::prop_assert!((0.0..=1.0).contains(&r.lots.street_access_share));
+        proptest::prop_assert!(r.blocks.shape_factor.max <= 1.0);
+        proptest::prop_assert!(r.buildings.coverage >= 0.0);
+        proptest::prop_assert!(r.defects.buildings_in_road_corridor <= r.buildings.count);
+        proptest::prop_assert!(r.defects.stubs_in_land_without_lots <= r.defects.stubs_in_land);
+        proptest::prop_assert!(
+            r.defects.length_inside_blocks_without_lots_m <= r.defects.length_inside_blocks_m + 1e-9
+        );
+        proptest::prop_assert_eq!(
+            r.defects.stubs,
+            r.defects.stubs_at_map_edge + r.defects.stubs_in_water + r.defects.stubs_in_land
+        );
+        let kinds: usize = r.buildings.kinds.values().sum();
+        proptest::prop_assert_eq!(kinds, r.buildings.count);
+        proptest::prop_assert_eq!(r.blocks.shape_factor_histogram.total(), r.blocks.shape_factor.count);
+    }
+}
