@@ -257,7 +257,7 @@ impl Default for SceneConfig {
         SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
-            batching: Batching::PerParentAndMaterial,
+            batching: Batching::default(),
         }
     }
 }

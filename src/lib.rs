@@ -26,9 +26,9 @@
 //! ## Configuration
 //!
 //! [`CityConfig`] is plain serde data; the built-in presets (`default`, `manhattan`,
-//! `paris`, `san_francisco`, `old_town`, `suburbia`) are JSON files in `presets/`,
-//! compiled in. Every map is procedural and seeded unless a grey-scale PNG replaces it
-//! ([`MapSpec::png`]).
+//! `paris`, `san_francisco`, `old_town`, `suburbia`, `citygen`) are JSON files in
+//! `presets/`, compiled in. Every map is procedural and seeded unless a grey-scale PNG
+//! replaces it ([`MapSpec::png`]).
 //!
 //! ## Guarantees
 //!

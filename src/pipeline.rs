@@ -92,7 +92,11 @@ impl Ticker<'_> {
         if d.is_multiple_of(step) || d == self.total {
             let in_chunk = d as f64 / self.total.max(1) as f64;
             let cells = self.span.first as f64 + in_chunk * self.span.len as f64;
-            p(self.stage, (cells / self.span.total.max(1) as f64).min(1.0));
+            let fraction = cells / self.span.total.max(1) as f64;
+            // The stage reports its own end (1.0) once, after its last chunk.
+            if fraction < 1.0 {
+                p(self.stage, fraction);
+            }
         }
     }
 }

@@ -280,6 +280,8 @@ fn progress_reaches_every_stage_and_ends_at_one() {
             .collect();
         assert_eq!(fractions.last(), Some(&1.0), "{stage}");
         assert!(fractions.iter().all(|f| (0.0..=1.0).contains(f)));
+        let done = fractions.iter().filter(|f| **f == 1.0).count();
+        assert_eq!(done, 1, "{stage} reported done {done} times: {fractions:?}");
     }
 }
 

@@ -77,6 +77,11 @@
 //! G. Kelly, *An Interactive System for Procedural City Generation*, 2008, §4.4.3, §7.4.
 
 pub use polis_geom as geom;
+/// The random-number crates of this crate's public signatures (`Rng` bounds, `Pcg64Mcg`),
+/// re-exported so callers never match their versions by hand.
+pub use rand;
+#[doc(no_inline)]
+pub use rand_pcg;
 
 pub mod building;
 mod error;

@@ -33,7 +33,9 @@
 //! let mut glb_bytes = Vec::new();
 //! glb::write_glb(&scene, &glb::GlbOptions::default(), &mut glb_bytes)?;
 //! let doc = gltf::Gltf::from_slice(&glb_bytes)?;
-//! assert_eq!(doc.nodes().count(), 2);
+//! // Batched by default: the house's mesh is merged into the city node, one primitive
+//! // per material.
+//! assert_eq!(doc.nodes().count(), 1);
 //!
 //! let (mut obj_bytes, mut side_files) = (Vec::new(), MemorySink::new());
 //! obj::write_obj(&scene, &obj::ObjOptions::default(), &mut obj_bytes, &mut side_files)?;

@@ -91,6 +91,11 @@
 //! * D. Ebert et al., *Texturing and Modeling: A Procedural Approach* (PULSE).
 
 pub use polis_geom as geom;
+/// The random-number crates of this crate's public signatures (`Rng` bounds, `Pcg64Mcg`),
+/// re-exported so callers never match their versions by hand.
+pub use rand;
+#[doc(no_inline)]
+pub use rand_pcg;
 
 pub mod axis;
 pub mod builtin;

@@ -12,7 +12,7 @@
 //! | [`hash`] | [`hash::splitmix64`]: the stateless mix behind derived seeds |
 //! | [`lines`] | offset lines and where they meet, angular order from any direction, splitting polygons and tagged regions by a line, which ring a hole belongs to |
 //! | [`graph`] | [`PlanarGraph`]: a planar straight-line graph with stable ids, exact counter-clockwise adjacency, planar segment insertion |
-//! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); [`spatial::RTreeIndex`] as the measured alternative |
+//! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); `spatial::RTreeIndex` (feature `rtree`) as the measured alternative |
 //! | [`field`] | [`Field`]: input maps (population, water, elevation …) — constants, closures, PNG rasters, seeded simplex/fBm noise, the slides' `populationAt`, combinators, serde [`field::FieldSpec`] |
 //! | [`measure`] | minimum enclosing circle (Welzl), segment–segment and segment–polygon distances |
 //! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks |

@@ -16,7 +16,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`skeleton`] | [`StraightSkeleton`]: nodes with times, arcs, the face each input edge sweeps |
-//! | [`inset`](mod@inset) | [`inset`], [`inset_weighted`], [`inset_shapes`], [`Inset`]: the wavefront at a time |
+//! | [`inset`](mod@inset) | [`inset`](fn@inset), [`inset_weighted`], [`inset_shapes`], [`Inset`]: the wavefront at a time |
 //! | [`block`] | [`Cell`] → [`Block`]s with [`Footpath`]s and parcels ([`blocks`]) |
 //! | [`subdivision`] | [`subdivide`], [`subdivide_block`], [`Subdivider`]: [`Lot`]s ([`LotParams`]) |
 //! | [`polygon_split`] | [`split_by_line`]: a region cut by a line into all its pieces |
@@ -81,7 +81,7 @@
 //!   index of the lines by direction and offset (from 256 edges on) that visits only the
 //!   lines that can come first; the worst case is still O(n) per reflex vertex (the
 //!   Felkel–Obdržálek bound, O(n·r) in all), met by vertices that cross a region where
-//!   many lines pass (see `BENCHMARKS.md` for the growth on stars and combs).
+//!   many lines pass (see the polis repository's `BENCHMARKS.md` for the growth on stars and combs).
 //! * Consecutive parallel edges with different weights meet in a perpendicular step (a
 //!   virtual edge of weight 0), the convention for this case, which has no bisector. An arc
 //!   along a step lies on the offset line of one of the two input edges it names, not both
@@ -96,6 +96,11 @@
 //! *Procedural Modeling of Cities* (2001) §4.1.
 
 pub use polis_geom as geom;
+/// The random-number crates of this crate's public signatures (`Rng` bounds, `Pcg64Mcg`),
+/// re-exported so callers never match their versions by hand.
+pub use rand;
+#[doc(no_inline)]
+pub use rand_pcg;
 
 pub mod block;
 mod error;

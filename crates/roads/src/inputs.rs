@@ -88,7 +88,7 @@ impl RoadInputs {
     /// on exactly these maps. Their finest noise octaves are 190–225 m across, so against
     /// the raw fBm the lattice moves the coastline by at most about 9 m and the hills by
     /// about 1 m (tested): detail far below the 90–240 m road segments, and a third of
-    /// the generator's time saved (`BENCHMARKS.md`). [`RoadInputs::procedural_with_lattice`]
+    /// the generator's time saved (the polis repository's `BENCHMARKS.md`). [`RoadInputs::procedural_with_lattice`]
     /// takes another spacing, or `None` for the raw fBm maps.
     ///
     /// # Errors

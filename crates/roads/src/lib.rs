@@ -23,6 +23,7 @@
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
+//! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
 //!
 //! ## Example
 //!
@@ -58,7 +59,7 @@
 //! * Roads stop where a proposal fails (illegal with no prune/rotate/bridge variant, or
 //!   below the minimum angle), so dead ends remain at the fringe of the city, as in the
 //!   paper's figures; there is no pass that removes or reconnects them.
-//! * Speed (see `BENCHMARKS.md`): 15,000 segments take about 100 ms of CPU with the
+//! * Speed (see the polis repository's `BENCHMARKS.md`): 15,000 segments take about 100 ms of CPU with the
 //!   procedural maps, whose coastline and hills are sampled on lazily cached 40 m
 //!   [`LazyLattice`]s. Maps given as other fields are sampled as they are, at every
 //!   legality sample (a few hundred thousand for 15,000 segments): an expensive water or
@@ -85,6 +86,7 @@ pub mod legality;
 pub mod modules;
 pub mod network;
 pub mod params;
+pub mod primary;
 pub mod smooth;
 pub mod snap;
 
@@ -99,3 +101,4 @@ pub use lattice::LazyLattice;
 pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};
+pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};

@@ -75,9 +75,10 @@ use plan::Plan;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum Batching {
     /// One glTF node per scene node, each with its own metadata (picking, editing).
-    #[default]
     PerNode,
     /// Leaf nodes merged into their parent, one primitive per material (few draw calls).
+    /// The default, here and in `polis::SceneConfig`.
+    #[default]
     PerParentAndMaterial,
 }
 
@@ -86,7 +87,7 @@ pub enum Batching {
 #[serde(default)]
 pub struct GlbOptions {
     /// Node structure: one node per object, or batched per parent and material.
-    /// Default: [`Batching::PerNode`].
+    /// Default: [`Batching::PerParentAndMaterial`].
     pub batching: Batching,
 }
 

@@ -32,7 +32,7 @@ impl<N, E> PlanarGraph<N, E> {
     ///   on another node or inside an edge it does not end.
     ///
     /// Cost: one spatial-index query per node and per edge, so about linear for road-like
-    /// graphs (about 1 s for 150,000 edges on the benchmark machine, see `BENCHMARKS.md`).
+    /// graphs (about 1 s for 150,000 edges on the benchmark machine, see the repository's `BENCHMARKS.md`).
     /// Run it in tests and after bulk edits.
     pub fn check_invariants(&self) -> Result<(), GeomError> {
         self.check_bookkeeping()?;

@@ -38,7 +38,7 @@ use crate::predicates::{in_circle, orient2d_value};
 
 /// The most vertices the direct path takes (the bit sets below are `u64`); larger
 /// polygons and polygons with holes go through spade. Chosen by measurement
-/// (BENCHMARKS.md, polis-geom): the direct path is faster at every size up to here.
+/// (the repository's BENCHMARKS.md, polis-geom): the direct path is faster at every size up to here.
 pub(super) const MAX_VERTICES: usize = 64;
 
 /// No triangle: the boundary of the polygon, in the adjacency table.

@@ -12,7 +12,7 @@
 //!
 //! Two backends implement the [`SpatialIndex`] trait with identical answers:
 //! [`GridIndex`] (a hashed uniform grid, the default, [`SegmentIndex`]) and
-//! [`RTreeIndex`] (an R*-tree from the `rstar` crate). The backends only gather
+//! `RTreeIndex` (an R*-tree from the `rstar` crate, behind the `rtree` feature). The backends only gather
 //! *candidates* by bounding box; every decision is then made by the trait's shared code with
 //! exact predicates ([`crate::predicates`]), and results are sorted by distance/parameter
 //! and then by key, so the answer never depends on the backend, the cell size, insertion
@@ -20,7 +20,7 @@
 //!
 //! # Why a grid
 //!
-//! Measured on 100,000 random segments of 5–50 m in a 10 km square (`BENCHMARKS.md`,
+//! Measured on 100,000 random segments of 5–50 m in a 10 km square (the polis repository's `BENCHMARKS.md`,
 //! `cargo bench -p polis-geom --bench spatial`): with 64 m cells the grid inserts about
 //! 3× and removes about 4× faster than the R*-tree, and answers small-radius nearest and
 //! segment-crossing queries 2–3× faster; the bulk-loaded R*-tree is about 1.3× faster on
@@ -46,6 +46,7 @@
 //! ```
 
 mod grid;
+#[cfg(feature = "rtree")]
 mod rtree;
 mod shape;
 
@@ -60,6 +61,7 @@ use crate::error::GeomError;
 use crate::predicates::{SegmentIntersection, segment_intersection};
 
 pub use grid::GridIndex;
+#[cfg(feature = "rtree")]
 pub use rtree::RTreeIndex;
 pub use shape::Shape;
 

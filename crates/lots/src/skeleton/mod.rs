@@ -5,7 +5,7 @@
 //! wavefront's vertices; each input edge sweeps one *face*. The algorithm is the
 //! event-driven wavefront simulation of Felkel & Obdržálek (1998): a set of circular lists
 //! of active vertices (one per wavefront component), a priority queue of edge events and
-//! split events, and a general collapse rule (see [`events`](self::events)) that also
+//! split events, and a general collapse rule (see the private `events` module) that also
 //! handles vertex events, multi-splits, simultaneous events, parallel edges meeting and
 //! collinear edges, all in a deterministic order.
 //!
