@@ -56,6 +56,11 @@ pub struct CityConfig {
     pub facades: FacadeConfig,
     /// How the 3-D scene is assembled.
     pub scene: SceneConfig,
+    /// The real city the statistics report compares this city with (a city of
+    /// `polis::stats::reference`, e.g. "Manhattan", or a regional mean such as
+    /// "US/Canada mean"). Default: None.
+    #[serde(default)]
+    pub imitates: Option<String>,
 }
 
 impl Default for CityConfig {
@@ -75,6 +80,7 @@ impl Default for CityConfig {
             buildings: BuildingParams::default(),
             facades: FacadeConfig::default(),
             scene: SceneConfig::default(),
+            imitates: None,
         }
     }
 }

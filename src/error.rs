@@ -67,6 +67,9 @@ pub enum Error {
     /// Writing an output failed.
     #[error("export: {0}")]
     Export(#[from] polis_export::ExportError),
+    /// The statistics report failed (unknown reference city, unmeasurable layers).
+    #[error("stats: {0}")]
+    Stats(#[from] polis_stats::StatsError),
     /// A user-supplied stage failed.
     #[error("stage {stage}: {source}")]
     Stage {

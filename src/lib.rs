@@ -49,12 +49,14 @@ pub use polis_geom as geom;
 pub use polis_lots as lots;
 pub use polis_lsystem as lsystem;
 pub use polis_roads as roads;
+pub use polis_stats as stats;
 
 mod city;
 mod config;
 mod error;
 mod maps;
 mod pipeline;
+mod report;
 mod scene;
 pub mod seed;
 pub mod stages;
@@ -66,6 +68,7 @@ pub use config::{
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
+pub use report::reference_city_name;
 pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

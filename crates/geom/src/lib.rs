@@ -14,6 +14,7 @@
 //! | [`graph`] | [`PlanarGraph`]: a planar straight-line graph with stable ids, exact counter-clockwise adjacency, planar segment insertion |
 //! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); `spatial::RTreeIndex` (feature `rtree`) as the measured alternative |
 //! | [`field`] | [`Field`]: input maps (population, water, elevation …) — constants, closures, PNG rasters, seeded simplex/fBm noise, the slides' `populationAt`, combinators, serde [`field::FieldSpec`] |
+//! | [`measure`] | minimum enclosing circle (Welzl), segment–segment and segment–polygon distances |
 //! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks |
 //! | [`scene`] | [`Scene`]: node tree, materials, textures, images — the contract between generators and exporters |
 //! | [`metadata`] | [`Metadata`](metadata::Metadata): a node's small ordered map of [`MetaValue`]s (glTF `extras`, GeoJSON properties) |
@@ -49,6 +50,7 @@ pub mod field;
 pub mod graph;
 pub mod hash;
 pub mod lines;
+pub mod measure;
 pub mod mesh;
 pub mod metadata;
 pub mod polygon;

@@ -1,0 +1,107 @@
+//! The statistics report of a [`City`] ([`polis_stats`]) and the real city each preset
+//! imitates.
+
+use polis_geom::{Aabb2, DVec2, Field};
+use polis_roads::RoadClass;
+use polis_stats::{
+    BuildingInput, CityInput, CityReport, LotInput, StatsOptions, StreetClass, StreetGraph,
+};
+
+use crate::error::Result;
+use crate::{City, CityConfig};
+
+/// The reference city a configuration is compared with: [`CityConfig::imitates`], or
+/// `None` when it names none. The presets name theirs (manhattan → Manhattan,
+/// san_francisco → San Francisco, old_town → Rome, suburbia → Charlotte, paris → Paris,
+/// default and citygen → the US/Canada regional mean).
+pub fn reference_city_name(config: &CityConfig) -> Option<&str> {
+    config.imitates.as_deref().filter(|s| !s.trim().is_empty())
+}
+
+/// Land (not water) area of the city square, m²: the square's area less the water map's
+/// share, sampled at the centres of a grid of at most 200 × 200 cells (at least 5 m).
+fn land_area(water: &dyn Field, size_m: f64) -> f64 {
+    let cells = (size_m / 5.0).clamp(1.0, 200.0) as usize;
+    let step = size_m / cells as f64;
+    let h = size_m * 0.5;
+    let mut wet = 0usize;
+    for j in 0..cells {
+        for i in 0..cells {
+            let p = DVec2::new(-h + (i as f64 + 0.5) * step, -h + (j as f64 + 0.5) * step);
+            if water.sample(p) >= 0.5 {
+                wet += 1;
+            }
+        }
+    }
+    size_m * size_m * (1.0 - wet as f64 / (cells * cells) as f64)
+}
+
+impl City {
+    /// The statistics report ([`polis_stats::report`]) with the default options, compared
+    /// with the city the configuration imitates ([`reference_city_name`]) when it names
+    /// one.
+    ///
+    /// # Errors
+    /// [`Error::Stats`](crate::Error::Stats): a reference city the table does not know,
+    /// or layers the report cannot measure.
+    pub fn statistics(&self) -> Result<CityReport> {
+        self.statistics_with(&StatsOptions::default())
+    }
+
+    /// [`statistics`](Self::statistics) with explicit options.
+    ///
+    /// # Errors
+    /// As [`statistics`](Self::statistics).
+    pub fn statistics_with(&self, options: &StatsOptions) -> Result<CityReport> {
+        let streets = StreetGraph::from_planar(&self.roads, |r| {
+            let class = match r.class {
+                RoadClass::Highway => StreetClass::Highway,
+                RoadClass::Street => StreetClass::Street,
+            };
+            (class, r.width)
+        })
+        .with_elevation(self.maps.inputs.elevation.as_ref());
+        let blocks: Vec<_> = self.blocks.iter().map(|b| &b.polygon).collect();
+        let lots: Vec<LotInput<'_>> = self
+            .lots
+            .iter()
+            .map(|l| LotInput {
+                polygon: &l.lot.polygon,
+                street_edges: &l.lot.street_edges,
+            })
+            .collect();
+        let buildings: Vec<BuildingInput<'_>> = self
+            .buildings
+            .iter()
+            .map(|b| BuildingInput {
+                footprint: &b.footprint,
+                height_m: b.height,
+                floors: b.floors,
+                kind: b.kind.name(),
+            })
+            .collect();
+        let size = self.config.size_m;
+        let water = self.maps.inputs.water.as_ref();
+        let input = CityInput {
+            streets: &streets,
+            blocks: &blocks,
+            lots: &lots,
+            buildings: &buildings,
+            bounds: Some(Aabb2::new(
+                DVec2::splat(-size * 0.5),
+                DVec2::splat(size * 0.5),
+            )),
+            land_area_m2: Some(if self.maps.has_water {
+                land_area(water, size)
+            } else {
+                size * size
+            }),
+            water: self.maps.has_water.then_some(water),
+        };
+        let report = polis_stats::report(&input, options)?;
+        Ok(match reference_city_name(&self.config) {
+            Some(name) => report.compare_with(name)?,
+            None => report,
+        })
+    }
+}

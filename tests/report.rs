@@ -1,0 +1,81 @@
+//! The statistics report of a small city per preset: complete, finite, compared with the
+//! city the preset imitates. (Whether the presets land in their real city's bands is
+//! measured in BENCHMARKS.md, not asserted here yet.)
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic on failure
+
+use polis::{CityConfig, Pipeline};
+
+/// Every number of the report is finite: serde_json writes NaN as null, and only the
+/// optional parts may be null.
+fn assert_finite(v: &serde_json::Value, path: &str) {
+    match v {
+        serde_json::Value::Null => {
+            let optional = ["grade", "realism", "real", "band", "in_band"];
+            assert!(optional.iter().any(|k| path.ends_with(k)), "null at {path}");
+        }
+        serde_json::Value::Number(n) => {
+            assert!(n.as_f64().is_some_and(f64::is_finite), "{path} = {n}")
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                assert_finite(x, &format!("{path}[{i}]"));
+            }
+        }
+        serde_json::Value::Object(o) => {
+            for (k, x) in o {
+                assert_finite(x, &format!("{path}.{k}"));
+            }
+        }
+        _ => {}
+    }
+}
+
+#[test]
+fn every_preset_reports_completely_against_its_city() {
+    for name in CityConfig::preset_names() {
+        let mut c = CityConfig::preset(name).unwrap();
+        c.size_m = c.size_m.min(1200.0);
+        c.roads.max_segments = 200;
+        c.facades.enabled = false;
+        let city = Pipeline::default().with_scene(false).generate(&c).unwrap();
+        let report = city.statistics().unwrap();
+        let imitates = polis::reference_city_name(&c).expect("every preset names its city");
+        let realism = report.realism.as_ref().expect("compared");
+        assert!(realism.city.eq_ignore_ascii_case(imitates), "{name}");
+        assert_eq!(realism.rows.len(), 8, "{name}");
+        // Every reference city has at least φ and the four-way share.
+        assert!(realism.in_band + realism.out_of_band >= 2, "{name}");
+        // Counts agree with the city's layers.
+        assert_eq!(report.streets.segments, city.roads.edge_count(), "{name}");
+        assert_eq!(report.blocks.count, city.blocks.len(), "{name}");
+        assert_eq!(report.lots.count, city.lots.len(), "{name}");
+        assert_eq!(report.buildings.count, city.buildings.len(), "{name}");
+        assert!(
+            report.streets.streets > 0 && report.streets.nodes > 0,
+            "{name}"
+        );
+        assert!(report.streets.grade.is_some(), "{name}");
+        assert!(report.streets.land_area_km2 > 0.0, "{name}");
+        let kinds: usize = report.buildings.kinds.values().sum();
+        assert_eq!(kinds, city.buildings.len(), "{name}");
+        assert_finite(&serde_json::to_value(&report).unwrap(), name);
+        let table = report.to_string();
+        assert!(table.contains("realism against"), "{name}");
+    }
+}
+
+#[test]
+fn unknown_reference_city_is_an_error() {
+    let mut c = CityConfig::preset("default").unwrap();
+    c.size_m = 500.0;
+    c.roads.max_segments = 60;
+    c.facades.enabled = false;
+    c.imitates = Some("Atlantis".into());
+    let city = Pipeline::default().with_scene(false).generate(&c).unwrap();
+    let err = city.statistics().unwrap_err();
+    assert!(matches!(err, polis::Error::Stats(_)), "{err}");
+    c.imitates = None;
+    let city = Pipeline::default().with_scene(false).generate(&c).unwrap();
+    assert!(city.statistics().unwrap().realism.is_none());
+}
