@@ -123,9 +123,6 @@ fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
     if e.is_finite() { e } else { 0.0 }
 }
 
-/// A dressed wall plane of a part: origin, outward normal, unit axes, width, height.
-type Plane = (DVec3, DVec3, DVec3, DVec3, f64, f64);
-
 /// Meshes by material, reused from building to building: the first `used` are the
 /// current building's.
 #[derive(Default)]
@@ -160,65 +157,41 @@ impl Targets {
     }
 }
 
-/// Per-thread scratch of [`building_meshes`], reused so that a building allocates only
-/// its finished meshes (each exactly sized).
-#[derive(Default)]
-struct MeshScratch {
-    targets: Targets,
-    /// Dressed face indices.
-    faces: Vec<usize>,
-    /// The dressed faces of the part being copied.
-    planes: Vec<Plane>,
-    /// Vertex renumbering of the part being copied (`u32::MAX`: not copied yet).
-    remap: Vec<u32>,
-}
+/// How far facade skins stand out of the wall they dress, metres: enough that no
+/// renderer's depth test mixes them with the closed mass behind, far below anything a
+/// viewer can see.
+pub const SKIN_OFFSET_M: f64 = 0.02;
 
 thread_local! {
-    static MESH_SCRATCH: std::cell::RefCell<MeshScratch> = std::cell::RefCell::default();
+    static MESH_SCRATCH: std::cell::RefCell<Targets> = std::cell::RefCell::default();
 }
 
-/// The meshes of one building: parts with their materials, walls covered by the skin left
-/// out, and one skin mesh per tile; one mesh per material, in order of first use.
+/// The meshes of one building: its parts merged into one closed solid
+/// ([`Building::merged_solid`], by role: walls, roofs, details) and, as their own
+/// surfaces [`SKIN_OFFSET_M`] in front of the walls, one skin mesh per facade tile; one
+/// mesh per material, in order of first use.
 fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
     MESH_SCRATCH.with(|scratch| {
-        let mut scratch = scratch.borrow_mut();
-        let MeshScratch {
-            targets,
-            faces,
-            planes,
-            remap,
-        } = &mut *scratch;
+        let mut targets = scratch.borrow_mut();
         targets.used = 0;
-        faces.clear();
-        if let Some(d) = dress {
-            faces.extend(d.quads.iter().map(|q| q.face as usize));
-        }
-        faces.sort_unstable();
-        faces.dedup();
         let wall = pal.walls[b.kind.index().min(5)];
-        for (pi, part) in b.parts.iter().enumerate() {
-            let material = Some(match part.role {
+        let material = |role: PartRole| {
+            Some(match role {
                 PartRole::Mass => wall,
                 PartRole::Roof => pal.roof,
                 PartRole::Detail | PartRole::Template => pal.detail,
-            });
-            let Some(mesh) = targets.get(material) else {
-                continue;
-            };
-            planes.clear();
-            planes.extend(
-                faces
-                    .iter()
-                    .filter_map(|&k| b.facades.get(k))
-                    .filter(|f| f.part_index() == pi)
-                    .map(|f| (f.origin, f.normal(), f.u, f.v, f.width, f.height)),
-            );
-            if planes.is_empty() {
-                mesh.append(&part.mesh);
-            } else {
-                remap.clear();
-                remap.resize(part.mesh.vertex_count(), u32::MAX);
-                copy_uncovered(mesh, &part.mesh, planes, remap);
+            })
+        };
+        if let [only] = b.parts.as_slice() {
+            // Already one closed solid: copied once, not through a merged copy.
+            if let Some(mesh) = targets.get(material(only.role)) {
+                mesh.append(&only.mesh);
+            }
+        } else {
+            for (role, part) in &b.merged_solid().meshes {
+                if let Some(mesh) = targets.get(material(*role)) {
+                    mesh.append(part);
+                }
             }
         }
         if let Some(d) = dress
@@ -251,7 +224,8 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
 /// coordinates, two triangles. Quads too small to stay a rectangle in `f32` (and any
 /// non-finite value) go through [`Mesh::add_quad`], which checks them.
 fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()> {
-    let corners = q.corners(face);
+    let out = face.normal() * SKIN_OFFSET_M;
+    let corners = q.corners(face).map(|c| c + out);
     let [s0, t0, s1, t1] = q.rect;
     let scale = corners
         .iter()
@@ -272,57 +246,6 @@ fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()
     mesh.indices
         .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
     Ok(())
-}
-
-/// Appends the triangles of `src` that no dressed plane covers, with only the vertices
-/// they use.
-fn copy_uncovered(mesh: &mut Mesh, src: &Mesh, planes: &[Plane], remap: &mut [u32]) {
-    const TOL: f64 = 1e-3;
-    for t in src.triangles() {
-        let p = t.map(|k| {
-            src.positions
-                .get(k as usize)
-                .map_or(DVec3::NAN, |v| v.as_dvec3())
-        });
-        // The unnormalised normal: a covered triangle is a wall (|n̂.y| < 0.1) facing
-        // a plane's way (n̂ · n ≥ 0.99), compared in squares to spare the square root.
-        let tn = (p[1] - p[0]).cross(p[2] - p[0]);
-        let len2 = tn.length_squared();
-        let covered = tn.y * tn.y < 0.01 * len2
-            && planes.iter().any(|&(o, n, u, v, w, h)| {
-                let along = tn.dot(n);
-                if along <= 0.0
-                    || along * along < 0.9801 * len2
-                    || p.iter().any(|q| (*q - o).dot(n).abs() > TOL)
-                {
-                    return false;
-                }
-                let c = (p[0] + p[1] + p[2]) / 3.0 - o;
-                let (s, t) = (c.dot(u), c.dot(v));
-                s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
-            });
-        if covered {
-            continue;
-        }
-        for k in t {
-            let k = k as usize;
-            let (Some(slot), Some(&pos), Some(&nrm), Some(&uv)) = (
-                remap.get_mut(k),
-                src.positions.get(k),
-                src.normals.get(k),
-                src.uvs.get(k),
-            ) else {
-                continue;
-            };
-            if *slot == u32::MAX {
-                *slot = mesh.positions.len() as u32;
-                mesh.positions.push(pos);
-                mesh.normals.push(nrm);
-                mesh.uvs.push(uv);
-            }
-            mesh.indices.push(*slot);
-        }
-    }
 }
 
 /// Everything the scene is built from.
@@ -544,10 +467,10 @@ pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
 mod tests {
     use super::*;
 
-    /// The skin replaces wall triangles without gaps or overlaps: each building's scene
-    /// meshes have the surface area of its closed parts.
+    /// Each building's untextured meshes are one closed, outward solid with its parts'
+    /// volume; the skins stand [`SKIN_OFFSET_M`] in front of the walls they dress.
     #[test]
-    fn skins_replace_exactly_the_walls_they_cover() {
+    fn buildings_are_closed_solids_dressed_by_skins() {
         let mut config = CityConfig::preset("default").unwrap();
         config.size_m = 1200.0;
         config.roads.max_segments = 200;
@@ -555,16 +478,30 @@ mod tests {
         let city = crate::generate(&config).unwrap();
         let mut scene = Scene::new();
         let pal = palette(&mut scene, &city.tile_sets).unwrap();
+        let tiles: Vec<MaterialId> = pal.tiles.iter().flatten().copied().collect();
         let mut dressed = 0;
         for (b, dress) in city.buildings.iter().zip(&city.dresses) {
             let meshes = building_meshes(b, dress.as_ref(), &pal).unwrap();
-            let area: f64 = meshes.iter().map(Mesh::surface_area).sum();
-            let parts: f64 = b.parts.iter().map(|p| p.mesh.surface_area()).sum();
-            assert!(
-                (area - parts).abs() <= 1e-4 * parts,
-                "building {}: {area} m² in the scene, {parts} m² of parts",
-                b.id
-            );
+            let (skins, mass): (Vec<&Mesh>, Vec<&Mesh>) = meshes
+                .iter()
+                .partition(|m| m.material.is_some_and(|k| tiles.contains(&k)));
+            let report = polis_geom::mesh::edge_use(mass);
+            assert!(report.is_solid(), "building {}: {report:?}", b.id);
+            let parts: f64 = b.parts.iter().map(|p| p.mesh.signed_volume()).sum();
+            assert!((report.signed_volume - parts).abs() <= 1e-3 * parts);
+            // Every skin vertex lies the offset in front of a dressed face's plane.
+            if let Some(d) = dress {
+                for m in skins {
+                    for p in &m.positions {
+                        let p = p.as_dvec3();
+                        let on_a_face = d.quads.iter().any(|q| {
+                            let f = &b.facades[q.face as usize];
+                            ((p - f.origin).dot(f.normal()) - SKIN_OFFSET_M).abs() < 1e-3
+                        });
+                        assert!(on_a_face, "building {}: skin vertex off its wall", b.id);
+                    }
+                }
+            }
             dressed += usize::from(dress.is_some());
         }
         assert!(dressed > 10, "{dressed} dressed buildings");

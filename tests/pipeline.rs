@@ -131,6 +131,64 @@ fn check_city(name: &str, city: &City) {
     let stats_tris = city.stats.scene_triangles;
     assert!(stats_tris > 0);
     assert_eq!(city.scene.triangle_count(), stats_tris);
+    check_solids(name, city);
+}
+
+/// 100 % of building masses and block plinths are one closed, 2-manifold, outward solid
+/// each, by the edge-use check: the merged solids the buildings stage offers and what the
+/// scene exports (a building or block node's untextured meshes; the textured ones are
+/// the facade skins, surfaces of their own).
+fn check_solids(name: &str, city: &City) {
+    use polis::geom::mesh::edge_use;
+    let mut failed = Vec::new();
+    for b in &city.buildings {
+        let solid = b.merged_solid();
+        let report = edge_use(solid.meshes.iter().map(|(_, m)| m));
+        if !(solid.closed && report.is_solid()) {
+            failed.push((b.id, solid.unmerged_because, report.open.len()));
+            continue;
+        }
+        let parts: f64 = b.parts.iter().map(|p| p.mesh.signed_volume()).sum();
+        assert!(
+            (report.signed_volume - parts).abs() <= 1e-3 * parts,
+            "{name}: building {}: merged volume {} m³, parts {parts} m³",
+            b.id,
+            report.signed_volume
+        );
+    }
+    assert!(
+        failed.is_empty(),
+        "{name}: {} of {} buildings not closed: {failed:?}",
+        failed.len(),
+        city.buildings.len()
+    );
+    let (mut buildings, mut blocks) = (0, 0);
+    for node in &city.scene.nodes {
+        let is_building = node.name.starts_with("building ");
+        if !(is_building || node.name.starts_with("block ")) {
+            continue;
+        }
+        let solid = node
+            .meshes
+            .iter()
+            .map(|id| &city.scene.meshes[id.0 as usize])
+            .filter(|m| {
+                m.material.is_none_or(|k| {
+                    city.scene.materials[k.0 as usize]
+                        .base_color_texture
+                        .is_none()
+                })
+            });
+        let report = edge_use(solid);
+        assert!(report.is_solid(), "{name}: {}: {report:?}", node.name);
+        if is_building {
+            buildings += 1;
+        } else {
+            blocks += 1;
+        }
+    }
+    assert_eq!(buildings, city.buildings.len(), "{name}");
+    assert_eq!(blocks, city.blocks.len(), "{name}");
 }
 
 #[test]

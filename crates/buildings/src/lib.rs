@@ -83,6 +83,7 @@ mod error;
 pub mod footprint;
 pub mod generate;
 pub mod grammar;
+pub mod merge;
 pub mod params;
 mod roofs;
 mod solid;
@@ -94,6 +95,7 @@ pub use generate::{
     BuildingGenerator, MIN_BUILDING_HEIGHT, Plan, ZoneRule, generate, kind_from_zoning, mix_seed,
 };
 pub use grammar::{BuildingGrammar, SHAPE_MODULES, default_text};
+pub use merge::{MergedSolid, merge_parts};
 pub use params::{
     BuildingKind, BuildingParams, FootprintParams, FootprintStrategy, HeightDistribution,
 };
