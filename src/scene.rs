@@ -48,6 +48,11 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
     ];
     let roof = m("roof", [0.45, 0.25, 0.20]);
     let detail = m("detail", [0.30, 0.30, 0.32]);
+    // Road ribbons and junction plates keep their metre coordinates for a texture added
+    // later in an engine; the other plain materials drop theirs in exports.
+    if let Some(mat) = scene.materials.get_mut(road.index()) {
+        mat.keep_texture_coordinates = true;
+    }
     let mut tiles = Vec::with_capacity(sets.len());
     for set in sets {
         let mut ids = Vec::with_capacity(set.tiles.len());
@@ -295,7 +300,8 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     name: format!("building {}", b.id),
                     translation: to_world(b.origin, base),
                     metadata: Metadata::from([
-                        ("kind", MetaValue::from_static(b.kind.name())),
+                        ("kind", MetaValue::from_static(kind_class(b.kind))),
+                        ("type", MetaValue::from_static(b.kind.name())),
                         ("height", MetaValue::from(b.height)),
                         ("floors", MetaValue::from(f64::from(b.floors))),
                         ("lot", MetaValue::from(b.lot_id as f64)),
@@ -452,6 +458,17 @@ fn insert_leaves(scene: &mut Scene, made: &mut [Leaf], parents: &[NodeId]) -> Re
     Ok(())
 }
 
+/// The name of a building kind's map class: the `kind` of a building in the glb, the
+/// GeoJSON and the SVG alike (the grammar's kind is the glb's `type`).
+pub(crate) fn kind_class(kind: BuildingKind) -> &'static str {
+    match kind {
+        BuildingKind::Skyscraper => "skyscraper",
+        BuildingKind::Office | BuildingKind::MidRise => "commercial",
+        BuildingKind::House | BuildingKind::Apartment => "residential",
+        BuildingKind::Industrial => "industrial",
+    }
+}
+
 /// The SVG/GeoJSON kind of a building kind.
 pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
     use polis_export::map::BuildingKind as K;
@@ -466,6 +483,13 @@ pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_name_for_building_kinds() {
+        for k in BuildingKind::ALL {
+            assert_eq!(kind_class(k), map_kind(k).as_str());
+        }
+    }
 
     /// Each building's untextured meshes are one closed, outward solid with its parts'
     /// volume; the skins stand [`SKIN_OFFSET_M`] in front of the walls they dress.
