@@ -244,6 +244,9 @@ pub struct SceneConfig {
     /// Node structure of the glb: per building, or batched per cell and material.
     /// Default: batched (few draw calls, as Citygen).
     pub batching: Batching,
+    /// Water bodies of the water map as flat surfaces at the level of their lowest
+    /// shore point, in a node `water` of their own (false leaves them out). Default: true.
+    pub water_surfaces: bool,
 }
 
 impl Default for SceneConfig {
@@ -252,6 +255,7 @@ impl Default for SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
             batching: Batching::PerParentAndMaterial,
+            water_surfaces: true,
         }
     }
 }

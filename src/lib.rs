@@ -59,7 +59,9 @@ mod scene;
 pub mod seed;
 pub mod stages;
 
-pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace_mask};
+pub use city::{
+    City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
+};
 pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
 };

@@ -12,7 +12,10 @@ use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 
 use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, Node, NodeId, Texture};
-use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
+use polis_geom::{
+    DVec2, DVec3, Facing, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene, Transform,
+    to_world,
+};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
 use rayon::prelude::*;
@@ -332,10 +335,40 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect()
     };
-    let (road, (blocks, buildings)) =
-        rayon::join(road_mesh, || rayon::join(blocks_job, buildings_job));
+    // Water bodies: flat surfaces at their shore's lowest point.
+    let water_job = || -> Result<Vec<(PolygonWithHoles, f64)>> {
+        if !(inp.config.scene.water_surfaces && inp.maps.has_water) {
+            return Ok(Vec::new());
+        }
+        let water = inp.maps.inputs.water.as_ref();
+        Ok(crate::city::smooth_mask(water, inp.config.size_m)?
+            .into_iter()
+            .map(|p| {
+                let level = ground(elevation, p.outer.points());
+                (p, level)
+            })
+            .collect())
+    };
+    let ((road, water), (blocks, buildings)) = rayon::join(
+        || rayon::join(road_mesh, water_job),
+        || rayon::join(blocks_job, buildings_job),
+    );
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
+    let water = water?;
+    if !water.is_empty() {
+        let material = scene.add_material(Material {
+            roughness: 0.1,
+            ..Material::new("water", [0.12, 0.28, 0.42, 1.0])
+        });
+        let mut mesh = Mesh::new(Some(material));
+        for (polygon, level) in &water {
+            mesh.add_flat_polygon(polygon, *level, Facing::Up)?;
+        }
+        let node = scene.add_node(root, "water")?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }

@@ -478,3 +478,40 @@ fn write_all_writes_every_file_and_the_obj_names_its_mtl() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Water bodies are flat surfaces at their shore's lowest point, in a `water` node, with
+/// the area of the smooth water layer of the maps; the flag leaves them out.
+#[test]
+fn water_is_a_surface_and_the_maps_trace_it_smoothly() {
+    let mut config = small("manhattan");
+    config.facades.pixels_per_metre = 2.0;
+    let city = polis::generate(&config).unwrap();
+    let map = city.map_layers().unwrap();
+    assert!(!map.water.is_empty());
+    for p in &map.water {
+        p.validate().unwrap();
+    }
+    let water_area: f64 = map.water.iter().map(|p| p.area()).sum();
+    let node = city
+        .scene
+        .nodes
+        .iter()
+        .find(|n| n.name == "water")
+        .expect("a water node");
+    let mesh = &city.scene.meshes[node.meshes[0].0 as usize];
+    mesh.validate().unwrap();
+    assert!((mesh.surface_area() - water_area).abs() < 1e-3 * water_area);
+    // Manhattan's ground is flat at 5 m: so is the water.
+    assert!(mesh.positions.iter().all(|p| p.y == 5.0));
+    assert!(mesh.normals.iter().all(|n| n.y == 1.0));
+    // Smooth: no staircase of 10 m cells (far fewer vertices than a cell outline).
+    let vertices: usize = map.water.iter().map(|p| p.outer.len()).sum();
+    let perimeter: f64 = map.water.iter().map(|p| p.outer.perimeter()).sum();
+    assert!(
+        (vertices as f64) < perimeter / 10.0,
+        "{vertices} vertices, {perimeter} m"
+    );
+    config.scene.water_surfaces = false;
+    let dry = polis::generate(&config).unwrap();
+    assert!(dry.scene.nodes.iter().all(|n| n.name != "water"));
+}
