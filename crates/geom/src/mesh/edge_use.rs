@@ -223,23 +223,25 @@ pub fn edge_use<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> EdgeUseReport
     report
 }
 
-/// The root of `x` and the parity of `x` relative to it (with path compression).
+/// The root of `x` and the parity of `x` relative to it (with path compression, in two
+/// passes without allocating).
 fn find(parent: &mut [u32], parity: &mut [u8], x: u32) -> (u32, u8) {
-    // Collect the path, then compress it.
-    let mut path = Vec::new();
-    let mut r = x;
+    // First pass: the root and x's parity to it.
+    let (mut r, mut acc) = (x, 0u8);
     while parent[r as usize] != r {
-        path.push(r);
+        acc ^= parity[r as usize];
         r = parent[r as usize];
     }
-    // Walk back from the node nearest the root, accumulating parity to the root.
-    let mut acc = 0u8;
-    for &v in path.iter().rev() {
-        acc ^= parity[v as usize];
-        parity[v as usize] = acc;
+    // Second pass: point every node of the path at the root with its own parity.
+    let (mut v, mut p) = (x, acc);
+    while parent[v as usize] != r && v != r {
+        let (next, own) = (parent[v as usize], parity[v as usize]);
         parent[v as usize] = r;
+        parity[v as usize] = p;
+        p ^= own;
+        v = next;
     }
-    (r, parity[x as usize] * u8::from(x != r))
+    (r, acc)
 }
 
 /// Joins the classes of triangles `a` and `b`; `differ` says they have opposite

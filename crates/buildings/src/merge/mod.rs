@@ -56,6 +56,8 @@ use polis_geom::{
 
 use crate::building::{Building, Part, PartRole};
 
+mod stack;
+
 /// Horizontal levels (and vertices near them) closer than this, in metres, are one level.
 ///
 /// Far below any storey or roof dimension, far above the rounding steps (`f32` at a few
@@ -146,6 +148,10 @@ fn try_merge(parts: &[Part]) -> Result<MergedSolid, Why> {
             closed: true,
             unmerged_because: None,
         });
+    }
+    // Stacks glued on identical caps (most buildings) need no overlay.
+    if let Some(solid) = stack::identical_stack(parts) {
+        return Ok(solid);
     }
     // Triangles with their attributes.
     let mut tris: Vec<Tri> = Vec::new();
