@@ -63,7 +63,8 @@ pub use city::{
     City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
 };
 pub use config::{
-    CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
+    CityConfig, FacadeConfig, FacadeDetail, Foundation, KindStyles, SceneConfig, ZoneBand,
+    ZoningConfig,
 };
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};

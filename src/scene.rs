@@ -22,7 +22,7 @@ use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::stages::{Dress, SkinQuad};
-use crate::{CityConfig, CityMaps};
+use crate::{CityConfig, CityMaps, Foundation};
 
 /// Plain materials of the scene, by role.
 struct Palette {
@@ -121,6 +121,87 @@ pub(crate) fn map_roads(network: &RoadNetwork) -> Result<Vec<MapRoad>> {
     Ok(roads)
 }
 
+/// Where a building stands: the level of its floor and, per footprint corner, how far
+/// below that level its bottom goes.
+struct Seat {
+    /// Elevation of the building's local origin (its floor), metres.
+    base: f64,
+    /// Depth of the plinth below the floor, metres (0: none).
+    plinth: f64,
+}
+
+/// The seat of a footprint on the ground under its corners, by foundation mode (see
+/// [`Foundation`]); non-finite ground samples are left out (0 m when none is finite).
+fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation) -> Seat {
+    let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
+    for &p in pts {
+        let g = elevation.sample(p);
+        if g.is_finite() {
+            lo = lo.min(g);
+            hi = hi.max(g);
+            sum += g;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return Seat {
+            base: 0.0,
+            plinth: 0.0,
+        };
+    }
+    let base = match mode {
+        Foundation::Lowest => lo,
+        Foundation::Highest | Foundation::Follow => hi,
+        Foundation::Average => (sum / n as f64).clamp(lo, hi),
+    };
+    Seat {
+        base,
+        plinth: base - lo,
+    }
+}
+
+/// Carries the bottom of a building's mass (every vertex at its floor, local height 0)
+/// down by the plinth depth, or for [`Foundation::Follow`] down to the ground under each
+/// vertex, so walls reach the ground. Texture `v` stays minus the height on walls.
+fn lower_bottom(
+    mesh: &mut Mesh,
+    from: usize,
+    seat: &Seat,
+    mode: Foundation,
+    elevation: &dyn Field,
+    origin: DVec2,
+) {
+    if seat.plinth <= 0.0 {
+        return;
+    }
+    let (positions, normals, uvs) = (
+        mesh.positions.get_mut(from..).unwrap_or_default(),
+        mesh.normals.get(from..).unwrap_or_default(),
+        mesh.uvs.get_mut(from..).unwrap_or_default(),
+    );
+    for ((p, n), uv) in positions.iter_mut().zip(normals).zip(uvs) {
+        if p.y != 0.0 {
+            continue;
+        }
+        let depth = match mode {
+            Foundation::Follow => {
+                let (q, _) = polis_geom::to_layout(p.as_dvec3());
+                let g = elevation.sample(q + origin);
+                if g.is_finite() {
+                    (seat.base - g).clamp(0.0, seat.plinth)
+                } else {
+                    seat.plinth
+                }
+            }
+            _ => seat.plinth,
+        };
+        p.y = -(depth as f32);
+        if n.y.abs() < 0.5 {
+            uv.y = -p.y;
+        }
+    }
+}
+
 /// Lowest ground under a ring of layout points.
 fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
     let e = pts
@@ -178,7 +259,15 @@ thread_local! {
 /// ([`Building::merged_solid`], by role: walls, roofs, details) and, as their own
 /// surfaces [`SKIN_OFFSET_M`] in front of the walls, one skin mesh per facade tile; one
 /// mesh per material, in order of first use.
-fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
+/// Where and how a building is seated: its seat, mode, and the ground.
+type Seating<'a> = (&'a Seat, Foundation, &'a dyn Field);
+
+fn building_meshes(
+    b: &Building,
+    dress: Option<&Dress>,
+    pal: &Palette,
+    seating: Option<Seating<'_>>,
+) -> Result<Vec<Mesh>> {
     MESH_SCRATCH.with(|scratch| {
         let mut targets = scratch.borrow_mut();
         targets.used = 0;
@@ -190,16 +279,21 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
                 PartRole::Detail | PartRole::Template => pal.detail,
             })
         };
+        let mut add = |role: PartRole, part: &Mesh| {
+            if let Some(mesh) = targets.get(material(role)) {
+                let from = mesh.positions.len();
+                mesh.append(part);
+                if let Some((seat, mode, ground)) = seating {
+                    lower_bottom(mesh, from, seat, mode, ground, b.origin);
+                }
+            }
+        };
         if let [only] = b.parts.as_slice() {
             // Already one closed solid: copied once, not through a merged copy.
-            if let Some(mesh) = targets.get(material(only.role)) {
-                mesh.append(&only.mesh);
-            }
+            add(only.role, &only.mesh);
         } else {
             for (role, part) in &b.merged_solid().meshes {
-                if let Some(mesh) = targets.get(material(*role)) {
-                    mesh.append(part);
-                }
+                add(*role, part);
             }
         }
         if let Some(d) = dress
@@ -297,8 +391,21 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
-                let meshes = building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal)?;
-                let base = ground(elevation, b.footprint.points());
+                let mode = inp
+                    .config
+                    .scene
+                    .foundations
+                    .get(b.kind.index())
+                    .copied()
+                    .unwrap_or_default();
+                let seat = seat(elevation, b.footprint.points(), mode);
+                let meshes = building_meshes(
+                    b,
+                    inp.dresses.get(i).and_then(Option::as_ref),
+                    &pal,
+                    Some((&seat, mode, elevation)),
+                )?;
+                let base = seat.base;
                 let node = LeafNode {
                     name: format!("building {}", b.id),
                     translation: to_world(b.origin, base),
@@ -538,7 +645,7 @@ mod tests {
         let tiles: Vec<MaterialId> = pal.tiles.iter().flatten().copied().collect();
         let mut dressed = 0;
         for (b, dress) in city.buildings.iter().zip(&city.dresses) {
-            let meshes = building_meshes(b, dress.as_ref(), &pal).unwrap();
+            let meshes = building_meshes(b, dress.as_ref(), &pal, None).unwrap();
             let (skins, mass): (Vec<&Mesh>, Vec<&Mesh>) = meshes
                 .iter()
                 .partition(|m| m.material.is_some_and(|k| tiles.contains(&k)));

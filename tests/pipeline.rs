@@ -217,6 +217,22 @@ fn check_glb_hygiene(name: &str, city: &City, doc: &polis::export::gltf::Gltf) {
     assert_eq!(glb_kinds, map_kinds, "{name}: building kinds differ");
 }
 
+/// A scene node's untextured meshes: a building's mass or a block's plinth (the
+/// textured ones are facade skins).
+fn solid_meshes<'a>(city: &'a City, node: &polis::geom::scene::Node) -> Vec<&'a polis::geom::Mesh> {
+    node.meshes
+        .iter()
+        .map(|id| &city.scene.meshes[id.0 as usize])
+        .filter(|m| {
+            m.material.is_none_or(|k| {
+                city.scene.materials[k.0 as usize]
+                    .base_color_texture
+                    .is_none()
+            })
+        })
+        .collect()
+}
+
 /// 100 % of building masses and block plinths are one closed, 2-manifold, outward solid
 /// each, by the edge-use check: the merged solids the buildings stage offers and what the
 /// scene exports (a building or block node's untextured meshes; the textured ones are
@@ -251,18 +267,7 @@ fn check_solids(name: &str, city: &City) {
         if !(is_building || node.name.starts_with("block ")) {
             continue;
         }
-        let solid = node
-            .meshes
-            .iter()
-            .map(|id| &city.scene.meshes[id.0 as usize])
-            .filter(|m| {
-                m.material.is_none_or(|k| {
-                    city.scene.materials[k.0 as usize]
-                        .base_color_texture
-                        .is_none()
-                })
-            });
-        let report = edge_use(solid);
+        let report = edge_use(solid_meshes(city, node));
         assert!(report.is_solid(), "{name}: {}: {report:?}", node.name);
         if is_building {
             buildings += 1;
@@ -514,4 +519,88 @@ fn water_is_a_surface_and_the_maps_trace_it_smoothly() {
     config.scene.water_surfaces = false;
     let dry = polis::generate(&config).unwrap();
     assert!(dry.scene.nodes.iter().all(|n| n.name != "water"));
+}
+
+/// Buildings on slopes: with `Highest` and `Follow` no building floats or is buried at
+/// its footprint's corners (within 1 cm); `Lowest` stands into the slope by at most the
+/// footprint's relief. Every mass stays one closed solid.
+#[test]
+fn buildings_are_seated_on_slopes() {
+    use polis::Foundation;
+    use polis::geom::Transform;
+    use polis::geom::mesh::edge_use;
+    const TOL: f64 = 0.01;
+    for mode in [
+        Foundation::Highest,
+        Foundation::Follow,
+        Foundation::Lowest,
+        Foundation::Average,
+    ] {
+        let mut config = small("san_francisco");
+        config.facades.pixels_per_metre = 2.0;
+        config.scene.foundations = [mode; 6];
+        let city = polis::generate(&config).unwrap();
+        let elevation = city.maps.inputs.elevation.as_ref();
+        let nodes: HashMap<&str, &polis::geom::scene::Node> = city
+            .scene
+            .nodes
+            .iter()
+            .map(|n| (n.name.as_str(), n))
+            .collect();
+        let mut sloped = 0;
+        for b in &city.buildings {
+            let node = nodes[format!("building {}", b.id).as_str()];
+            let Transform::Trs { translation, .. } = node.transform else {
+                panic!("building nodes are placed by translation");
+            };
+            let base = translation.y;
+            let ground: Vec<f64> = b
+                .footprint
+                .points()
+                .iter()
+                .map(|&p| elevation.sample(p))
+                .collect();
+            let (lo, hi) = ground
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), &g| {
+                    (a.min(g), z.max(g))
+                });
+            sloped += usize::from(hi - lo > 0.5);
+            let mass = solid_meshes(&city, node);
+            assert!(
+                edge_use(mass.iter().copied()).is_solid(),
+                "{mode:?}: building {}",
+                b.id
+            );
+            // The lowest point of the mass at each footprint corner, in world height.
+            let bottom_at = |p: polis::geom::DVec2| {
+                let local = p - b.origin;
+                mass.iter()
+                    .flat_map(|m| m.positions.iter())
+                    .filter(|q| {
+                        (f64::from(q.x) - local.x).abs() < 1e-3
+                            && (f64::from(-q.z) - local.y).abs() < 1e-3
+                    })
+                    .map(|q| base + f64::from(q.y))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            for (&p, &g) in b.footprint.points().iter().zip(&ground) {
+                let bottom = bottom_at(p);
+                match mode {
+                    Foundation::Highest | Foundation::Follow => {
+                        assert!(base >= g - TOL, "{mode:?}: building {} buried", b.id);
+                        assert!(bottom <= g + TOL, "{mode:?}: building {} floats", b.id);
+                        if mode == Foundation::Follow {
+                            assert!(bottom >= g - TOL, "{mode:?}: {} digs in", b.id);
+                        }
+                    }
+                    Foundation::Lowest | Foundation::Average => {
+                        assert!(bottom <= g + TOL, "{mode:?}: building {} floats", b.id);
+                        assert!(base >= lo - TOL && g - base <= hi - lo + TOL);
+                    }
+                }
+            }
+        }
+        assert!(sloped > 20, "{mode:?}: only {sloped} buildings on slopes");
+    }
 }
