@@ -41,6 +41,10 @@
 //! * Every part is a closed, consistently wound 2-manifold with outward normals, no
 //!   degenerate triangle and texture coordinates in metres (checked in tests over random
 //!   convex and concave lots).
+//! * The parts of a building of the shipped grammars merge into one closed 2-manifold
+//!   with their total volume ([`Building::merged_solid`], [`merge`]; checked in the same
+//!   tests); any grammar's parts merge or come back unmerged with the reason, never a
+//!   panic (fuzzed).
 //! * Every footprint lies inside its lot; nothing rises above the building's height,
 //!   which never exceeds the maximum height given.
 //! * LOD `k` is the string after `k` derivation steps, drawn; the axiom (LOD 0) is the

@@ -21,7 +21,7 @@
 //! 3. **T-junctions.** Every other triangle with an edge on a split boundary edge is
 //!    fanned from its opposite corner through the split points, so walls, roofs and
 //!    caps share every edge exactly.
-//! 4. **Check.** The result must pass the edge-use check ([`polis_geom::mesh::edge_use`]):
+//! 4. **Check.** The result must pass the edge-use check ([`polis_geom::mesh::edge_use()`]):
 //!    every edge used exactly twice in opposite directions, positive volume.
 //!
 //! # Guarantees

@@ -4,7 +4,7 @@
 //! A [`Mesh`] is one glTF *primitive*: `f32` positions, normals and texture coordinates, `u32`
 //! triangle indices and one material. It is plain data with public fields, so anyone can
 //! build one by hand; [`Mesh::validate`] checks it and [`Mesh::check_closed`] checks that it
-//! bounds a solid; [`edge_use`] reports everything that keeps a surface (one mesh or
+//! bounds a solid; [`edge_use()`] reports everything that keeps a surface (one mesh or
 //! several) from being a closed, 2-manifold, outward solid.
 //!
 //! ## Axes and units
