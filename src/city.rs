@@ -170,14 +170,15 @@ fn write_file(
 
 impl City {
     /// The 2-D map layers (water, parks, blocks, lots, roads, footprints) for the SVG and
-    /// GeoJSON writers. Water is traced from the water map on a 10 m grid.
+    /// GeoJSON writers. Water and parks are the smooth outlines of their maps (≥ 0.5),
+    /// traced on a 10 m grid and simplified to 1 m ([`smooth_mask`]).
     pub fn map_layers(&self) -> Result<MapLayers> {
         let mut map = MapLayers::default();
         if self.maps.has_water {
-            map.water = trace_mask(self.maps.inputs.water.as_ref(), self.config.size_m, 10.0);
+            map.water = smooth_mask(self.maps.inputs.water.as_ref(), self.config.size_m)?;
         }
         if self.maps.has_parks {
-            map.parks = trace_mask(self.maps.inputs.parks.as_ref(), self.config.size_m, 10.0);
+            map.parks = smooth_mask(self.maps.inputs.parks.as_ref(), self.config.size_m)?;
         }
         map.parks.extend(self.green_spaces.iter().cloned());
         map.roads = crate::scene::map_roads(&self.roads)?;
@@ -265,6 +266,23 @@ impl City {
             files: vec![svg, geojson, glb?, obj?, dir.join("city.mtl")],
         })
     }
+}
+
+/// The area where `mask ≥ 0.5` inside the square map of side `size_m` (centred on the
+/// origin), as smooth polygons: marching squares on a 10 m grid, simplified to 1 m
+/// ([`polis_geom::field::contour_regions`]). The water and park layers of the maps and
+/// the water surfaces of the scene.
+///
+/// # Errors
+/// A size that is not a positive finite number of metres.
+pub fn smooth_mask(mask: &dyn Field, size_m: f64) -> Result<Vec<PolygonWithHoles>> {
+    let h = size_m * 0.5;
+    let bounds = polis_geom::Aabb2::new(DVec2::splat(-h), DVec2::splat(h));
+    Ok(polis_geom::field::contour_regions(
+        mask,
+        bounds,
+        &polis_geom::field::ContourOptions::default(),
+    )?)
 }
 
 /// The area where `mask ≥ 0.5` inside the square map of side `size_m`, as row runs of

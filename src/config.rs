@@ -250,6 +250,36 @@ pub struct SceneConfig {
     /// Node structure of the glb: per building, or batched per cell and material.
     /// Default: batched (few draw calls, as Citygen).
     pub batching: Batching,
+    /// Water bodies of the water map as flat surfaces at the level of their lowest
+    /// shore point, in a node `water` of their own (false leaves them out). Default: true.
+    pub water_surfaces: bool,
+    /// How each building kind is seated on sloping ground, in
+    /// [`BuildingKind::ALL`] order. Default: [`Foundation::Highest`] for every kind.
+    pub foundations: [Foundation; 6],
+}
+
+/// How a building is seated on the ground under its footprint (CityEngine's four
+/// alignments). The ground is the elevation map sampled at the footprint's corners.
+///
+/// Guarantees, at the footprint's corners: with [`Highest`](Self::Highest) and
+/// [`Follow`](Self::Follow) no building floats and none is buried (the building's floor
+/// is at or above the ground, its plinth or walls reach down to the ground); with
+/// [`Lowest`](Self::Lowest) the uphill side is buried by the footprint's ground relief
+/// (highest minus lowest corner), with [`Average`](Self::Average) by the relief above
+/// the mean. Nothing is checked between corners: a footprint over a ridge can still cut
+/// into it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Foundation {
+    /// Level at the lowest ground, no plinth: the building stands into the slope.
+    Lowest,
+    /// Level at the highest ground, on a plinth (the walls carried down) to the lowest.
+    #[default]
+    Highest,
+    /// Level at the mean ground, on a plinth to the lowest.
+    Average,
+    /// Level at the highest ground; every corner's walls reach down to the ground under
+    /// it, so the bottom follows the slope.
+    Follow,
 }
 
 impl Default for SceneConfig {
@@ -258,6 +288,8 @@ impl Default for SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
             batching: Batching::default(),
+            water_surfaces: true,
+            foundations: [Foundation::Highest; 6],
         }
     }
 }

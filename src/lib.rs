@@ -61,9 +61,12 @@ mod scene;
 pub mod seed;
 pub mod stages;
 
-pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace_mask};
+pub use city::{
+    City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
+};
 pub use config::{
-    CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
+    CityConfig, FacadeConfig, FacadeDetail, Foundation, KindStyles, SceneConfig, ZoneBand,
+    ZoningConfig,
 };
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};

@@ -12,14 +12,17 @@ use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 
 use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, Node, NodeId, Texture};
-use polis_geom::{DVec2, DVec3, Field, Material, MaterialId, Mesh, Scene, Transform, to_world};
+use polis_geom::{
+    DVec2, DVec3, Facing, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene, Transform,
+    to_world,
+};
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
 use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::stages::{Dress, SkinQuad};
-use crate::{CityConfig, CityMaps};
+use crate::{CityConfig, CityMaps, Foundation};
 
 /// Plain materials of the scene, by role.
 struct Palette {
@@ -48,6 +51,11 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
     ];
     let roof = m("roof", [0.45, 0.25, 0.20]);
     let detail = m("detail", [0.30, 0.30, 0.32]);
+    // Road ribbons and junction plates keep their metre coordinates for a texture added
+    // later in an engine; the other plain materials drop theirs in exports.
+    if let Some(mat) = scene.materials.get_mut(road.index()) {
+        mat.keep_texture_coordinates = true;
+    }
     let mut tiles = Vec::with_capacity(sets.len());
     for set in sets {
         let mut ids = Vec::with_capacity(set.tiles.len());
@@ -113,6 +121,87 @@ pub(crate) fn map_roads(network: &RoadNetwork) -> Result<Vec<MapRoad>> {
     Ok(roads)
 }
 
+/// Where a building stands: the level of its floor and, per footprint corner, how far
+/// below that level its bottom goes.
+struct Seat {
+    /// Elevation of the building's local origin (its floor), metres.
+    base: f64,
+    /// Depth of the plinth below the floor, metres (0: none).
+    plinth: f64,
+}
+
+/// The seat of a footprint on the ground under its corners, by foundation mode (see
+/// [`Foundation`]); non-finite ground samples are left out (0 m when none is finite).
+fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation) -> Seat {
+    let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
+    for &p in pts {
+        let g = elevation.sample(p);
+        if g.is_finite() {
+            lo = lo.min(g);
+            hi = hi.max(g);
+            sum += g;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return Seat {
+            base: 0.0,
+            plinth: 0.0,
+        };
+    }
+    let base = match mode {
+        Foundation::Lowest => lo,
+        Foundation::Highest | Foundation::Follow => hi,
+        Foundation::Average => (sum / n as f64).clamp(lo, hi),
+    };
+    Seat {
+        base,
+        plinth: base - lo,
+    }
+}
+
+/// Carries the bottom of a building's mass (every vertex at its floor, local height 0)
+/// down by the plinth depth, or for [`Foundation::Follow`] down to the ground under each
+/// vertex, so walls reach the ground. Texture `v` stays minus the height on walls.
+fn lower_bottom(
+    mesh: &mut Mesh,
+    from: usize,
+    seat: &Seat,
+    mode: Foundation,
+    elevation: &dyn Field,
+    origin: DVec2,
+) {
+    if seat.plinth <= 0.0 {
+        return;
+    }
+    let (positions, normals, uvs) = (
+        mesh.positions.get_mut(from..).unwrap_or_default(),
+        mesh.normals.get(from..).unwrap_or_default(),
+        mesh.uvs.get_mut(from..).unwrap_or_default(),
+    );
+    for ((p, n), uv) in positions.iter_mut().zip(normals).zip(uvs) {
+        if p.y != 0.0 {
+            continue;
+        }
+        let depth = match mode {
+            Foundation::Follow => {
+                let (q, _) = polis_geom::to_layout(p.as_dvec3());
+                let g = elevation.sample(q + origin);
+                if g.is_finite() {
+                    (seat.base - g).clamp(0.0, seat.plinth)
+                } else {
+                    seat.plinth
+                }
+            }
+            _ => seat.plinth,
+        };
+        p.y = -(depth as f32);
+        if n.y.abs() < 0.5 {
+            uv.y = -p.y;
+        }
+    }
+}
+
 /// Lowest ground under a ring of layout points.
 fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
     let e = pts
@@ -122,9 +211,6 @@ fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
         .fold(f64::INFINITY, f64::min);
     if e.is_finite() { e } else { 0.0 }
 }
-
-/// A dressed wall plane of a part: origin, outward normal, unit axes, width, height.
-type Plane = (DVec3, DVec3, DVec3, DVec3, f64, f64);
 
 /// Meshes by material, reused from building to building: the first `used` are the
 /// current building's.
@@ -160,65 +246,54 @@ impl Targets {
     }
 }
 
-/// Per-thread scratch of [`building_meshes`], reused so that a building allocates only
-/// its finished meshes (each exactly sized).
-#[derive(Default)]
-struct MeshScratch {
-    targets: Targets,
-    /// Dressed face indices.
-    faces: Vec<usize>,
-    /// The dressed faces of the part being copied.
-    planes: Vec<Plane>,
-    /// Vertex renumbering of the part being copied (`u32::MAX`: not copied yet).
-    remap: Vec<u32>,
-}
+/// How far facade skins stand out of the wall they dress, metres: enough that no
+/// renderer's depth test mixes them with the closed mass behind, far below anything a
+/// viewer can see.
+pub const SKIN_OFFSET_M: f64 = 0.02;
 
 thread_local! {
-    static MESH_SCRATCH: std::cell::RefCell<MeshScratch> = std::cell::RefCell::default();
+    static MESH_SCRATCH: std::cell::RefCell<Targets> = std::cell::RefCell::default();
 }
 
-/// The meshes of one building: parts with their materials, walls covered by the skin left
-/// out, and one skin mesh per tile; one mesh per material, in order of first use.
-fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result<Vec<Mesh>> {
+/// The meshes of one building: its parts merged into one closed solid
+/// ([`Building::merged_solid`], by role: walls, roofs, details) and, as their own
+/// surfaces [`SKIN_OFFSET_M`] in front of the walls, one skin mesh per facade tile; one
+/// mesh per material, in order of first use.
+/// Where and how a building is seated: its seat, mode, and the ground.
+type Seating<'a> = (&'a Seat, Foundation, &'a dyn Field);
+
+fn building_meshes(
+    b: &Building,
+    dress: Option<&Dress>,
+    pal: &Palette,
+    seating: Option<Seating<'_>>,
+) -> Result<Vec<Mesh>> {
     MESH_SCRATCH.with(|scratch| {
-        let mut scratch = scratch.borrow_mut();
-        let MeshScratch {
-            targets,
-            faces,
-            planes,
-            remap,
-        } = &mut *scratch;
+        let mut targets = scratch.borrow_mut();
         targets.used = 0;
-        faces.clear();
-        if let Some(d) = dress {
-            faces.extend(d.quads.iter().map(|q| q.face as usize));
-        }
-        faces.sort_unstable();
-        faces.dedup();
         let wall = pal.walls[b.kind.index().min(5)];
-        for (pi, part) in b.parts.iter().enumerate() {
-            let material = Some(match part.role {
+        let material = |role: PartRole| {
+            Some(match role {
                 PartRole::Mass => wall,
                 PartRole::Roof => pal.roof,
                 PartRole::Detail | PartRole::Template => pal.detail,
-            });
-            let Some(mesh) = targets.get(material) else {
-                continue;
-            };
-            planes.clear();
-            planes.extend(
-                faces
-                    .iter()
-                    .filter_map(|&k| b.facades.get(k))
-                    .filter(|f| f.part_index() == pi)
-                    .map(|f| (f.origin, f.normal(), f.u, f.v, f.width, f.height)),
-            );
-            if planes.is_empty() {
-                mesh.append(&part.mesh);
-            } else {
-                remap.clear();
-                remap.resize(part.mesh.vertex_count(), u32::MAX);
-                copy_uncovered(mesh, &part.mesh, planes, remap);
+            })
+        };
+        let mut add = |role: PartRole, part: &Mesh| {
+            if let Some(mesh) = targets.get(material(role)) {
+                let from = mesh.positions.len();
+                mesh.append(part);
+                if let Some((seat, mode, ground)) = seating {
+                    lower_bottom(mesh, from, seat, mode, ground, b.origin);
+                }
+            }
+        };
+        if let [only] = b.parts.as_slice() {
+            // Already one closed solid: copied once, not through a merged copy.
+            add(only.role, &only.mesh);
+        } else {
+            for (role, part) in &b.merged_solid().meshes {
+                add(*role, part);
             }
         }
         if let Some(d) = dress
@@ -251,7 +326,8 @@ fn building_meshes(b: &Building, dress: Option<&Dress>, pal: &Palette) -> Result
 /// coordinates, two triangles. Quads too small to stay a rectangle in `f32` (and any
 /// non-finite value) go through [`Mesh::add_quad`], which checks them.
 fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()> {
-    let corners = q.corners(face);
+    let out = face.normal() * SKIN_OFFSET_M;
+    let corners = q.corners(face).map(|c| c + out);
     let [s0, t0, s1, t1] = q.rect;
     let scale = corners
         .iter()
@@ -272,57 +348,6 @@ fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()
     mesh.indices
         .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
     Ok(())
-}
-
-/// Appends the triangles of `src` that no dressed plane covers, with only the vertices
-/// they use.
-fn copy_uncovered(mesh: &mut Mesh, src: &Mesh, planes: &[Plane], remap: &mut [u32]) {
-    const TOL: f64 = 1e-3;
-    for t in src.triangles() {
-        let p = t.map(|k| {
-            src.positions
-                .get(k as usize)
-                .map_or(DVec3::NAN, |v| v.as_dvec3())
-        });
-        // The unnormalised normal: a covered triangle is a wall (|n̂.y| < 0.1) facing
-        // a plane's way (n̂ · n ≥ 0.99), compared in squares to spare the square root.
-        let tn = (p[1] - p[0]).cross(p[2] - p[0]);
-        let len2 = tn.length_squared();
-        let covered = tn.y * tn.y < 0.01 * len2
-            && planes.iter().any(|&(o, n, u, v, w, h)| {
-                let along = tn.dot(n);
-                if along <= 0.0
-                    || along * along < 0.9801 * len2
-                    || p.iter().any(|q| (*q - o).dot(n).abs() > TOL)
-                {
-                    return false;
-                }
-                let c = (p[0] + p[1] + p[2]) / 3.0 - o;
-                let (s, t) = (c.dot(u), c.dot(v));
-                s > -TOL && s < w + TOL && t > -TOL && t < h + TOL
-            });
-        if covered {
-            continue;
-        }
-        for k in t {
-            let k = k as usize;
-            let (Some(slot), Some(&pos), Some(&nrm), Some(&uv)) = (
-                remap.get_mut(k),
-                src.positions.get(k),
-                src.normals.get(k),
-                src.uvs.get(k),
-            ) else {
-                continue;
-            };
-            if *slot == u32::MAX {
-                *slot = mesh.positions.len() as u32;
-                mesh.positions.push(pos);
-                mesh.normals.push(nrm);
-                mesh.uvs.push(uv);
-            }
-            mesh.indices.push(*slot);
-        }
-    }
 }
 
 /// Everything the scene is built from.
@@ -366,13 +391,27 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
-                let meshes = building_meshes(b, inp.dresses.get(i).and_then(Option::as_ref), &pal)?;
-                let base = ground(elevation, b.footprint.points());
+                let mode = inp
+                    .config
+                    .scene
+                    .foundations
+                    .get(b.kind.index())
+                    .copied()
+                    .unwrap_or_default();
+                let seat = seat(elevation, b.footprint.points(), mode);
+                let meshes = building_meshes(
+                    b,
+                    inp.dresses.get(i).and_then(Option::as_ref),
+                    &pal,
+                    Some((&seat, mode, elevation)),
+                )?;
+                let base = seat.base;
                 let node = LeafNode {
                     name: format!("building {}", b.id),
                     translation: to_world(b.origin, base),
                     metadata: Metadata::from([
-                        ("kind", MetaValue::from_static(b.kind.name())),
+                        ("kind", MetaValue::from_static(kind_class(b.kind))),
+                        ("type", MetaValue::from_static(b.kind.name())),
                         ("height", MetaValue::from(b.height)),
                         ("floors", MetaValue::from(f64::from(b.floors))),
                         ("lot", MetaValue::from(b.lot_id as f64)),
@@ -403,10 +442,40 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect()
     };
-    let (road, (blocks, buildings)) =
-        rayon::join(road_mesh, || rayon::join(blocks_job, buildings_job));
+    // Water bodies: flat surfaces at their shore's lowest point.
+    let water_job = || -> Result<Vec<(PolygonWithHoles, f64)>> {
+        if !(inp.config.scene.water_surfaces && inp.maps.has_water) {
+            return Ok(Vec::new());
+        }
+        let water = inp.maps.inputs.water.as_ref();
+        Ok(crate::city::smooth_mask(water, inp.config.size_m)?
+            .into_iter()
+            .map(|p| {
+                let level = ground(elevation, p.outer.points());
+                (p, level)
+            })
+            .collect())
+    };
+    let ((road, water), (blocks, buildings)) = rayon::join(
+        || rayon::join(road_mesh, water_job),
+        || rayon::join(blocks_job, buildings_job),
+    );
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
+    let water = water?;
+    if !water.is_empty() {
+        let material = scene.add_material(Material {
+            roughness: 0.1,
+            ..Material::new("water", [0.12, 0.28, 0.42, 1.0])
+        });
+        let mut mesh = Mesh::new(Some(material));
+        for (polygon, level) in &water {
+            mesh.add_flat_polygon(polygon, *level, Facing::Up)?;
+        }
+        let node = scene.add_node(root, "water")?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }
@@ -529,6 +598,17 @@ fn insert_leaves(scene: &mut Scene, made: &mut [Leaf], parents: &[NodeId]) -> Re
     Ok(())
 }
 
+/// The name of a building kind's map class: the `kind` of a building in the glb, the
+/// GeoJSON and the SVG alike (the grammar's kind is the glb's `type`).
+pub(crate) fn kind_class(kind: BuildingKind) -> &'static str {
+    match kind {
+        BuildingKind::Skyscraper => "skyscraper",
+        BuildingKind::Office | BuildingKind::MidRise => "commercial",
+        BuildingKind::House | BuildingKind::Apartment => "residential",
+        BuildingKind::Industrial => "industrial",
+    }
+}
+
 /// The SVG/GeoJSON kind of a building kind.
 pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
     use polis_export::map::BuildingKind as K;
@@ -544,10 +624,17 @@ pub(crate) fn map_kind(kind: BuildingKind) -> polis_export::map::BuildingKind {
 mod tests {
     use super::*;
 
-    /// The skin replaces wall triangles without gaps or overlaps: each building's scene
-    /// meshes have the surface area of its closed parts.
     #[test]
-    fn skins_replace_exactly_the_walls_they_cover() {
+    fn one_name_for_building_kinds() {
+        for k in BuildingKind::ALL {
+            assert_eq!(kind_class(k), map_kind(k).as_str());
+        }
+    }
+
+    /// Each building's untextured meshes are one closed, outward solid with its parts'
+    /// volume; the skins stand [`SKIN_OFFSET_M`] in front of the walls they dress.
+    #[test]
+    fn buildings_are_closed_solids_dressed_by_skins() {
         let mut config = CityConfig::preset("default").unwrap();
         config.size_m = 1200.0;
         config.roads.max_segments = 200;
@@ -555,16 +642,30 @@ mod tests {
         let city = crate::generate(&config).unwrap();
         let mut scene = Scene::new();
         let pal = palette(&mut scene, &city.tile_sets).unwrap();
+        let tiles: Vec<MaterialId> = pal.tiles.iter().flatten().copied().collect();
         let mut dressed = 0;
         for (b, dress) in city.buildings.iter().zip(&city.dresses) {
-            let meshes = building_meshes(b, dress.as_ref(), &pal).unwrap();
-            let area: f64 = meshes.iter().map(Mesh::surface_area).sum();
-            let parts: f64 = b.parts.iter().map(|p| p.mesh.surface_area()).sum();
-            assert!(
-                (area - parts).abs() <= 1e-4 * parts,
-                "building {}: {area} m² in the scene, {parts} m² of parts",
-                b.id
-            );
+            let meshes = building_meshes(b, dress.as_ref(), &pal, None).unwrap();
+            let (skins, mass): (Vec<&Mesh>, Vec<&Mesh>) = meshes
+                .iter()
+                .partition(|m| m.material.is_some_and(|k| tiles.contains(&k)));
+            let report = polis_geom::mesh::edge_use(mass);
+            assert!(report.is_solid(), "building {}: {report:?}", b.id);
+            let parts: f64 = b.parts.iter().map(|p| p.mesh.signed_volume()).sum();
+            assert!((report.signed_volume - parts).abs() <= 1e-3 * parts);
+            // Every skin vertex lies the offset in front of a dressed face's plane.
+            if let Some(d) = dress {
+                for m in skins {
+                    for p in &m.positions {
+                        let p = p.as_dvec3();
+                        let on_a_face = d.quads.iter().any(|q| {
+                            let f = &b.facades[q.face as usize];
+                            ((p - f.origin).dot(f.normal()) - SKIN_OFFSET_M).abs() < 1e-3
+                        });
+                        assert!(on_a_face, "building {}: skin vertex off its wall", b.id);
+                    }
+                }
+            }
             dressed += usize::from(dress.is_some());
         }
         assert!(dressed > 10, "{dressed} dressed buildings");

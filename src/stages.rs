@@ -388,8 +388,8 @@ impl SkinQuad {
     }
 }
 
-/// A building's facade skin: quads textured with one style's tiles. The quads replace the
-/// wall triangles they cover in the scene.
+/// A building's facade skin: quads textured with one style's tiles. In the scene they are
+/// surfaces of their own, just in front of the walls of the building's closed mass.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dress {
     /// Index of the style in [`City::tile_sets`](crate::City::tile_sets).

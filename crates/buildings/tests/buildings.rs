@@ -101,6 +101,18 @@ fn check(b: &Building, lot: &Lot, max_height: f64) {
             "footprint vertex {p} outside the lot"
         );
     }
+    // The shipped grammars' parts merge into one closed, outward solid of their volume.
+    let solid = b.merged_solid();
+    let report = polis_geom::mesh::edge_use(solid.meshes.iter().map(|(_, m)| m));
+    assert!(
+        solid.closed && report.is_solid(),
+        "{:?} lod {} not one solid ({:?}): {report:?}",
+        b.kind,
+        b.lod,
+        solid.unmerged_because
+    );
+    let volume: f64 = b.parts.iter().map(|p| p.mesh.signed_volume()).sum();
+    assert!((report.signed_volume - volume).abs() <= 1e-3 * volume.max(1.0));
     for f in &b.facades {
         assert!(f.width > 0.0 && f.height > 0.0 && f.part_index() < b.parts.len());
         assert!((f.u.length() - 1.0).abs() < 1e-9 && (f.v.length() - 1.0).abs() < 1e-9);

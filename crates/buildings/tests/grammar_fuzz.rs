@@ -257,6 +257,15 @@ fn exercise(text: &str) -> Result<(), TestCaseError> {
                     prop_assert!(p.mesh.signed_volume() > 0.0);
                     prop_assert!(p.mesh.bbox().max.y as f64 <= b.height + 1e-3);
                 }
+                // Any grammar: the merge never panics; a merged solid passes the check,
+                // an unmerged one says why.
+                let solid = b.merged_solid();
+                if solid.closed {
+                    let report = polis_geom::mesh::edge_use(solid.meshes.iter().map(|(_, m)| m));
+                    prop_assert!(report.is_solid(), "{:?}", report);
+                } else {
+                    prop_assert!(solid.unmerged_because.is_some());
+                }
             }
         }
         Err(e) => prop_assert!(

@@ -407,8 +407,15 @@ mod tests {
         let strip =
             PolygonWithHoles::new(rect(4.0, 4.0, 46.0, 36.0), vec![rect(6.5, 6.5, 43.5, 33.5)]);
         let mut scene = Scene::new();
-        let asphalt = scene.add_material(Material::new("asphalt", [0.2, 0.2, 0.2, 1.0]));
-        let paving = scene.add_material(Material::new("paving", [0.7, 0.7, 0.65, 1.0]));
+        // Road and footpath surfaces keep their metre texture coordinates.
+        let asphalt = scene.add_material(Material {
+            keep_texture_coordinates: true,
+            ..Material::new("asphalt", [0.2, 0.2, 0.2, 1.0])
+        });
+        let paving = scene.add_material(Material {
+            keep_texture_coordinates: true,
+            ..Material::new("paving", [0.7, 0.7, 0.65, 1.0])
+        });
         let road = road_surfaces(
             &roads,
             &slope,
@@ -439,6 +446,12 @@ mod tests {
             .map(|p| p.indices.len() / 3)
             .collect();
         assert_eq!(tris, vec![rt, pt]);
+        assert!(
+            doc.prims
+                .iter()
+                .flatten()
+                .all(|p| p.uvs.len() == p.positions.len())
+        );
         let (mut obj, mut files) = (Vec::new(), crate::sink::MemorySink::new());
         crate::obj::write_obj(&scene, &Default::default(), &mut obj, &mut files).unwrap();
         let (models, _) = crate::obj::tests::load(&obj, &files);

@@ -252,14 +252,17 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
             assert_eq!(p.mode(), gltf::mesh::Mode::Triangles);
             let pos = p.get(&gltf::Semantic::Positions).unwrap();
             let nrm = p.get(&gltf::Semantic::Normals).unwrap();
-            let uv = p.get(&gltf::Semantic::TexCoords(0)).unwrap();
+            // Written only for materials that use them.
+            let uv = p.get(&gltf::Semantic::TexCoords(0));
             let idx = p.indices().unwrap();
             assert_eq!(pos.dimensions(), Dimensions::Vec3);
             assert_eq!(nrm.dimensions(), Dimensions::Vec3);
-            assert_eq!(uv.dimensions(), Dimensions::Vec2);
+            if let Some(uv) = &uv {
+                assert_eq!(uv.dimensions(), Dimensions::Vec2);
+            }
             assert_eq!(idx.dimensions(), Dimensions::Scalar);
             let n = pos.count();
-            assert!(n > 0 && nrm.count() == n && uv.count() == n);
+            assert!(n > 0 && nrm.count() == n && uv.as_ref().is_none_or(|uv| uv.count() == n));
             let positions: Vec<[f32; 3]> = floats(&pos)
                 .chunks_exact(3)
                 .map(|c| [c[0], c[1], c[2]])
@@ -268,7 +271,10 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
                 .chunks_exact(3)
                 .map(|c| [c[0], c[1], c[2]])
                 .collect();
-            let uvs: Vec<[f32; 2]> = floats(&uv).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+            let uvs: Vec<[f32; 2]> = uv
+                .as_ref()
+                .map(|uv| floats(uv).chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+                .unwrap_or_default();
             // Bounds.
             let mut lo = [f32::INFINITY; 3];
             let mut hi = [f32::NEG_INFINITY; 3];

@@ -214,6 +214,13 @@ pub struct Material {
     pub metallic_roughness_texture: Option<TextureId>,
     /// Whether back faces are drawn too (for open surfaces such as sheets). Default: false.
     pub double_sided: bool,
+    /// Whether exporters keep the texture coordinates of meshes drawn with this material
+    /// although it has no texture (surfaces whose metre coordinates an engine may texture
+    /// later: road ribbons, junction plates, footpaths). A textured material always keeps
+    /// them; an untextured one without this flag drops them (glTF validators list unused
+    /// `TEXCOORD_0` attributes). Default: false.
+    #[serde(default)]
+    pub keep_texture_coordinates: bool,
 }
 
 impl Default for Material {
@@ -227,6 +234,7 @@ impl Default for Material {
             normal_texture: None,
             metallic_roughness_texture: None,
             double_sided: false,
+            keep_texture_coordinates: false,
         }
     }
 }
@@ -239,6 +247,15 @@ impl Material {
             base_color,
             ..Material::default()
         }
+    }
+
+    /// Whether meshes drawn with this material need texture coordinates in an export: it
+    /// has a texture, or [`keep_texture_coordinates`](Self::keep_texture_coordinates).
+    pub fn uses_texture_coordinates(&self) -> bool {
+        self.keep_texture_coordinates
+            || self.base_color_texture.is_some()
+            || self.normal_texture.is_some()
+            || self.metallic_roughness_texture.is_some()
     }
 
     fn textures(&self) -> impl Iterator<Item = (&'static str, TextureId)> {

@@ -10,15 +10,19 @@
 //!   (`VEC2` f32, metres, `v` down as glTF wants), indices (`u16` when the geometry has at
 //!   most 65,535 vertices, else `u32`) and, when the material has a normal texture,
 //!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`), each in its own buffer
-//!   view with the right `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written even for untextured
-//!   materials (so textures can be added in an engine later); the Khronos validator lists
-//!   it as possibly unused (an info, not a warning).
+//!   view with the right `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written only
+//!   when the material uses it: it has a texture, or asks to keep its coordinates
+//!   ([`Material::keep_texture_coordinates`], e.g. roads in metres); the Khronos validator
+//!   lists unused texture coordinates otherwise.
 //! * Materials: glTF metallic-roughness PBR (base colour, metallic, roughness, base colour,
 //!   normal and metallic-roughness textures, double-sidedness); `alphaMode` is `BLEND` when
 //!   the base colour's alpha is below 1, else `OPAQUE`. Meshes without a material use
 //!   glTF's default material.
 //! * Textures with deduplicated samplers; images embedded as PNG (raw RGBA pixels are
 //!   encoded, PNG bytes pass through unchanged) in buffer views with `mimeType`.
+//! * Only what is used: materials no written primitive draws with, textures no written
+//!   material refers to and images no written texture shows are left out (and indices
+//!   renumbered in scene order), so validators find no unused object.
 //! * The node tree with names, transforms (`translation`/`rotation`/`scale`; a general
 //!   matrix is decomposed when it is a TRS, else written as `matrix`) and the node metadata
 //!   as a JSON object in `extras`; one glTF scene holding the roots.
@@ -64,7 +68,7 @@ use gltf::json;
 use gltf::json::validation::{Checked, USize64};
 use polis_geom::Mesh;
 use polis_geom::glam::{DMat4, Vec3};
-use polis_geom::scene::{Filter, Scene, Transform, Wrap};
+use polis_geom::scene::{Filter, Material, Scene, Transform, Wrap};
 use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
@@ -102,11 +106,11 @@ pub struct GlbReport {
     pub primitives: usize,
     /// Triangles stored (each stored geometry once).
     pub triangles: usize,
-    /// Materials.
+    /// Materials written (unused ones are left out).
     pub materials: usize,
-    /// Textures.
+    /// Textures written (unused ones are left out).
     pub textures: usize,
-    /// Images.
+    /// Images written (unused ones are left out).
     pub images: usize,
     /// Scene meshes left out because they have no triangles.
     pub skipped_empty_meshes: usize,
@@ -145,14 +149,14 @@ pub fn write_glb<W: Write>(
         Batching::PerNode => plan::per_node(scene),
         Batching::PerParentAndMaterial => plan::batched(scene)?,
     };
-    let pngs = scene
+    let used = Used::new(scene, &plan);
+    let pngs = used
         .images
         .iter()
-        .enumerate()
-        .map(|(i, img)| png_bytes(i, img))
+        .map(|&i| png_bytes(i, &scene.images[i]))
         .collect::<Result<Vec<_>, _>>()?;
     let layout = Layout::new(scene, &plan.geometries, &pngs);
-    let root = document(scene, &plan, &layout)?;
+    let root = document(scene, &plan, &layout, &used)?;
     let json_bytes = json::serialize::to_vec(&root).map_err(ExportError::json("glTF JSON"))?;
 
     let json_len = pad4(json_bytes.len() as u64);
@@ -200,9 +204,9 @@ pub fn write_glb<W: Write>(
         meshes: plan.meshes.len(),
         primitives: plan.meshes.iter().map(|m| m.primitives.len()).sum(),
         triangles: plan.geometries.iter().map(|g| g.triangle_count()).sum(),
-        materials: scene.materials.len(),
-        textures: scene.textures.len(),
-        images: scene.images.len(),
+        materials: used.materials.len(),
+        textures: used.textures.len(),
+        images: used.images.len(),
         skipped_empty_meshes: plan.skipped_empty_meshes,
         unused_meshes: plan.unused_meshes,
         bytes: total,
@@ -211,6 +215,96 @@ pub fn write_glb<W: Write>(
 
 fn pad4(n: u64) -> u64 {
     n.div_ceil(4) * 4
+}
+
+/// The materials, textures and images the written primitives use (scene indices in
+/// scene order), and their new glTF indices.
+struct Used {
+    materials: Vec<usize>,
+    textures: Vec<usize>,
+    images: Vec<usize>,
+    /// glTF index of each scene material / texture / image (`u32::MAX`: left out).
+    material_index: Vec<u32>,
+    texture_index: Vec<u32>,
+    image_index: Vec<u32>,
+}
+
+impl Used {
+    fn new(scene: &Scene, plan: &Plan<'_>) -> Used {
+        let mut material_used = vec![false; scene.materials.len()];
+        for m in &plan.meshes {
+            for &(_, material) in &m.primitives {
+                if let Some(u) = material.and_then(|k| material_used.get_mut(k.index())) {
+                    *u = true;
+                }
+            }
+        }
+        let mut texture_used = vec![false; scene.textures.len()];
+        for (mat, _) in scene
+            .materials
+            .iter()
+            .zip(&material_used)
+            .filter(|(_, u)| **u)
+        {
+            for t in [
+                mat.base_color_texture,
+                mat.normal_texture,
+                mat.metallic_roughness_texture,
+            ]
+            .into_iter()
+            .flatten()
+            {
+                if let Some(u) = texture_used.get_mut(t.0 as usize) {
+                    *u = true;
+                }
+            }
+        }
+        let mut image_used = vec![false; scene.images.len()];
+        for (tex, _) in scene
+            .textures
+            .iter()
+            .zip(&texture_used)
+            .filter(|(_, u)| **u)
+        {
+            if let Some(u) = image_used.get_mut(tex.image.0 as usize) {
+                *u = true;
+            }
+        }
+        let renumber = |used: &[bool]| {
+            let mut list = Vec::new();
+            let index = used
+                .iter()
+                .enumerate()
+                .map(|(i, &u)| {
+                    if u {
+                        list.push(i);
+                        list.len() as u32 - 1
+                    } else {
+                        u32::MAX
+                    }
+                })
+                .collect::<Vec<u32>>();
+            (list, index)
+        };
+        let (materials, material_index) = renumber(&material_used);
+        let (textures, texture_index) = renumber(&texture_used);
+        let (images, image_index) = renumber(&image_used);
+        Used {
+            materials,
+            textures,
+            images,
+            material_index,
+            texture_index,
+            image_index,
+        }
+    }
+}
+
+/// Whether a geometry drawn with `material` writes `TEXCOORD_0`.
+fn writes_uvs(scene: &Scene, material: Option<polis_geom::scene::MaterialId>) -> bool {
+    material
+        .and_then(|m| scene.materials.get(m.index()))
+        .is_some_and(Material::uses_texture_coordinates)
 }
 
 /// Where one geometry's four arrays lie in the binary chunk.
@@ -223,6 +317,8 @@ struct GeometryLayout {
     max: Vec3,
     /// Whether tangents are written (the material has a normal texture).
     tangents: bool,
+    /// Whether texture coordinates are written (the material uses them).
+    uvs: bool,
     /// Byte offsets of positions, normals, uvs, indices, tangents.
     offsets: [u64; 5],
     /// Byte lengths of the same.
@@ -252,10 +348,11 @@ impl Layout {
                 .material
                 .and_then(|m| scene.materials.get(m.index()))
                 .is_some_and(|m| m.normal_texture.is_some());
+            let uvs = writes_uvs(scene, g.material);
             let lengths = [
                 12 * n as u64,
                 12 * n as u64,
-                8 * n as u64,
+                if uvs { 8 * n as u64 } else { 0 },
                 g.indices.len() as u64 * if wide { 4 } else { 2 },
                 if tangents { 16 * n as u64 } else { 0 },
             ];
@@ -270,6 +367,7 @@ impl Layout {
                 indices: g.indices.len(),
                 wide,
                 tangents,
+                uvs,
                 min: b.min,
                 max: b.max,
                 offsets,
@@ -290,7 +388,12 @@ impl Layout {
 }
 
 /// The glTF JSON document for a plan and its layout.
-fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Root, ExportError> {
+fn document(
+    scene: &Scene,
+    plan: &Plan<'_>,
+    layout: &Layout,
+    used: &Used,
+) -> Result<json::Root, ExportError> {
     let mut root = json::Root {
         asset: json::Asset {
             generator: Some(format!("polis-export {}", env!("CARGO_PKG_VERSION"))),
@@ -320,13 +423,16 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 extras: None,
             })
         };
-    // Four or five accessors per geometry, in order: position, normal, uv, indices,
-    // tangents (for normal-mapped materials).
+    // Three to five accessors per geometry, in order: position, normal, uv (when the
+    // material uses it), indices, tangents (for normal-mapped materials).
     let mut accessors = Vec::with_capacity(layout.geometries.len());
     for gl in &layout.geometries {
         let arrays = if gl.tangents { 5 } else { 4 };
         let mut ids = [json::Index::new(0); 5];
         for (k, id) in ids.iter_mut().enumerate().take(arrays) {
+            if k == 2 && !gl.uvs {
+                continue;
+            }
             let target = if k == 3 {
                 json::buffer::Target::ElementArrayBuffer
             } else {
@@ -383,9 +489,15 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 sparse: None,
             });
         }
-        accessors.push((ids, gl.tangents));
+        accessors.push((ids, gl.tangents, gl.uvs));
     }
-    for (i, (img, &(offset, length))) in scene.images.iter().zip(&layout.images).enumerate() {
+    for (i, (img, &(offset, length))) in used
+        .images
+        .iter()
+        .map(|&k| &scene.images[k])
+        .zip(&layout.images)
+        .enumerate()
+    {
         let v = view(&mut root, offset, length, None);
         root.push(json::Image {
             buffer_view: Some(v),
@@ -397,7 +509,7 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
         });
     }
     let mut samplers: BTreeMap<(u8, u8, u8), json::Index<json::texture::Sampler>> = BTreeMap::new();
-    for tex in &scene.textures {
+    for tex in used.textures.iter().map(|&k| &scene.textures[k]) {
         let key = (
             wrap_key(tex.wrap_u),
             wrap_key(tex.wrap_v),
@@ -432,15 +544,28 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
         root.push(json::Texture {
             name: named(&tex.name),
             sampler: Some(sampler),
-            source: json::Index::new(tex.image.0),
+            source: json::Index::new(
+                used.image_index
+                    .get(tex.image.0 as usize)
+                    .copied()
+                    .unwrap_or(u32::MAX),
+            ),
             extensions: None,
             extras: None,
         });
     }
-    for mat in &scene.materials {
+    let texture = |t: polis_geom::scene::TextureId| {
+        json::Index::new(
+            used.texture_index
+                .get(t.0 as usize)
+                .copied()
+                .unwrap_or(u32::MAX),
+        )
+    };
+    for mat in used.materials.iter().map(|&k| &scene.materials[k]) {
         let info = |t: Option<polis_geom::scene::TextureId>| {
             t.map(|t| json::texture::Info {
-                index: json::Index::new(t.0),
+                index: texture(t),
                 tex_coord: 0,
                 extensions: None,
                 extras: None,
@@ -464,7 +589,7 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                 extras: None,
             },
             normal_texture: mat.normal_texture.map(|t| json::material::NormalTexture {
-                index: json::Index::new(t.0),
+                index: texture(t),
                 scale: 1.0,
                 tex_coord: 0,
                 extensions: None,
@@ -478,12 +603,14 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
             .primitives
             .iter()
             .map(|&(g, material)| {
-                let ([pos, nrm, uv, idx, tan], has_tangents) = accessors[g];
+                let ([pos, nrm, uv, idx, tan], has_tangents, has_uvs) = accessors[g];
                 let mut attributes = BTreeMap::from([
                     (Checked::Valid(json::mesh::Semantic::Positions), pos),
                     (Checked::Valid(json::mesh::Semantic::Normals), nrm),
-                    (Checked::Valid(json::mesh::Semantic::TexCoords(0)), uv),
                 ]);
+                if has_uvs {
+                    attributes.insert(Checked::Valid(json::mesh::Semantic::TexCoords(0)), uv);
+                }
                 if has_tangents {
                     attributes.insert(Checked::Valid(json::mesh::Semantic::Tangents), tan);
                 }
@@ -492,7 +619,14 @@ fn document(scene: &Scene, plan: &Plan<'_>, layout: &Layout) -> Result<json::Roo
                     extensions: None,
                     extras: None,
                     indices: Some(idx),
-                    material: material.map(|m| json::Index::new(m.0)),
+                    material: material.map(|m| {
+                        json::Index::new(
+                            used.material_index
+                                .get(m.index())
+                                .copied()
+                                .unwrap_or(u32::MAX),
+                        )
+                    }),
                     mode: Checked::Valid(json::mesh::Mode::Triangles),
                     targets: None,
                 }
@@ -687,13 +821,15 @@ fn write_geometry<W: Write>(
         w.put(&b)?;
     }
     w.pad4()?;
-    for t in &g.uvs {
-        let mut b = [0u8; 8];
-        b[0..4].copy_from_slice(&t.x.to_le_bytes());
-        b[4..8].copy_from_slice(&t.y.to_le_bytes());
-        w.put(&b)?;
+    if gl.uvs {
+        for t in &g.uvs {
+            let mut b = [0u8; 8];
+            b[0..4].copy_from_slice(&t.x.to_le_bytes());
+            b[4..8].copy_from_slice(&t.y.to_le_bytes());
+            w.put(&b)?;
+        }
+        w.pad4()?;
     }
-    w.pad4()?;
     if gl.wide {
         for &i in &g.indices {
             w.put(&i.to_le_bytes())?;

@@ -16,7 +16,9 @@ fn per_node_reads_back_with_counts_bounds_and_extras() {
     let (bytes, report) = glb(&scene, Batching::PerNode);
     let d = decode_glb(&bytes);
     assert_eq!(d.nodes, scene.nodes.len());
-    assert_eq!(d.materials, 3);
+    // The scene's third material is drawn by nothing: left out.
+    assert_eq!(d.materials, 2);
+    assert_eq!(report.materials, 2);
     assert_eq!(d.textures, 2);
     assert_eq!(d.images, 2);
     assert_eq!(d.samplers, 2, "two distinct samplers");
@@ -302,6 +304,72 @@ fn texture_coordinates_pass_through() {
     scene.attach_mesh(r, id).unwrap();
     let (bytes, _) = glb(&scene, Batching::PerNode);
     let d = decode_glb(&bytes);
+    // The default material has no texture: no TEXCOORD_0.
+    assert!(d.prims[0][0].uvs.is_empty());
+    // A material that keeps its coordinates (or has a texture) gets them unchanged.
+    let keep = scene.add_material(polis_geom::Material {
+        keep_texture_coordinates: true,
+        ..polis_geom::Material::new("road", [0.2, 0.2, 0.2, 1.0])
+    });
+    scene.meshes[0].material = Some(keep);
+    let (bytes, _) = glb(&scene, Batching::PerNode);
+    let d = decode_glb(&bytes);
     let uvs: Vec<Vec2> = d.prims[0][0].uvs.iter().map(|&u| Vec2::from(u)).collect();
     assert_eq!(uvs, vec![Vec2::ZERO, Vec2::X, Vec2::new(0.0, -1.0)]);
+}
+
+/// Only used materials, textures and images are written, renumbered, and texture
+/// coordinates only where the material uses them: what the glTF validator checks.
+#[test]
+fn unused_objects_and_texture_coordinates_are_left_out() {
+    let mut scene = sample_scene();
+    // An image and texture only an unused material refers to.
+    let lonely_image = scene.add_image(polis_geom::scene::Image {
+        name: "lonely".into(),
+        data: polis_geom::scene::ImageData::Rgba8 {
+            width: 3,
+            height: 5,
+            pixels: vec![128; 60],
+        },
+    });
+    let lonely = scene
+        .add_texture(polis_geom::scene::Texture {
+            name: "lonely".into(),
+            image: lonely_image,
+            ..Default::default()
+        })
+        .unwrap();
+    scene.add_material(polis_geom::Material {
+        base_color_texture: Some(lonely),
+        ..polis_geom::Material::new("unused", [1.0; 4])
+    });
+    for batching in [Batching::PerNode, Batching::PerParentAndMaterial] {
+        let (bytes, report) = glb(&scene, batching);
+        let doc = gltf::Gltf::from_slice(&bytes).unwrap();
+        assert_eq!(
+            (report.materials, report.textures, report.images),
+            (2, 2, 2)
+        );
+        let mut used = vec![false; doc.materials().count()];
+        for p in doc
+            .meshes()
+            .flat_map(|m| m.primitives().collect::<Vec<_>>())
+        {
+            let m = p.material();
+            if let Some(i) = m.index() {
+                used[i] = true;
+            }
+            let textured = m.pbr_metallic_roughness().base_color_texture().is_some();
+            assert_eq!(p.get(&gltf::Semantic::TexCoords(0)).is_some(), textured);
+            if textured {
+                assert!(p.get(&gltf::Semantic::Tangents).is_some());
+            }
+        }
+        assert!(used.iter().all(|&u| u));
+        assert!(doc.images().all(|i| i.name() != Some("lonely")));
+        assert!(
+            doc.textures()
+                .all(|t| t.source().index() < doc.images().count())
+        );
+    }
 }

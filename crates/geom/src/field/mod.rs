@@ -84,6 +84,7 @@ use std::sync::Arc;
 use glam::DVec2;
 
 pub mod combinators;
+pub mod contour;
 #[cfg(feature = "png")]
 mod image;
 pub mod noise;
@@ -94,6 +95,7 @@ pub mod spec;
 pub use combinators::{
     Blend, Clamp, DomainTransform, Mask, Max, Min, Offset, Product, Scaled, Sum, Threshold,
 };
+pub use contour::{ContourOptions, MAX_CONTOUR_CELLS, contour_regions};
 #[cfg(feature = "png")]
 pub use image::{MAX_PNG_DECODED_BYTES, decode_png_rgba8};
 pub use noise::{Fbm, FbmParams, MAX_OCTAVES, SimplexNoise};

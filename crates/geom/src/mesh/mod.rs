@@ -4,7 +4,8 @@
 //! A [`Mesh`] is one glTF *primitive*: `f32` positions, normals and texture coordinates, `u32`
 //! triangle indices and one material. It is plain data with public fields, so anyone can
 //! build one by hand; [`Mesh::validate`] checks it and [`Mesh::check_closed`] checks that it
-//! bounds a solid.
+//! bounds a solid; [`edge_use()`] reports everything that keeps a surface (one mesh or
+//! several) from being a closed, 2-manifold, outward solid.
 //!
 //! ## Axes and units
 //!
@@ -59,12 +60,14 @@ use serde::{Deserialize, Serialize};
 use crate::GeomError;
 use crate::scene::MaterialId;
 
+pub mod edge_use;
 mod extrude;
 mod normals;
 mod planar;
 mod small_cdt;
 mod triangulate;
 
+pub use edge_use::{EdgeUseReport, ReportedEdge, edge_use};
 pub use extrude::{Facing, flat_polygon, prism};
 pub use planar::{FRAME_TOLERANCE, PlaneFrame};
 pub use triangulate::{RefineOptions, RefinedTriangulation, triangulate, triangulate_refined};
