@@ -85,6 +85,7 @@ pub mod legality;
 pub mod modules;
 pub mod network;
 pub mod params;
+pub mod secondary;
 pub mod smooth;
 pub mod snap;
 
