@@ -51,6 +51,7 @@ pub use polis_lsystem as lsystem;
 pub use polis_roads as roads;
 
 mod city;
+pub mod citygen;
 mod config;
 mod error;
 mod maps;
@@ -60,6 +61,7 @@ pub mod seed;
 pub mod stages;
 
 pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace_mask};
+pub use citygen::{CitygenConfig, RoadMode};
 pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
 };
