@@ -3,8 +3,12 @@
 //! (primary black, secondary red) and prints counts and timings.
 //!
 //! ```text
-//! cargo run --release --example citygen -- [PRESET] [--city] [--threads N] [--out DIR]
+//! cargo run --release --example citygen -- [PRESET] [--city | --city-only] [--lod N]
+//!     [--threads N] [--out DIR]
 //! ```
+//!
+//! `--city` also generates the whole city (without the 3-D scene) after the road part;
+//! `--city-only` only generates the whole city, scene included (for timing any preset).
 //!
 //! `PRESET` is a built-in preset in the Citygen mode (`citygen`, `suburbia`, `milan`) or a
 //! configuration file (`….json`); default `citygen`.
@@ -24,12 +28,16 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut preset = "citygen".to_string();
     let mut city = false;
+    let mut city_only = false;
+    let mut lod = None;
     let mut threads = None;
     let mut out = std::path::PathBuf::from("out");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--city" => city = true,
+            "--city-only" => city_only = true,
+            "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
             "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
             "--out" => out = args.next().unwrap_or_default().into(),
             _ => preset = a,
@@ -42,6 +50,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let preset = config.name.clone();
     config.threads = threads;
+    config.lod = lod.or(config.lod);
+    if city_only {
+        let t = Instant::now();
+        let c = Pipeline::default().generate(&config)?;
+        println!(
+            "city: {} road segments, {} buildings, {} scene triangles; {:.3} s",
+            c.stats.road_segments,
+            c.stats.buildings,
+            c.stats.scene_triangles,
+            t.elapsed().as_secs_f64()
+        );
+        return Ok(());
+    }
     let maps = CityMaps::build(
         &config.maps,
         polis::seed::sub_seed(config.seed, Stage::Maps, 0),

@@ -470,35 +470,63 @@ impl Run<'_> {
             step: self.report.steps,
         };
         let step = self.report.steps;
-        let ins = self.g.insert_segment_with(
-            a,
-            t,
-            road,
-            &SnapOptions {
-                snap_distance: self.tolerance,
-            },
-            |_| Junction { step },
-        );
-        let ins = match ins {
-            Ok(ins) => ins,
-            Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {
-                self.report.refused_blocked += 1;
-                return Ok(None);
+        // A free end met nothing within the snap size and a node target passed the exact
+        // check, so the road goes in as it is; a road target splits the road through
+        // planar insertion, which anchors the end onto it.
+        let end = match target {
+            Target::Free(q) => {
+                let n = self.g.add_node(q, Junction { step })?;
+                self.g.add_edge(source, n, road)?;
+                n
             }
-            Err(e) => return Err(e.into()),
+            Target::Node(n) => match self.g.add_edge(source, n, road) {
+                Ok(_) => n,
+                Err(
+                    polis_geom::GeomError::DuplicateEdge { .. }
+                    | polis_geom::GeomError::ZeroLengthEdge { .. },
+                ) => {
+                    self.report.refused_blocked += 1;
+                    return Ok(None);
+                }
+                Err(e) => return Err(e.into()),
+            },
+            Target::OnEdge(..) => {
+                let ins = self.g.insert_segment_with(
+                    a,
+                    t,
+                    road,
+                    &SnapOptions {
+                        snap_distance: self.tolerance,
+                    },
+                    |_| Junction { step },
+                );
+                let ins = match ins {
+                    Ok(ins) => ins,
+                    Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {
+                        self.report.refused_blocked += 1;
+                        return Ok(None);
+                    }
+                    Err(e) => return Err(e.into()),
+                };
+                if ins.created.is_empty() {
+                    // The road exists already (the insertion followed existing roads).
+                    self.report.refused_blocked += 1;
+                    return Ok(None);
+                }
+                self.edges += ins.created.len() as u32 - 1;
+                match ins.nodes.last() {
+                    Some(&n) => n,
+                    None => return Ok(None),
+                }
+            }
         };
-        if ins.created.is_empty() {
-            // The road exists already (the insertion followed existing roads).
-            self.report.refused_blocked += 1;
-            return Ok(None);
-        }
-        self.edges += ins.created.len() as u32;
+        self.edges += 1;
         match target {
             Target::Free(_) => self.report.placed_free += 1,
             Target::Node(_) => self.report.placed_node += 1,
             Target::OnEdge(..) => self.report.placed_road += 1,
         }
-        Ok(ins.nodes.last().map(|&node| Placed { node }))
+        Ok(Some(Placed { node: end }))
     }
 
     fn is_primary(&self, e: EdgeId) -> bool {
