@@ -30,6 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut city = false;
     let mut city_only = false;
     let mut lod = None;
+    let mut bench_growth = 0usize;
     let mut threads = None;
     let mut out = std::path::PathBuf::from("out");
     let mut args = std::env::args().skip(1);
@@ -37,6 +38,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match a.as_str() {
             "--city" => city = true,
             "--city-only" => city_only = true,
+            "--bench-growth" => {
+                bench_growth = args.next().and_then(|t| t.parse().ok()).unwrap_or(5)
+            }
             "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
             "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
             "--out" => out = args.next().unwrap_or_default().into(),
@@ -77,6 +81,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let (net, _) = pool.install(|| citygen_network(&cx))?;
     let total = t.elapsed();
+    if bench_growth > 0 {
+        return growth_bench(&cx, &net.primary, bench_growth);
+    }
     let mut stats = StreetStats::default();
     let mut per_cell = Vec::new();
     for c in &net.cells {
@@ -145,6 +152,70 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             c.stats.buildings,
             c.report.skipped.len(),
             t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// CPU time of the calling thread, nanoseconds (Linux: `/proc/thread-self/schedstat`).
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
+}
+
+/// Grows every cell of the primary network serially on this thread, `runs` times, and
+/// prints wall and CPU time per run (the inputs are prepared before the clock starts).
+fn growth_bench(
+    cx: &StageContext<'_>,
+    primary: &polis::roads::RoadNetwork,
+    runs: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth};
+    let cg = &cx.config.citygen;
+    let cells = polis::cells::extract_with(primary, &cx.config.cells)?;
+    let mut inputs = Vec::new();
+    for cell in &cells.cells {
+        let Ok(region) = cell.polygon_with_holes() else {
+            continue;
+        };
+        let n = polis::citygen::neighbourhood_of(cx, &region);
+        let mut p = n.preset()?.to_params(cg.unit_m);
+        p.road_width_m.value *= cg.road_width_factor;
+        let filaments = cell
+            .filaments
+            .iter()
+            .flat_map(|f| f.points.windows(2).map(|w| [w[0], w[1]]))
+            .collect();
+        let id = polis::citygen::stable_cell_id(cell);
+        inputs.push((
+            SecondaryCell {
+                id,
+                region,
+                filaments,
+            },
+            p,
+        ));
+    }
+    let seed = cx.seed(Stage::Roads, 1);
+    let maps = CellMaps::none();
+    for run in 0..runs {
+        let (t, c) = (Instant::now(), thread_cpu_ns());
+        let mut roads = 0;
+        for (cell, p) in &inputs {
+            if let Ok(r) = SecondaryGrowth::new(p.clone())?.grow(cell, &maps, seed) {
+                roads += r.segments().count();
+            }
+        }
+        let (wall, cpu) = (
+            t.elapsed().as_secs_f64() * 1e3,
+            (thread_cpu_ns() - c) as f64 / 1e6,
+        );
+        println!(
+            "run {run}: {} cells, {roads} secondary roads, serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
+            inputs.len(),
+            cpu / inputs.len().max(1) as f64
         );
     }
     Ok(())

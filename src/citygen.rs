@@ -393,8 +393,13 @@ fn filament_segments(cell: &Cell) -> Vec<[DVec2; 2]> {
         .collect()
 }
 
-/// The neighbourhood of the cell with region `region`.
-fn neighbourhood_of(cx: &StageContext<'_>, region: &polis_geom::PolygonWithHoles) -> Neighbourhood {
+/// The neighbourhood the configuration gives the cell with region `region`: the first
+/// override inside it, else the highest population band reached at the mean of its outer
+/// ring's vertices, else [`CitygenConfig::neighbourhood`].
+pub fn neighbourhood_of(
+    cx: &StageContext<'_>,
+    region: &polis_geom::PolygonWithHoles,
+) -> Neighbourhood {
     let cg = &cx.config.citygen;
     for o in &cg.overrides {
         if region.contains(DVec2::new(o.at[0], o.at[1])) {

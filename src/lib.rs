@@ -26,8 +26,10 @@
 //! ## Configuration
 //!
 //! [`CityConfig`] is plain serde data; the built-in presets (`default`, `manhattan`,
-//! `paris`, `san_francisco`, `old_town`, `suburbia`) are JSON files in `presets/`,
-//! compiled in. Every map is procedural and seeded unless a grey-scale PNG replaces it
+//! `paris`, `san_francisco`, `old_town`, `suburbia`, `citygen`, `milan`) are JSON files in
+//! `presets/`, compiled in. [`CityConfig::road_mode`] picks the road stage: one Parish &
+//! Müller growth, or Kelly's Citygen ([`citygen`]: primary network, city cells, secondary
+//! roads per cell); `suburbia`, `citygen` and `milan` use Citygen. Every map is procedural and seeded unless a grey-scale PNG replaces it
 //! ([`MapSpec::png`]).
 //!
 //! ## Guarantees
