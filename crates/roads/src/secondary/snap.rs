@@ -4,9 +4,10 @@
 //! answer is the single highest-priority *snap event*, priority being closeness to the
 //! root `a`, measured by the parameter `r` along `a–b`:
 //!
-//! 1. **Extended bounding box exclusion** (§4.3.3.1): only nodes and roads whose boxes
-//!    meet the box of `a–b` grown by the snap size are tested (candidates come from the
-//!    graph's spatial index, then Kelly's box test decides).
+//! 1. **Extended bounding box exclusion** (§4.3.3.1): only roads whose boxes meet the box
+//!    of `a–b` grown by the snap size are tested (candidates come from the graph's edge
+//!    index, then Kelly's box test decides), and only their end nodes that lie in that
+//!    box (every node of a cell graph ends a road, so no node index walk is needed).
 //! 2. **Test 1, node proximity** (§4.3.3.3): for each node, `r = ap·ab / |ab|²` and
 //!    `s = ap⊥·ab / |ab|²`; a node with `0 < r ≤ 1` and `|s|·|ab| ≤ snap` is an event at
 //!    `r`; one with `1 < r ≤ 1 + snap/|ab|` is an event if it lies within the snap size of
@@ -113,18 +114,39 @@ impl Snapper {
         let radius = radius.max(0.0);
         self.begin(g.node_bound());
         let ext = Aabb2::new(a, b).expanded(radius);
+        // Extended bounding box exclusion: the roads whose boxes meet the extended box.
+        // Every node of a cell graph ends a road, and a node in the extended box ends a
+        // road whose box meets it, so the ends of these roads are test 1's candidates too.
+        let mut roads = std::mem::take(&mut self.roads);
+        roads.clear();
+        g.edge_index().for_each_candidate(&ext, |e, shape| {
+            if let Shape::Segment(u, v) = *shape
+                && Aabb2::new(u, v).intersects(&ext)
+            {
+                roads.push(e);
+            }
+        });
+        roads.sort_unstable();
+        roads.dedup();
+        self.box_hits += roads.len() as u64;
         // Test 1: node proximity.
         let mut best: Option<(f64, NodeId)> = None;
         let mut best_r = 1.0 + radius / len;
         let mut found = std::mem::take(&mut self.found);
         found.clear();
-        g.node_index().for_each_candidate(&ext, |n, shape| {
-            if let Shape::Point(p) = *shape
-                && ext.contains(p)
-            {
-                found.push((n, p));
+        for &e in &roads {
+            if let Ok((u, v)) = g.endpoints(e) {
+                for n in [u, v] {
+                    if let Ok(p) = g.position(n)
+                        && ext.contains(p)
+                    {
+                        found.push((n, p));
+                    }
+                }
             }
-        });
+        }
+        found.sort_unstable_by_key(|&(n, _)| n);
+        found.dedup_by_key(|&mut (n, _)| n);
         for &(n, p) in &found {
             let sc = self.scalars(n, p, a, b);
             let r = sc.r;
@@ -146,18 +168,6 @@ impl Snapper {
         // Test 2: segment intersection before the benchmark.
         let limit = best_r.min(1.0);
         let mut cross: Option<(f64, EdgeId, DVec2)> = None;
-        let mut roads = std::mem::take(&mut self.roads);
-        roads.clear();
-        g.edge_index().for_each_candidate(&ext, |e, shape| {
-            if let Shape::Segment(u, v) = *shape
-                && Aabb2::new(u, v).intersects(&ext)
-            {
-                roads.push(e);
-            }
-        });
-        roads.sort_unstable();
-        roads.dedup();
-        self.box_hits += roads.len() as u64;
         for &e in &roads {
             let Ok((u, v)) = g.endpoints(e) else { continue };
             if u == root || v == root {
