@@ -11,6 +11,7 @@ use polis_lots::{BlockParams, LotParams};
 use polis_roads::RoadParams;
 use serde::{Deserialize, Serialize};
 
+use crate::citygen::{CitygenConfig, RoadMode};
 use crate::error::{Error, Result};
 use crate::maps::MapsConfig;
 
@@ -40,6 +41,13 @@ pub struct CityConfig {
     pub threads: Option<usize>,
     /// Input maps.
     pub maps: MapsConfig,
+    /// How the roads are made: one Parish & Müller growth, or Kelly's Citygen (primary
+    /// network, cells, secondary growth per cell). Default: parish_muller.
+    #[serde(skip_serializing_if = "RoadMode::is_default")]
+    pub road_mode: RoadMode,
+    /// The Citygen mode's options (read when `road_mode` is `citygen`).
+    #[serde(skip_serializing_if = "CitygenConfig::is_default")]
+    pub citygen: CitygenConfig,
     /// Road generator (Parish & Müller §3).
     pub roads: RoadParams,
     /// Cell extraction (Eberly's minimal cycle basis).
@@ -72,6 +80,8 @@ impl Default for CityConfig {
             lod: None,
             threads: None,
             maps: MapsConfig::default(),
+            road_mode: RoadMode::default(),
+            citygen: CitygenConfig::default(),
             roads: RoadParams::default(),
             cells: CellParams::default(),
             blocks: BlockParams::default(),
@@ -306,6 +316,7 @@ const PRESETS: &[(&str, &str)] = &[
     ("old_town", include_str!("../presets/old_town.json")),
     ("suburbia", include_str!("../presets/suburbia.json")),
     ("citygen", include_str!("../presets/citygen.json")),
+    ("milan", include_str!("../presets/milan.json")),
 ];
 
 impl CityConfig {
@@ -441,6 +452,7 @@ impl CityConfig {
             ));
         }
         self.effective_road_params().validate()?;
+        self.citygen.validate()?;
         self.effective_building_params().validate()?;
         Ok(())
     }

@@ -26,9 +26,11 @@
 //! ## Configuration
 //!
 //! [`CityConfig`] is plain serde data; the built-in presets (`default`, `manhattan`,
-//! `paris`, `san_francisco`, `old_town`, `suburbia`, `citygen`) are JSON files in
-//! `presets/`, compiled in. Every map is procedural and seeded unless a grey-scale PNG
-//! replaces it ([`MapSpec::png`]).
+//! `paris`, `san_francisco`, `old_town`, `suburbia`, `citygen`, `milan`) are JSON files
+//! in `presets/`, compiled in. [`CityConfig::road_mode`] picks the road stage: one Parish &
+//! Müller growth, or Kelly's Citygen ([`citygen`]: primary network, city cells, secondary
+//! roads per cell); `suburbia`, `citygen` and `milan` use Citygen. Every map is procedural
+//! and seeded unless a grey-scale PNG replaces it ([`MapSpec::png`]).
 //!
 //! ## Guarantees
 //!
@@ -52,6 +54,7 @@ pub use polis_roads as roads;
 pub use polis_stats as stats;
 
 mod city;
+pub mod citygen;
 mod config;
 mod error;
 mod maps;
@@ -64,6 +67,7 @@ pub mod stages;
 pub use city::{
     City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
 };
+pub use citygen::{CitygenConfig, RoadMode};
 pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, Foundation, KindStyles, SceneConfig, ZoneBand,
     ZoningConfig,

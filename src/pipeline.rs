@@ -19,8 +19,8 @@ use crate::error::{Error, Result};
 use crate::scene::{SceneInputs, assemble};
 use crate::stages::{
     BuildLot, BuildingStage, CellInput, CellLots, CellStage, Dress, DressBuilding, EberlyCells,
-    FacadeStage, GrammarBuildings, KellyLots, LotInput, LotStage, ParishMullerRoads, RoadStage,
-    Skip, Stage, StageContext, TiledFacades,
+    FacadeStage, GrammarBuildings, KellyLots, LotInput, LotStage, RoadStage, Skip, Stage,
+    StageContext, TiledFacades,
 };
 use crate::{CityConfig, CityMaps};
 
@@ -54,7 +54,7 @@ pub struct Pipeline {
 impl Default for Pipeline {
     fn default() -> Self {
         Pipeline {
-            roads: Box::new(ParishMullerRoads::default()),
+            roads: Box::new(crate::citygen::ConfiguredRoads::default()),
             cells: Box::new(EberlyCells),
             lots: Box::new(KellyLots),
             buildings: Box::new(GrammarBuildings::default()),
@@ -276,6 +276,7 @@ impl Pipeline {
         let (roads, roads_time) = roads?;
         let ((builder, buildings_time), (dresser, facades_time)) = prepared?;
         let network = roads.network;
+        report.skipped.extend(roads.skipped);
         timings.push(StageTiming {
             stage: Stage::Roads,
             time: roads_time,

@@ -117,6 +117,9 @@ pub struct RoadsOutput {
     pub network: RoadNetwork,
     /// The growth report of an L-system generator, if there is one.
     pub growth: Option<GrowthReport>,
+    /// Items the road stage skipped (the Citygen mode's cells too small for secondary
+    /// roads), for the city's skip report.
+    pub skipped: Vec<Skip>,
 }
 
 /// Makes the road network of the whole map.
@@ -172,6 +175,7 @@ impl RoadStage for ParishMullerRoads {
         Ok(RoadsOutput {
             network: generated.network,
             growth: Some(generated.report),
+            skipped: Vec::new(),
         })
     }
 }

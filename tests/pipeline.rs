@@ -292,7 +292,7 @@ fn every_preset_makes_a_valid_city() {
 
 #[test]
 fn two_runs_and_any_thread_count_give_identical_bytes() {
-    for name in ["default", "paris"] {
+    for name in ["default", "paris", "milan"] {
         let mut config = small(name);
         config.threads = Some(1);
         let a = polis::generate(&config).unwrap();

@@ -89,6 +89,7 @@ pub mod modules;
 pub mod network;
 pub mod params;
 pub mod primary;
+pub mod secondary;
 pub mod smooth;
 pub mod snap;
 

@@ -1,0 +1,574 @@
+//! Kelly's secondary road growth (§4.3.2, Fig. 42) inside one city cell.
+
+use std::collections::VecDeque;
+
+use polis_geom::graph::SnapOptions;
+use polis_geom::hash::splitmix64;
+use polis_geom::{DVec2, EdgeId, NodeId, PointLocation, PolygonWithHoles};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
+
+use super::cell::{CellMaps, SecondaryCell};
+use super::error::SecondaryError;
+use super::params::{BuildingHint, Deviated, SecondaryParams};
+use super::snap::{SnapEvent, Snapper};
+use crate::network::{Junction, Road, RoadClass, RoadNetwork};
+
+/// What one cell's growth did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct CellGrowthReport {
+    /// Nodes taken from the queue (growth steps).
+    pub steps: u32,
+    /// Segments proposed (`placeSegment` calls).
+    pub proposals: u32,
+    /// Segments placed with no snap event (a new node).
+    pub placed_free: u32,
+    /// Segments joined to a road (road snap or crossing: the road is split).
+    pub placed_road: u32,
+    /// Segments joined to an existing node.
+    pub placed_node: u32,
+    /// Proposals dropped by the connectivity draw.
+    pub refused_connectivity: u32,
+    /// Proposals dropped because they folded onto a road at their root, or were blocked
+    /// by a road after snapping.
+    pub refused_blocked: u32,
+    /// Proposals dropped because they left the cell.
+    pub refused_outside: u32,
+    /// Proposals dropped because they ran into water or a park.
+    pub refused_map: u32,
+    /// Whether growth stopped at the step limit or the segment guard, not on an empty
+    /// queue.
+    pub stopped_early: bool,
+}
+
+/// Kelly keeps these per cell for the lot and building stages (§5.5.1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CellTraits {
+    /// Lot width and its deviance, metres.
+    pub lot_size_m: Deviated,
+    /// Building height and its deviance, metres.
+    pub building_height_m: Deviated,
+    /// The building hint.
+    pub building_hint: BuildingHint,
+}
+
+/// One cell's secondary roads.
+#[derive(Debug, Clone)]
+pub struct SecondaryRoads {
+    /// The cell's id.
+    pub cell: u64,
+    /// The cell's private graph: the boundary rings and filaments as
+    /// [`RoadClass::Highway`] edges (split where secondary roads join them) and the
+    /// secondary roads as [`RoadClass::Street`] edges. Planar.
+    pub network: RoadNetwork,
+    /// What the growth did.
+    pub report: CellGrowthReport,
+    /// Lot and building parameters of the cell.
+    pub traits: CellTraits,
+}
+
+impl SecondaryRoads {
+    /// The secondary roads (street edges) as segments, in edge-id order.
+    pub fn segments(&self) -> impl Iterator<Item = (DVec2, DVec2, &Road)> + '_ {
+        self.network.edges().filter_map(|(e, _, _, r)| {
+            if r.class != RoadClass::Street {
+                return None;
+            }
+            let (a, b) = self.network.segment(e).ok()?;
+            Some((a, b, r))
+        })
+    }
+}
+
+/// Kelly's secondary road growth: a reusable worker holding one parameter set and the
+/// snap algorithm's scratch.
+///
+/// # Algorithm (Fig. 42)
+///
+/// 1. The `start_sides` longest boundary sides (of any ring) are split at a *deviated
+///    midpoint* and grow a first segment along their *deviated* inward perpendicular.
+/// 2. A FIFO queue of `(node, direction)`; each node taken tries `degree` directions,
+///    the incoming one turned by `i · 360° / degree` and deviated.
+/// 3. `placeSegment` draws a deviated length (with the block aspect), asks the
+///    [snap algorithm](super::snap) and acts on its single event: none → a new node
+///    (queued); road → with probability *connectivity*, split the road and join it;
+///    node → with probability *connectivity*, join the node. Joined nodes are queued too,
+///    as in Kelly's pseudo-code.
+///
+/// # Guarantees
+///
+/// * The cell's graph stays planar (every road goes in through
+///   [`PlanarGraph::insert_segment`](polis_geom::PlanarGraph::insert_segment) after the
+///   exact checks below) and every secondary road lies inside the cell region: a
+///   proposal that touches or crosses anything other than its own two ends, or whose
+///   midpoint is not strictly inside the region (exact point location), is dropped.
+/// * Every secondary road is connected to the boundary: growth starts from boundary
+///   nodes and only ever extends from nodes already connected.
+/// * No secondary road has a sample (every [`CellMaps::step_m`]) in water or a park.
+/// * Deterministic: the result depends only on the parameters, the cell (its id
+///   sub-seeds the generator), the maps and the seed.
+///
+/// # Limitations
+///
+/// * Growth stops at `max_steps`, or at a guard of `16 · area / segment² + 64` segments
+///   that only pathological parameters reach (reported as `stopped_early`).
+/// * The direction deviation is taken from the degree deviance; Kelly does not say which
+///   deviance turns the directions.
+///
+/// # References
+///
+/// G. Kelly, *An Interactive System for Procedural City Generation*, 2008: §4.3.2
+/// (Fig. 42), §4.3.3, §5.5.1 (Fig. 76), §6.3.
+#[derive(Debug, Clone)]
+pub struct SecondaryGrowth {
+    params: SecondaryParams,
+    snapper: Snapper,
+}
+
+/// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
+/// than this are merged, so no road shorter than it is ever made (1 mm per metre of
+/// segment size, at least 1 mm).
+pub const INSERT_TOLERANCE: f64 = 1e-3;
+
+/// A placed segment's end, for the queue.
+struct Placed {
+    node: NodeId,
+}
+
+/// Where the proposal will end.
+enum Target {
+    Free(DVec2),
+    Node(NodeId),
+    OnEdge(EdgeId, DVec2),
+}
+
+impl SecondaryGrowth {
+    /// A worker for `params`.
+    ///
+    /// # Errors
+    /// [`SecondaryError::InvalidParameter`] from [`SecondaryParams::validate`].
+    pub fn new(params: SecondaryParams) -> Result<Self, SecondaryError> {
+        params.validate()?;
+        Ok(SecondaryGrowth {
+            params,
+            snapper: Snapper::default(),
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &SecondaryParams {
+        &self.params
+    }
+
+    /// Exact segment-intersection tests run so far and roads that passed the extended
+    /// bounding box (Kelly's measure of the `r`/`s` optimisation).
+    pub fn snap_counters(&self) -> (u64, u64) {
+        (self.snapper.exact_tests, self.snapper.box_hits)
+    }
+
+    /// Grows the secondary roads of `cell`. `seed` is mixed with the cell's id.
+    ///
+    /// # Errors
+    /// [`SecondaryError::InvalidCell`] for an invalid region,
+    /// [`SecondaryError::CellTooSmall`] when no boundary side can start a segment (both
+    /// are [`is_skip`](SecondaryError::is_skip)); [`SecondaryError::Geometry`] on an
+    /// internal failure.
+    pub fn grow(
+        &mut self,
+        cell: &SecondaryCell,
+        maps: &CellMaps<'_>,
+        seed: u64,
+    ) -> Result<SecondaryRoads, SecondaryError> {
+        let mut region = cell.region.clone();
+        region
+            .validate()
+            .map_err(|source| SecondaryError::InvalidCell {
+                cell: cell.id,
+                source,
+            })?;
+        region.normalize();
+        let p = self.params.clone();
+        let mut rng = Pcg64Mcg::seed_from_u64(splitmix64(seed ^ splitmix64(cell.id)));
+        let mut g = RoadNetwork::new();
+        let primary = Road {
+            class: RoadClass::Highway,
+            width: 0.0,
+            bridge: false,
+            step: 0,
+        };
+        // The boundary rings, and their sides with inward normals.
+        let mut sides: Vec<(f64, usize, EdgeId, DVec2)> = Vec::new();
+        for (_, ring) in region.rings() {
+            let pts = ring.points();
+            let ids = pts
+                .iter()
+                .map(|&q| g.add_node(q, Junction::default()))
+                .collect::<Result<Vec<_>, _>>()?;
+            for i in 0..ids.len() {
+                let j = (i + 1) % ids.len();
+                let (Some(&u), Some(&v)) = (ids.get(i), ids.get(j)) else {
+                    continue;
+                };
+                let e = g.add_edge(u, v, primary)?;
+                let (pu, pv) = (g.position(u)?, g.position(v)?);
+                let d = pv - pu;
+                sides.push((d.length(), sides.len(), e, d.perp().normalize_or_zero()));
+            }
+        }
+        for f in &cell.filaments {
+            // A filament that coincides with a boundary piece is already there.
+            match g.insert_segment_with(f[0], f[1], primary, &SnapOptions::default(), |_| {
+                Junction::default()
+            }) {
+                Ok(_) | Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        let area = region.area();
+        let seg_min =
+            (p.segment_size_m.value * (1.0 - p.segment_size_m.deviance) * p.aspect.min(1.0))
+                .max(1e-3);
+        let guard = (16.0 * area / (seg_min * seg_min) + 64.0).min(4.0e6) as u32;
+        // The main axis for the aspect: the longest side.
+        sides.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        let axis = sides
+            .first()
+            .and_then(|s| g.segment(s.2).ok())
+            .map_or(DVec2::X, |(a, b)| (b - a).normalize_or(DVec2::X));
+        let snap_max = p.snap_size_m.value * (1.0 + p.snap_size_m.deviance);
+        let long_enough = |len: f64| len > 2.0 * snap_max && len > 1e-6;
+        if !sides.iter().any(|s| long_enough(s.0)) {
+            return Err(SecondaryError::CellTooSmall {
+                cell: cell.id,
+                reason: format!(
+                    "the longest side is {:.2} m, not more than twice the snap size ({:.2} m)",
+                    sides.first().map_or(0.0, |s| s.0),
+                    snap_max
+                ),
+            });
+        }
+        let mut run = Run {
+            p: &p,
+            g,
+            region: &region,
+            maps,
+            rng: &mut rng,
+            snapper: &mut self.snapper,
+            axis,
+            report: CellGrowthReport::default(),
+            edges: 0,
+            guard,
+            tolerance: (p.segment_size_m.value * INSERT_TOLERANCE).max(1e-3),
+        };
+        let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
+        // Initial segments from deviated midpoints of the longest sides: the first
+        // `start_sides` sides, longest first, whose first segment can be placed.
+        let mut started = 0;
+        for &(len, _, e, inward) in &sides {
+            if started >= p.start_sides || !long_enough(len) {
+                break;
+            }
+            let (a, b) = run.g.segment(e)?;
+            let u: f64 = run.rng.random::<f64>();
+            let t = 0.5 + p.segment_size_m.deviance * (u - 0.5);
+            let t = t.clamp(snap_max / len, 1.0 - snap_max / len);
+            let mid = a.lerp(b, t);
+            // The perpendicular deviates by up to ± degree deviance × 45°.
+            let dir = run.deviate(inward, std::f64::consts::FRAC_PI_2);
+            // Split the side only if the first segment fits.
+            let Ok((source, piece)) = run.g.split_edge(e, mid, Junction::default()) else {
+                continue;
+            };
+            if let Some(placed) = run.place_segment(source, dir)? {
+                queue.push_back((placed.node, dir));
+                started += 1;
+            } else {
+                // Undo the split: the side stays one road.
+                let far = run.g.other_end(piece, source)?;
+                let near = run.g.other_end(e, source)?;
+                run.g.remove_node(source)?;
+                run.g.add_edge(near, far, primary)?;
+            }
+        }
+        // Road growth.
+        let mut expanded: Vec<bool> = Vec::new();
+        while let Some((source, dir)) = queue.pop_front() {
+            if p.max_steps.is_some_and(|m| run.report.steps >= m)
+                || run.edges >= run.guard
+                || run.report.steps >= run.guard.saturating_mul(4)
+            {
+                run.report.stopped_early = true;
+                break;
+            }
+            // Each node branches once: a node queued again (a join onto a node that has
+            // grown already) is passed over.
+            if let Some(seen) = expanded.get_mut(source.index()) {
+                if *seen {
+                    continue;
+                }
+                *seen = true;
+            } else {
+                expanded.resize(source.index() + 1, false);
+                if let Some(seen) = expanded.get_mut(source.index()) {
+                    *seen = true;
+                }
+            }
+            run.report.steps += 1;
+            let du: f64 = run.rng.random::<f64>();
+            let degree = ((p.degree as f64) * (1.0 + p.degree_deviance * (2.0 * du - 1.0)))
+                .round()
+                .max(1.0) as u32;
+            let step = std::f64::consts::TAU / degree as f64;
+            for i in 0..degree {
+                let turned = rotate(dir, step * i as f64);
+                let new_dir = run.deviate(turned, step);
+                if let Some(placed) = run.place_segment(source, new_dir)? {
+                    queue.push_back((placed.node, new_dir));
+                }
+            }
+        }
+        let report = run.report;
+        Ok(SecondaryRoads {
+            cell: cell.id,
+            network: run.g,
+            report,
+            traits: CellTraits {
+                lot_size_m: p.lot_size_m,
+                building_height_m: p.building_height_m,
+                building_hint: p.building_hint,
+            },
+        })
+    }
+}
+
+/// Grows the secondary roads of one cell with `params` (the one-call form of
+/// [`SecondaryGrowth`]).
+///
+/// # Errors
+/// As [`SecondaryGrowth::new`] and [`SecondaryGrowth::grow`].
+pub fn grow_cell(
+    params: &SecondaryParams,
+    cell: &SecondaryCell,
+    maps: &CellMaps<'_>,
+    seed: u64,
+) -> Result<SecondaryRoads, SecondaryError> {
+    SecondaryGrowth::new(params.clone())?.grow(cell, maps, seed)
+}
+
+fn rotate(v: DVec2, angle: f64) -> DVec2 {
+    let (s, c) = angle.sin_cos();
+    DVec2::new(v.x * c - v.y * s, v.x * s + v.y * c)
+}
+
+/// One growth run's state.
+struct Run<'a> {
+    p: &'a SecondaryParams,
+    g: RoadNetwork,
+    region: &'a PolygonWithHoles,
+    maps: &'a CellMaps<'a>,
+    rng: &'a mut Pcg64Mcg,
+    snapper: &'a mut Snapper,
+    axis: DVec2,
+    report: CellGrowthReport,
+    edges: u32,
+    guard: u32,
+    tolerance: f64,
+}
+
+impl Run<'_> {
+    /// `dir` turned by up to ± degree deviance × half of `step` (radians).
+    fn deviate(&mut self, dir: DVec2, step: f64) -> DVec2 {
+        let u: f64 = self.rng.random::<f64>();
+        rotate(dir, self.p.degree_deviance * (2.0 * u - 1.0) * 0.5 * step)
+    }
+
+    /// The segment length in direction `dir`: the deviated size on the aspect ellipse.
+    fn length(&mut self, dir: DVec2) -> f64 {
+        let size = self.p.segment_size_m.sample(self.rng);
+        let along = size * self.p.aspect;
+        let (c, s) = (dir.dot(self.axis), dir.perp_dot(self.axis));
+        along * size
+            / ((size * c).powi(2) + (along * s).powi(2))
+                .sqrt()
+                .max(f64::MIN_POSITIVE)
+    }
+
+    /// Kelly's `placeSegment`: returns the node to queue, or `None` when the proposal is
+    /// dropped.
+    fn place_segment(
+        &mut self,
+        source: NodeId,
+        dir: DVec2,
+    ) -> Result<Option<Placed>, SecondaryError> {
+        self.report.proposals += 1;
+        let len = self.length(dir);
+        let snap = self.p.snap_size_m.sample(self.rng).max(0.0);
+        let width = self.p.road_width_m.sample(self.rng);
+        let connectivity = self.p.connectivity.sample(self.rng).clamp(0.0, 1.0);
+        let draw: f64 = self.rng.random::<f64>();
+        let a = self.g.position(source)?;
+        let b = a + dir * len;
+        let target = match self.snapper.snap(&self.g, source, a, b, snap) {
+            SnapEvent::None => Target::Free(b),
+            SnapEvent::Blocked => {
+                self.report.refused_blocked += 1;
+                return Ok(None);
+            }
+            ev => {
+                if draw >= connectivity {
+                    self.report.refused_connectivity += 1;
+                    return Ok(None);
+                }
+                match ev {
+                    SnapEvent::Node(n) => Target::Node(n),
+                    SnapEvent::Cross(e, q) | SnapEvent::Road(e, q) => Target::OnEdge(e, q),
+                    SnapEvent::None | SnapEvent::Blocked => return Ok(None),
+                }
+            }
+        };
+        let t = match target {
+            Target::Free(q) | Target::OnEdge(_, q) => q,
+            Target::Node(n) => self.g.position(n)?,
+        };
+        if !t.is_finite() || t == a {
+            self.report.refused_blocked += 1;
+            return Ok(None);
+        }
+        // A free end met nothing in the snap area, so the segment crosses and touches
+        // nothing (tests 1 and 2); a snapped end needs the exact check.
+        if !matches!(target, Target::Free(_)) && !self.clear(source, a, t, &target) {
+            self.report.refused_blocked += 1;
+            return Ok(None);
+        }
+        // A segment that touches the boundary nowhere else stays on one side of it: only
+        // segments from or to a primary road can leave the cell.
+        let on_primary = self.touches_primary(source)
+            || match target {
+                Target::Free(_) => false,
+                Target::Node(n) => self.touches_primary(n),
+                Target::OnEdge(e, _) => self.is_primary(e),
+            };
+        if on_primary && self.region.locate(a.lerp(t, 0.5)) != PointLocation::Inside {
+            self.report.refused_outside += 1;
+            return Ok(None);
+        }
+        if !self.maps.segment_legal(a, t) {
+            self.report.refused_map += 1;
+            return Ok(None);
+        }
+        // A road snap ends on the road: planar insertion anchors the end onto it (splits
+        // it), within the insertion tolerance.
+        let t = match target {
+            Target::Node(n) => self.g.position(n)?,
+            Target::Free(q) | Target::OnEdge(_, q) => q,
+        };
+        let road = Road {
+            class: RoadClass::Street,
+            width,
+            bridge: false,
+            step: self.report.steps,
+        };
+        let step = self.report.steps;
+        // A free end met nothing within the snap size and a node target passed the exact
+        // check, so the road goes in as it is; a road target splits the road through
+        // planar insertion, which anchors the end onto it.
+        let end = match target {
+            Target::Free(q) => {
+                let n = self.g.add_node(q, Junction { step })?;
+                self.g.add_edge(source, n, road)?;
+                n
+            }
+            Target::Node(n) => match self.g.add_edge(source, n, road) {
+                Ok(_) => n,
+                Err(
+                    polis_geom::GeomError::DuplicateEdge { .. }
+                    | polis_geom::GeomError::ZeroLengthEdge { .. },
+                ) => {
+                    self.report.refused_blocked += 1;
+                    return Ok(None);
+                }
+                Err(e) => return Err(e.into()),
+            },
+            Target::OnEdge(..) => {
+                let ins = self.g.insert_segment_with(
+                    a,
+                    t,
+                    road,
+                    &SnapOptions {
+                        snap_distance: self.tolerance,
+                    },
+                    |_| Junction { step },
+                );
+                let ins = match ins {
+                    Ok(ins) => ins,
+                    Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {
+                        self.report.refused_blocked += 1;
+                        return Ok(None);
+                    }
+                    Err(e) => return Err(e.into()),
+                };
+                if ins.created.is_empty() {
+                    // The road exists already (the insertion followed existing roads).
+                    self.report.refused_blocked += 1;
+                    return Ok(None);
+                }
+                self.edges += ins.created.len() as u32 - 1;
+                match ins.nodes.last() {
+                    Some(&n) => n,
+                    None => return Ok(None),
+                }
+            }
+        };
+        self.edges += 1;
+        match target {
+            Target::Free(_) => self.report.placed_free += 1,
+            Target::Node(_) => self.report.placed_node += 1,
+            Target::OnEdge(..) => self.report.placed_road += 1,
+        }
+        Ok(Some(Placed { node: end }))
+    }
+
+    fn is_primary(&self, e: EdgeId) -> bool {
+        self.g
+            .edge_payload(e)
+            .is_ok_and(|r| r.class == RoadClass::Highway)
+    }
+
+    fn touches_primary(&self, n: NodeId) -> bool {
+        self.g
+            .edges_at(n)
+            .is_ok_and(|es| es.iter().any(|&e| self.is_primary(e)))
+    }
+
+    /// Whether the straight road `a–t` meets nothing but its root's roads at `a` and its
+    /// target (the node, or the road it ends on) at `t`.
+    fn clear(&self, source: NodeId, a: DVec2, t: DVec2, target: &Target) -> bool {
+        use polis_geom::predicates::SegmentIntersection as X;
+        for hit in self.g.edges_crossing(a, t) {
+            let Ok((u, v)) = self.g.endpoints(hit.key) else {
+                return false;
+            };
+            let at_end = |p: DVec2| p == a || p == t;
+            let ok = match (hit.kind, target) {
+                (X::Overlap { .. }, _) | (X::Crossing { .. }, Target::Free(_)) => false,
+                (X::Crossing { .. }, Target::Node(_)) => false,
+                (X::Crossing { .. }, Target::OnEdge(e, _)) => hit.key == *e,
+                (X::Touching { point, .. }, Target::OnEdge(e, _)) => {
+                    hit.key == *e || ((u == source || v == source) && point == a)
+                }
+                (X::Touching { point, .. }, Target::Node(n)) => {
+                    (u == *n || v == *n || u == source || v == source) && at_end(point)
+                }
+                (X::Touching { point, .. }, Target::Free(_)) => {
+                    (u == source || v == source) && point == a
+                }
+                (X::Disjoint, _) => true,
+            };
+            if !ok {
+                return false;
+            }
+        }
+        true
+    }
+}

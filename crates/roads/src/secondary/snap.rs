@@ -1,0 +1,386 @@
+//! Kelly's snap algorithm for secondary growth (§4.3.3), on a cell's private graph.
+//!
+//! The query is a proposed segment `a–b` from an existing node `a` and a snap size. The
+//! answer is the single highest-priority *snap event*, priority being closeness to the
+//! root `a`, measured by the parameter `r` along `a–b`:
+//!
+//! 1. **Extended bounding box exclusion** (§4.3.3.1): only roads whose boxes meet the box
+//!    of `a–b` grown by the snap size are tested (candidates come from the graph's edge
+//!    index, then Kelly's box test decides), and only their end nodes that lie in that
+//!    box (every node of a cell graph ends a road, so no node index walk is needed).
+//! 2. **Test 1, node proximity** (§4.3.3.3): for each node, `r = ap·ab / |ab|²` and
+//!    `s = ap⊥·ab / |ab|²`; a node with `0 < r ≤ 1` and `|s|·|ab| ≤ snap` is an event at
+//!    `r`; one with `1 < r ≤ 1 + snap/|ab|` is an event if it lies within the snap size of
+//!    `b`. The best `r` so far is the benchmark: only smaller `r` are tested further.
+//! 3. **Test 2, segment intersection** (§4.3.3.4): the `r` and `s` of test 1 are reused.
+//!    A road whose end nodes lie strictly on opposite sides of the line `ab` (the sign of
+//!    `s`, decided exactly by `orient2d`) meets the line at
+//!    `r = (r_u·|s_v| + r_v·|s_u|) / (|s_u| + |s_v|)`, known without computing the
+//!    intersection; only when that `r` beats the benchmark is the exact crossing test run.
+//! 4. **Test 3, segment proximity** (§4.3.3.5): only if tests 1 and 2 found nothing,
+//!    the road nearest to `b` within the snap size gives a road event at `b`'s end.
+//!
+//! Events on the root's own roads (a node adjacent to `a`, a road at `a`) are reported
+//! as [`SnapEvent::Blocked`]: joining them would duplicate or fold onto an existing road.
+
+use polis_geom::predicates::{Orientation, closest_point_on_segment, orient2d};
+use polis_geom::spatial::{Shape, SpatialIndex};
+use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
+
+use crate::network::RoadNetwork;
+
+/// The outcome of one snap query.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SnapEvent {
+    /// Nothing within the snap area: the segment may end at `b` as proposed.
+    None,
+    /// An existing node within the snap area (test 1).
+    Node(NodeId),
+    /// The segment crosses road `edge` at `point` (test 2).
+    Cross(EdgeId, DVec2),
+    /// `b` lies within the snap size of road `edge`, whose closest point is `point`
+    /// (test 3).
+    Road(EdgeId, DVec2),
+    /// The first event is on a road at the root: the proposal would fold onto it.
+    Blocked,
+}
+
+/// Kelly's `r` and `s` of a node for the current query, with the exact side.
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeScalars {
+    r: f64,
+    s: f64,
+    side: i8,
+}
+
+/// The snap algorithm with its per-query scratch (reused between queries).
+#[derive(Debug, Default, Clone)]
+pub struct Snapper {
+    stamp: Vec<u32>,
+    scalars: Vec<NodeScalars>,
+    query: u32,
+    found: Vec<(NodeId, DVec2)>,
+    roads: Vec<EdgeId>,
+    /// Exact segment-intersection tests run (the rest were excluded by `r`/`s`).
+    pub exact_tests: u64,
+    /// Roads that passed the extended bounding box.
+    pub box_hits: u64,
+}
+
+impl Snapper {
+    fn begin(&mut self, nodes: usize) {
+        if self.stamp.len() < nodes {
+            self.stamp.resize(nodes, 0);
+            self.scalars.resize(nodes, NodeScalars::default());
+        }
+        self.query = self.query.wrapping_add(1);
+        if self.query == 0 {
+            self.stamp.fill(0);
+            self.query = 1;
+        }
+    }
+
+    fn scalars(&mut self, n: NodeId, p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
+        let i = n.index();
+        if let (Some(&st), Some(&sc)) = (self.stamp.get(i), self.scalars.get(i))
+            && st == self.query
+        {
+            return sc;
+        }
+        let sc = compute(p, a, b);
+        if let (Some(st), Some(slot)) = (self.stamp.get_mut(i), self.scalars.get_mut(i)) {
+            *st = self.query;
+            *slot = sc;
+        }
+        sc
+    }
+
+    /// The highest-priority snap event of the proposal from node `root` (at `a`) to `b`
+    /// with snap size `radius` (metres, ≥ 0).
+    pub fn snap(
+        &mut self,
+        g: &RoadNetwork,
+        root: NodeId,
+        a: DVec2,
+        b: DVec2,
+        radius: f64,
+    ) -> SnapEvent {
+        let d = b - a;
+        let len2 = d.length_squared();
+        if !(len2 > 0.0 && len2.is_finite()) {
+            return SnapEvent::Blocked;
+        }
+        let len = len2.sqrt();
+        let radius = radius.max(0.0);
+        self.begin(g.node_bound());
+        let ext = Aabb2::new(a, b).expanded(radius);
+        // Extended bounding box exclusion: the roads whose boxes meet the extended box.
+        // Every node of a cell graph ends a road, and a node in the extended box ends a
+        // road whose box meets it, so the ends of these roads are test 1's candidates too.
+        let mut roads = std::mem::take(&mut self.roads);
+        roads.clear();
+        g.edge_index().for_each_candidate(&ext, |e, shape| {
+            if let Shape::Segment(u, v) = *shape
+                && Aabb2::new(u, v).intersects(&ext)
+            {
+                roads.push(e);
+            }
+        });
+        roads.sort_unstable();
+        roads.dedup();
+        self.box_hits += roads.len() as u64;
+        // Test 1: node proximity.
+        let mut best: Option<(f64, NodeId)> = None;
+        let mut best_r = 1.0 + radius / len;
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
+        for &e in &roads {
+            if let Ok((u, v)) = g.endpoints(e) {
+                for n in [u, v] {
+                    if let Ok(p) = g.position(n)
+                        && ext.contains(p)
+                    {
+                        found.push((n, p));
+                    }
+                }
+            }
+        }
+        found.sort_unstable_by_key(|&(n, _)| n);
+        found.dedup_by_key(|&mut (n, _)| n);
+        for &(n, p) in &found {
+            let sc = self.scalars(n, p, a, b);
+            let r = sc.r;
+            let better = r < best_r || (r == best_r && best.is_some_and(|(_, m)| n < m));
+            if !(r > 0.0 && better) {
+                continue;
+            }
+            let hit = if r <= 1.0 {
+                sc.s.abs() * len <= radius
+            } else {
+                p.distance(b) <= radius
+            };
+            if hit {
+                best_r = r;
+                best = Some((r, n));
+            }
+        }
+        self.found = found;
+        // Test 2: segment intersection before the benchmark.
+        let limit = best_r.min(1.0);
+        let mut cross: Option<(f64, EdgeId, DVec2)> = None;
+        for &e in &roads {
+            let Ok((u, v)) = g.endpoints(e) else { continue };
+            if u == root || v == root {
+                continue;
+            }
+            let (Ok(pu), Ok(pv)) = (g.position(u), g.position(v)) else {
+                continue;
+            };
+            let su = self.scalars(u, pu, a, b);
+            let sv = self.scalars(v, pv, a, b);
+            if su.side * sv.side >= 0 {
+                continue; // same side of the line ab, or touching it (a node event)
+            }
+            let (wu, wv) = (su.s.abs(), sv.s.abs());
+            let r = (su.r * wv + sv.r * wu) / (wu + wv);
+            let bound = cross.map_or(limit, |(cr, _, _)| cr);
+            if !(r > 0.0 && r <= bound) {
+                continue;
+            }
+            self.exact_tests += 1;
+            let oa = orient2d(pu, pv, a);
+            let ob = orient2d(pu, pv, b);
+            let opposite = matches!(
+                (oa, ob),
+                (Orientation::Clockwise, Orientation::CounterClockwise)
+                    | (Orientation::CounterClockwise, Orientation::Clockwise)
+            );
+            if !opposite {
+                continue;
+            }
+            let better = cross.is_none_or(|(cr, ce, _)| r < cr || (r == cr && e < ce));
+            if better {
+                let point = pu + (pv - pu) * (wu / (wu + wv));
+                cross = Some((r, e, point));
+            }
+        }
+        self.roads = roads;
+        let adjacent = |n: NodeId| g.find_edge(root, n).is_some();
+        // A crossing within the snap size of an end of the crossed road joins that end
+        // (the nearer one) instead of splitting the road next to it.
+        let cross = cross.map(|(r, e, p)| {
+            let end = g.endpoints(e).ok().and_then(|(u, v)| {
+                let (pu, pv) = (g.position(u).ok()?, g.position(v).ok()?);
+                let (du, dv) = (pu.distance(p), pv.distance(p));
+                let (n, dn) = if (du, u) <= (dv, v) { (u, du) } else { (v, dv) };
+                (dn <= radius).then_some(n)
+            });
+            (r, e, p, end)
+        });
+        let cross_event = |e: EdgeId, p: DVec2, end: Option<NodeId>| match end {
+            Some(n) if adjacent(n) => SnapEvent::Blocked,
+            Some(n) => SnapEvent::Node(n),
+            None => SnapEvent::Cross(e, p),
+        };
+        match (best, cross) {
+            (Some((r, n)), Some((cr, e, p, end))) => {
+                if cr < r {
+                    return cross_event(e, p, end);
+                }
+                return if adjacent(n) {
+                    SnapEvent::Blocked
+                } else {
+                    SnapEvent::Node(n)
+                };
+            }
+            (Some((_, n)), None) => {
+                return if adjacent(n) {
+                    SnapEvent::Blocked
+                } else {
+                    SnapEvent::Node(n)
+                };
+            }
+            (None, Some((_, e, p, end))) => return cross_event(e, p, end),
+            (None, None) => {}
+        }
+        // Test 3: proximity of b to a road.
+        let around = Aabb2::new(b, b).expanded(radius);
+        let mut near: Option<(f64, EdgeId, DVec2)> = None;
+        g.edge_index().for_each_candidate(&around, |e, shape| {
+            let Shape::Segment(u, v) = *shape else { return };
+            let (c, _) = closest_point_on_segment(b, u, v);
+            let dist = c.distance(b);
+            if dist <= radius && near.is_none_or(|(bd, be, _)| (dist, e) < (bd, be)) {
+                near = Some((dist, e, c));
+            }
+        });
+        let Some((_, e, c)) = near else {
+            return SnapEvent::None;
+        };
+        let Ok((u, v)) = g.endpoints(e) else {
+            return SnapEvent::Blocked;
+        };
+        if u == root || v == root {
+            return SnapEvent::Blocked;
+        }
+        // The closest point is an end of the road: that is a node event.
+        for n in [u, v] {
+            if g.position(n).is_ok_and(|p| p == c) {
+                return if adjacent(n) {
+                    SnapEvent::Blocked
+                } else {
+                    SnapEvent::Node(n)
+                };
+            }
+        }
+        SnapEvent::Road(e, c)
+    }
+}
+
+/// Kelly's `r` and `s` of `p` against `a–b`, with the exact side of `p`.
+fn compute(p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
+    let ab = b - a;
+    let ap = p - a;
+    let len2 = ab.length_squared();
+    let side = match orient2d(a, b, p) {
+        Orientation::CounterClockwise => 1,
+        Orientation::Clockwise => -1,
+        Orientation::Collinear => 0,
+    };
+    NodeScalars {
+        r: ap.dot(ab) / len2,
+        s: ab.perp_dot(ap) / len2,
+        side,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::network::{Junction, Road, RoadClass};
+    use polis_geom::graph::SnapOptions;
+
+    type Seg = ((f64, f64), (f64, f64));
+
+    fn net(segs: &[Seg]) -> RoadNetwork {
+        let mut n = RoadNetwork::new();
+        let road = Road {
+            class: RoadClass::Street,
+            width: 8.0,
+            bridge: false,
+            step: 0,
+        };
+        for &((ax, ay), (bx, by)) in segs {
+            n.insert_segment_with(
+                DVec2::new(ax, ay),
+                DVec2::new(bx, by),
+                road,
+                &SnapOptions::default(),
+                |_| Junction::default(),
+            )
+            .unwrap();
+        }
+        n
+    }
+
+    fn node_at(g: &RoadNetwork, x: f64, y: f64) -> NodeId {
+        g.nearest_node(DVec2::new(x, y), 1e-9).unwrap().0
+    }
+
+    #[test]
+    fn the_three_tests_in_priority_order() {
+        // A root at (0, 0) with a road going west; a road x = 50 crossing the proposal
+        // and a node near the proposal further on.
+        let g = net(&[
+            ((0.0, 0.0), (-30.0, 0.0)),
+            ((50.0, -20.0), (50.0, 20.0)),
+            ((80.0, 3.0), (80.0, 30.0)),
+            ((200.0, -50.0), (200.0, 50.0)),
+        ]);
+        let root = node_at(&g, 0.0, 0.0);
+        let a = DVec2::ZERO;
+        let mut s = Snapper::default();
+        // The crossing at x = 50 comes first.
+        let ev = s.snap(&g, root, a, DVec2::new(100.0, 0.0), 5.0);
+        assert!(
+            matches!(ev, SnapEvent::Cross(_, p) if p == DVec2::new(50.0, 0.0)),
+            "{ev:?}"
+        );
+        // A short proposal ending near the node (80, 3): node event.
+        let g2 = net(&[((0.0, 0.0), (-30.0, 0.0)), ((80.0, 3.0), (80.0, 30.0))]);
+        let root2 = node_at(&g2, 0.0, 0.0);
+        let ev = s.snap(&g2, root2, a, DVec2::new(78.0, 0.0), 5.0);
+        assert_eq!(ev, SnapEvent::Node(node_at(&g2, 80.0, 3.0)));
+        // Ending near the road x = 200 but not near a node: road event at the foot.
+        let ev = s.snap(
+            &g,
+            root,
+            DVec2::new(120.0, 0.0),
+            DVec2::new(196.0, 0.0),
+            5.0,
+        );
+        assert!(
+            matches!(ev, SnapEvent::Road(_, p) if p == DVec2::new(200.0, 0.0)),
+            "{ev:?}"
+        );
+        // Nothing around: none.
+        let ev = s.snap(&g, root, a, DVec2::new(0.0, 40.0), 5.0);
+        assert_eq!(ev, SnapEvent::None);
+        // Back along its own road: blocked.
+        let ev = s.snap(&g, root, a, DVec2::new(-20.0, 1.0), 5.0);
+        assert_eq!(ev, SnapEvent::Blocked);
+    }
+
+    #[test]
+    fn a_node_before_a_crossing_wins() {
+        let g = net(&[
+            ((0.0, 0.0), (-30.0, 0.0)),
+            ((30.0, 2.0), (30.0, 40.0)),
+            ((60.0, -20.0), (60.0, 20.0)),
+        ]);
+        let root = node_at(&g, 0.0, 0.0);
+        let ev = Snapper::default().snap(&g, root, DVec2::ZERO, DVec2::new(100.0, 0.0), 5.0);
+        assert_eq!(ev, SnapEvent::Node(node_at(&g, 30.0, 2.0)));
+    }
+}

@@ -1,0 +1,222 @@
+//! The Citygen road mode step by step: primary network, cells, secondary growth per cell,
+//! the union graph, then (with `--city`) the whole city on it. Writes an SVG of the roads
+//! (primary black, secondary red) and prints counts and timings.
+//!
+//! ```text
+//! cargo run --release --example citygen -- [PRESET] [--city | --city-only] [--lod N]
+//!     [--threads N] [--out DIR]
+//! ```
+//!
+//! `--city` also generates the whole city (without the 3-D scene) after the road part;
+//! `--city-only` only generates the whole city, scene included (for timing any preset).
+//!
+//! `PRESET` is a built-in preset in the Citygen mode (`citygen`, `suburbia`, `milan`) or a
+//! configuration file (`….json`); default `citygen`.
+
+use std::fmt::Write as _;
+use std::time::Instant;
+
+use polis::citygen::citygen_network;
+use polis::roads::RoadClass;
+use polis::roads::secondary::StreetStats;
+use polis::stages::{Stage, StageContext};
+use polis::{CityConfig, CityMaps, Pipeline};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut preset = "citygen".to_string();
+    let mut city = false;
+    let mut city_only = false;
+    let mut lod = None;
+    let mut bench_growth = 0usize;
+    let mut threads = None;
+    let mut out = std::path::PathBuf::from("out");
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--city" => city = true,
+            "--city-only" => city_only = true,
+            "--bench-growth" => {
+                bench_growth = args.next().and_then(|t| t.parse().ok()).unwrap_or(5)
+            }
+            "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
+            "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
+            "--out" => out = args.next().unwrap_or_default().into(),
+            _ => preset = a,
+        }
+    }
+    let mut config = if preset.ends_with(".json") {
+        CityConfig::from_path(&preset)?
+    } else {
+        CityConfig::preset(&preset)?
+    };
+    let preset = config.name.clone();
+    config.threads = threads;
+    config.lod = lod.or(config.lod);
+    if city_only {
+        let t = Instant::now();
+        let c = Pipeline::default().generate(&config)?;
+        println!(
+            "city: {} road segments, {} buildings, {} scene triangles; {:.3} s",
+            c.stats.road_segments,
+            c.stats.buildings,
+            c.stats.scene_triangles,
+            t.elapsed().as_secs_f64()
+        );
+        return Ok(());
+    }
+    let maps = CityMaps::build(
+        &config.maps,
+        polis::seed::sub_seed(config.seed, Stage::Maps, 0),
+    )?;
+    let cx = StageContext {
+        config: &config,
+        maps: &maps,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()?;
+    let t = Instant::now();
+    let (net, _) = pool.install(|| citygen_network(&cx))?;
+    let total = t.elapsed();
+    if bench_growth > 0 {
+        return growth_bench(&cx, &net.primary, bench_growth);
+    }
+    let mut stats = StreetStats::default();
+    let mut per_cell = Vec::new();
+    for c in &net.cells {
+        stats.add(&StreetStats::of(&c.network));
+        per_cell.push(c.segments().count());
+    }
+    println!(
+        "{preset}: primary {} roads; {} cells grown, {} skipped; {} secondary roads; union {} roads, {} junctions",
+        net.primary.edge_count(),
+        net.cells.len(),
+        net.skipped.len(),
+        stats.streets,
+        net.network.edge_count(),
+        net.network.node_count()
+    );
+    println!(
+        "secondary growth {:.2} ms ({:.3} ms per cell); road part total {:.1} ms",
+        net.secondary_s * 1e3,
+        net.secondary_s * 1e3 / net.cells.len().max(1) as f64,
+        total.as_secs_f64() * 1e3
+    );
+    println!(
+        "cell junctions: dead ends {:.3}, 4-way or boundary {:.3}",
+        stats.dead_end_share(),
+        stats.four_way_or_boundary_share()
+    );
+    let whole = polis::roads::network_stats(&net.network);
+    println!(
+        "union: dead ends {:.3} of junctions, mean degree {:.2}",
+        whole.dead_ends as f64 / whole.junctions.max(1) as f64,
+        2.0 * whole.edges as f64 / whole.junctions.max(1) as f64
+    );
+    std::fs::create_dir_all(&out)?;
+    let h = config.size_m * 0.5;
+    let mut svg = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="1600" height="1600" viewBox="{} {} {} {}"><rect x="{}" y="{}" width="100%" height="100%" fill="white"/>"#,
+        -h, -h, config.size_m, config.size_m, -h, -h
+    );
+    for (e, _, _, r) in net.network.edges() {
+        let Ok((a, b)) = net.network.segment(e) else {
+            continue;
+        };
+        let (c, w) = match r.class {
+            RoadClass::Highway => ("#111", 14.0),
+            RoadClass::Street => ("#c0392b", 4.0),
+        };
+        let _ = writeln!(
+            svg,
+            r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{c}" stroke-width="{w}"/>"#,
+            a.x, -a.y, b.x, -b.y
+        );
+    }
+    svg.push_str("</svg>");
+    let path = out.join(format!("citygen_{preset}.svg"));
+    std::fs::write(&path, svg)?;
+    println!("wrote {}", path.display());
+    if city {
+        let t = Instant::now();
+        let c = Pipeline::default().with_scene(false).generate(&config)?;
+        println!(
+            "city: {} road segments, {} cells, {} blocks, {} lots, {} buildings, {} skipped; {:.2} s",
+            c.stats.road_segments,
+            c.stats.cells,
+            c.stats.blocks,
+            c.stats.lots,
+            c.stats.buildings,
+            c.report.skipped.len(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// CPU time of the calling thread, nanoseconds (Linux: `/proc/thread-self/schedstat`).
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
+}
+
+/// Grows every cell of the primary network serially on this thread, `runs` times, and
+/// prints wall and CPU time per run (the inputs are prepared before the clock starts).
+fn growth_bench(
+    cx: &StageContext<'_>,
+    primary: &polis::roads::RoadNetwork,
+    runs: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth};
+    let cg = &cx.config.citygen;
+    let cells = polis::cells::extract_with(primary, &cx.config.cells)?;
+    let mut inputs = Vec::new();
+    for cell in &cells.cells {
+        let Ok(region) = cell.polygon_with_holes() else {
+            continue;
+        };
+        let n = polis::citygen::neighbourhood_of(cx, &region);
+        let mut p = n.preset()?.to_params(cg.unit_m);
+        p.road_width_m.value *= cg.road_width_factor;
+        let filaments = cell
+            .filaments
+            .iter()
+            .flat_map(|f| f.points.windows(2).map(|w| [w[0], w[1]]))
+            .collect();
+        let id = polis::citygen::stable_cell_id(cell);
+        inputs.push((
+            SecondaryCell {
+                id,
+                region,
+                filaments,
+            },
+            p,
+        ));
+    }
+    let seed = cx.seed(Stage::Roads, 1);
+    let maps = CellMaps::none();
+    for run in 0..runs {
+        let (t, c) = (Instant::now(), thread_cpu_ns());
+        let mut roads = 0;
+        for (cell, p) in &inputs {
+            if let Ok(r) = SecondaryGrowth::new(p.clone())?.grow(cell, &maps, seed) {
+                roads += r.segments().count();
+            }
+        }
+        let (wall, cpu) = (
+            t.elapsed().as_secs_f64() * 1e3,
+            (thread_cpu_ns() - c) as f64 / 1e6,
+        );
+        println!(
+            "run {run}: {} cells, {roads} secondary roads, serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
+            inputs.len(),
+            cpu / inputs.len().max(1) as f64
+        );
+    }
+    Ok(())
+}

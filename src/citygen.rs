@@ -1,0 +1,739 @@
+//! The Citygen road mode (Kelly 2008, §4.1–4.3): a primary network, its city cells, and
+//! secondary roads grown inside each cell, joined into one road graph for the later
+//! stages (blocks, lots, buildings, facades).
+//!
+//! ```text
+//!  primary network ──polis-cells──▶ city cells ──SecondaryGrowth per cell (rayon)──▶
+//!  union graph (primary + every cell's secondary roads) ──▶ cells = blocks ──▶ lots …
+//! ```
+//!
+//! The primary network comes from a [`PrimarySource`]: the highways of a Parish & Müller
+//! growth with the configuration's road parameters, a ring-and-spoke network (Kelly
+//! §6.1's Milan), or a road graph in a JSON file. Each cell's neighbourhood preset is
+//! chosen by an explicit override (a point inside the cell), else by the population at
+//! the cell's centre ([`CitygenConfig::by_population`]), else the default.
+//!
+//! Cell ids are stable: a hash of the cell's sorted boundary positions, so editing one
+//! part of the primary network does not reseed the cells elsewhere. Cells are grown in
+//! parallel and joined in cell order, so any thread count gives the same graph.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use polis_cells::Cell;
+use polis_geom::graph::SnapOptions;
+use polis_geom::hash::splitmix64;
+use polis_geom::{DVec2, Field};
+use polis_roads::secondary::{
+    CellMaps, Neighbourhood, SecondaryCell, SecondaryError, SecondaryGrowth, SecondaryRoads,
+};
+use polis_roads::{Junction, Road, RoadClass, RoadNetwork};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::stages::{ParishMullerRoads, RoadStage, RoadsOutput, Skip, Stage, StageContext};
+
+/// How the city's roads are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RoadMode {
+    /// One Parish & Müller growth over the whole map (§3). Default.
+    #[default]
+    ParishMuller,
+    /// Kelly's Citygen: primary network, cells, secondary growth per cell
+    /// ([`CitygenConfig`]).
+    Citygen,
+}
+
+impl RoadMode {
+    /// Whether this is the default mode (for serde's `skip_serializing_if`).
+    pub fn is_default(&self) -> bool {
+        *self == RoadMode::ParishMuller
+    }
+}
+
+/// Where the Citygen mode's primary network comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[non_exhaustive]
+pub enum PrimarySource {
+    /// The highways of a Parish & Müller growth with the configuration's `roads`
+    /// parameters (streets switched off): its highway edges and their junctions. Default.
+    #[default]
+    Highways,
+    /// Concentric rings joined by radial spokes, inside the map's square (Kelly §6.1,
+    /// Milan's ring roads).
+    Rings {
+        /// Centre, metres. Default: the origin.
+        #[serde(default)]
+        centre: [f64; 2],
+        /// Number of rings. Must be 1 to 64.
+        rings: u32,
+        /// Distance between rings, metres (the first ring has this radius). Must be > 0.
+        spacing_m: f64,
+        /// Radial spokes from the first ring to the map's edge. Must be 3 to 256.
+        spokes: u32,
+        /// Length of the pieces the rings are drawn with, metres. Default: 150.
+        #[serde(default = "ring_piece")]
+        piece_m: f64,
+    },
+    /// A road graph read from a JSON file (the serde form of
+    /// [`RoadNetwork`](polis_roads::RoadNetwork), e.g. an exported `roads.json`).
+    Graph {
+        /// The file.
+        path: PathBuf,
+    },
+}
+
+fn ring_piece() -> f64 {
+    150.0
+}
+
+/// One population band of [`CitygenConfig::by_population`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PopulationBand {
+    /// The band applies where the population at the cell's centre is at least this.
+    pub min_density: f64,
+    /// The neighbourhood of such cells.
+    pub neighbourhood: Neighbourhood,
+}
+
+/// An explicit neighbourhood for the cell containing a point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellOverride {
+    /// A point inside the cell, metres.
+    pub at: [f64; 2],
+    /// Its neighbourhood.
+    pub neighbourhood: Neighbourhood,
+}
+
+/// The Citygen mode's options (used when [`CityConfig::road_mode`](crate::CityConfig) is
+/// [`RoadMode::Citygen`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CitygenConfig {
+    /// The primary network. Default: the P&M highways.
+    pub primary: PrimarySource,
+    /// Metres per Citygen unit for the neighbourhood presets (see
+    /// [`polis_roads::secondary::presets`]). Must be in (0, 1000]. Default: 20.
+    pub unit_m: f64,
+    /// The neighbourhood of cells no band or override picks. Default: Manhattan.
+    pub neighbourhood: Neighbourhood,
+    /// Neighbourhood by population at the cell's centre: the band with the highest
+    /// `min_density` reached applies. Default: none.
+    pub by_population: Vec<PopulationBand>,
+    /// Explicit neighbourhoods; the first override whose point lies in a cell applies.
+    /// Default: none.
+    pub overrides: Vec<CellOverride>,
+    /// Carriageway widths of secondary roads are multiplied by this (Kelly's widths in
+    /// Citygen units come out narrow in metres). Must be in (0, 10]. Default: 1.
+    pub road_width_factor: f64,
+}
+
+impl Default for CitygenConfig {
+    fn default() -> Self {
+        CitygenConfig {
+            primary: PrimarySource::Highways,
+            unit_m: polis_roads::secondary::CITYGEN_UNIT_M,
+            neighbourhood: Neighbourhood::Manhattan,
+            by_population: Vec::new(),
+            overrides: Vec::new(),
+            road_width_factor: 1.0,
+        }
+    }
+}
+
+impl CitygenConfig {
+    /// Whether every field is at its default (for serde's `skip_serializing_if`).
+    pub fn is_default(&self) -> bool {
+        *self == CitygenConfig::default()
+    }
+
+    /// Checks the ranges documented on each field.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.unit_m.is_finite() && self.unit_m > 0.0 && self.unit_m <= 1000.0) {
+            return Err(Error::config(
+                "citygen.unit_m",
+                "give metres per unit in (0, 1000]",
+            ));
+        }
+        let f = self.road_width_factor;
+        if !(f.is_finite() && f > 0.0 && f <= 10.0) {
+            return Err(Error::config(
+                "citygen.road_width_factor",
+                "give a factor in (0, 10]",
+            ));
+        }
+        for (i, b) in self.by_population.iter().enumerate() {
+            if !b.min_density.is_finite() {
+                return Err(Error::config(
+                    format!("citygen.by_population[{i}].min_density"),
+                    "must be finite",
+                ));
+            }
+        }
+        for (i, o) in self.overrides.iter().enumerate() {
+            if !(o.at[0].is_finite() && o.at[1].is_finite()) {
+                return Err(Error::config(
+                    format!("citygen.overrides[{i}].at"),
+                    "must be finite",
+                ));
+            }
+        }
+        if let PrimarySource::Rings {
+            rings,
+            spacing_m,
+            spokes,
+            piece_m,
+            centre,
+        } = &self.primary
+        {
+            let ok = (1..=64).contains(rings)
+                && spacing_m.is_finite()
+                && *spacing_m > 0.0
+                && (3..=256).contains(spokes)
+                && piece_m.is_finite()
+                && *piece_m >= 1.0
+                && centre.iter().all(|c| c.is_finite());
+            if !ok {
+                return Err(Error::config(
+                    "citygen.primary",
+                    "rings: 1 to 64 rings, spacing_m > 0, 3 to 256 spokes, piece_m ≥ 1, a finite centre",
+                ));
+            }
+        }
+        for n in Neighbourhood::ALL {
+            n.params().map_err(polis_roads::RoadError::from)?;
+        }
+        Ok(())
+    }
+}
+
+/// What the Citygen mode made, stage by stage (for reports and benchmarks).
+#[derive(Debug, Clone)]
+pub struct CitygenNetwork {
+    /// The primary network.
+    pub primary: RoadNetwork,
+    /// Every grown cell's secondary roads, in cell order.
+    pub cells: Vec<SecondaryRoads>,
+    /// The union: primary and secondary roads in one planar graph.
+    pub network: RoadNetwork,
+    /// Cells that could not be grown (too small, invalid boundary), with why.
+    pub skipped: Vec<Skip>,
+    /// Wall time of the secondary growth of all cells (parallel), seconds.
+    pub secondary_s: f64,
+}
+
+/// The Citygen road stage: see the [module docs](self).
+#[derive(Debug, Clone, Default)]
+pub struct CitygenRoads;
+
+impl RoadStage for CitygenRoads {
+    fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput> {
+        let (net, growth) = citygen_network(cx)?;
+        Ok(RoadsOutput {
+            network: net.network,
+            growth,
+            skipped: net.skipped,
+        })
+    }
+}
+
+/// The default road stage: Parish & Müller or Citygen, as
+/// [`CityConfig::road_mode`](crate::CityConfig) says.
+#[derive(Debug, Clone, Default)]
+pub struct ConfiguredRoads {
+    /// The P&M stage (with its optional custom goals).
+    pub parish_muller: ParishMullerRoads,
+}
+
+impl RoadStage for ConfiguredRoads {
+    fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput> {
+        match cx.config.road_mode {
+            RoadMode::ParishMuller => self.parish_muller.roads(cx),
+            RoadMode::Citygen => CitygenRoads.roads(cx),
+        }
+    }
+}
+
+/// A stable id of a cell: a hash of its sorted boundary positions.
+pub fn stable_cell_id(cell: &Cell) -> u64 {
+    let mut keys: Vec<(u64, u64)> = cell
+        .boundary
+        .polygon
+        .points()
+        .iter()
+        .map(|p| (p.x.to_bits(), p.y.to_bits()))
+        .collect();
+    keys.sort_unstable();
+    keys.iter().fold(0x00C1_7C3E_u64, |h, &(x, y)| {
+        splitmix64(splitmix64(h ^ x) ^ y)
+    })
+}
+
+/// Runs the Citygen mode's road part: primary network, cells, secondary growth, union.
+/// Returns the P&M growth report too when the primary network came from it.
+///
+/// # Errors
+/// Configuration errors, a primary graph file that cannot be read, a failed stage.
+pub fn citygen_network(
+    cx: &StageContext<'_>,
+) -> Result<(CitygenNetwork, Option<polis_roads::GrowthReport>)> {
+    let cg = &cx.config.citygen;
+    cg.validate()?;
+    let (primary, growth) = primary_network(cx)?;
+    let decomposition = polis_cells::extract_with(&primary, &cx.config.cells)?;
+    // Maps: water and parks through lazily cached lattices, as the P&M stage reads them.
+    let params = cx.config.effective_road_params();
+    let spacing = polis_roads::procedural_lattice_m(&params);
+    let window = params.bounds();
+    let cache = |map: &Arc<dyn Field>| -> Result<Arc<dyn Field>> {
+        Ok(Arc::new(polis_roads::LazyLattice::new(
+            Arc::clone(map),
+            spacing,
+            window,
+        )?))
+    };
+    let water = cx
+        .maps
+        .has_water
+        .then(|| cache(&cx.maps.inputs.water))
+        .transpose()?;
+    let parks = cx
+        .maps
+        .has_parks
+        .then(|| cache(&cx.maps.inputs.parks))
+        .transpose()?;
+    let maps = CellMaps {
+        water: water.as_deref(),
+        parks: parks.as_deref(),
+        step_m: params.legality_step_m,
+    };
+    let mut presets = Vec::new();
+    for n in Neighbourhood::ALL {
+        let mut p = n
+            .preset()
+            .map_err(polis_roads::RoadError::from)?
+            .to_params(cg.unit_m);
+        p.road_width_m.value *= cg.road_width_factor;
+        presets.push((n, p));
+    }
+    let seed = cx.seed(Stage::Roads, 1);
+    let started = std::time::Instant::now();
+    let grown: Vec<Result<std::result::Result<SecondaryRoads, Skip>>> = decomposition
+        .cells
+        .par_iter()
+        .map(|cell| {
+            let id = stable_cell_id(cell);
+            let skip = |reason: String| Skip {
+                stage: Stage::Roads,
+                id,
+                reason,
+            };
+            let region = match cell.polygon_with_holes() {
+                Ok(r) => r,
+                Err(e) => return Ok(Err(skip(format!("cell {id}: {e}")))),
+            };
+            let n = neighbourhood_of(cx, &region);
+            let params = presets
+                .iter()
+                .find(|(m, _)| *m == n)
+                .map(|(_, p)| p.clone())
+                .unwrap_or_default();
+            let input = SecondaryCell {
+                id,
+                region,
+                filaments: filament_segments(cell),
+            };
+            let result = SecondaryGrowth::new(params).and_then(|mut g| g.grow(&input, &maps, seed));
+            match result {
+                Ok(r) => Ok(Ok(r)),
+                Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
+                Err(e) => Err(secondary_error(e)),
+            }
+        })
+        .collect();
+    let secondary_s = started.elapsed().as_secs_f64();
+    let mut cells = Vec::with_capacity(grown.len());
+    let mut skipped = Vec::new();
+    for g in grown {
+        match g? {
+            Ok(r) => cells.push(r),
+            Err(s) => skipped.push(s),
+        }
+    }
+    let network = union(&primary, &cells)?;
+    Ok((
+        CitygenNetwork {
+            primary,
+            cells,
+            network,
+            skipped,
+            secondary_s,
+        },
+        growth,
+    ))
+}
+
+fn secondary_error(e: SecondaryError) -> Error {
+    Error::Roads(e.into())
+}
+
+/// The filament roads inside a cell, as segments.
+fn filament_segments(cell: &Cell) -> Vec<[DVec2; 2]> {
+    cell.filaments
+        .iter()
+        .flat_map(|f| f.points.windows(2).map(|w| [w[0], w[1]]))
+        .collect()
+}
+
+/// The neighbourhood the configuration gives the cell with region `region`: the first
+/// override inside it, else the highest population band reached at the mean of its outer
+/// ring's vertices, else [`CitygenConfig::neighbourhood`].
+pub fn neighbourhood_of(
+    cx: &StageContext<'_>,
+    region: &polis_geom::PolygonWithHoles,
+) -> Neighbourhood {
+    let cg = &cx.config.citygen;
+    for o in &cg.overrides {
+        if region.contains(DVec2::new(o.at[0], o.at[1])) {
+            return o.neighbourhood;
+        }
+    }
+    let pts = region.outer.points();
+    let centre = pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64;
+    let density = cx.maps.inputs.population.sample(centre);
+    cg.by_population
+        .iter()
+        .filter(|b| density >= b.min_density)
+        .max_by(|a, b| a.min_density.total_cmp(&b.min_density))
+        .map_or(cg.neighbourhood, |b| b.neighbourhood)
+}
+
+/// Primary and secondary roads in one planar graph, cells joined in order.
+fn union(primary: &RoadNetwork, cells: &[SecondaryRoads]) -> Result<RoadNetwork> {
+    let mut net = primary.clone();
+    let snap = SnapOptions {
+        snap_distance: 0.01,
+    };
+    for cell in cells {
+        for (a, b, road) in cell.segments() {
+            match net.insert_segment_with(a, b, *road, &snap, |_| Junction::default()) {
+                Ok(_) | Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+    Ok(net)
+}
+
+/// The primary network of the configured source.
+fn primary_network(
+    cx: &StageContext<'_>,
+) -> Result<(RoadNetwork, Option<polis_roads::GrowthReport>)> {
+    match &cx.config.citygen.primary {
+        PrimarySource::Highways => {
+            let mut config = cx.config.clone();
+            config.roads.street_branch_probability = 0.0;
+            let scx = StageContext {
+                config: &config,
+                maps: cx.maps,
+            };
+            let out = ParishMullerRoads::default().roads(&scx)?;
+            Ok((highways_of(&out.network)?, out.growth))
+        }
+        PrimarySource::Rings {
+            centre,
+            rings,
+            spacing_m,
+            spokes,
+            piece_m,
+        } => Ok((
+            rings_network(
+                cx.config.size_m,
+                DVec2::new(centre[0], centre[1]),
+                *rings,
+                *spacing_m,
+                *spokes,
+                *piece_m,
+            )?,
+            None,
+        )),
+        PrimarySource::Graph { path } => {
+            let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+                path: path.clone(),
+                source,
+            })?;
+            let net: RoadNetwork = serde_json::from_str(&text).map_err(|e| Error::Parse {
+                source_name: path.display().to_string(),
+                message: e.to_string(),
+            })?;
+            net.check_invariants()?;
+            Ok((net, None))
+        }
+    }
+}
+
+/// The highway edges of `net` and their junctions (same positions, new ids).
+fn highways_of(net: &RoadNetwork) -> Result<RoadNetwork> {
+    let mut out = RoadNetwork::new();
+    let mut map = vec![None; net.node_bound()];
+    for (_, u, v, road) in net.edges() {
+        if road.class != RoadClass::Highway {
+            continue;
+        }
+        let mut id = |n: polis_geom::NodeId, out: &mut RoadNetwork| -> Result<polis_geom::NodeId> {
+            if let Some(Some(m)) = map.get(n.index()) {
+                return Ok(*m);
+            }
+            let m = out.add_node(net.position(n)?, *net.node_payload(n)?)?;
+            if let Some(slot) = map.get_mut(n.index()) {
+                *slot = Some(m);
+            }
+            Ok(m)
+        };
+        let (a, b) = (id(u, &mut out)?, id(v, &mut out)?);
+        out.add_edge(a, b, *road)?;
+    }
+    Ok(out)
+}
+
+/// Rings and spokes inside the square of side `size_m` centred on the origin, with the
+/// square's edge as the outermost road.
+fn rings_network(
+    size_m: f64,
+    centre: DVec2,
+    rings: u32,
+    spacing: f64,
+    spokes: u32,
+    piece: f64,
+) -> Result<RoadNetwork> {
+    let h = size_m * 0.5;
+    let inside = |p: DVec2| p.x.abs() < h && p.y.abs() < h;
+    let mut net = RoadNetwork::new();
+    let snap = SnapOptions::default();
+    let road = |width: f64| Road {
+        class: RoadClass::Highway,
+        width,
+        bridge: false,
+        step: 0,
+    };
+    let add = |net: &mut RoadNetwork, a: DVec2, b: DVec2, w: f64| -> Result<()> {
+        match net.insert_segment_with(a, b, road(w), &snap, |_| Junction::default()) {
+            Ok(_) | Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => Ok(()),
+            Err(e) => Err(e.into()),
+        }
+    };
+    let corners = [
+        DVec2::new(-h, -h),
+        DVec2::new(h, -h),
+        DVec2::new(h, h),
+        DVec2::new(-h, h),
+    ];
+    for i in 0..4 {
+        add(&mut net, corners[i], corners[(i + 1) % 4], 16.0)?;
+    }
+    for k in 1..=rings {
+        let r = spacing * k as f64;
+        let n = ((std::f64::consts::TAU * r / piece).ceil() as usize).max(12);
+        let at = |i: usize| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            centre + r * DVec2::new(a.cos(), a.sin())
+        };
+        for i in 0..n {
+            let (a, b) = (at(i), at(i + 1));
+            if inside(a) && inside(b) {
+                add(&mut net, a, b, 20.0)?;
+            }
+        }
+    }
+    for s in 0..spokes {
+        let a = std::f64::consts::TAU * (s as f64 + 0.5) / spokes as f64;
+        let d = DVec2::new(a.cos(), a.sin());
+        let start = centre + spacing * d;
+        // To the square's edge.
+        let tx = if d.x.abs() > 1e-12 {
+            ((h.copysign(d.x)) - start.x) / d.x
+        } else {
+            f64::INFINITY
+        };
+        let ty = if d.y.abs() > 1e-12 {
+            ((h.copysign(d.y)) - start.y) / d.y
+        } else {
+            f64::INFINITY
+        };
+        let t = tx.min(ty);
+        if t.is_finite() && t > 0.0 && inside(start) {
+            add(&mut net, start, start + d * t, 16.0)?;
+        }
+    }
+    Ok(net)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::CityConfig;
+
+    fn small_rings() -> CityConfig {
+        let mut c = CityConfig::preset("milan").unwrap();
+        c.size_m = 1400.0;
+        c.citygen.primary = PrimarySource::Rings {
+            centre: [0.0, 0.0],
+            rings: 2,
+            spacing_m: 300.0,
+            spokes: 6,
+            piece_m: 150.0,
+        };
+        c
+    }
+
+    fn network(config: &CityConfig, threads: usize) -> CitygenNetwork {
+        let maps = crate::CityMaps::build(&config.maps, 7).unwrap();
+        let cx = StageContext {
+            config,
+            maps: &maps,
+        };
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| citygen_network(&cx))
+            .unwrap()
+            .0
+    }
+
+    #[test]
+    fn the_road_part_is_planar_joined_and_the_same_on_any_thread_count() {
+        let config = small_rings();
+        let a = network(&config, 1);
+        let b = network(&config, 3);
+        a.network.check_invariants().unwrap();
+        assert!(
+            a.cells.len() >= 8,
+            "{} cells, {:?}",
+            a.cells.len(),
+            a.skipped
+        );
+        let json = |n: &CitygenNetwork| serde_json::to_string(&n.network).unwrap();
+        assert_eq!(json(&a), json(&b));
+        // Every cell's secondary roads are in the union, joined to the primary network:
+        // every street component of the union reaches a highway.
+        let streets: usize = a.cells.iter().map(|c| c.segments().count()).sum();
+        let union_streets = a
+            .network
+            .edges()
+            .filter(|e| e.3.class == RoadClass::Street)
+            .count();
+        assert!(union_streets >= streets && streets > 100);
+        for comp in a.network.connected_components() {
+            let highway = comp.iter().any(|&n| {
+                a.network
+                    .edges_at(n)
+                    .unwrap()
+                    .iter()
+                    .any(|&e| a.network.edge_payload(e).unwrap().class == RoadClass::Highway)
+            });
+            assert!(highway, "a street component away from the primary network");
+        }
+    }
+
+    #[test]
+    fn cell_ids_are_stable_under_edits_elsewhere() {
+        let config = small_rings();
+        let a = network(&config, 1);
+        // A different centre moves every cell; the same network gives the same ids.
+        let b = network(&config, 2);
+        let ids = |n: &CitygenNetwork| n.cells.iter().map(|c| c.cell).collect::<Vec<_>>();
+        assert_eq!(ids(&a), ids(&b));
+        let mut set = ids(&a);
+        set.sort_unstable();
+        set.dedup();
+        assert_eq!(set.len(), a.cells.len(), "ids are unique");
+    }
+
+    #[test]
+    fn overrides_and_population_bands_pick_neighbourhoods() {
+        let mut config = small_rings();
+        config.citygen.by_population.clear();
+        config.citygen.neighbourhood = Neighbourhood::Industrial;
+        config.citygen.overrides = vec![CellOverride {
+            at: [0.0, 0.0],
+            neighbourhood: Neighbourhood::Manhattan,
+        }];
+        let maps = crate::CityMaps::build(&config.maps, 7).unwrap();
+        let cx = StageContext {
+            config: &config,
+            maps: &maps,
+        };
+        let square = |c: f64, h: f64| {
+            polis_geom::PolygonWithHoles::from(polis_geom::Polygon::new(vec![
+                DVec2::new(c - h, -h),
+                DVec2::new(c + h, -h),
+                DVec2::new(c + h, h),
+                DVec2::new(c - h, h),
+            ]))
+        };
+        assert_eq!(
+            neighbourhood_of(&cx, &square(0.0, 50.0)),
+            Neighbourhood::Manhattan
+        );
+        assert_eq!(
+            neighbourhood_of(&cx, &square(500.0, 50.0)),
+            Neighbourhood::Industrial
+        );
+        config.citygen.by_population = vec![PopulationBand {
+            min_density: -1.0,
+            neighbourhood: Neighbourhood::Organic,
+        }];
+        let cx = StageContext {
+            config: &config,
+            maps: &maps,
+        };
+        assert_eq!(
+            neighbourhood_of(&cx, &square(500.0, 50.0)),
+            Neighbourhood::Organic
+        );
+    }
+
+    #[test]
+    fn the_default_mode_leaves_configurations_as_they_were() {
+        let c = CityConfig::preset("default").unwrap();
+        assert_eq!(c.road_mode, RoadMode::ParishMuller);
+        let json = c.to_json();
+        assert!(
+            !json.contains("road_mode") && !json.contains("citygen"),
+            "{json}"
+        );
+        for name in ["suburbia", "citygen", "milan"] {
+            let c = CityConfig::preset(name).unwrap();
+            assert_eq!(c.road_mode, RoadMode::Citygen, "{name}");
+            let back = CityConfig::from_json(&c.to_json(), name).unwrap();
+            assert_eq!(back, c);
+        }
+    }
+
+    #[test]
+    fn bad_citygen_options_are_config_errors() {
+        let mut c = CityConfig::preset("milan").unwrap();
+        c.citygen.unit_m = f64::NAN;
+        assert!(matches!(c.validate(), Err(Error::Config { .. })));
+        let mut c = small_rings();
+        if let PrimarySource::Rings { rings, .. } = &mut c.citygen.primary {
+            *rings = 0;
+        }
+        assert!(matches!(c.validate(), Err(Error::Config { .. })));
+        let mut c = CityConfig::preset("milan").unwrap();
+        c.citygen.primary = PrimarySource::Graph {
+            path: "/no/such/graph.json".into(),
+        };
+        assert!(crate::generate(&c).is_err());
+    }
+}
