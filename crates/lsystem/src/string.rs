@@ -221,8 +221,11 @@ impl ModuleString for ParamString {
         if i < src.heads.len() {
             let (s, e) = src.range(i);
             self.begin(src.symbol(i));
-            if let Some(p) = src.params.get(s..e) {
-                self.params.extend_from_slice(p);
+            match src.params.get(s..e) {
+                // One or no parameter (most modules): a plain push, not a `memcpy` call.
+                Some(&[v]) => self.params.push(v),
+                Some(p) => self.params.extend_from_slice(p),
+                None => {}
             }
         }
     }

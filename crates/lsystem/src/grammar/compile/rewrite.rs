@@ -98,11 +98,11 @@ impl Grammar {
         }
         vars.clear();
         for &k in left.iter() {
-            vars.extend_from_slice(s.params(k as usize));
+            push_params(vars, s.params(k as usize));
         }
-        vars.extend_from_slice(s.params(i));
+        push_params(vars, s.params(i));
         for &k in right.iter() {
-            vars.extend_from_slice(s.params(k as usize));
+            push_params(vars, s.params(k as usize));
         }
         Some(vars)
     }
@@ -259,6 +259,15 @@ type Lent<'s, 'x> = (
     &'x mut Vec<f64>,
     &'s mut Vec<f64>,
 );
+
+/// Appends parameters; one parameter (the common case) without a `memcpy` call.
+#[inline(always)]
+fn push_params(vars: &mut Vec<f64>, p: &[f64]) {
+    match p {
+        &[v] => vars.push(v),
+        _ => vars.extend_from_slice(p),
+    }
+}
 
 /// Symbol and parameter count of module `pos` match the pattern module.
 #[inline]
