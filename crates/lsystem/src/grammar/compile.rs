@@ -682,7 +682,14 @@ impl Rules for Grammar {
         scratch: &mut GrammarScratch,
         dst: &mut ParamString,
     ) -> Result<bool> {
-        Ok(self.apply(&self.productions, src, i, branches, rng, scratch, dst))
+        // Most modules of a string have no production (turtle symbols, brackets): that is
+        // decided here, inline, without entering `apply`.
+        match self.productions.by_symbol.get(src.symbol(i) as usize) {
+            Some(list) if !list.is_empty() => {
+                Ok(self.apply(&self.productions, src, i, branches, rng, scratch, dst))
+            }
+            _ => Ok(false),
+        }
     }
     fn has_decomposition(&self) -> bool {
         !self.decompositions.productions.is_empty()

@@ -152,6 +152,7 @@ impl Grammar {
     }
 
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     pub(super) fn apply(
         &self,
         table: &Table,
