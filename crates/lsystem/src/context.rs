@@ -33,6 +33,7 @@ const NONE: u32 = u32::MAX;
 pub struct BranchIndex {
     partner: Vec<u32>,
     stack: Vec<u32>,
+    bracket_free: bool,
 }
 
 impl BranchIndex {
@@ -42,10 +43,15 @@ impl BranchIndex {
         self.partner.clear();
         self.partner.resize(n, NONE);
         self.stack.clear();
+        self.bracket_free = true;
         for i in 0..n {
             match kind(i) {
-                ModuleKind::BranchOpen => self.stack.push(i as u32),
+                ModuleKind::BranchOpen => {
+                    self.bracket_free = false;
+                    self.stack.push(i as u32);
+                }
                 ModuleKind::BranchClose => {
+                    self.bracket_free = false;
                     if let Some(o) = self.stack.pop() {
                         if let Some(p) = self.partner.get_mut(o as usize) {
                             *p = i as u32;
@@ -67,6 +73,14 @@ impl BranchIndex {
             Some(&p) if p != NONE => Some(p as usize),
             _ => None,
         }
+    }
+
+    /// `true` if the last [`rebuild`](Self::rebuild) saw no bracket at all (then every
+    /// context is made of neighbouring modules, ignored ones aside). `false` for an index
+    /// never built.
+    #[inline]
+    pub fn bracket_free(&self) -> bool {
+        self.bracket_free
     }
 
     /// Heap bytes reserved.

@@ -245,6 +245,13 @@ pub trait Rules {
     /// `true` if the string may hold query or communication modules, so the
     /// interpretation pass must run after a step.
     fn needs_pass(&self, s: &Self::String) -> bool;
+    /// `false` if no production or decomposition rule ever writes a query or
+    /// communication module: a string without them then stays without them, and the
+    /// engine skips [`needs_pass`](Self::needs_pass) once it has said `false` (until the
+    /// string is replaced or edited). Default: `true` (always ask).
+    fn may_introduce_pass(&self) -> bool {
+        true
+    }
     /// Checks storage limits after a rewrite (e.g. the parameter arena). Default: none.
     fn check_storage(&self, _s: &Self::String) -> Result<()> {
         Ok(())
@@ -320,6 +327,9 @@ macro_rules! forward_rules {
             fn check_storage(&self, s: &Self::String) -> Result<()> {
                 (**self).check_storage(s)
             }
+            fn may_introduce_pass(&self) -> bool {
+                (**self).may_introduce_pass()
+            }
         }
     )*};
 }
@@ -367,6 +377,11 @@ pub struct Derivation<R: Rules> {
     rng: Pcg64Mcg,
     step: usize,
     passed: bool,
+    /// The current string is known to hold no query or communication module.
+    pass_free: bool,
+    /// Length of the last step's rewritten string over its input's (sizes the next
+    /// step's buffer); `None` before the first step.
+    growth: Option<f64>,
 }
 
 impl<R: Rules> Derivation<R> {
@@ -384,6 +399,8 @@ impl<R: Rules> Derivation<R> {
             scratch: R::Scratch::default(),
             step: 0,
             passed: false,
+            pass_free: false,
+            growth: None,
         }
     }
 
@@ -402,6 +419,8 @@ impl<R: Rules> Derivation<R> {
         self.rng = Pcg64Mcg::seed_from_u64(seed);
         self.step = 0;
         self.passed = false;
+        self.pass_free = false;
+        self.growth = None;
     }
 
     /// The current string.
@@ -411,6 +430,7 @@ impl<R: Rules> Derivation<R> {
 
     /// Mutable access to the current string (e.g. to edit parameters between steps).
     pub fn string_mut(&mut self) -> &mut R::String {
+        self.pass_free = false;
         &mut self.current
     }
 
@@ -522,6 +542,7 @@ impl<R: Rules> Derivation<R> {
             branches,
             scratch,
             rng,
+            growth,
             ..
         } = self;
         let max_len = options.max_len;
@@ -530,6 +551,11 @@ impl<R: Rules> Derivation<R> {
             branches.rebuild(n, |i| rules.kind(current, i));
         }
         next.clear();
+        // Size the buffer from the last step's growth (the same length before the first
+        // step), with 1/16 slack, so it is not grown by doubling and copying.
+        let ratio = growth.unwrap_or(1.0);
+        let estimate = (n as f64 * ratio * (17.0 / 16.0)).ceil() + 16.0;
+        next.reserve_like(current, estimate.min(max_len as f64 + 1.0) as usize);
         let mut i = 0;
         while i < n {
             if rules.kind(current, i) == ModuleKind::Cut {
@@ -561,6 +587,9 @@ impl<R: Rules> Derivation<R> {
             i += 1;
         }
         rules.check_storage(next)?;
+        if n > 0 {
+            self.growth = Some(self.next.len() as f64 / n as f64);
+        }
         if self.rules.has_decomposition() {
             self.decompose_next(report.step)?;
         }
@@ -618,7 +647,11 @@ impl<R: Rules> Derivation<R> {
         mut env: Option<&mut E>,
     ) -> Result<usize> {
         self.passed = true;
+        if self.pass_free && !self.rules.may_introduce_pass() {
+            return Ok(0);
+        }
         if !self.rules.needs_pass(&self.current) {
+            self.pass_free = true;
             return Ok(0);
         }
         self.ensure_levels();

@@ -24,6 +24,11 @@ pub trait ModuleString: Default + Clone {
     fn push_copy(&mut self, src: &Self, i: usize);
     /// Bytes of heap memory currently reserved by this string.
     fn heap_bytes(&self) -> usize;
+    /// Reserves room for `modules` modules shaped on average like those of `like` (for
+    /// [`ParamString`]: as many parameters per module), so that a derivation step that
+    /// writes about that many does not grow the buffer by repeated doubling and copying.
+    /// Only capacity changes. Default: nothing.
+    fn reserve_like(&mut self, _like: &Self, _modules: usize) {}
 }
 
 impl<M: Clone> ModuleString for Vec<M> {
@@ -43,6 +48,9 @@ impl<M: Clone> ModuleString for Vec<M> {
     }
     fn heap_bytes(&self) -> usize {
         self.capacity() * std::mem::size_of::<M>()
+    }
+    fn reserve_like(&mut self, _like: &Self, modules: usize) {
+        self.reserve(modules.saturating_sub(self.len()));
     }
 }
 
@@ -213,14 +221,24 @@ impl ModuleString for ParamString {
         if i < src.heads.len() {
             let (s, e) = src.range(i);
             self.begin(src.symbol(i));
-            if let Some(p) = src.params.get(s..e) {
-                self.params.extend_from_slice(p);
+            match src.params.get(s..e) {
+                // One or no parameter (most modules): a plain push, not a `memcpy` call.
+                Some(&[v]) => self.params.push(v),
+                Some(p) => self.params.extend_from_slice(p),
+                None => {}
             }
         }
     }
     fn heap_bytes(&self) -> usize {
         self.heads.capacity() * std::mem::size_of::<Head>()
             + self.params.capacity() * std::mem::size_of::<f64>()
+    }
+    fn reserve_like(&mut self, like: &Self, modules: usize) {
+        let per_module = like.params.len() as f64 / like.heads.len().max(1) as f64;
+        let params = (modules as f64 * per_module).ceil().min(MAX_PARAMS as f64) as usize;
+        self.heads.reserve(modules.saturating_sub(self.heads.len()));
+        self.params
+            .reserve(params.saturating_sub(self.params.len()));
     }
 }
 

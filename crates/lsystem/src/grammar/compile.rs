@@ -8,12 +8,13 @@ use super::ast::{GrammarAst, ModuleCall, PatternItem, ProductionAst, Section};
 use super::expr::{self, BinaryOp, Expr, Op};
 use super::parse;
 use crate::command::{Command, ModuleKind, QueryKind};
-use crate::context::{BranchIndex, ContextItem, ContextView, match_left, match_right};
+use crate::context::{BranchIndex, ContextItem, ContextView};
 use crate::derivation::{Derivation, DeriveOptions, Rules};
 use crate::error::{LsystemError, Result};
-use crate::random::pick_weighted;
 use crate::string::ParamString;
 use crate::turtle::TurtleState;
+
+mod rewrite;
 
 /// Symbols with a fixed id and meaning in every grammar, in id order.
 pub const BUILTIN_SYMBOLS: &[(&str, Command)] = &[
@@ -72,6 +73,8 @@ enum Arg {
     VarConst(u32, BinaryOp, f64),
     ConstVar(f64, BinaryOp, u32),
     VarVar(u32, BinaryOp, u32),
+    /// `a op b` with `a` and `b` of the shapes above, stored in `Grammar::pairs`.
+    Pair(BinaryOp, u32),
     Code(u32, u32),
 }
 
@@ -125,9 +128,12 @@ pub struct Grammar {
     decompositions: Table,
     interpretations: Table,
     code: Vec<Op>,
+    pairs: Vec<(Arg, Arg)>,
     axiom: ParamString,
     defines: Vec<(String, f64)>,
     context_sensitive: bool,
+    ignores_any: bool,
+    introduces_pass: bool,
     needs_pass: bool,
     pass_symbols: Vec<bool>,
 }
@@ -229,9 +235,12 @@ impl Grammar {
             decompositions: Table::default(),
             interpretations: Table::default(),
             code: Vec::new(),
+            pairs: Vec::new(),
             axiom: ParamString::new(),
             defines: Vec::new(),
             context_sensitive: false,
+            ignores_any: false,
+            introduces_pass: false,
             needs_pass: false,
             pass_symbols: Vec::new(),
             ast: GrammarAst::default(),
@@ -259,6 +268,7 @@ impl Grammar {
                 *f = true;
             }
         }
+        g.ignores_any = g.ignore.iter().any(|&f| f);
         for s in &ast.communication {
             let id = g.intern(s) as usize;
             let kind = g.kinds.get(id).copied().unwrap_or(ModuleKind::Plain);
@@ -285,12 +295,12 @@ impl Grammar {
             .map(|c| matches!(c, Command::Query(_) | Command::Communicate))
             .collect();
         let uses_pass = |id: u32| pass_symbols.get(id as usize).copied().unwrap_or(false);
-        g.needs_pass = g.axiom.iter().any(|(s, _)| uses_pass(s))
-            || [&g.productions, &g.decompositions].iter().any(|t| {
-                t.productions
-                    .iter()
-                    .any(|p| p.successor.iter().any(|m| uses_pass(m.symbol)))
-            });
+        g.introduces_pass = [&g.productions, &g.decompositions].iter().any(|t| {
+            t.productions
+                .iter()
+                .any(|p| p.successor.iter().any(|m| uses_pass(m.symbol)))
+        });
+        g.needs_pass = g.axiom.iter().any(|(s, _)| uses_pass(s)) || g.introduces_pass;
         g.pass_symbols = pass_symbols;
         g.ast = ast;
         Ok(g)
@@ -404,14 +414,7 @@ impl Grammar {
                     Expr::Var(n) => {
                         Arg::Var(slot(n).ok_or_else(|| err(format!("unknown name `{n}`")))?)
                     }
-                    _ if !has_vars(&e) && !e.is_random() => {
-                        Arg::Const(expr::eval_const(&e, &|_| None).map_err(err)?)
-                    }
-                    _ => {
-                        let start = self.code.len() as u32;
-                        expr::compile(&e, &slot, &mut self.code).map_err(err)?;
-                        Arg::Code(start, self.code.len() as u32)
-                    }
+                    _ => self.compile_arg(&e, &slot).map_err(err)?,
                 };
                 args.push(arg);
             }
@@ -463,44 +466,20 @@ impl Grammar {
         e: &Expr,
         slot: &dyn Fn(&str) -> Option<u32>,
     ) -> core::result::Result<Arg, String> {
-        let var = |e: &Expr| match e {
-            Expr::Var(n) => slot(n),
-            _ => None,
-        };
-        let num = |e: &Expr| match e {
-            Expr::Num(v) => Some(*v),
-            _ => None,
-        };
-        if !has_vars(e) && !e.is_random() {
-            return Ok(Arg::Const(expr::eval_const(e, &|_| None)?));
+        if let Some(a) = simple_shape(e, slot)? {
+            return Ok(a);
         }
-        if let Some(k) = var(e) {
-            return Ok(Arg::Var(k));
-        }
-        if let Expr::Binary(op, a, b) = e {
-            match (var(a), num(a), var(b), num(b)) {
-                (Some(x), _, _, Some(c)) => return Ok(Arg::VarConst(x, *op, c)),
-                (_, Some(c), Some(y), _) => return Ok(Arg::ConstVar(c, *op, y)),
-                (Some(x), _, Some(y), _) => return Ok(Arg::VarVar(x, *op, y)),
-                _ => {}
-            }
+        // `a op b` of two simple shapes (e.g. `0.25*x + 0.75*y`, `x + y + z`): evaluated
+        // left then right like the bytecode, so the result is bit-identical.
+        if let Expr::Binary(op, a, b) = e
+            && let (Ok(Some(x)), Ok(Some(y))) = (simple_shape(a, slot), simple_shape(b, slot))
+        {
+            self.pairs.push((x, y));
+            return Ok(Arg::Pair(*op, (self.pairs.len() - 1) as u32));
         }
         let start = self.code.len() as u32;
         expr::compile(e, slot, &mut self.code)?;
         Ok(Arg::Code(start, self.code.len() as u32))
-    }
-
-    #[inline]
-    fn eval_arg(&self, a: Arg, scratch: &mut GrammarScratch, rng: &mut Pcg64Mcg) -> f64 {
-        let var = |k: u32| scratch.vars.get(k as usize).copied().unwrap_or(f64::NAN);
-        match a {
-            Arg::Const(v) => v,
-            Arg::Var(k) => var(k),
-            Arg::VarConst(x, op, c) => expr::binary(op, var(x), c),
-            Arg::ConstVar(c, op, y) => expr::binary(op, c, var(y)),
-            Arg::VarVar(x, op, y) => expr::binary(op, var(x), var(y)),
-            Arg::Code(s, e) => self.eval((s, e), scratch, rng),
-        }
     }
 
     /// The syntax tree this grammar was compiled from.
@@ -606,159 +585,37 @@ impl Grammar {
             .copied()
             .unwrap_or(ModuleKind::Plain)
     }
+}
 
-    #[inline]
-    fn eval(&self, range: (u32, u32), scratch: &mut GrammarScratch, rng: &mut Pcg64Mcg) -> f64 {
-        let code = self
-            .code
-            .get(range.0 as usize..range.1 as usize)
-            .unwrap_or(&[]);
-        expr::run(code, &scratch.vars, &mut scratch.stack, Some(rng))
+/// `e` as one of the simple argument shapes (constant, parameter, `x op c`, `c op x`,
+/// `x op y`), if it is one.
+fn simple_shape(
+    e: &Expr,
+    slot: &dyn Fn(&str) -> Option<u32>,
+) -> core::result::Result<Option<Arg>, String> {
+    let var = |e: &Expr| match e {
+        Expr::Var(n) => slot(n),
+        _ => None,
+    };
+    let num = |e: &Expr| match e {
+        Expr::Num(v) => Some(*v),
+        _ => None,
+    };
+    if !has_vars(e) && !e.is_random() {
+        return Ok(Some(Arg::Const(expr::eval_const(e, &|_| None)?)));
     }
-
-    /// Matches contexts, binds parameters and checks the condition of `p` at module `i`.
-    #[inline]
-    fn matches(
-        &self,
-        p: &CProduction,
-        view: &TextView<'_>,
-        branches: &BranchIndex,
-        i: usize,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut GrammarScratch,
-    ) -> bool {
-        let s = view.s;
-        let eq = |&(sym, arity): &(u32, u32), pos: usize| {
-            s.symbol(pos) == sym && s.params(pos).len() == arity as usize
-        };
-        if p.left.is_empty() {
-            scratch.left.clear();
-        } else if !match_left(view, branches, i, &p.left, eq, &mut scratch.left) {
-            return false;
-        }
-        if p.right.is_empty() {
-            scratch.right.clear();
-        } else if !match_right(view, branches, i, &p.right, eq, &mut scratch.right) {
-            return false;
-        }
-        scratch.vars.clear();
-        for &k in &scratch.left {
-            scratch.vars.extend_from_slice(s.params(k as usize));
-        }
-        scratch.vars.extend_from_slice(s.params(i));
-        for &k in &scratch.right {
-            scratch.vars.extend_from_slice(s.params(k as usize));
-        }
-        match p.condition {
-            None => true,
-            Some(c) => expr::truth(self.eval_arg(c, scratch, rng)),
+    if let Some(k) = var(e) {
+        return Ok(Some(Arg::Var(k)));
+    }
+    if let Expr::Binary(op, a, b) = e {
+        match (var(a), num(a), var(b), num(b)) {
+            (Some(x), _, _, Some(c)) => return Ok(Some(Arg::VarConst(x, *op, c))),
+            (_, Some(c), Some(y), _) => return Ok(Some(Arg::ConstVar(c, *op, y))),
+            (Some(x), _, Some(y), _) => return Ok(Some(Arg::VarVar(x, *op, y))),
+            _ => {}
         }
     }
-
-    #[inline]
-    fn produce(
-        &self,
-        p: &CProduction,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut GrammarScratch,
-        dst: &mut ParamString,
-    ) {
-        for m in &p.successor {
-            dst.begin(m.symbol);
-            for a in &m.args {
-                let v = self.eval_arg(*a, scratch, rng);
-                dst.push_param(v);
-            }
-        }
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn apply(
-        &self,
-        table: &Table,
-        s: &ParamString,
-        i: usize,
-        branches: &BranchIndex,
-        rng: &mut Pcg64Mcg,
-        scratch: &mut GrammarScratch,
-        dst: &mut ParamString,
-    ) -> bool {
-        let Some(list) = table.by_symbol.get(s.symbol(i) as usize) else {
-            return false;
-        };
-        let arity = s.params(i).len() as u32;
-        let view = TextView { g: self, s };
-        for (k, &pi) in list.iter().enumerate() {
-            let Some(p) = table.productions.get(pi as usize) else {
-                continue;
-            };
-            if p.arity != arity || !self.matches(p, &view, branches, i, rng, scratch) {
-                continue;
-            }
-            let Some(w) = p.probability else {
-                self.produce(p, rng, scratch, dst);
-                return true;
-            };
-            scratch.candidates.clear();
-            scratch.candidates.push((pi, w));
-            let mut total = w;
-            for &qi in list.get(k + 1..).unwrap_or(&[]) {
-                let Some(q) = table.productions.get(qi as usize) else {
-                    continue;
-                };
-                if let Some(wq) = q.probability
-                    && q.arity == arity
-                    && self.matches(q, &view, branches, i, rng, scratch)
-                {
-                    scratch.candidates.push((qi, wq));
-                    total += wq;
-                }
-            }
-            if total <= 0.0 {
-                return false;
-            }
-            let chosen = pick_weighted(&scratch.candidates, total, pi, rng);
-            let Some(c) = table.productions.get(chosen as usize) else {
-                return false;
-            };
-            // Re-bind the chosen production's parameters (its condition held above).
-            self.rebind(c, &view, branches, i, scratch);
-            self.produce(c, rng, scratch, dst);
-            return true;
-        }
-        false
-    }
-
-    /// Binds the parameters of `p` at `i` without evaluating its condition.
-    fn rebind(
-        &self,
-        p: &CProduction,
-        view: &TextView<'_>,
-        branches: &BranchIndex,
-        i: usize,
-        scratch: &mut GrammarScratch,
-    ) {
-        let s = view.s;
-        let eq = |&(sym, arity): &(u32, u32), pos: usize| {
-            s.symbol(pos) == sym && s.params(pos).len() == arity as usize
-        };
-        scratch.left.clear();
-        scratch.right.clear();
-        if !p.left.is_empty() {
-            match_left(view, branches, i, &p.left, eq, &mut scratch.left);
-        }
-        if !p.right.is_empty() {
-            match_right(view, branches, i, &p.right, eq, &mut scratch.right);
-        }
-        scratch.vars.clear();
-        for &k in &scratch.left {
-            scratch.vars.extend_from_slice(s.params(k as usize));
-        }
-        scratch.vars.extend_from_slice(s.params(i));
-        for &k in &scratch.right {
-            scratch.vars.extend_from_slice(s.params(k as usize));
-        }
-    }
+    Ok(None)
 }
 
 struct TextView<'a> {
@@ -825,7 +682,14 @@ impl Rules for Grammar {
         scratch: &mut GrammarScratch,
         dst: &mut ParamString,
     ) -> Result<bool> {
-        Ok(self.apply(&self.productions, src, i, branches, rng, scratch, dst))
+        // Most modules of a string have no production (turtle symbols, brackets): that is
+        // decided here, inline, without entering `apply`.
+        match self.productions.by_symbol.get(src.symbol(i) as usize) {
+            Some(list) if !list.is_empty() => {
+                Ok(self.apply(&self.productions, src, i, branches, rng, scratch, dst))
+            }
+            _ => Ok(false),
+        }
     }
     fn has_decomposition(&self) -> bool {
         !self.decompositions.productions.is_empty()
@@ -890,6 +754,9 @@ impl Rules for Grammar {
                     .copied()
                     .unwrap_or(false)
             })
+    }
+    fn may_introduce_pass(&self) -> bool {
+        self.introduces_pass
     }
     fn check_storage(&self, s: &ParamString) -> Result<()> {
         if s.arena_overflowed() {
