@@ -250,11 +250,13 @@ impl Targets {
 /// foundation, so the ground between the plinth's vertices never shows under it.
 pub const PLINTH_FOOT_M: f64 = 0.5;
 
-/// Triangles of draped plinths: at most 100 m² (about 14 m sides), so a plinth bends
-/// with ground whose features are tens of metres long.
+/// Triangles of draped plinths: at most 400 m² (about 30 m sides), so a plinth bends
+/// with ground whose features are a hundred metres or more long (the preset maps'
+/// hills); between vertices it stays within `s²·κ/8` of the ground (side `s`, ground
+/// curvature `κ`), which the foot below covers.
 const PLINTH_REFINE: polis_geom::mesh::RefineOptions = polis_geom::mesh::RefineOptions {
-    max_area: 100.0,
-    min_angle_deg: 20.0,
+    max_area: 400.0,
+    min_angle_deg: 15.0,
     max_additional_vertices: 100_000,
 };
 
