@@ -246,6 +246,20 @@ impl Targets {
     }
 }
 
+/// How far a block plinth draped on an elevation map reaches below the ground, metres: a
+/// foundation, so the ground between the plinth's vertices never shows under it.
+pub const PLINTH_FOOT_M: f64 = 0.5;
+
+/// Triangles of draped plinths: at most 400 m² (about 30 m sides), so a plinth bends
+/// with ground whose features are a hundred metres or more long (the preset maps'
+/// hills); between vertices it stays within `s²·κ/8` of the ground (side `s`, ground
+/// curvature `κ`), which the foot below covers.
+const PLINTH_REFINE: polis_geom::mesh::RefineOptions = polis_geom::mesh::RefineOptions {
+    max_area: 400.0,
+    min_angle_deg: 15.0,
+    max_additional_vertices: 100_000,
+};
+
 /// How far facade skins stand out of the wall they dress, metres: enough that no
 /// renderer's depth test mixes them with the closed mass behind, far below anything a
 /// viewer can see.
@@ -431,8 +445,25 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .map(|block| {
                 let base = ground(elevation, block.polygon.outer.points());
-                let plinth =
-                    polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?;
+                let plinth = if inp.config.maps.elevation.is_some() {
+                    // On an elevation map the plinth follows the ground: its top a kerb
+                    // above it, its bottom a foot below it, at every vertex.
+                    let mut m = Mesh::new(Some(pal.pavement));
+                    let height = |p: DVec2| {
+                        let g = elevation.sample(p);
+                        if g.is_finite() { g } else { base }
+                    };
+                    m.add_draped_slab(
+                        &block.polygon,
+                        &PLINTH_REFINE,
+                        height,
+                        -PLINTH_FOOT_M,
+                        kerb,
+                    )?;
+                    m
+                } else {
+                    polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
+                };
                 let node = LeafNode {
                     name: format!("block {}", block.id()),
                     translation: DVec3::ZERO,

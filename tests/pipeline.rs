@@ -604,5 +604,28 @@ fn buildings_are_seated_on_slopes() {
             }
         }
         assert!(sloped > 20, "{mode:?}: only {sloped} buildings on slopes");
+        // Block plinths follow the ground: every vertex a kerb above it or a foot below.
+        let kerb = config.scene.kerb_height_m;
+        let mut plinths = 0;
+        for node in city
+            .scene
+            .nodes
+            .iter()
+            .filter(|n| n.name.starts_with("block "))
+        {
+            for m in solid_meshes(&city, node) {
+                for p in &m.positions {
+                    let (q, h) = polis::geom::to_layout(p.as_dvec3());
+                    let above = h - elevation.sample(q);
+                    assert!(
+                        (above - kerb).abs() < 1e-3 || (above + 0.5).abs() < 1e-3,
+                        "{}: a vertex {above} m above the ground",
+                        node.name
+                    );
+                }
+            }
+            plinths += 1;
+        }
+        assert_eq!(plinths, city.blocks.len());
     }
 }

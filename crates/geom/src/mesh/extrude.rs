@@ -384,7 +384,7 @@ fn normalized_for_walls(
     Ok(poly)
 }
 
-fn check_height(name: &'static str, h: f64) -> Result<(), GeomError> {
+pub(super) fn check_height(name: &'static str, h: f64) -> Result<(), GeomError> {
     if !h.is_finite() || h.abs() > MAX_COORDINATE {
         return Err(GeomError::InvalidParameter {
             name,

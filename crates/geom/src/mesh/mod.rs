@@ -60,6 +60,7 @@ use serde::{Deserialize, Serialize};
 use crate::GeomError;
 use crate::scene::MaterialId;
 
+mod drape;
 pub mod edge_use;
 mod extrude;
 mod normals;
