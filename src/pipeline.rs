@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use polis_geom::Field;
+use polis_geom::{Field, SpatialIndex};
 use rayon::prelude::*;
 
 use polis_buildings::Building;
@@ -415,6 +415,10 @@ impl Pipeline {
         // Blocks and lots, cell by cell in parallel (the cell's input is made in its own
         // task); results in cell order.
         let ticker = self.ticker(Stage::Lots, cells.len(), span);
+        let widest = network
+            .edges()
+            .map(|(_, _, _, r)| r.width)
+            .fold(0.0, f64::max);
         let per_cell: Vec<Result<std::result::Result<(u64, CellLots), Skip>>> = cells
             .par_iter()
             .map(|cell| {
@@ -424,6 +428,18 @@ impl Pipeline {
                     for &e in &ring.edges {
                         widths.push(network.edge_payload(e)?.width);
                     }
+                }
+                // Every road near the cell (its rings, its filaments, roads of other
+                // cells passing close by), for the lots to keep out of their corridors.
+                let reach = cell.boundary.polygon.bbox().expanded(widest * 0.5);
+                let mut nearby_roads = Vec::new();
+                for e in network.edge_index().query_box(&reach) {
+                    let (a, b) = network.endpoints(e)?;
+                    nearby_roads.push((
+                        network.position(a)?,
+                        network.position(b)?,
+                        network.edge_payload(e)?.width,
+                    ));
                 }
                 // Islands touching the boundary at a node are moved apart by a
                 // micrometre so the region is a valid polygon with holes; a cell where
@@ -446,6 +462,7 @@ impl Pipeline {
                         road_widths: widths,
                     },
                     seed: cx.seed(Stage::Lots, id),
+                    nearby_roads,
                 };
                 let lots = self.lots.lots(&input, cx);
                 ticker.tick();

@@ -215,6 +215,11 @@ pub struct CellInput<'a> {
     pub region: polis_lots::Cell,
     /// This cell's seed.
     pub seed: u64,
+    /// The roads near the cell as `(a, b, width)` segments, metres: its rings, its
+    /// filaments (dead ends and connectors inside it, which the blocks are not cut
+    /// along) and other cells' roads passing close by. No lot may enter their corridors
+    /// (centreline ± width / 2).
+    pub nearby_roads: Vec<(DVec2, DVec2, f64)>,
 }
 
 /// What the lot stage makes of one cell.
@@ -263,7 +268,11 @@ impl LotStage for KellyLots {
         for block in blocks {
             match polis_lots::subdivide_block(&block, &cx.config.lots, &mut rng) {
                 Ok(sub) => {
-                    out.lots.extend(sub.lots);
+                    out.lots.extend(
+                        sub.lots
+                            .into_iter()
+                            .filter(|lot| clear_of_roads(&lot.polygon, &input.nearby_roads)),
+                    );
                     out.green_spaces.extend(sub.green_spaces);
                     out.blocks.push(block);
                 }
@@ -276,6 +285,26 @@ impl LotStage for KellyLots {
         }
         Ok(out)
     }
+}
+
+/// Whether `lot` stays out of every road corridor of `roads` (`(a, b, width)`): its
+/// distance to each centreline is at least half the road's width.
+///
+/// Kelly's blocks are the cell inset by the roads along its rings; a filament (a dead end
+/// or connector growing into the cell) is no ring edge, so subdivision lays lots across
+/// it, and where a wide road's edge vanishes in the weighted skeleton, or another
+/// cell's road passes close by, the inset can come nearer than half its width. Such a
+/// lot would put a building on the carriageway; it is dropped, and its land stays open
+/// along the road.
+///
+/// Limitations: the whole lot is dropped rather than cut back to the corridor's edge.
+pub fn clear_of_roads(lot: &polis_geom::Polygon, roads: &[(DVec2, DVec2, f64)]) -> bool {
+    let bb = lot.bbox();
+    roads.iter().all(|&(a, b, width)| {
+        let half = width * 0.5;
+        !polis_geom::Aabb2::new(a, b).expanded(half).intersects(&bb)
+            || polis_geom::measure::polygon_segment_distance(lot, a, b) >= half
+    })
 }
 
 // ---------------------------------------------------------------------------------------
