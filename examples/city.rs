@@ -5,12 +5,15 @@
 //!     [--size METRES] [--lod N] [--segments N] [--threads N] [--out DIR]
 //!     [--population PNG] [--water PNG] [--parks PNG] [--elevation PNG METRES]
 //!     [--zoning PNG] [--max-height PNG METRES] [--report]
+//!     [--formats glb,obj,svg,geojson] [--anchor LON,LAT]
 //! cargo run --release --example city -- --help
 //! ```
 //!
 //! With no arguments it builds the `default` preset and writes `out/city.glb`,
-//! `out/city.obj` (+ `city.mtl` and the facade textures), `out/city.svg` and
-//! `out/city.geojson`, then prints counts and per-stage timings. A grey-scale PNG map
+//! `out/city.obj` (+ `city.mtl` and the facade textures in `out/textures/`),
+//! `out/city.svg` and `out/city.geojson`, then prints counts, per-stage timings and every
+//! file written. `--formats` picks the outputs; `--anchor LON,LAT` writes the GeoJSON in
+//! WGS 84 longitude/latitude around that point (local metres otherwise). A grey-scale PNG map
 //! covers the whole city square (top row = north edge); its values in [0, 1] are used as
 //! they are, except elevation and maximum height, which are scaled to the given metres
 //! and zoning, which is scaled to the six building kinds (0 skyscraper … 5 industrial).
@@ -39,7 +42,7 @@ use clap::{CommandFactory, Parser};
 use indicatif::{ProgressBar, ProgressStyle};
 use polis::geom::Aabb2;
 use polis::geom::field::FieldSpec;
-use polis::{CityConfig, MapSpec, Pipeline, Stage};
+use polis::{CityConfig, Formats, MapSpec, Pipeline, Stage, WriteOptions};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -93,6 +96,29 @@ struct Cli {
     /// Print the city statistics report and write `report.json` beside the outputs.
     #[arg(long)]
     report: bool,
+    /// Output formats to write, comma-separated: glb, obj, svg, geojson (or all).
+    #[arg(long, value_name = "LIST", default_value = "all")]
+    formats: Formats,
+    /// Where the layout origin is on Earth (degrees): the GeoJSON is then written in WGS 84
+    /// longitude/latitude (RFC 7946) instead of local metres.
+    #[arg(long, value_name = "LON,LAT", allow_hyphen_values = true, value_parser = lon_lat)]
+    anchor: Option<[f64; 2]>,
+}
+
+/// `LON,LAT` in degrees, inside WGS 84 bounds.
+fn lon_lat(text: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{e}; give LON,LAT in degrees"))?;
+    match parts[..] {
+        [lon, lat] if (-180.0..=180.0).contains(&lon) && lat > -90.0 && lat < 90.0 => {
+            Ok([lon, lat])
+        }
+        [_, _] => Err("give a longitude in [-180, 180] and a latitude in (-90, 90)".into()),
+        _ => Err("give two numbers, LON,LAT".into()),
+    }
 }
 
 /// The preset names, so clap lists them in `--help` and suggests the nearest.
@@ -114,6 +140,7 @@ struct Args {
     config: CityConfig,
     out: PathBuf,
     report: bool,
+    write: WriteOptions,
 }
 
 /// Builds the configuration from the parsed flags; a bad combination or value becomes a
@@ -203,6 +230,10 @@ fn configure(cli: Cli) -> Result<Args, clap::Error> {
         config,
         out: cli.out,
         report: cli.report,
+        write: WriteOptions {
+            formats: cli.formats,
+            anchor_lon_lat: cli.anchor,
+        },
     })
 }
 
@@ -288,7 +319,7 @@ fn run(args: &Args, progress: &Progress) -> Result<(), Box<dyn std::error::Error
     let city = pipeline.generate(c)?;
     progress.end(true);
     let t = Instant::now();
-    let written = city.write_all(&args.out)?;
+    let written = city.write_all_with(&args.out, &args.write)?;
     let write_time = t.elapsed();
 
     let s = &city.stats;

@@ -10,7 +10,7 @@
 //! let config = polis::CityConfig::preset("manhattan")?;
 //! let city = polis::generate(&config)?;
 //! println!("{} roads, {} buildings", city.stats.road_segments, city.stats.buildings);
-//! city.write_all("out")?;
+//! city.write_all("out", polis::Formats::ALL)?;
 //! # Ok::<(), polis::Error>(())
 //! ```
 //!
@@ -55,6 +55,7 @@ mod city;
 mod config;
 mod error;
 mod maps;
+mod output;
 mod pipeline;
 mod report;
 mod scene;
@@ -67,6 +68,7 @@ pub use config::{
 };
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
+pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::reference_city_name;
 pub use stages::{Skip, Stage};

@@ -62,6 +62,8 @@ fn help_exits_zero_and_lists_every_flag() {
         "--elevation <PNG> <METRES>",
         "--max-height <PNG> <METRES>",
         "--report",
+        "--formats",
+        "--anchor <LON,LAT>",
     ] {
         assert!(help.contains(flag), "--help misses {flag}:\n{help}");
     }
@@ -119,6 +121,9 @@ fn out_of_range_values_are_errors_not_clamped() {
         &["--size", "-5"],
         &["--seed", "x"],
         &["--elevation", "a.png", "high"],
+        &["--formats=glb,gltf"],
+        &["--anchor", "200,10"],
+        &["--anchor=-10"],
     ] {
         let out = run("city", args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {out:?}");
