@@ -862,6 +862,38 @@ fn encode(image: &[Vec3], width: usize, height: usize) -> BoxResult<Vec<u8>> {
 mod tests {
     use super::*;
 
+    fn parse(args: &[&str]) -> Result<Args, clap::Error> {
+        let cli = Cli::try_parse_from(std::iter::once("render").chain(args.iter().copied()))?;
+        configure(cli)
+    }
+
+    /// `--help` is help (exit 0), `--x=y` parses, typos get suggestions, and every
+    /// out-of-range value is an error rather than clamped.
+    #[test]
+    fn command_line_validates_instead_of_clamping() {
+        let help = parse(&["--help"]).err().unwrap();
+        assert_eq!(help.kind(), ErrorKind::DisplayHelp);
+        assert_eq!(help.exit_code(), 0);
+        let a = parse(&["--seed=9", "--view=-30,20,500", "--samples", "2"]).unwrap();
+        assert_eq!(a.config.seed, 9);
+        assert_eq!(a.view, [Some(-30.0), Some(20.0), Some(500.0)]);
+        assert_eq!(a.samples, 2);
+        let typo = parse(&["--sampels", "2"]).err().unwrap();
+        assert!(typo.to_string().contains("'--samples'"), "{typo}");
+        for bad in [
+            &["--samples", "9"][..],
+            &["--lod", "7"],
+            &["--fov", "180"],
+            &["--view=0,95,900"],
+            &["--width", "0"],
+            &["--width", "16384", "--height", "16384"],
+            &["--preset", "pari"],
+        ] {
+            let e = parse(bad).err().unwrap();
+            assert_ne!(e.exit_code(), 0, "{bad:?}");
+        }
+    }
+
     /// Two triangles sharing a diagonal cover every pixel centre of their square, and
     /// none outside it.
     #[test]

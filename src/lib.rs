@@ -39,6 +39,9 @@
 //! - **No panics on input**: bad configurations are [`Error::Config`] naming the field;
 //!   degenerate cells and lots are skipped and listed in [`City::report`].
 //!
+//! `use polis::prelude::*;` brings the everyday names ([`prelude`]);
+//! `examples/custom_stage.rs` plugs a custom road stage into the pipeline.
+//!
 //! The stage crates are re-exported as modules ([`roads`], [`cells`], …) for direct use.
 
 pub use polis_buildings as buildings;
@@ -57,6 +60,7 @@ mod error;
 mod maps;
 mod output;
 mod pipeline;
+pub mod prelude;
 mod report;
 mod scene;
 pub mod seed;
@@ -66,7 +70,7 @@ pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace
 pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
 };
-pub use error::{BoxError, Error, Result};
+pub use error::{BoxError, Error, PolisError, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};

@@ -1,10 +1,12 @@
-//! The `city` and `render` example programs as a user meets them: `--help` succeeds,
+//! The `city` and `custom_stage` example programs as a user meets them: `--help` succeeds,
 //! `--x=y` is accepted, a mistyped flag gets a suggestion, an out-of-range value is an
 //! error with a non-zero exit status, and the error starts its own line.
 //!
 //! `cargo test` builds every example next to the test binaries
 //! (`target/<profile>/examples/`); the tests run those binaries. Running this file alone
 //! (`cargo test --test cli`) does not build examples: run `cargo build --examples` first.
+//! (The `render` example is built as a test harness, so its command line is tested by
+//! its own unit tests.)
 
 #![allow(clippy::expect_used)] // tests may panic on failure
 
@@ -70,15 +72,6 @@ fn help_exits_zero_and_lists_every_flag() {
     // The presets are listed, so a user can pick one without reading the source.
     assert!(help.contains("manhattan"), "{help}");
     assert!(out.stderr.is_empty(), "{}", text(&out.stderr));
-
-    let out = run("render", &["-h"]);
-    assert!(out.status.success(), "{out:?}");
-    for flag in ["--view", "--target", "--samples", "--fov", "--lod"] {
-        assert!(
-            text(&out.stdout).contains(flag),
-            "render --help misses {flag}"
-        );
-    }
 }
 
 #[test]
@@ -129,18 +122,6 @@ fn out_of_range_values_are_errors_not_clamped() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {out:?}");
         assert!(text(&out.stderr).starts_with("error: "), "{args:?}");
     }
-
-    for args in [
-        &["--samples", "9"][..],
-        &["--lod", "7"],
-        &["--fov", "180"],
-        &["--view=0,95,900"],
-        &["--width", "0"],
-    ] {
-        let out = run("render", args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {out:?}");
-        assert!(text(&out.stderr).starts_with("error: "), "{args:?}");
-    }
 }
 
 #[test]
@@ -159,4 +140,20 @@ fn config_errors_start_on_their_own_line() {
     assert!(err.contains("size_m"), "{err}");
     assert!(!err.contains('\r'), "{err:?}");
     assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn the_custom_road_stage_makes_a_whole_city() {
+    let dir = std::env::temp_dir().join(format!("polis-cli-grid-{}", std::process::id()));
+    let out = run("custom_stage", &["150", dir.to_str().expect("utf-8 path")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.starts_with("grid roads every 150 m"), "{stdout}");
+    assert!(dir.join("city.svg").is_file() && dir.join("city.glb").is_file());
+    assert!(!dir.join("city.obj").exists(), "only the formats asked for");
+    let _ = std::fs::remove_dir_all(&dir);
+    // A bad parameter is the stage's typed error, not a panic.
+    let out = run("custom_stage", &["5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).starts_with("error: stage roads: spacing 5 m"));
 }
