@@ -55,6 +55,7 @@ pub use polis_roads as roads;
 pub use polis_stats as stats;
 
 mod city;
+mod clock;
 mod config;
 mod error;
 mod maps;
