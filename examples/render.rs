@@ -5,6 +5,7 @@
 //! cargo run --release --example render -- [--preset NAME] [--seed N] [--size METRES]
 //!     [--lod N] [--target X,Y] [--view AZIMUTH,ELEVATION,DISTANCE] [--fov DEGREES]
 //!     [--width PX] [--height PX] [--samples N] [--out FILE.png]
+//! cargo run --release --example render -- --help
 //! ```
 //!
 //! The camera looks at `--target` (layout metres: x east, y north; default the centre of
@@ -27,6 +28,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser};
 use polis::geom::field::decode_png_rgba8;
 use polis::geom::glam::{DVec3, Vec2, Vec3};
 use polis::geom::scene::{ImageData, Scene};
@@ -36,11 +39,51 @@ use rayon::prelude::*;
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-const USAGE: &str = "usage: render [--preset NAME] [--seed N] [--size METRES] [--lod N] \
-    [--target X,Y] [--view AZIMUTH,ELEVATION,DISTANCE] [--fov DEGREES] [--width PX] \
-    [--height PX] [--samples N] [--out FILE.png]";
-
 type BoxResult<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Render a generated city's 3-D scene to a PNG with a software rasteriser.
+#[derive(Debug, Parser)]
+#[command(name = "render", version)]
+struct Cli {
+    /// The built-in preset to generate.
+    #[arg(long, value_name = "NAME", default_value = "default", value_parser = preset_names())]
+    preset: String,
+    /// The city seed.
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Side of the square map in metres (10 to 1,000,000).
+    #[arg(long, value_name = "METRES", value_parser = positive)]
+    size: Option<f64>,
+    /// Level of detail of the buildings, 0 to the preset's `buildings.max_lod`.
+    #[arg(long, value_name = "N")]
+    lod: Option<usize>,
+    /// Layout point looked at (metres: x east, y north). Default: the tallest buildings.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = numbers::<2>)]
+    target: Option<[f64; 2]>,
+    /// Camera: azimuth (degrees clockwise from north), elevation (degrees, within ±89),
+    /// distance (metres, positive). Default: from the city centre's side, 24°, 900 m.
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,DISTANCE", allow_hyphen_values = true,
+          value_parser = view)]
+    view: Option<[f64; 3]>,
+    /// Vertical field of view in degrees (1 to 170).
+    #[arg(long, value_name = "DEGREES", default_value_t = 40.0, value_parser = fov)]
+    fov: f64,
+    /// Image width in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 1280,
+          value_parser = clap::value_parser!(u16).range(1..=16384))]
+    width: u16,
+    /// Image height in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 720,
+          value_parser = clap::value_parser!(u16).range(1..=16384))]
+    height: u16,
+    /// Samples per pixel along each axis (1 to 8).
+    #[arg(long, value_name = "N", default_value_t = 3,
+          value_parser = clap::value_parser!(u8).range(1..=8))]
+    samples: u8,
+    /// The PNG to write (its folder is created if missing).
+    #[arg(long, value_name = "FILE.png", default_value = "out/city-3d.png")]
+    out: PathBuf,
+}
 
 /// What to render and how.
 struct Args {
@@ -57,96 +100,114 @@ struct Args {
     out: PathBuf,
 }
 
-fn numbers<const N: usize>(flag: &str, text: &str) -> BoxResult<[f64; N]> {
+/// The preset names, so clap lists them in `--help` and suggests the nearest.
+fn preset_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(CityConfig::preset_names())
+}
+
+/// `N` comma-separated finite numbers.
+fn numbers<const N: usize>(text: &str) -> Result<[f64; N], String> {
     let parts: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("{flag}: {e}"))?;
+        .map_err(|e| e.to_string())?;
     let out: [f64; N] = parts
         .try_into()
-        .map_err(|_| format!("{flag}: expected {N} comma-separated numbers"))?;
+        .map_err(|_| format!("expected {N} comma-separated numbers"))?;
     if out.iter().any(|v| !v.is_finite()) {
-        return Err(format!("{flag}: numbers must be finite").into());
+        return Err("numbers must be finite".into());
     }
     Ok(out)
 }
 
-fn parse_args() -> BoxResult<Args> {
-    let raw: Vec<String> = std::env::args().skip(1).collect();
-    let mut args = Args {
-        config: CityConfig::preset("default")?,
-        target: None,
-        view: [None, Some(24.0), Some(900.0)],
-        fov_deg: 40.0,
-        width: 1280,
-        height: 720,
-        samples: 3,
-        out: PathBuf::from("out/city-3d.png"),
-    };
-    // The preset first, so the other flags override it.
-    if let Some(i) = raw.iter().position(|a| a == "--preset") {
-        let name = raw.get(i + 1).ok_or("--preset needs a value")?;
-        args.config = CityConfig::preset(name)?;
+fn positive(text: &str) -> Result<f64, String> {
+    match numbers::<1>(text)? {
+        [v] if v > 0.0 => Ok(v),
+        _ => Err("expected a positive number".into()),
     }
-    let mut i = 0;
-    while i < raw.len() {
-        let flag = raw[i].as_str();
-        if flag == "-h" || flag == "--help" {
-            return Err(USAGE.into());
+}
+
+fn fov(text: &str) -> Result<f64, String> {
+    match numbers::<1>(text)? {
+        [v] if (1.0..=170.0).contains(&v) => Ok(v),
+        _ => Err("expected degrees in 1..=170".into()),
+    }
+}
+
+fn view(text: &str) -> Result<[f64; 3], String> {
+    let v = numbers::<3>(text)?;
+    if v[2] <= 0.0 || !(-89.0..=89.0).contains(&v[1]) {
+        return Err("the elevation must be within ±89° and the distance positive".into());
+    }
+    Ok(v)
+}
+
+fn configure(cli: Cli) -> Result<Args, clap::Error> {
+    let mut cmd = Cli::command();
+    let mut config = CityConfig::preset(&cli.preset)
+        .map_err(|e| cmd.error(ErrorKind::InvalidValue, format!("--preset: {e}")))?;
+    if let Some(seed) = cli.seed {
+        config.seed = seed;
+    }
+    if let Some(size) = cli.size {
+        config.size_m = size;
+    }
+    if let Some(lod) = cli.lod {
+        let max = config.buildings.max_lod;
+        if lod > max {
+            return Err(cmd.error(
+                ErrorKind::ValueValidation,
+                format!(
+                    "--lod {lod} is above the preset's most detailed level ({max}); give 0..={max}"
+                ),
+            ));
         }
-        let value = raw
-            .get(i + 1)
-            .ok_or_else(|| format!("{flag} needs a value\n{USAGE}"))?;
-        let count = |v: &str| -> BoxResult<usize> {
-            match v.parse::<usize>() {
-                Ok(n) if (1..=16384).contains(&n) => Ok(n),
-                _ => Err(format!("{flag}: expected a whole number in 1..=16384").into()),
-            }
-        };
-        match flag {
-            "--preset" => {}
-            "--seed" => args.config.seed = value.parse().map_err(|e| format!("--seed: {e}"))?,
-            "--size" => args.config.size_m = numbers::<1>(flag, value)?[0],
-            "--lod" => args.config.lod = Some(count(value)?),
-            "--target" => args.target = Some(numbers(flag, value)?),
-            "--view" => args.view = numbers::<3>(flag, value)?.map(Some),
-            "--fov" => args.fov_deg = numbers::<1>(flag, value)?[0],
-            "--width" => args.width = count(value)?,
-            "--height" => args.height = count(value)?,
-            "--samples" => args.samples = count(value)?.min(8),
-            "--out" => args.out = PathBuf::from(value),
-            _ => return Err(format!("unknown flag {flag}\n{USAGE}").into()),
-        }
-        i += 2;
+        config.lod = Some(lod);
     }
-    let samples = (args.width * args.samples) as u64 * (args.height * args.samples) as u64;
-    if samples > 1 << 27 {
-        return Err(format!(
-            "{} × {} px with {}² samples each is more than 2^27 samples; lower one of them",
-            args.width, args.height, args.samples
-        )
-        .into());
+    config
+        .validate()
+        .map_err(|e| cmd.error(ErrorKind::ValueValidation, e.to_string()))?;
+    let (width, height, samples) = (
+        usize::from(cli.width),
+        usize::from(cli.height),
+        usize::from(cli.samples),
+    );
+    if (width * samples) as u64 * (height * samples) as u64 > 1 << 27 {
+        return Err(cmd.error(
+            ErrorKind::ValueValidation,
+            format!(
+                "{width} × {height} px with {samples}² samples each is more than 2^27 \
+                 samples; lower one of them"
+            ),
+        ));
     }
-    if !(1.0..=170.0).contains(&args.fov_deg) {
-        return Err("--fov: expected degrees in 1..=170".into());
-    }
-    if args.view[2].unwrap_or(1.0) <= 0.0 || !(-89.0..=89.0).contains(&args.view[1].unwrap_or(0.0))
-    {
-        return Err("--view: elevation must be within ±89° and the distance positive".into());
-    }
-    Ok(args)
+    Ok(Args {
+        config,
+        target: cli.target,
+        view: cli
+            .view
+            .map_or([None, Some(24.0), Some(900.0)], |v| v.map(Some)),
+        fov_deg: cli.fov,
+        width,
+        height,
+        samples,
+        out: cli.out,
+    })
 }
 
 fn main() {
-    if let Err(e) = run() {
+    let args = match configure(Cli::parse()) {
+        Ok(args) => args,
+        Err(e) => e.exit(),
+    };
+    if let Err(e) = run(args) {
         eprintln!("error: {e}");
         std::process::exit(1);
     }
 }
 
-fn run() -> BoxResult<()> {
-    let args = parse_args()?;
+fn run(args: Args) -> BoxResult<()> {
     let t = Instant::now();
     let city = Pipeline::default().generate(&args.config)?;
     println!(
@@ -800,6 +861,38 @@ fn encode(image: &[Vec3], width: usize, height: usize) -> BoxResult<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn parse(args: &[&str]) -> Result<Args, clap::Error> {
+        let cli = Cli::try_parse_from(std::iter::once("render").chain(args.iter().copied()))?;
+        configure(cli)
+    }
+
+    /// `--help` is help (exit 0), `--x=y` parses, typos get suggestions, and every
+    /// out-of-range value is an error rather than clamped.
+    #[test]
+    fn command_line_validates_instead_of_clamping() {
+        let help = parse(&["--help"]).err().unwrap();
+        assert_eq!(help.kind(), ErrorKind::DisplayHelp);
+        assert_eq!(help.exit_code(), 0);
+        let a = parse(&["--seed=9", "--view=-30,20,500", "--samples", "2"]).unwrap();
+        assert_eq!(a.config.seed, 9);
+        assert_eq!(a.view, [Some(-30.0), Some(20.0), Some(500.0)]);
+        assert_eq!(a.samples, 2);
+        let typo = parse(&["--sampels", "2"]).err().unwrap();
+        assert!(typo.to_string().contains("'--samples'"), "{typo}");
+        for bad in [
+            &["--samples", "9"][..],
+            &["--lod", "7"],
+            &["--fov", "180"],
+            &["--view=0,95,900"],
+            &["--width", "0"],
+            &["--width", "16384", "--height", "16384"],
+            &["--preset", "pari"],
+        ] {
+            let e = parse(bad).err().unwrap();
+            assert_ne!(e.exit_code(), 0, "{bad:?}");
+        }
+    }
 
     /// Two triangles sharing a diagonal cover every pixel centre of their square, and
     /// none outside it.

@@ -8,7 +8,7 @@ use std::time::Duration;
 use polis_buildings::Building;
 use polis_cells::CellDecomposition;
 use polis_export::map::{MapBlock, MapFootprint, MapLayers, MapLot};
-use polis_export::sink::DirSink;
+use polis_export::sink::{DirSink, FileSink};
 use polis_export::{geojson, glb, obj, svg};
 use polis_facades::TileSet;
 use polis_geom::{DVec2, Field, Polygon, PolygonWithHoles, Scene};
@@ -17,6 +17,7 @@ use polis_roads::{GrowthReport, RoadNetwork};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::output::{Formats, TEXTURE_DIR, WriteOptions};
 use crate::stages::{Dress, Skip, Stage};
 use crate::{CityConfig, CityMaps};
 
@@ -149,7 +150,8 @@ pub struct City {
 /// Which files [`City::write_all`] wrote.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Written {
-    /// Paths, in the order written.
+    /// Every file written, textures included (see [`City::write_all_with`] for the
+    /// order).
     pub files: Vec<PathBuf>,
 }
 
@@ -225,46 +227,116 @@ impl City {
         Ok(glb::write_glb(&self.scene, &options, out)?)
     }
 
-    /// Writes `city.glb`, `city.obj` (+ `city.mtl` and the `city_*.png` textures),
-    /// `city.svg` and `city.geojson` into `dir` (created if missing).
+    /// Writes the chosen `formats` into `dir` (created if missing): `city.glb`,
+    /// `city.obj` (+ `city.mtl` and the texture PNGs in `textures/`), `city.svg` and
+    /// `city.geojson` (local metres). `Formats::ALL` writes all four.
     ///
     /// # Errors
     /// Export and I/O errors, naming the file.
-    pub fn write_all(&self, dir: impl AsRef<Path>) -> Result<Written> {
+    pub fn write_all(&self, dir: impl AsRef<Path>, formats: Formats) -> Result<Written> {
+        self.write_all_with(dir, &formats.into())
+    }
+
+    /// [`write_all`](Self::write_all) with every option: the formats and the GeoJSON's
+    /// geographic anchor (WGS 84 longitude/latitude output). [`Written`] lists every file
+    /// written, textures included, in a fixed order: svg, geojson, glb, obj, mtl, then
+    /// the textures by name.
+    ///
+    /// # Errors
+    /// Export and I/O errors, naming the file; [`Error::Export`] for an anchor outside
+    /// WGS 84 bounds or a map that would cross the antimeridian or reach a pole there.
+    pub fn write_all_with(&self, dir: impl AsRef<Path>, options: &WriteOptions) -> Result<Written> {
         let dir = dir.as_ref();
+        let formats = options.formats;
         std::fs::create_dir_all(dir).map_err(|source| Error::Io {
             path: dir.into(),
             source,
         })?;
-        // The four files are written at the same time (the OBJ text is also formatted in
+        // The files are written at the same time (the OBJ text is also formatted in
         // parallel); the first error in the order below is returned.
-        let maps = || -> Result<(PathBuf, PathBuf)> {
+        let maps = || -> Result<Vec<PathBuf>> {
+            if !(formats.svg || formats.geojson) {
+                return Ok(Vec::new());
+            }
             let map = self.map_layers()?;
-            let svg = write_file(dir.join("city.svg"), |w| {
-                svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
-                Ok(())
-            })?;
-            let geojson = write_file(dir.join("city.geojson"), |w| {
-                geojson::write_geojson(&map, &geojson::GeoJsonOptions::default(), w)?;
-                Ok(())
-            })?;
-            Ok((svg, geojson))
+            let mut files = Vec::new();
+            if formats.svg {
+                files.push(write_file(dir.join("city.svg"), |w| {
+                    svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
+                    Ok(())
+                })?);
+            }
+            if formats.geojson {
+                let geo = geojson::GeoJsonOptions {
+                    anchor_lon_lat: options.anchor_lon_lat,
+                    coordinates: match options.anchor_lon_lat {
+                        Some(_) => geojson::Coordinates::Wgs84,
+                        None => geojson::Coordinates::Local,
+                    },
+                    ..geojson::GeoJsonOptions::default()
+                };
+                files.push(write_file(dir.join("city.geojson"), |w| {
+                    geojson::write_geojson(&map, &geo, w)?;
+                    Ok(())
+                })?);
+            }
+            Ok(files)
         };
-        let glb = || write_file(dir.join("city.glb"), |w| self.write_glb(w).map(|_| ()));
-        let obj = || {
-            write_file(dir.join("city.obj"), |w| {
+        let glb = || -> Result<Vec<PathBuf>> {
+            if !formats.glb {
+                return Ok(Vec::new());
+            }
+            let path = write_file(dir.join("city.glb"), |w| self.write_glb(w).map(|_| ()))?;
+            Ok(vec![path])
+        };
+        let obj = || -> Result<Vec<PathBuf>> {
+            if !formats.obj {
+                return Ok(Vec::new());
+            }
+            let mut sink = RecordingSink {
+                inner: DirSink::new(dir),
+                names: Vec::new(),
+            };
+            let path = write_file(dir.join("city.obj"), |w| {
                 let options = obj::ObjOptions {
                     stem: "city".into(),
+                    texture_dir: TEXTURE_DIR.into(),
                 };
-                obj::write_obj(&self.scene, &options, w, &mut DirSink::new(dir))?;
+                obj::write_obj(&self.scene, &options, w, &mut sink)?;
                 Ok(())
-            })
+            })?;
+            // The MTL first, then the textures by name.
+            sink.names
+                .sort_by_key(|n| (!n.ends_with(".mtl"), n.clone()));
+            let mut files = vec![path];
+            files.extend(sink.names.iter().map(|n| dir.join(n)));
+            Ok(files)
         };
         let (maps, (glb, obj)) = rayon::join(maps, || rayon::join(glb, obj));
-        let (svg, geojson) = maps?;
-        Ok(Written {
-            files: vec![svg, geojson, glb?, obj?, dir.join("city.mtl")],
-        })
+        let mut files = maps?;
+        files.extend(glb?);
+        files.extend(obj?);
+        Ok(Written { files })
+    }
+}
+
+/// A [`DirSink`] that remembers the names of the files it wrote.
+struct RecordingSink {
+    inner: DirSink,
+    names: Vec<String>,
+}
+
+impl FileSink for RecordingSink {
+    fn write_file(&mut self, name: &str, contents: &[u8]) -> std::io::Result<()> {
+        self.inner.write_file(name, contents)?;
+        self.names.push(name.to_string());
+        Ok(())
+    }
+
+    fn create(&mut self, name: &str) -> std::io::Result<Box<dyn Write + '_>> {
+        let w = self.inner.create(name)?;
+        self.names.push(name.to_string());
+        Ok(w)
     }
 }
 

@@ -325,7 +325,7 @@ pub fn citygen_network(
         presets.push((n, p));
     }
     let seed = cx.seed(Stage::Roads, 1);
-    let started = std::time::Instant::now();
+    let started = crate::clock::Instant::now();
     let grown: Vec<Result<std::result::Result<SecondaryRoads, Skip>>> = decomposition
         .cells
         .par_iter()

@@ -101,3 +101,7 @@ impl Error {
 
 /// Result alias of the facade.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// [`Error`] under the `<Crate>Error` name every polis crate's error follows
+/// (`polis_roads::RoadsError`, `polis_cells::CellsError`, …).
+pub type PolisError = Error;

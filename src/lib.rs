@@ -10,7 +10,7 @@
 //! let config = polis::CityConfig::preset("manhattan")?;
 //! let city = polis::generate(&config)?;
 //! println!("{} roads, {} buildings", city.stats.road_segments, city.stats.buildings);
-//! city.write_all("out")?;
+//! city.write_all("out", polis::Formats::ALL)?;
 //! # Ok::<(), polis::Error>(())
 //! ```
 //!
@@ -41,6 +41,9 @@
 //! - **No panics on input**: bad configurations are [`Error::Config`] naming the field;
 //!   degenerate cells and lots are skipped and listed in [`City::report`].
 //!
+//! `use polis::prelude::*;` brings the everyday names ([`prelude`]);
+//! `examples/custom_stage.rs` plugs a custom road stage into the pipeline.
+//!
 //! The stage crates are re-exported as modules ([`roads`], [`cells`], …) for direct use.
 
 pub use polis_buildings as buildings;
@@ -55,10 +58,13 @@ pub use polis_stats as stats;
 
 mod city;
 pub mod citygen;
+mod clock;
 mod config;
 mod error;
 mod maps;
+mod output;
 mod pipeline;
+pub mod prelude;
 mod report;
 mod scene;
 pub mod seed;
@@ -72,8 +78,9 @@ pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, Foundation, KindStyles, SceneConfig, ZoneBand,
     ZoningConfig,
 };
-pub use error::{BoxError, Error, Result};
+pub use error::{BoxError, Error, PolisError, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
+pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::reference_city_name;
 pub use stages::{Skip, Stage};

@@ -1,9 +1,9 @@
 //! [`Pipeline`]: the stages in order, per-cell and per-lot work in parallel, timings,
 //! progress and the skip report.
 
+use crate::clock::Instant;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Instant;
 
 use polis_geom::{Field, SpatialIndex};
 use rayon::prelude::*;

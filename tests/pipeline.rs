@@ -461,7 +461,7 @@ fn bad_configurations_are_errors_not_panics() {
 fn write_all_writes_every_file_and_the_obj_names_its_mtl() {
     let city = polis::generate(&small("suburbia")).unwrap();
     let dir = std::env::temp_dir().join(format!("polis-write-all-{}", std::process::id()));
-    let written = city.write_all(&dir).unwrap();
+    let written = city.write_all(&dir, polis::Formats::ALL).unwrap();
     for name in [
         "city.svg",
         "city.geojson",

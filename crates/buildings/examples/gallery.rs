@@ -189,6 +189,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &scene,
         &obj::ObjOptions {
             stem: "buildings_gallery".into(),
+            ..obj::ObjOptions::default()
         },
         BufWriter::new(File::create("out/buildings_gallery.obj")?),
         &mut DirSink::new("out"),

@@ -67,7 +67,7 @@ fn list(conflicts: &[Conflict], total: usize) -> String {
 /// What went wrong while extracting cells.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
-pub enum Error {
+pub enum CellsError {
     /// The graph is not planar: edges cross, overlap, or pass through nodes.
     #[error(
         "the road graph is not planar: {}; insert roads with `PlanarGraph::insert_segment` (which splits at crossings) or fix the listed edges",
@@ -109,3 +109,7 @@ pub enum Error {
     #[error("internal error in cell extraction: {0}; please report the input graph")]
     Internal(String),
 }
+
+/// The former name of [`CellsError`], kept so existing code compiles: every polis crate
+/// names its error `<Crate>Error`.
+pub type Error = CellsError;

@@ -122,7 +122,7 @@ mod topology;
 pub use polis_geom as geom;
 
 pub use cell_graph::CellGraph;
-pub use error::{Conflict, Error};
+pub use error::{CellsError, Conflict, Error};
 pub use output::{
     Cell, CellDecomposition, CellId, DropReason, DroppedEdge, ExtractionReport, Filament,
     FilamentKind, IsolatedNode, NodeMerge, Ring,

@@ -275,6 +275,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         &scene,
         &ObjOptions {
             stem: "demo".into(),
+            ..ObjOptions::default()
         },
         File::create("out/demo.obj")?,
         &mut DirSink::new("out"),

@@ -18,7 +18,14 @@
 //!
 //! ## Coordinate system
 //!
-//! Positions are **not** WGS 84 longitude/latitude: they are `[x, y]` in metres in the
+//! With [`Coordinates::Wgs84`] and an anchor, positions are WGS 84 `[longitude,
+//! latitude]` in degrees as RFC 7946 requires, projected from the layout plane by a local
+//! tangent-plane projection around the anchor ([`projection`]; its error is documented
+//! there: about 2 m at the corners of a 4 km city), and the foreign member says
+//! `"type": "wgs84"`. GIS tools (QGIS, geopandas, kepler.gl) read such a file as it is.
+//!
+//! By default ([`Coordinates::Local`]) positions are **not** WGS 84 longitude/latitude:
+//! they are `[x, y]` in metres in the
 //! city's local layout plane, `x` east and `y` north, as every 2-D stage of polis uses
 //! them. RFC 7946 §4 allows other coordinate systems "where all involved parties have a
 //! prior arrangement" and has no `crs` member; the arrangement is stated in a top-level
@@ -43,6 +50,10 @@ use serde::{Deserialize, Serialize, Serializer};
 use crate::ExportError;
 use crate::map::{LayerSet, MapLayers};
 
+pub mod projection;
+
+use projection::TangentPlane;
+
 /// The name of the top-level foreign member that states the coordinate system.
 pub const CRS_MEMBER: &str = "polis:coordinates";
 
@@ -57,6 +68,22 @@ pub struct GeoJsonOptions {
     pub anchor_lon_lat: Option<[f64; 2]>,
     /// Indent the output (larger, for reading). Default: false.
     pub pretty: bool,
+    /// Local metres or WGS 84 longitude/latitude (which needs
+    /// [`anchor_lon_lat`](Self::anchor_lon_lat)). Default: [`Coordinates::Local`].
+    pub coordinates: Coordinates,
+}
+
+/// The coordinate system of the positions [`write_geojson`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum Coordinates {
+    /// `[x, y]` metres in the layout plane (`x` east, `y` north), as polis computes them.
+    #[default]
+    Local,
+    /// RFC 7946's WGS 84 `[longitude, latitude]` in degrees, projected around
+    /// [`GeoJsonOptions::anchor_lon_lat`] ([`projection`]).
+    Wgs84,
 }
 
 impl Default for GeoJsonOptions {
@@ -65,6 +92,7 @@ impl Default for GeoJsonOptions {
             layers: LayerSet::ALL,
             anchor_lon_lat: None,
             pretty: false,
+            coordinates: Coordinates::Local,
         }
     }
 }
@@ -106,18 +134,42 @@ pub fn write_geojson<W: Write>(
         });
     }
     map.validate()?;
+    let proj = match (options.coordinates, options.anchor_lon_lat) {
+        (Coordinates::Local, _) => None,
+        (Coordinates::Wgs84, None) => {
+            return Err(ExportError::InvalidOption {
+                name: "coordinates",
+                reason: "WGS 84 coordinates need anchor_lon_lat (where the layout origin is)"
+                    .into(),
+            });
+        }
+        (Coordinates::Wgs84, Some(anchor)) => {
+            let plane = TangentPlane::new(anchor)?;
+            if let Some((min, max)) = map.bounds(options.layers) {
+                plane.check_extent(min, max)?;
+            }
+            Some(plane)
+        }
+    };
     let mut w = std::io::BufWriter::with_capacity(1 << 16, out);
     let mut report = GeoJsonReport::default();
     let l = options.layers;
     let nl = if options.pretty { "\n" } else { "" };
     let io = ExportError::io("geojson");
-    let crs = serde_json::json!({
-        "type": "local-metric",
-        "units": "m",
-        "x": "east",
-        "y": "north",
-        "anchor_lon_lat": options.anchor_lon_lat,
-    });
+    let crs = match proj {
+        None => serde_json::json!({
+            "type": "local-metric",
+            "units": "m",
+            "x": "east",
+            "y": "north",
+            "anchor_lon_lat": options.anchor_lon_lat,
+        }),
+        Some(_) => serde_json::json!({
+            "type": "wgs84",
+            "projection": "local tangent plane (equirectangular) around the anchor",
+            "anchor_lon_lat": options.anchor_lon_lat,
+        }),
+    };
     write!(
         w,
         r#"{{"type":"FeatureCollection",{nl}"{CRS_MEMBER}":{crs},{nl}"features":["#
@@ -132,6 +184,7 @@ pub fn write_geojson<W: Write>(
     };
     let area = |layer: &'static str, i: usize, p| Feature {
         id: format!("{layer}-{i}"),
+        proj,
         geometry: Geometry::Polygon(p),
         properties: Layer { layer },
     };
@@ -148,6 +201,7 @@ pub fn write_geojson<W: Write>(
     if l.blocks {
         for b in &map.blocks {
             emit(&Feature {
+                proj,
                 id: format!("block-{}", b.id),
                 geometry: Geometry::Polygon(&b.polygon),
                 properties: BlockProps {
@@ -160,6 +214,7 @@ pub fn write_geojson<W: Write>(
     if l.lots {
         for lot in &map.lots {
             emit(&Feature {
+                proj,
                 id: format!("lot-{}", lot.id),
                 geometry: Geometry::Polygon(&lot.polygon),
                 properties: LotProps {
@@ -173,6 +228,7 @@ pub fn write_geojson<W: Write>(
     if l.roads {
         for r in &map.roads {
             emit(&Feature {
+                proj,
                 id: format!("road-{}", r.id),
                 geometry: Geometry::LineString(&r.points),
                 properties: RoadProps {
@@ -188,6 +244,7 @@ pub fn write_geojson<W: Write>(
     if l.footprints {
         for f in &map.footprints {
             emit(&Feature {
+                proj,
                 id: format!("building-{}", f.id),
                 geometry: Geometry::Polygon(&f.polygon),
                 properties: BuildingProps {
@@ -229,6 +286,8 @@ mod erased {
 
 struct Feature<'a, P> {
     id: String,
+    /// `Some` for WGS 84 output.
+    proj: Option<TangentPlane>,
     geometry: Geometry<'a>,
     properties: P,
 }
@@ -238,7 +297,13 @@ impl<P: Serialize> Serialize for Feature<'_, P> {
         let mut m = s.serialize_map(Some(4))?;
         m.serialize_entry("type", "Feature")?;
         m.serialize_entry("id", &self.id)?;
-        m.serialize_entry("geometry", &self.geometry)?;
+        m.serialize_entry(
+            "geometry",
+            &Projected {
+                geometry: &self.geometry,
+                proj: self.proj,
+            },
+        )?;
         m.serialize_entry("properties", &self.properties)?;
         m.end()
     }
@@ -286,10 +351,17 @@ enum Geometry<'a> {
     Polygon(&'a PolygonWithHoles),
 }
 
-impl Serialize for Geometry<'_> {
+/// A geometry with the projection its positions go through.
+struct Projected<'a> {
+    geometry: &'a Geometry<'a>,
+    proj: Option<TangentPlane>,
+}
+
+impl Serialize for Projected<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(Some(2))?;
-        match self {
+        let proj = self.proj;
+        match self.geometry {
             Geometry::LineString(points) => {
                 m.serialize_entry("type", "LineString")?;
                 m.serialize_entry(
@@ -298,12 +370,13 @@ impl Serialize for Geometry<'_> {
                         points,
                         reverse: false,
                         close: false,
+                        proj,
                     },
                 )?;
             }
             Geometry::Polygon(p) => {
                 m.serialize_entry("type", "Polygon")?;
-                m.serialize_entry("coordinates", &Rings(p))?;
+                m.serialize_entry("coordinates", &Rings(p, proj))?;
             }
         }
         m.end()
@@ -311,7 +384,7 @@ impl Serialize for Geometry<'_> {
 }
 
 /// A polygon's rings: outer counter-clockwise, holes clockwise, each closed.
-struct Rings<'a>(&'a PolygonWithHoles);
+struct Rings<'a>(&'a PolygonWithHoles, Option<TangentPlane>);
 
 impl Serialize for Rings<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -322,6 +395,7 @@ impl Serialize for Rings<'_> {
                 points: poly.points(),
                 reverse: (poly.signed_area() > 0.0) != ccw,
                 close: true,
+                proj: self.1,
             })?;
         }
         seq.end()
@@ -333,6 +407,7 @@ struct Positions<'a> {
     points: &'a [DVec2],
     reverse: bool,
     close: bool,
+    proj: Option<TangentPlane>,
 }
 
 impl Serialize for Positions<'_> {
@@ -346,7 +421,10 @@ impl Serialize for Positions<'_> {
             } else {
                 self.points[k]
             };
-            [p.x, p.y]
+            match &self.proj {
+                Some(plane) => plane.lon_lat(p),
+                None => [p.x, p.y],
+            }
         };
         for k in 0..n {
             seq.serialize_element(&at(k))?;

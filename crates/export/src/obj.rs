@@ -20,7 +20,8 @@
 //!   RGB), `d` (alpha), `Ks`/`Ns` derived from roughness, the PBR extension lines `Pr`
 //!   (roughness) and `Pm` (metallic), `map_Kd` and `map_Bump`/`norm` for the base colour
 //!   and normal textures. Meshes without a material use `polis_default` (white).
-//! * `<stem>_<image index>_<name>.png` per image a material uses.
+//! * `<stem>_<image index>_<name>.png` per image a material uses, beside the OBJ or in
+//!   the subfolder [`ObjOptions::texture_dir`] (the MTL names the relative path).
 //!
 //! Numbers are written exactly as Rust's `Display` writes them (shortest round-trip digits,
 //! plain notation), so output is byte-identical for identical scenes, and `f32` values
@@ -55,12 +56,17 @@ pub struct ObjOptions {
     /// `mtllib`), textures `<stem>_<image>_<name>.png`. ASCII letters, digits, `-`, `_`
     /// and `.` only. Default: `"scene"`.
     pub stem: String,
+    /// A subfolder for the texture PNGs, relative to the OBJ (the MTL's `map_Kd` lines
+    /// name `<texture_dir>/<file>`, and the sink receives that relative name); empty for
+    /// textures beside the OBJ. Same characters as `stem`. Default: `""`.
+    pub texture_dir: String,
 }
 
 impl Default for ObjOptions {
     fn default() -> Self {
         ObjOptions {
             stem: "scene".to_string(),
+            texture_dir: String::new(),
         }
     }
 }
@@ -125,15 +131,26 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
 ) -> Result<ObjReport, ExportError> {
     scene.validate()?;
     let stem = &options.stem;
-    if stem.is_empty()
-        || !stem
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
-        || stem.starts_with('.')
-    {
+    let plain = |name: &str| {
+        !name.is_empty()
+            && name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+            && !name.starts_with('.')
+    };
+    if !plain(stem) {
         return Err(ExportError::InvalidOption {
             name: "stem",
             reason: format!("{stem:?} must be non-empty ASCII letters, digits, '-', '_', '.'"),
+        });
+    }
+    let texture_dir = &options.texture_dir;
+    if !texture_dir.is_empty() && !plain(texture_dir) {
+        return Err(ExportError::InvalidOption {
+            name: "texture_dir",
+            reason: format!(
+                "{texture_dir:?} must be empty or ASCII letters, digits, '-', '_', '.'"
+            ),
         });
     }
     let mtl_name = format!("{stem}.mtl");
@@ -241,7 +258,12 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     let mut file_of = |t: polis_geom::scene::TextureId| -> Option<String> {
         let image = scene.textures.get(t.index())?.image.index();
         let img = scene.images.get(image)?;
-        let name = format!("{stem}_{image}_{}.png", sanitize(&img.name, "image"));
+        let file = format!("{stem}_{image}_{}.png", sanitize(&img.name, "image"));
+        let name = if texture_dir.is_empty() {
+            file
+        } else {
+            format!("{texture_dir}/{file}")
+        };
         texture_files[image] = Some(name.clone());
         Some(name)
     };

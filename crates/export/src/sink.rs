@@ -10,7 +10,9 @@ use std::path::PathBuf;
 /// tests, or to zip them up). A closure `FnMut(&str, &[u8]) -> std::io::Result<()>` is a
 /// sink too, receiving each whole file at once.
 pub trait FileSink {
-    /// Writes the file `name` (a plain file name, no folders) with the given contents.
+    /// Writes the file `name` with the given contents: a plain file name, or
+    /// `folder/file` for a file in a subfolder (the OBJ writer's
+    /// [`texture_dir`](crate::obj::ObjOptions::texture_dir)).
     fn write_file(&mut self, name: &str, contents: &[u8]) -> std::io::Result<()>;
 
     /// Opens the file `name` for streaming writes. The default buffers the contents and
@@ -81,7 +83,8 @@ impl FileSink for MemorySink {
     }
 }
 
-/// Writes side files into a folder (which must exist).
+/// Writes side files into a folder (which must exist); a `folder/file` name creates the
+/// subfolder.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DirSink {
     /// The folder.
@@ -94,14 +97,28 @@ impl DirSink {
         DirSink { dir: dir.into() }
     }
 
+    /// The path of `name` (`file` or `folder/file`, plain names only), creating the
+    /// subfolder.
     fn path(&self, name: &str) -> std::io::Result<PathBuf> {
-        if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
+        let bad = |part: &str| {
+            part.is_empty() || part.contains(['/', '\\', ':']) || part == "." || part == ".."
+        };
+        let (folder, file) = match name.split_once('/') {
+            Some((folder, file)) => (Some(folder), file),
+            None => (None, name),
+        };
+        if bad(file) || folder.is_some_and(bad) {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
-                format!("{name:?} is not a plain file name"),
+                format!("{name:?} is not a plain file name or folder/file"),
             ));
         }
-        Ok(self.dir.join(name))
+        let mut path = self.dir.clone();
+        if let Some(folder) = folder {
+            path.push(folder);
+            std::fs::create_dir_all(&path)?;
+        }
+        Ok(path.join(file))
     }
 }
 

@@ -7,7 +7,7 @@ use thiserror::Error;
 /// Messages say what was wrong and what to do about it.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
-pub enum FacadeError {
+pub enum FacadesError {
     /// A length, size or resolution was NaN, infinite, negative or out of range.
     #[error("{what} must be a finite number in {range}, got {value}; fix the input")]
     InvalidNumber {
@@ -86,3 +86,7 @@ pub(crate) fn check_range(
         Err(FacadeError::InvalidNumber { what, value, range })
     }
 }
+
+/// The former name of [`FacadesError`], kept so existing code compiles: every polis crate
+/// names its error `<Crate>Error`.
+pub type FacadeError = FacadesError;

@@ -117,7 +117,7 @@ pub mod tiles;
 
 pub use axis::{AxisStyle, Segment};
 pub use color::{Bricks, Col, ColFn, PointCtx};
-pub use error::{FacadeError, Result};
+pub use error::{FacadeError, FacadesError, Result};
 pub use facade::{
     Facade, FacadeLayout, FacadeReport, FacadeSpec, FacadeStyle, FaceRole, PreparedStyle,
 };

@@ -6,7 +6,7 @@ use polis_lsystem::LsystemError;
 /// Everything that can go wrong while growing a road network.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-pub enum RoadError {
+pub enum RoadsError {
     /// A [`RoadParams`](crate::RoadParams) field is out of its documented range.
     #[error("invalid road parameter `{name}`: {reason}")]
     InvalidParameter {
@@ -32,3 +32,7 @@ pub enum RoadError {
 
 /// `Result` with [`RoadError`].
 pub type Result<T> = core::result::Result<T, RoadError>;
+
+/// The former name of [`RoadsError`], kept so existing code compiles: every polis crate
+/// names its error `<Crate>Error`.
+pub type RoadError = RoadsError;

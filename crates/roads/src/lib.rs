@@ -94,7 +94,7 @@ pub mod smooth;
 pub mod snap;
 
 pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
-pub use error::{Result, RoadError};
+pub use error::{Result, RoadError, RoadsError};
 pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };

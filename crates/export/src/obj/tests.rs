@@ -156,6 +156,7 @@ fn byte_identical_and_validated() {
     for stem in ["", "a b", "../x", ".hidden"] {
         let opts = ObjOptions {
             stem: stem.to_string(),
+            ..ObjOptions::default()
         };
         assert!(matches!(
             write_obj(&scene, &opts, &mut obj, &mut files),
@@ -175,6 +176,7 @@ fn closure_sinks_receive_side_files() {
     };
     let opts = ObjOptions {
         stem: "city.v2".to_string(),
+        ..ObjOptions::default()
     };
     write_obj(&scene, &opts, std::io::sink(), &mut sink).unwrap();
     let got: Vec<&str> = names.iter().map(|(n, _)| n.as_str()).collect();
@@ -209,6 +211,7 @@ fn default_material_only_when_drawn_and_dir_sink_writes_files() {
     let mut sink = crate::sink::DirSink::new(&dir);
     let opts = ObjOptions {
         stem: "disk".to_string(),
+        ..ObjOptions::default()
     };
     let file = std::fs::File::create(dir.join("disk.obj")).unwrap();
     write_obj(&scene, &opts, file, &mut sink).unwrap();
@@ -223,6 +226,59 @@ fn default_material_only_when_drawn_and_dir_sink_writes_files() {
     assert_eq!(models.len(), 7);
     assert_eq!(mats.len(), 3);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// With `texture_dir`, the textures go into the subfolder and the MTL names them by
+/// their path relative to the OBJ, so a reader resolving `map_Kd` from the OBJ's folder
+/// finds every texture file.
+#[test]
+fn textures_in_a_subfolder_are_found_from_the_mtl() {
+    let scene = crate::testing::sample_scene();
+    let dir = std::env::temp_dir().join(format!("polis-export-texdir-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let opts = ObjOptions {
+        stem: "sub".to_string(),
+        texture_dir: "textures".to_string(),
+    };
+    let file = std::fs::File::create(dir.join("sub.obj")).unwrap();
+    let report = write_obj(&scene, &opts, file, &mut crate::sink::DirSink::new(&dir)).unwrap();
+    assert!(report.textures > 0);
+    let (_, mats) = tobj::load_obj(dir.join("sub.obj"), &tobj::GPU_LOAD_OPTIONS).unwrap();
+    let mut named = 0;
+    for m in mats.unwrap() {
+        for t in [m.diffuse_texture, m.normal_texture].into_iter().flatten() {
+            assert!(t.starts_with("textures/sub_"), "{t}");
+            assert!(dir.join(&t).is_file(), "{t} missing");
+            named += 1;
+        }
+    }
+    assert!(named >= report.textures);
+    let loose = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "png")
+        })
+        .count();
+    assert_eq!(loose, 0, "no texture beside the OBJ");
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    for bad in ["../up", "a/b", ".hidden"] {
+        let opts = ObjOptions {
+            texture_dir: bad.to_string(),
+            ..ObjOptions::default()
+        };
+        assert!(matches!(
+            write_obj(&scene, &opts, std::io::sink(), &mut MemorySink::new()),
+            Err(ExportError::InvalidOption {
+                name: "texture_dir",
+                ..
+            })
+        ));
+    }
 }
 
 /// The OBJ text of `scene` as the first writer made it, one `writeln!` at a time with
