@@ -127,6 +127,7 @@ impl RoadStage for GridRoads {
         Ok(RoadsOutput {
             network,
             growth: None,
+            skipped: Vec::new(),
         })
     }
 }
