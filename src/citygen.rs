@@ -9,9 +9,12 @@
 //!
 //! The primary network comes from a [`PrimarySource`]: the highways of a Parish & Müller
 //! growth with the configuration's road parameters, a ring-and-spoke network (Kelly
-//! §6.1's Milan), or a road graph in a JSON file. Each cell's neighbourhood preset is
-//! chosen by an explicit override (a point inside the cell), else by the population at
-//! the cell's centre ([`CitygenConfig::by_population`]), else the default.
+//! §6.1's Milan), a road graph in a JSON file, or a Kelly [`PrimaryNetwork`](polis_roads::primary::PrimaryNetwork)
+//! (inline or from a file; its paths simplified within [`PATH_TOLERANCE_M`]). Each
+//! cell's pattern ([`CellPatternChoice`]: a Kelly neighbourhood preset, or the course
+//! report's grid road builders with Downtown or Residential rules) is chosen by an
+//! explicit override (a point inside the cell), else by the population at the cell's
+//! centre ([`CitygenConfig::by_population`]), else the default.
 //!
 //! Cell ids are stable: a hash of the cell's sorted boundary positions, so editing one
 //! part of the primary network does not reseed the cells elsewhere. Cells are grown in
@@ -83,7 +86,7 @@ pub enum PrimarySource {
         piece_m: f64,
     },
     /// A road graph read from a JSON file (the serde form of
-    /// [`RoadNetwork`](polis_roads::RoadNetwork), e.g. an exported `roads.json`).
+    /// [`RoadNetwork`], e.g. an exported `roads.json`).
     Graph {
         /// The file.
         path: PathBuf,

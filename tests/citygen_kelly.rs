@@ -162,6 +162,32 @@ fn a_kelly_spec_file_and_a_saved_network_file_give_the_same_cells() {
     let a = network(&c, 1);
     assert_eq!(a.cells.len() + a.skipped.len(), 2, "{:?}", a.skipped);
     assert_eq!(json(&a), json(&network(&c, 3)));
+    // The same square as GeoJSON: corner points, then lines between them.
+    let geojson = dir.join("square.geojson");
+    let line = |a: (i32, i32), b: (i32, i32)| {
+        format!(
+            r#"{{"type": "Feature", "properties": {{"class": "InnerCity"}}, "geometry": {{"type": "LineString", "coordinates": [[{}, {}], [{}, {}]]}}}}"#,
+            a.0, a.1, b.0, b.1
+        )
+    };
+    let (p1, p2, p3, p4) = ((-500, -500), (500, -500), (500, 500), (-500, 500));
+    let lines = [
+        line(p1, p2),
+        line(p2, p3),
+        line(p3, p4),
+        line(p4, p1),
+        line(p1, p3),
+    ];
+    std::fs::write(
+        &geojson,
+        format!(
+            r#"{{"type": "FeatureCollection", "features": [{}]}}"#,
+            lines.join(",")
+        ),
+    )
+    .unwrap();
+    let g = network(&config(PrimarySource::KellyFile { path: geojson }), 1);
+    assert_eq!(g.cells.len() + g.skipped.len(), 2, "{:?}", g.skipped);
     // Bad files are typed errors.
     let bad = dir.join("bad.json");
     std::fs::write(&bad, r#"{"nodes": [{"id": 1, "x": "west"}]}"#).unwrap();

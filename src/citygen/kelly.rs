@@ -17,7 +17,7 @@ use crate::stages::StageContext;
 pub struct InlinePrimary(pub Box<PrimaryNetwork>);
 
 impl<'de> Deserialize<'de> for InlinePrimary {
-    /// Through JSON text: inside the internally tagged [`PrimarySource`], serde buffers
+    /// Through JSON text: inside the internally tagged [`PrimarySource`](super::PrimarySource), serde buffers
     /// the network, and the buffer cannot read the network's integer map keys (JSON
     /// strings) back; its own JSON reader can. Every invariant is checked.
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
@@ -176,4 +176,39 @@ pub(super) fn kelly_from_text(
     }
     .map_err(parse)?;
     Ok(editor.into_network())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polis_geom::hash::splitmix64;
+
+    /// Douglas–Peucker keeps both ends, and every dropped point lies within the tolerance
+    /// of the kept segment spanning it: 300 random wiggly polylines (splitmix64 stream).
+    #[test]
+    fn simplification_keeps_ends_and_stays_within_the_tolerance() {
+        let mut h = 0x5EED_u64;
+        let mut next = || {
+            h = splitmix64(h);
+            (h >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..300 {
+            let n = 2 + (next() * 38.0) as usize;
+            let amp = 4.0 * next();
+            let pts: Vec<DVec2> = (0..n)
+                .map(|i| DVec2::new(i as f64 * 7.0, amp * (next() - 0.5)))
+                .collect();
+            let mut kept = vec![false; n];
+            douglas_peucker(&pts, 0, n - 1, &mut kept);
+            assert!(kept[0] && kept[n - 1]);
+            let idx: Vec<usize> = (0..n).filter(|&k| kept[k]).collect();
+            for w in idx.windows(2) {
+                for k in w[0] + 1..w[1] {
+                    let d =
+                        polis_geom::predicates::distance_to_segment(pts[k], pts[w[0]], pts[w[1]]);
+                    assert!(d <= PATH_TOLERANCE_M + 1e-9, "{d}");
+                }
+            }
+        }
+    }
 }
