@@ -180,7 +180,12 @@ fn growth_bench(
         let Ok(region) = cell.polygon_with_holes() else {
             continue;
         };
-        let n = polis::citygen::neighbourhood_of(cx, &region);
+        // Kelly's growth only: cells given a grid pattern are not in this benchmark.
+        let polis::citygen::CellPatternChoice::Kelly(n) =
+            polis::citygen::neighbourhood_of(cx, &region)
+        else {
+            continue;
+        };
         let mut p = n.preset()?.to_params(cg.unit_m);
         p.road_width_m.value *= cg.road_width_factor;
         let filaments = cell

@@ -9,9 +9,12 @@
 //!
 //! The primary network comes from a [`PrimarySource`]: the highways of a Parish & Müller
 //! growth with the configuration's road parameters, a ring-and-spoke network (Kelly
-//! §6.1's Milan), or a road graph in a JSON file. Each cell's neighbourhood preset is
-//! chosen by an explicit override (a point inside the cell), else by the population at
-//! the cell's centre ([`CitygenConfig::by_population`]), else the default.
+//! §6.1's Milan), a road graph in a JSON file, or a Kelly [`PrimaryNetwork`](polis_roads::primary::PrimaryNetwork)
+//! (inline or from a file; its paths simplified within [`PATH_TOLERANCE_M`]). Each
+//! cell's pattern ([`CellPatternChoice`]: a Kelly neighbourhood preset, or the course
+//! report's grid road builders with Downtown or Residential rules) is chosen by an
+//! explicit override (a point inside the cell), else by the population at the cell's
+//! centre ([`CitygenConfig::by_population`]), else the default.
 //!
 //! Cell ids are stable: a hash of the cell's sorted boundary positions, so editing one
 //! part of the primary network does not reseed the cells elsewhere. Cells are grown in
@@ -24,6 +27,7 @@ use polis_cells::Cell;
 use polis_geom::graph::SnapOptions;
 use polis_geom::hash::splitmix64;
 use polis_geom::{DVec2, Field};
+use polis_roads::grid_builders::{GridBuilderGrowth, GridError, GridMaps, GridParams};
 use polis_roads::secondary::{
     CellMaps, Neighbourhood, SecondaryCell, SecondaryError, SecondaryGrowth, SecondaryRoads,
 };
@@ -32,7 +36,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+
+mod kelly;
 use crate::stages::{ParishMullerRoads, RoadStage, RoadsOutput, Skip, Stage, StageContext};
+pub use kelly::{InlinePrimary, PATH_TOLERANCE_M};
 
 /// How the city's roads are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -79,8 +86,23 @@ pub enum PrimarySource {
         piece_m: f64,
     },
     /// A road graph read from a JSON file (the serde form of
-    /// [`RoadNetwork`](polis_roads::RoadNetwork), e.g. an exported `roads.json`).
+    /// [`RoadNetwork`], e.g. an exported `roads.json`).
     Graph {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A Kelly primary network ([`PrimaryNetwork`](polis_roads::primary::PrimaryNetwork), issue 17), inline in its serde form;
+    /// its low-level graph ([`PrimaryNetwork::to_road_network`](polis_roads::primary::PrimaryNetwork::to_road_network)) is the primary network.
+    Kelly {
+        /// The network (checked when the configuration is read).
+        network: InlinePrimary,
+    },
+    /// A Kelly primary network read from a file: its serde form
+    /// ([`PrimaryNetwork::to_json`](polis_roads::primary::PrimaryNetwork::to_json)), a hand-written [`PrimarySpec`](polis_roads::primary::PrimarySpec) (`nodes` + `roads`)
+    /// or a GeoJSON `FeatureCollection` ([`PrimaryNetwork::from_geojson`](polis_roads::primary::PrimaryNetwork::from_geojson)). Specs and
+    /// GeoJSON are built by validity-checked edits and plotted over the city's terrain
+    /// (elevation, water, parks) inside the map's square.
+    KellyFile {
         /// The file.
         path: PathBuf,
     },
@@ -90,6 +112,69 @@ fn ring_piece() -> f64 {
     150.0
 }
 
+/// The course report's grid road builders' shipped rule sets, as a cell pattern
+/// ([`polis_roads::grid_builders`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum GridPattern {
+    /// The report's Downtown rules ([`GridParams::downtown`]): no dead ends, many
+    /// crossings.
+    Downtown,
+    /// The report's Residential rules ([`GridParams::residential`]): builders may stop.
+    Residential,
+}
+
+impl GridPattern {
+    /// The pattern's parameters.
+    pub fn params(self) -> GridParams {
+        match self {
+            GridPattern::Downtown => GridParams::downtown(),
+            GridPattern::Residential => GridParams::residential(),
+        }
+    }
+
+    /// The Kelly preset whose lot and building traits the pattern's cells take (grid
+    /// builders make roads only): Manhattan for Downtown, Suburbia for Residential.
+    pub fn traits_from(self) -> Neighbourhood {
+        match self {
+            GridPattern::Downtown => Neighbourhood::Manhattan,
+            GridPattern::Residential => Neighbourhood::Suburbia,
+        }
+    }
+}
+
+/// What fills a cell: one of Kelly's neighbourhood presets or the grid road builders. In
+/// JSON just the name (`"manhattan"`, …, `"downtown"`, `"residential"`), so
+/// configurations written before grid patterns existed read unchanged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+#[non_exhaustive]
+pub enum CellPatternChoice {
+    /// Kelly's secondary growth with a neighbourhood preset.
+    Kelly(Neighbourhood),
+    /// The grid road builders with a shipped rule set.
+    Grid(GridPattern),
+}
+
+impl Default for CellPatternChoice {
+    fn default() -> Self {
+        CellPatternChoice::Kelly(Neighbourhood::Manhattan)
+    }
+}
+
+impl From<Neighbourhood> for CellPatternChoice {
+    fn from(n: Neighbourhood) -> Self {
+        CellPatternChoice::Kelly(n)
+    }
+}
+
+impl From<GridPattern> for CellPatternChoice {
+    fn from(g: GridPattern) -> Self {
+        CellPatternChoice::Grid(g)
+    }
+}
+
 /// One population band of [`CitygenConfig::by_population`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -97,7 +182,7 @@ pub struct PopulationBand {
     /// The band applies where the population at the cell's centre is at least this.
     pub min_density: f64,
     /// The neighbourhood of such cells.
-    pub neighbourhood: Neighbourhood,
+    pub neighbourhood: CellPatternChoice,
 }
 
 /// An explicit neighbourhood for the cell containing a point.
@@ -107,7 +192,7 @@ pub struct CellOverride {
     /// A point inside the cell, metres.
     pub at: [f64; 2],
     /// Its neighbourhood.
-    pub neighbourhood: Neighbourhood,
+    pub neighbourhood: CellPatternChoice,
 }
 
 /// The Citygen mode's options (used when [`CityConfig::road_mode`](crate::CityConfig) is
@@ -121,7 +206,7 @@ pub struct CitygenConfig {
     /// [`polis_roads::secondary::presets`]). Must be in (0, 1000]. Default: 20.
     pub unit_m: f64,
     /// The neighbourhood of cells no band or override picks. Default: Manhattan.
-    pub neighbourhood: Neighbourhood,
+    pub neighbourhood: CellPatternChoice,
     /// Neighbourhood by population at the cell's centre: the band with the highest
     /// `min_density` reached applies. Default: none.
     pub by_population: Vec<PopulationBand>,
@@ -138,7 +223,7 @@ impl Default for CitygenConfig {
         CitygenConfig {
             primary: PrimarySource::Highways,
             unit_m: polis_roads::secondary::CITYGEN_UNIT_M,
-            neighbourhood: Neighbourhood::Manhattan,
+            neighbourhood: CellPatternChoice::Kelly(Neighbourhood::Manhattan),
             by_population: Vec::new(),
             overrides: Vec::new(),
             road_width_factor: 1.0,
@@ -340,22 +425,39 @@ pub fn citygen_network(
                 Ok(r) => r,
                 Err(e) => return Ok(Err(skip(format!("cell {id}: {e}")))),
             };
-            let n = neighbourhood_of(cx, &region);
-            let params = presets
-                .iter()
-                .find(|(m, _)| *m == n)
-                .map(|(_, p)| p.clone())
-                .unwrap_or_default();
+            let preset = |n: Neighbourhood| {
+                presets
+                    .iter()
+                    .find(|(m, _)| *m == n)
+                    .map(|(_, p)| p.clone())
+                    .unwrap_or_default()
+            };
             let input = SecondaryCell {
                 id,
                 region,
                 filaments: filament_segments(cell),
             };
-            let result = SecondaryGrowth::new(params).and_then(|mut g| g.grow(&input, &maps, seed));
-            match result {
-                Ok(r) => Ok(Ok(r)),
-                Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
-                Err(e) => Err(secondary_error(e)),
+            match neighbourhood_of(cx, &input.region) {
+                CellPatternChoice::Kelly(n) => {
+                    let result = SecondaryGrowth::new(preset(n))
+                        .and_then(|mut g| g.grow(&input, &maps, seed));
+                    match result {
+                        Ok(r) => Ok(Ok(r)),
+                        Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
+                        Err(e) => Err(secondary_error(e)),
+                    }
+                }
+                CellPatternChoice::Grid(g) => {
+                    match grow_grid(&input, &maps, g, &preset(g.traits_from()), seed) {
+                        Ok(r) => Ok(Ok(r)),
+                        Err(
+                            e @ (GridError::NoStart { .. }
+                            | GridError::InvalidCell(_)
+                            | GridError::TooManyLatticePoints { .. }),
+                        ) => Ok(Err(skip(format!("cell {id}: {e}")))),
+                        Err(e) => Err(Error::config("citygen.neighbourhood", e.to_string())),
+                    }
+                }
             }
         })
         .collect();
@@ -381,6 +483,43 @@ pub fn citygen_network(
     ))
 }
 
+/// One cell grown by the grid road builders, in the shape of Kelly's cell graph
+/// (boundary and filaments as highways, streets as streets), with the lot and building
+/// traits of `traits` (the builders make roads only). Seeded by `seed` and the cell id.
+fn grow_grid(
+    cell: &SecondaryCell,
+    maps: &CellMaps<'_>,
+    pattern: GridPattern,
+    traits: &polis_roads::secondary::SecondaryParams,
+    seed: u64,
+) -> std::result::Result<SecondaryRoads, GridError> {
+    let grid_maps = GridMaps {
+        water: maps.water,
+        parks: maps.parks,
+    };
+    let mut params = pattern.params();
+    if maps.step_m > 0.0 {
+        params.legality_step_m = maps.step_m;
+    }
+    let grown = GridBuilderGrowth::new().grow(
+        &cell.region,
+        &cell.filaments,
+        &grid_maps,
+        &params,
+        splitmix64(seed ^ splitmix64(cell.id)),
+    )?;
+    Ok(SecondaryRoads {
+        cell: cell.id,
+        network: grown.cell_graph(&cell.region, &cell.filaments)?,
+        report: polis_roads::secondary::CellGrowthReport::default(),
+        traits: polis_roads::secondary::CellTraits {
+            lot_size_m: traits.lot_size_m,
+            building_height_m: traits.building_height_m,
+            building_hint: traits.building_hint,
+        },
+    })
+}
+
 fn secondary_error(e: SecondaryError) -> Error {
     Error::Roads(e.into())
 }
@@ -399,7 +538,7 @@ fn filament_segments(cell: &Cell) -> Vec<[DVec2; 2]> {
 pub fn neighbourhood_of(
     cx: &StageContext<'_>,
     region: &polis_geom::PolygonWithHoles,
-) -> Neighbourhood {
+) -> CellPatternChoice {
     let cg = &cx.config.citygen;
     for o in &cg.overrides {
         if region.contains(DVec2::new(o.at[0], o.at[1])) {
@@ -476,6 +615,17 @@ fn primary_network(
             })?;
             net.check_invariants()?;
             Ok((net, None))
+        }
+        PrimarySource::Kelly { network } => Ok((kelly::low_level(&network.0)?, None)),
+        PrimarySource::KellyFile { path } => {
+            let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+                path: path.clone(),
+                source,
+            })?;
+            Ok((
+                kelly::low_level(&kelly::kelly_from_text(cx, &text, path)?)?,
+                None,
+            ))
         }
     }
 }
@@ -663,10 +813,10 @@ mod tests {
     fn overrides_and_population_bands_pick_neighbourhoods() {
         let mut config = small_rings();
         config.citygen.by_population.clear();
-        config.citygen.neighbourhood = Neighbourhood::Industrial;
+        config.citygen.neighbourhood = Neighbourhood::Industrial.into();
         config.citygen.overrides = vec![CellOverride {
             at: [0.0, 0.0],
-            neighbourhood: Neighbourhood::Manhattan,
+            neighbourhood: Neighbourhood::Manhattan.into(),
         }];
         let maps = crate::CityMaps::build(&config.maps, 7).unwrap();
         let cx = StageContext {
@@ -683,15 +833,15 @@ mod tests {
         };
         assert_eq!(
             neighbourhood_of(&cx, &square(0.0, 50.0)),
-            Neighbourhood::Manhattan
+            Neighbourhood::Manhattan.into()
         );
         assert_eq!(
             neighbourhood_of(&cx, &square(500.0, 50.0)),
-            Neighbourhood::Industrial
+            Neighbourhood::Industrial.into()
         );
         config.citygen.by_population = vec![PopulationBand {
             min_density: -1.0,
-            neighbourhood: Neighbourhood::Organic,
+            neighbourhood: Neighbourhood::Organic.into(),
         }];
         let cx = StageContext {
             config: &config,
@@ -699,7 +849,7 @@ mod tests {
         };
         assert_eq!(
             neighbourhood_of(&cx, &square(500.0, 50.0)),
-            Neighbourhood::Organic
+            Neighbourhood::Organic.into()
         );
     }
 
