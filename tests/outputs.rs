@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use polis::{City, CityConfig, Formats, TEXTURE_DIR, WriteOptions};
 
 fn small_city() -> City {
-    let mut c = CityConfig::preset("suburbia").unwrap();
+    let mut c = CityConfig::preset("default").unwrap();
     c.size_m = 900.0;
     c.roads.max_segments = 160;
     c.facades.pixels_per_metre = 4.0;
@@ -63,7 +63,7 @@ fn written_lists_every_file_and_textures_sit_in_their_folder() {
         .lines()
         .filter_map(|l| l.strip_prefix("map_Kd "))
         .collect();
-    assert!(!maps.is_empty(), "the suburb's facades are textured");
+    assert!(!maps.is_empty(), "the small city's facades are textured");
     for m in maps {
         assert!(m.starts_with(&format!("{TEXTURE_DIR}/")), "{m}");
         assert!(dir.join(m).is_file(), "{m} missing");
