@@ -163,6 +163,28 @@ impl MapSpec {
     }
 }
 
+impl MapSpec {
+    /// A conservative interval holding every value the built map can take, from the
+    /// description alone (see [`FieldSpec::value_range`]); NaN or infinite bounds flag a
+    /// NaN or overflowing parameter. [`CityConfig::validate`](crate::CityConfig::validate)
+    /// checks it against each map's physical range.
+    pub fn value_range(&self) -> (f64, f64) {
+        match self {
+            MapSpec::Field(spec) => spec.value_range(),
+            MapSpec::Shape(Shape::Coast { .. } | Shape::Island { .. }) => (0.0, 1.0),
+            MapSpec::Shape(Shape::Radial { peak, noise, .. }) => {
+                // max(peak · base · (1 + noise · n), 0) with base in [0, 1], n in [-1, 1].
+                let top = peak * (1.0 + noise.abs());
+                if top.is_nan() {
+                    (f64::NAN, f64::NAN)
+                } else {
+                    (0.0, top.max(0.0))
+                }
+            }
+        }
+    }
+}
+
 fn finite_pos(name: &str, field: &str, v: f64) -> Result<()> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -369,13 +391,15 @@ pub struct MapsConfig {
     pub water: Option<MapSpec>,
     /// Parks and other no-build land: ≥ 0.5 is a park. Default: none.
     pub parks: Option<MapSpec>,
-    /// Ground elevation, metres. Default: flat (0 m).
+    /// Ground elevation, metres, within ±[`MAX_ELEVATION_M`](crate::MAX_ELEVATION_M).
+    /// Default: flat (0 m).
     pub elevation: Option<MapSpec>,
     /// Zoning: the value, rounded, indexes the building kinds (0 skyscraper, 1 office,
     /// 2 mid-rise, 3 house, 4 apartment, 5 industrial); replaces the zoning bands.
     /// Default: none (the bands of [`ZoningConfig`](crate::ZoningConfig) apply).
     pub zoning: Option<MapSpec>,
-    /// Maximum building height, metres; replaces the bands' limits. Default: none.
+    /// Maximum building height, metres, in [0, [`MAX_BUILDING_HEIGHT_M`](crate::MAX_BUILDING_HEIGHT_M)];
+    /// replaces the bands' limits, and where it is 0 no building stands. Default: none.
     pub max_height: Option<MapSpec>,
     /// Pattern-weight maps; empty = `roads.pattern` everywhere. Default: empty.
     pub pattern_weights: Vec<PatternMap>,

@@ -233,6 +233,134 @@ impl FieldSpec {
     }
 }
 
+/// A closed interval `[lo, hi]` of field values, for [`FieldSpec::value_range`].
+pub type ValueRange = (f64, f64);
+
+/// `min` and `max` that keep a NaN (`f64::min` drops it).
+fn nan_min(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+fn range_union(a: ValueRange, b: ValueRange) -> ValueRange {
+    (nan_min(a.0, b.0), nan_max(a.1, b.1))
+}
+
+fn range_product(a: ValueRange, b: ValueRange) -> ValueRange {
+    let p = [a.0 * b.0, a.0 * b.1, a.1 * b.0, a.1 * b.1];
+    if p.iter().any(|v| v.is_nan()) {
+        return (f64::NAN, f64::NAN);
+    }
+    (
+        p.iter().copied().fold(f64::INFINITY, f64::min),
+        p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    )
+}
+
+fn nan_if(bad: bool, r: ValueRange) -> ValueRange {
+    if bad { (f64::NAN, f64::NAN) } else { r }
+}
+
+impl FieldSpec {
+    /// A conservative interval holding every value the built field can take at a point
+    /// whose sample is defined, computed from the description alone (no file is read):
+    /// interval arithmetic over the combinators, `[-1, 1]` for noise, `[0, 1]` for the
+    /// population and PNG images, the data's extremes for an inline raster.
+    ///
+    /// A NaN bound means a parameter is NaN (e.g. a `scaled` factor); an infinite bound
+    /// means a parameter is infinite or the arithmetic overflows. Configuration checks use
+    /// this to refuse maps that can only produce non-finite or unphysical values.
+    ///
+    /// Guarantees: for every point `p` where `build()?.sample(p)` is finite, the value
+    /// lies in the returned interval (property-tested). Limitations: the interval may be
+    /// wider than the values actually taken (e.g. `a − a` gives `[-2, 2]` for noise).
+    pub fn value_range(&self) -> ValueRange {
+        match self {
+            FieldSpec::Constant { value } => (*value, *value),
+            FieldSpec::Simplex { .. } | FieldSpec::Fbm(_) => (-1.0, 1.0),
+            FieldSpec::Population(_) => (0.0, 1.0),
+            FieldSpec::Raster(r) => r
+                .data()
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(f64::from(v)), hi.max(f64::from(v)))
+                }),
+            #[cfg(feature = "png")]
+            FieldSpec::Png { .. } => (0.0, 1.0),
+            FieldSpec::Scaled { field, factor } => {
+                range_product(field.value_range(), (*factor, *factor))
+            }
+            FieldSpec::Offset { field, offset } => {
+                let (lo, hi) = field.value_range();
+                (lo + offset, hi + offset)
+            }
+            FieldSpec::Sum { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (a.0 + b.0, a.1 + b.1)
+            }
+            FieldSpec::Product { a, b } => range_product(a.value_range(), b.value_range()),
+            FieldSpec::Threshold { field, threshold } => {
+                let (lo, hi) = field.value_range();
+                nan_if(lo.is_nan() || hi.is_nan() || threshold.is_nan(), (0.0, 1.0))
+            }
+            FieldSpec::Min { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (nan_min(a.0, b.0), nan_min(a.1, b.1))
+            }
+            FieldSpec::Max { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (nan_max(a.0, b.0), nan_max(a.1, b.1))
+            }
+            FieldSpec::Clamp { field, lo, hi } => {
+                let (a, b) = field.value_range();
+                let clamp = |v: f64| v.max(*lo).min(*hi);
+                nan_if(
+                    a.is_nan() || b.is_nan() || lo.is_nan() || hi.is_nan(),
+                    (clamp(a).min(clamp(b)), clamp(a).max(clamp(b))),
+                )
+            }
+            FieldSpec::Mask {
+                mask,
+                if_true,
+                if_false,
+                threshold,
+            } => {
+                let (m0, m1) = mask.value_range();
+                nan_if(
+                    m0.is_nan() || m1.is_nan() || threshold.is_nan(),
+                    range_union(if_true.value_range(), if_false.value_range()),
+                )
+            }
+            FieldSpec::Blend { weight, zero, one } => {
+                let (w0, w1) = weight.value_range();
+                nan_if(
+                    w0.is_nan() || w1.is_nan(),
+                    range_union(zero.value_range(), one.value_range()),
+                )
+            }
+            FieldSpec::Transform {
+                field,
+                scale,
+                offset,
+            } => nan_if(
+                !(scale.is_finite() && offset.is_finite()),
+                field.value_range(),
+            ),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -432,5 +560,101 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
         let missing = FieldSpec::Png { path, extent };
         assert!(matches!(missing.build(), Err(GeomError::Image(_))));
+    }
+
+    /// Random trees of combinators over noise, population and constants.
+    fn arb_spec() -> impl proptest::strategy::Strategy<Value = FieldSpec> {
+        use proptest::prelude::*;
+        let leaf = prop_oneof![
+            (-50.0f64..50.0).prop_map(|value| FieldSpec::Constant { value }),
+            (0u64..4, 50.0f64..500.0)
+                .prop_map(|(seed, wavelength_m)| FieldSpec::Simplex { seed, wavelength_m }),
+            (0u64..4)
+                .prop_map(|seed| FieldSpec::Population(PopulationParams { seed, unit_m: 50.0 })),
+        ];
+        leaf.prop_recursive(4, 24, 3, |inner| {
+            prop_oneof![
+                (inner.clone(), -10.0f64..10.0).prop_map(|(f, factor)| FieldSpec::Scaled {
+                    field: b(f),
+                    factor
+                }),
+                (inner.clone(), -10.0f64..10.0).prop_map(|(f, offset)| FieldSpec::Offset {
+                    field: b(f),
+                    offset
+                }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Sum { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Product { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Min { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Max { a: b(a), b: b(c) }),
+                (inner.clone(), -2.0f64..2.0, 0.0f64..3.0).prop_map(|(f, lo, w)| {
+                    FieldSpec::Clamp {
+                        field: b(f),
+                        lo,
+                        hi: lo + w,
+                    }
+                }),
+                (inner.clone(), inner.clone(), inner.clone()).prop_map(|(m, t, f)| {
+                    FieldSpec::Mask {
+                        mask: b(m),
+                        if_true: b(t),
+                        if_false: b(f),
+                        threshold: 0.2,
+                    }
+                }),
+                (inner.clone(), inner.clone(), inner).prop_map(|(w, z, o)| FieldSpec::Blend {
+                    weight: b(w),
+                    zero: b(z),
+                    one: b(o)
+                }),
+            ]
+        })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(96))]
+
+        /// Every sample of the built field lies in the range computed from the data.
+        #[test]
+        fn value_range_holds_every_sample(spec in arb_spec(), x in -3000.0f64..3000.0, y in -3000.0f64..3000.0) {
+            let (lo, hi) = spec.value_range();
+            let f = spec.build().unwrap();
+            for k in 0..8 {
+                let p = DVec2::new(x + 97.0 * f64::from(k), y - 61.0 * f64::from(k));
+                let v = f.sample(p);
+                let slack = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
+                proptest::prop_assert!(v >= lo - slack && v <= hi + slack, "{v} outside [{lo}, {hi}]");
+            }
+        }
+    }
+
+    #[test]
+    fn value_range_flags_nan_and_overflow() {
+        let png = FieldSpec::Constant { value: 0.5 };
+        let nan = FieldSpec::Scaled {
+            field: b(png.clone()),
+            factor: f64::NAN,
+        };
+        let (lo, hi) = nan.value_range();
+        assert!(lo.is_nan() && hi.is_nan());
+        // NaN survives min/max/blend, which `f64::min` would drop.
+        let hidden = FieldSpec::Max {
+            a: b(nan.clone()),
+            b: b(png.clone()),
+        };
+        assert!(hidden.value_range().0.is_nan());
+        let huge = FieldSpec::Scaled {
+            field: b(FieldSpec::Fbm(FbmParams::default())),
+            factor: 1e300,
+        };
+        assert_eq!(huge.value_range(), (-1e300, 1e300));
+        let over = FieldSpec::Scaled {
+            field: b(huge),
+            factor: 1e300,
+        };
+        assert_eq!(over.value_range(), (f64::NEG_INFINITY, f64::INFINITY));
     }
 }
