@@ -20,6 +20,9 @@ use crate::maps::{MapSpec, MapsConfig};
 /// refused with an error instead of exhausting the machine.
 pub const MAX_THREADS: usize = 256;
 
+/// The largest value of `maps.max_image_pixels`: 2³⁰ pixels (a 4 GiB map raster).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 30;
+
 /// The largest ground elevation, in metres above or below 0, an elevation map may give
 /// (deeper than the deepest ocean trench, higher than the highest mountain).
 pub const MAX_ELEVATION_M: f64 = 12_000.0;
@@ -449,6 +452,15 @@ impl CityConfig {
     /// crate docs and ARCHITECTURE.md), from the descriptions alone.
     fn check_maps(&self) -> Result<()> {
         let m = &self.maps;
+        if !(1..=MAX_IMAGE_PIXELS).contains(&m.max_image_pixels) {
+            return Err(Error::config(
+                "maps.max_image_pixels",
+                format!(
+                    "{} pixels; give 1 to {MAX_IMAGE_PIXELS} (2^30)",
+                    m.max_image_pixels
+                ),
+            ));
+        }
         let mut all: Vec<(String, &MapSpec)> = vec![("maps.population".into(), &m.population)];
         let named = [
             ("maps.water", &m.water),
@@ -657,6 +669,11 @@ mod tests {
             ),
             "{err}"
         );
+        for px in [0, MAX_IMAGE_PIXELS + 1] {
+            let mut c = base.clone();
+            c.maps.max_image_pixels = px;
+            assert_eq!(field_of(c.validate().unwrap_err()), "maps.max_image_pixels");
+        }
         let mut c = base.clone();
         c.lots.lot_width = f64::NAN;
         assert!(c.validate().unwrap_err().to_string().contains("lot_width"));

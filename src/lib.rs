@@ -63,7 +63,7 @@ pub use city::{City, CityLot, CityStats, SkipReport, StageTiming, Written, trace
 pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, KindStyles, SceneConfig, ZoneBand, ZoningConfig,
 };
-pub use config::{MAX_BUILDING_HEIGHT_M, MAX_ELEVATION_M, MAX_THREADS};
+pub use config::{MAX_BUILDING_HEIGHT_M, MAX_ELEVATION_M, MAX_IMAGE_PIXELS, MAX_THREADS};
 pub use error::{BoxError, Error, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};

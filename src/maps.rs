@@ -156,8 +156,17 @@ impl MapSpec {
     /// [`Error::Config`] naming `name` for out-of-range shape parameters; geometry errors
     /// for bad field parameters or unreadable PNG files.
     pub fn build(&self, name: &str, salt: u64) -> Result<Arc<dyn Field>> {
+        self.build_limited(name, salt, polis_geom::field::DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`build`](Self::build) with PNG images limited to `max_pixels` pixels each,
+    /// checked from the header before decoding.
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub fn build_limited(&self, name: &str, salt: u64, max_pixels: u64) -> Result<Arc<dyn Field>> {
         match self {
-            MapSpec::Field(spec) => Ok(Arc::from(salted(spec, salt).build()?)),
+            MapSpec::Field(spec) => Ok(Arc::from(salted(spec, salt).build_limited(max_pixels)?)),
             MapSpec::Shape(shape) => build_shape(shape, name, salt),
         }
     }
@@ -405,6 +414,10 @@ pub struct MapsConfig {
     pub pattern_weights: Vec<PatternMap>,
     /// Local New York grid angle, degrees. Default: none (`roads.grid_angle_deg`).
     pub grid_angle: Option<MapSpec>,
+    /// The largest PNG map, in pixels (width × height), read from each image's header
+    /// before decoding; 1 to 2³⁰. Default:
+    /// [`DEFAULT_MAX_PNG_PIXELS`](polis_geom::field::DEFAULT_MAX_PNG_PIXELS) (8192²).
+    pub max_image_pixels: u64,
 }
 
 impl Default for MapsConfig {
@@ -421,6 +434,7 @@ impl Default for MapsConfig {
             max_height: None,
             pattern_weights: Vec::new(),
             grid_angle: None,
+            max_image_pixels: polis_geom::field::DEFAULT_MAX_PNG_PIXELS,
         }
     }
 }
@@ -460,8 +474,11 @@ impl CityMaps {
     /// # Errors
     /// The first map that cannot be built, named (`maps.water.radius_m`).
     pub fn build(config: &MapsConfig, seed: u64) -> Result<CityMaps> {
+        let px = config.max_image_pixels;
         let opt = |m: &Option<MapSpec>, name: &str, k: u64| -> Result<Option<Arc<dyn Field>>> {
-            m.as_ref().map(|m| m.build(name, mix(seed, k))).transpose()
+            m.as_ref()
+                .map(|m| m.build_limited(name, mix(seed, k), px))
+                .transpose()
         };
         let zero = || -> Arc<dyn Field> { Arc::new(Constant(0.0)) };
         let water = opt(&config.water, "maps.water", 2)?;
@@ -469,13 +486,18 @@ impl CityMaps {
         let mut pattern_weights = Vec::with_capacity(config.pattern_weights.len());
         for (i, pm) in config.pattern_weights.iter().enumerate() {
             let name = format!("maps.pattern_weights[{i}]");
-            pattern_weights.push((pm.pattern, pm.map.build(&name, mix(seed, 100 + i as u64))?));
+            pattern_weights.push((
+                pm.pattern,
+                pm.map.build_limited(&name, mix(seed, 100 + i as u64), px)?,
+            ));
         }
         Ok(CityMaps {
             has_water: water.is_some(),
             has_parks: parks.is_some(),
             inputs: RoadInputs {
-                population: config.population.build("maps.population", mix(seed, 1))?,
+                population: config
+                    .population
+                    .build_limited("maps.population", mix(seed, 1), px)?,
                 water: water.unwrap_or_else(zero),
                 parks: parks.unwrap_or_else(zero),
                 elevation: opt(&config.elevation, "maps.elevation", 4)?.unwrap_or_else(zero),

@@ -182,6 +182,15 @@ impl FieldSpec {
     /// [`Population::new`], [`Raster::from_png_path`]) and
     /// [`GeomError::InvalidParameter`] for a bad simplex `wavelength_m`.
     pub fn build(&self) -> Result<Box<dyn Field>, GeomError> {
+        self.build_limited(super::DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`build`](Self::build) with PNG images limited to `max_pixels` pixels each
+    /// (width × height, checked from the header before decoding; see
+    /// [`Raster::from_png_bytes_limited`]).
+    ///
+    /// Errors: as [`build`](Self::build).
+    pub fn build_limited(&self, max_pixels: u64) -> Result<Box<dyn Field>, GeomError> {
         Ok(match self {
             FieldSpec::Constant { value } => Box::new(Constant(*value)),
             FieldSpec::Simplex { seed, wavelength_m } => {
@@ -201,34 +210,64 @@ impl FieldSpec {
             FieldSpec::Population(params) => Box::new(Population::new(*params)?),
             FieldSpec::Raster(raster) => Box::new(raster.clone()),
             #[cfg(feature = "png")]
-            FieldSpec::Png { path, extent } => Box::new(Raster::from_png_path(path, *extent)?),
-            FieldSpec::Scaled { field, factor } => Box::new(Scaled::new(field.build()?, *factor)),
-            FieldSpec::Offset { field, offset } => Box::new(Offset::new(field.build()?, *offset)),
-            FieldSpec::Sum { a, b } => Box::new(Sum::new(a.build()?, b.build()?)),
-            FieldSpec::Product { a, b } => Box::new(Product::new(a.build()?, b.build()?)),
-            FieldSpec::Threshold { field, threshold } => {
-                Box::new(Threshold::new(field.build()?, *threshold))
+            FieldSpec::Png { path, extent } => {
+                Box::new(Raster::from_png_path_limited(path, *extent, max_pixels)?)
             }
-            FieldSpec::Min { a, b } => Box::new(Min::new(a.build()?, b.build()?)),
-            FieldSpec::Max { a, b } => Box::new(Max::new(a.build()?, b.build()?)),
-            FieldSpec::Clamp { field, lo, hi } => Box::new(Clamp::new(field.build()?, *lo, *hi)),
+            FieldSpec::Scaled { field, factor } => {
+                Box::new(Scaled::new(field.build_limited(max_pixels)?, *factor))
+            }
+            FieldSpec::Offset { field, offset } => {
+                Box::new(Offset::new(field.build_limited(max_pixels)?, *offset))
+            }
+            FieldSpec::Sum { a, b } => Box::new(Sum::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Product { a, b } => Box::new(Product::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Threshold { field, threshold } => {
+                Box::new(Threshold::new(field.build_limited(max_pixels)?, *threshold))
+            }
+            FieldSpec::Min { a, b } => Box::new(Min::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Max { a, b } => Box::new(Max::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Clamp { field, lo, hi } => {
+                Box::new(Clamp::new(field.build_limited(max_pixels)?, *lo, *hi))
+            }
             FieldSpec::Mask {
                 mask,
                 if_true,
                 if_false,
                 threshold,
             } => Box::new(
-                Mask::new(mask.build()?, if_true.build()?, if_false.build()?)
-                    .with_threshold(*threshold),
+                Mask::new(
+                    mask.build_limited(max_pixels)?,
+                    if_true.build_limited(max_pixels)?,
+                    if_false.build_limited(max_pixels)?,
+                )
+                .with_threshold(*threshold),
             ),
-            FieldSpec::Blend { weight, zero, one } => {
-                Box::new(Blend::new(weight.build()?, zero.build()?, one.build()?))
-            }
+            FieldSpec::Blend { weight, zero, one } => Box::new(Blend::new(
+                weight.build_limited(max_pixels)?,
+                zero.build_limited(max_pixels)?,
+                one.build_limited(max_pixels)?,
+            )),
             FieldSpec::Transform {
                 field,
                 scale,
                 offset,
-            } => Box::new(DomainTransform::new(field.build()?, *scale, *offset)),
+            } => Box::new(DomainTransform::new(
+                field.build_limited(max_pixels)?,
+                *scale,
+                *offset,
+            )),
         })
     }
 }
