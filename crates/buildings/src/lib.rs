@@ -93,6 +93,7 @@ pub use error::BuildingsError;
 pub use generate::{
     BuildingGenerator, MIN_BUILDING_HEIGHT, Plan, ZoneRule, generate, kind_from_zoning, mix_seed,
 };
+pub use generate::{LOT_RESOLUTION_M, resolved_lot};
 pub use grammar::{BuildingGrammar, SHAPE_MODULES, default_text};
 pub use params::{
     BuildingKind, BuildingParams, FootprintParams, FootprintStrategy, HeightDistribution,

@@ -55,6 +55,7 @@ pub mod polygon;
 pub mod predicates;
 pub mod scene;
 mod simplicity;
+pub mod simplify;
 pub mod spatial;
 
 pub use bbox::Aabb2;
