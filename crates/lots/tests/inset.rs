@@ -184,3 +184,34 @@ proptest::proptest! {
         }
     }
 }
+
+/// Fuzzing finding (issue 22, skeleton_inset): a quad 100 m long and 9e-6 m thin, with a
+/// vertex 1e-7 m (the coincidence tolerance, 1e-9 of its size) off its base, inset by 0.
+/// The inset came out 3.6e-8 m² larger than the polygon: points within the tolerance are
+/// merged and pinches separated by twice it, so an inset is exact up to that distance
+/// along the perimeter (here 4e-5 m²), which the fuzz target now allows for.
+#[test]
+fn thin_quad_inset_by_zero_stays_within_the_tolerance() {
+    let h = 10f64.powf(-14.0 + 15.0 * f64::from(0x98ffu16) / 65535.0);
+    let mut p = poly(&[
+        (0.0, 0.0),
+        (100.0, 0.0),
+        (100.0 * f64::from(0xa2deu16) / 65535.0, h),
+        (
+            50.0 * f64::from(0x0019u16) / 65535.0,
+            h * f64::from(0x02deu16) / 65535.0,
+        ),
+    ]);
+    p.make_ccw();
+    let p: PolygonWithHoles = p.into();
+    let a = p.area();
+    let slack = 4e-9 * 100.0 * 200.0;
+    for d in [0.0, 1e-9, 1e-7] {
+        let area: f64 = inset(&p, d)
+            .unwrap()
+            .iter()
+            .map(PolygonWithHoles::area)
+            .sum();
+        assert!(area <= a + slack, "d = {d}: {area} > {a}");
+    }
+}
