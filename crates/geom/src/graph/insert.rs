@@ -464,7 +464,12 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             let pn = self.position(n)?;
             let (closest, t) = closest_point_on_segment(pn, pc, pt);
             let on = point_on_segment(pn, pc, pt);
-            if (on || (closest.distance(pn) <= snap && near_line(pn))) && t > 0.0 && t < 1.0 {
+            // Within rounding of the leg, a node is on it whatever the snap bound says.
+            let touching = closest.distance(pn) <= rounding_eps(pn);
+            if (on || touching || (closest.distance(pn) <= snap && near_line(pn)))
+                && t > 0.0
+                && t < 1.0
+            {
                 offer(t, Event::Node(n));
             }
         }
