@@ -363,6 +363,8 @@ impl FieldSpec {
             }
             FieldSpec::Clamp { field, lo, hi } => {
                 let (a, b) = field.value_range();
+                // Bounds in either order, as `Clamp::new` takes them.
+                let (lo, hi) = if lo > hi { (hi, lo) } else { (lo, hi) };
                 let clamp = |v: f64| v.max(*lo).min(*hi);
                 nan_if(
                     a.is_nan() || b.is_nan() || lo.is_nan() || hi.is_nan(),
@@ -629,7 +631,7 @@ mod tests {
                     .prop_map(|(a, c)| FieldSpec::Min { a: b(a), b: b(c) }),
                 (inner.clone(), inner.clone())
                     .prop_map(|(a, c)| FieldSpec::Max { a: b(a), b: b(c) }),
-                (inner.clone(), -2.0f64..2.0, 0.0f64..3.0).prop_map(|(f, lo, w)| {
+                (inner.clone(), -2.0f64..2.0, -3.0f64..3.0).prop_map(|(f, lo, w)| {
                     FieldSpec::Clamp {
                         field: b(f),
                         lo,
@@ -667,6 +669,23 @@ mod tests {
                 let slack = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
                 proptest::prop_assert!(v >= lo - slack && v <= hi + slack, "{v} outside [{lo}, {hi}]");
             }
+        }
+    }
+
+    /// Fuzzing finding (issue 22, config_maps): a clamp written with `lo > hi` (which
+    /// `Clamp::new` takes in either order) got the range `[hi, hi]`.
+    #[test]
+    fn value_range_of_a_clamp_with_bounds_swapped() {
+        let spec = FieldSpec::Clamp {
+            field: b(FieldSpec::Population(PopulationParams::default())),
+            lo: 5.0,
+            hi: 0.0,
+        };
+        assert_eq!(spec.value_range(), (0.0, 1.0));
+        let f = spec.build().unwrap();
+        for k in 0..50 {
+            let v = f.sample(DVec2::new(37.0 * f64::from(k), -53.0 * f64::from(k)));
+            assert!((0.0..=1.0).contains(&v), "{v}");
         }
     }
 
