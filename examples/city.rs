@@ -337,6 +337,9 @@ fn run(args: &Args, progress: &Progress) -> Result<(), Box<dyn std::error::Error
     );
     println!("  triangles       {:>9}", s.scene_triangles);
     println!("  skipped         {:>9}", city.report.skipped.len());
+    for w in &city.report.warnings {
+        println!("warning: {w}");
+    }
     for stage in Stage::ALL {
         println!(
             "  {:<15} {:>7.1} ms",

@@ -98,6 +98,11 @@ impl CityStats {
 pub struct SkipReport {
     /// Every skipped item, in pipeline order.
     pub skipped: Vec<Skip>,
+    /// Settings that are valid but leave the city empty or nearly so
+    /// ([`CityConfig::warnings`](crate::CityConfig::warnings)), and empty results (no
+    /// road, no building), with the field to change. Default: none.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl SkipReport {

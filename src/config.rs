@@ -13,7 +13,24 @@ use serde::{Deserialize, Serialize};
 
 use crate::citygen::{CitygenConfig, RoadMode};
 use crate::error::{Error, Result};
-use crate::maps::MapsConfig;
+use crate::maps::{MapSpec, MapsConfig};
+
+/// The most worker threads [`CityConfig::threads`] may ask for. Per-cell work gains
+/// nothing from more workers than cores, and every worker costs a stack and scratch
+/// buffers; 256 covers the largest machines while a typo (4,000 or 100,000 threads) is
+/// refused with an error instead of exhausting the machine.
+pub const MAX_THREADS: usize = 256;
+
+/// The largest value of `maps.max_image_pixels`: 2³⁰ pixels (a 4 GiB map raster).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 30;
+
+/// The largest ground elevation, in metres above or below 0, an elevation map may give
+/// (deeper than the deepest ocean trench, higher than the highest mountain).
+pub const MAX_ELEVATION_M: f64 = 12_000.0;
+
+/// The tallest building height limit, metres, a zoning band or maximum-height map may
+/// give (the tallest buildings are about 830 m).
+pub const MAX_BUILDING_HEIGHT_M: f64 = 1_000.0;
 
 /// The whole description of a city. Every field has a default, so a configuration file
 /// names only what differs (`{ "seed": 7, "size_m": 2000 }` is a complete file); unknown
@@ -23,6 +40,16 @@ use crate::maps::MapsConfig;
 /// `buildings.seed` (both derived from [`seed`](Self::seed)) and `roads.bounds_*` (the
 /// square of side [`size_m`](Self::size_m) centred on the origin). Values written there
 /// are replaced.
+///
+/// # Sanity policy
+/// [`validate`](Self::validate) checks every numeric field against a documented range
+/// and names the field it refuses: `size_m` in [10, 10⁶] m; `threads` 1 to
+/// [`MAX_THREADS`]; every map's value range (computed from its description,
+/// [`MapSpec::value_range`]) finite, elevation within ±[`MAX_ELEVATION_M`], maximum height
+/// in [0, [`MAX_BUILDING_HEIGHT_M`]]; zoning heights in (0, [`MAX_BUILDING_HEIGHT_M`]];
+/// the stage parameters through their own `validate` (e.g. `roads.max_segments` ≥ 1).
+/// Valid settings that leave the city empty are listed by [`warnings`](Self::warnings)
+/// and in the city's report. The full table is in ARCHITECTURE.md.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CityConfig {
@@ -37,7 +64,8 @@ pub struct CityConfig {
     /// detail (`buildings.max_lod`). Default: None.
     pub lod: Option<usize>,
     /// Worker threads for per-cell and per-lot work; `None` = one per core, `Some(1)` =
-    /// serial. The output is byte-identical for any value. Default: None.
+    /// serial, at most [`MAX_THREADS`]. The output is byte-identical for any value.
+    /// Default: None.
     pub threads: Option<usize>,
     /// Input maps.
     pub maps: MapsConfig,
@@ -104,7 +132,7 @@ pub struct ZoneBand {
     pub min_density: f64,
     /// The building kind.
     pub kind: BuildingKind,
-    /// Height limit, metres.
+    /// Height limit, metres, in (0, [`MAX_BUILDING_HEIGHT_M`]].
     pub max_height_m: f64,
 }
 
@@ -347,6 +375,9 @@ impl CityConfig {
     /// [`Error::Parse`] with the line and column, or [`Error::Config`] from
     /// [`validate`](Self::validate).
     pub fn from_json(text: &str, source_name: &str) -> Result<CityConfig> {
+        // Editors on some systems start UTF-8 files with a byte-order mark; JSON forbids
+        // it, so it is dropped here rather than reported as a syntax error.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let config: CityConfig = serde_json::from_str(text).map_err(|e| Error::Parse {
             source_name: source_name.into(),
             message: e.to_string(),
@@ -414,28 +445,36 @@ impl CityConfig {
                 format!("{} m; give a map side in [10, 1000000] m", self.size_m),
             ));
         }
-        if self.threads == Some(0) {
+        if let Some(t) = self.threads
+            && !(1..=MAX_THREADS).contains(&t)
+        {
             return Err(Error::config(
                 "threads",
-                "0 threads; give at least 1, or leave it out for one per core",
+                format!("{t} threads; give 1 to {MAX_THREADS}, or leave it out for one per core"),
             ));
         }
+        let height_ok = |h: f64| h.is_finite() && h > 0.0 && h <= MAX_BUILDING_HEIGHT_M;
         for (i, b) in self.zoning.bands.iter().enumerate() {
-            if !(b.min_density.is_finite() && b.max_height_m.is_finite() && b.max_height_m > 0.0) {
+            if !(b.min_density.is_finite() && height_ok(b.max_height_m)) {
                 return Err(Error::config(
                     format!("zoning.bands[{i}]"),
-                    "min_density must be finite and max_height_m finite and > 0",
+                    format!(
+                        "min_density {} must be finite and max_height_m {} in (0, {MAX_BUILDING_HEIGHT_M}] m",
+                        b.min_density, b.max_height_m
+                    ),
                 ));
             }
         }
-        if !(self.zoning.fallback_max_height_m.is_finite()
-            && self.zoning.fallback_max_height_m > 0.0)
-        {
+        if !height_ok(self.zoning.fallback_max_height_m) {
             return Err(Error::config(
                 "zoning.fallback_max_height_m",
-                "must be finite and > 0",
+                format!(
+                    "{} m; give a height in (0, {MAX_BUILDING_HEIGHT_M}] m",
+                    self.zoning.fallback_max_height_m
+                ),
             ));
         }
+        self.check_maps()?;
         let ppm = self.facades.pixels_per_metre;
         if !(ppm.is_finite() && (1.0..=512.0).contains(&ppm)) {
             return Err(Error::config(
@@ -454,7 +493,113 @@ impl CityConfig {
         self.effective_road_params().validate()?;
         self.citygen.validate()?;
         self.effective_building_params().validate()?;
+        self.lots.validate()?;
+        self.blocks.validate()?;
         Ok(())
+    }
+
+    /// The maps' value ranges against their physical ranges (the sanity policy in the
+    /// crate docs and ARCHITECTURE.md), from the descriptions alone.
+    fn check_maps(&self) -> Result<()> {
+        let m = &self.maps;
+        if !(1..=MAX_IMAGE_PIXELS).contains(&m.max_image_pixels) {
+            return Err(Error::config(
+                "maps.max_image_pixels",
+                format!(
+                    "{} pixels; give 1 to {MAX_IMAGE_PIXELS} (2^30)",
+                    m.max_image_pixels
+                ),
+            ));
+        }
+        let mut all: Vec<(String, &MapSpec)> = vec![("maps.population".into(), &m.population)];
+        let named = [
+            ("maps.water", &m.water),
+            ("maps.parks", &m.parks),
+            ("maps.elevation", &m.elevation),
+            ("maps.zoning", &m.zoning),
+            ("maps.max_height", &m.max_height),
+            ("maps.grid_angle", &m.grid_angle),
+        ];
+        all.extend(
+            named
+                .iter()
+                .filter_map(|(n, s)| s.as_ref().map(|s| (n.to_string(), s))),
+        );
+        for (i, pm) in m.pattern_weights.iter().enumerate() {
+            all.push((format!("maps.pattern_weights[{i}].map"), &pm.map));
+        }
+        for (name, spec) in all {
+            let (lo, hi) = spec.value_range();
+            if !(lo.is_finite() && hi.is_finite()) {
+                return Err(Error::config(
+                    name,
+                    format!(
+                        "the map's values can reach [{lo}, {hi}]; every map must stay finite \
+                         (check its scale factors and constants)"
+                    ),
+                ));
+            }
+        }
+        if let Some(e) = &m.elevation {
+            let (lo, hi) = e.value_range();
+            if lo < -MAX_ELEVATION_M || hi > MAX_ELEVATION_M {
+                return Err(Error::config(
+                    "maps.elevation",
+                    format!(
+                        "the map's values can reach [{lo}, {hi}] m; ground elevation must stay \
+                         within ±{MAX_ELEVATION_M} m (check the elevation scale)"
+                    ),
+                ));
+            }
+        }
+        if let Some(h) = &m.max_height {
+            let (lo, hi) = h.value_range();
+            if lo < 0.0 || hi > MAX_BUILDING_HEIGHT_M {
+                return Err(Error::config(
+                    "maps.max_height",
+                    format!(
+                        "the map's values can reach [{lo}, {hi}] m; a height limit must be in \
+                         [0, {MAX_BUILDING_HEIGHT_M}] m (check the maximum-height scale)"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Settings that are valid but leave the city (nearly) empty, as messages for the
+    /// report ([`SkipReport::warnings`](crate::SkipReport::warnings)): a maximum-height map
+    /// that is 0 everywhere, parks or water everywhere, a population map that never
+    /// reaches the street threshold.
+    pub fn warnings(&self) -> Vec<String> {
+        let m = &self.maps;
+        let mut out = Vec::new();
+        if let Some((_, hi)) = m.max_height.as_ref().map(MapSpec::value_range)
+            && hi <= 0.0
+        {
+            out.push(format!(
+                "maps.max_height is at most {hi} m everywhere: no building can stand"
+            ));
+        }
+        if let Some((lo, _)) = m.parks.as_ref().map(MapSpec::value_range)
+            && lo >= 0.5
+        {
+            out.push("maps.parks is a park (≥ 0.5) everywhere: no lot can be built".into());
+        }
+        if let Some((lo, _)) = m.water.as_ref().map(MapSpec::value_range)
+            && lo >= 0.5
+        {
+            out.push("maps.water is water (≥ 0.5) everywhere: no road can start".into());
+        }
+        let (_, pop) = m.population.value_range();
+        if pop < self.roads.population_threshold {
+            out.push(format!(
+                "maps.population is at most {pop} everywhere, below roads.population_threshold \
+                 {}: no street can branch",
+                self.roads.population_threshold
+            ));
+        }
+        out
     }
 }
 
@@ -492,5 +637,131 @@ mod tests {
         assert_eq!(z.zone(0.3).0, BuildingKind::Apartment);
         assert_eq!(z.zone(0.0).0, BuildingKind::Industrial);
         assert_eq!(z.zone(f64::NAN).0, BuildingKind::Industrial);
+    }
+
+    fn png_map(scale: f64) -> MapSpec {
+        let extent = polis_geom::Aabb2::new(
+            polis_geom::DVec2::splat(-100.0),
+            polis_geom::DVec2::splat(100.0),
+        );
+        MapSpec::Field(polis_geom::field::FieldSpec::Scaled {
+            field: Box::new(polis_geom::field::FieldSpec::Png {
+                path: "/nonexistent/map.png".into(),
+                extent,
+            }),
+            factor: scale,
+        })
+    }
+
+    fn field_of(err: Error) -> String {
+        match err {
+            Error::Config { field, .. } => field,
+            other => panic!("not a configuration error: {other}"),
+        }
+    }
+
+    /// The adversarial run's bad values: each is refused naming the field, before any
+    /// file is read.
+    #[test]
+    fn out_of_range_values_name_their_field() {
+        let base = CityConfig::default();
+        for threads in [0, MAX_THREADS + 1, 4_000, 100_000] {
+            let c = CityConfig {
+                threads: Some(threads),
+                ..base.clone()
+            };
+            assert_eq!(field_of(c.validate().unwrap_err()), "threads");
+        }
+        for threads in [1, MAX_THREADS] {
+            let c = CityConfig {
+                threads: Some(threads),
+                ..base.clone()
+            };
+            c.validate().unwrap();
+        }
+        for scale in [f64::NAN, 1e300, f64::INFINITY, -13_000.0] {
+            let mut c = base.clone();
+            c.maps.elevation = Some(png_map(scale));
+            assert_eq!(
+                field_of(c.validate().unwrap_err()),
+                "maps.elevation",
+                "{scale}"
+            );
+        }
+        let mut c = base.clone();
+        c.maps.elevation = Some(png_map(300.0));
+        c.validate().unwrap();
+        for scale in [-50.0, f64::NAN, 1e6] {
+            let mut c = base.clone();
+            c.maps.max_height = Some(png_map(scale));
+            assert_eq!(
+                field_of(c.validate().unwrap_err()),
+                "maps.max_height",
+                "{scale}"
+            );
+        }
+        let mut c = base.clone();
+        c.maps.population = png_map(f64::NAN);
+        assert_eq!(field_of(c.validate().unwrap_err()), "maps.population");
+        let mut c = base.clone();
+        c.zoning.bands[0].max_height_m = 5_000.0;
+        assert_eq!(field_of(c.validate().unwrap_err()), "zoning.bands[0]");
+        let mut c = base.clone();
+        c.roads.max_segments = 0;
+        let err = c.validate().unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                Error::Roads(polis_roads::RoadError::InvalidParameter {
+                    name: "max_segments",
+                    ..
+                })
+            ),
+            "{err}"
+        );
+        for px in [0, MAX_IMAGE_PIXELS + 1] {
+            let mut c = base.clone();
+            c.maps.max_image_pixels = px;
+            assert_eq!(field_of(c.validate().unwrap_err()), "maps.max_image_pixels");
+        }
+        let mut c = base.clone();
+        c.lots.lot_width = f64::NAN;
+        assert!(c.validate().unwrap_err().to_string().contains("lot_width"));
+        let mut c = base;
+        c.blocks.footpath_width = -1.0;
+        assert!(
+            c.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("footpath_width")
+        );
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_accepted() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/config_with_bom.json"
+        );
+        let bytes = std::fs::read(path).unwrap();
+        assert_eq!(
+            &bytes[..3],
+            b"\xef\xbb\xbf",
+            "the fixture starts with a BOM"
+        );
+        let c = CityConfig::from_path(path).unwrap();
+        assert_eq!((c.seed, c.size_m), (7, 600.0));
+    }
+
+    #[test]
+    fn empty_but_valid_settings_are_warned_about() {
+        let mut c = CityConfig::default();
+        assert!(c.warnings().is_empty(), "{:?}", c.warnings());
+        c.maps.max_height = Some(png_map(0.0));
+        c.validate().unwrap();
+        let w = c.warnings();
+        assert!(w.len() == 1 && w[0].contains("maps.max_height"), "{w:?}");
+        c.maps.population = MapSpec::constant(0.01);
+        assert!(c.warnings().iter().any(|w| w.contains("maps.population")));
     }
 }

@@ -78,6 +78,7 @@ pub use config::{
     CityConfig, FacadeConfig, FacadeDetail, Foundation, KindStyles, SceneConfig, ZoneBand,
     ZoningConfig,
 };
+pub use config::{MAX_BUILDING_HEIGHT_M, MAX_ELEVATION_M, MAX_IMAGE_PIXELS, MAX_THREADS};
 pub use error::{BoxError, Error, PolisError, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};

@@ -156,9 +156,40 @@ impl MapSpec {
     /// [`Error::Config`] naming `name` for out-of-range shape parameters; geometry errors
     /// for bad field parameters or unreadable PNG files.
     pub fn build(&self, name: &str, salt: u64) -> Result<Arc<dyn Field>> {
+        self.build_limited(name, salt, polis_geom::field::DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`build`](Self::build) with PNG images limited to `max_pixels` pixels each,
+    /// checked from the header before decoding.
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub fn build_limited(&self, name: &str, salt: u64, max_pixels: u64) -> Result<Arc<dyn Field>> {
         match self {
-            MapSpec::Field(spec) => Ok(Arc::from(salted(spec, salt).build()?)),
+            MapSpec::Field(spec) => Ok(Arc::from(salted(spec, salt).build_limited(max_pixels)?)),
             MapSpec::Shape(shape) => build_shape(shape, name, salt),
+        }
+    }
+}
+
+impl MapSpec {
+    /// A conservative interval holding every value the built map can take, from the
+    /// description alone (see [`FieldSpec::value_range`]); NaN or infinite bounds flag a
+    /// NaN or overflowing parameter. [`CityConfig::validate`](crate::CityConfig::validate)
+    /// checks it against each map's physical range.
+    pub fn value_range(&self) -> (f64, f64) {
+        match self {
+            MapSpec::Field(spec) => spec.value_range(),
+            MapSpec::Shape(Shape::Coast { .. } | Shape::Island { .. }) => (0.0, 1.0),
+            MapSpec::Shape(Shape::Radial { peak, noise, .. }) => {
+                // max(peak · base · (1 + noise · n), 0) with base in [0, 1], n in [-1, 1].
+                let top = peak * (1.0 + noise.abs());
+                if top.is_nan() {
+                    (f64::NAN, f64::NAN)
+                } else {
+                    (0.0, top.max(0.0))
+                }
+            }
         }
     }
 }
@@ -369,18 +400,24 @@ pub struct MapsConfig {
     pub water: Option<MapSpec>,
     /// Parks and other no-build land: ≥ 0.5 is a park. Default: none.
     pub parks: Option<MapSpec>,
-    /// Ground elevation, metres. Default: flat (0 m).
+    /// Ground elevation, metres, within ±[`MAX_ELEVATION_M`](crate::MAX_ELEVATION_M).
+    /// Default: flat (0 m).
     pub elevation: Option<MapSpec>,
     /// Zoning: the value, rounded, indexes the building kinds (0 skyscraper, 1 office,
     /// 2 mid-rise, 3 house, 4 apartment, 5 industrial); replaces the zoning bands.
     /// Default: none (the bands of [`ZoningConfig`](crate::ZoningConfig) apply).
     pub zoning: Option<MapSpec>,
-    /// Maximum building height, metres; replaces the bands' limits. Default: none.
+    /// Maximum building height, metres, in [0, [`MAX_BUILDING_HEIGHT_M`](crate::MAX_BUILDING_HEIGHT_M)];
+    /// replaces the bands' limits, and where it is 0 no building stands. Default: none.
     pub max_height: Option<MapSpec>,
     /// Pattern-weight maps; empty = `roads.pattern` everywhere. Default: empty.
     pub pattern_weights: Vec<PatternMap>,
     /// Local New York grid angle, degrees. Default: none (`roads.grid_angle_deg`).
     pub grid_angle: Option<MapSpec>,
+    /// The largest PNG map, in pixels (width × height), read from each image's header
+    /// before decoding; 1 to 2³⁰. Default:
+    /// [`DEFAULT_MAX_PNG_PIXELS`](polis_geom::field::DEFAULT_MAX_PNG_PIXELS) (8192²).
+    pub max_image_pixels: u64,
 }
 
 impl Default for MapsConfig {
@@ -397,6 +434,7 @@ impl Default for MapsConfig {
             max_height: None,
             pattern_weights: Vec::new(),
             grid_angle: None,
+            max_image_pixels: polis_geom::field::DEFAULT_MAX_PNG_PIXELS,
         }
     }
 }
@@ -436,8 +474,11 @@ impl CityMaps {
     /// # Errors
     /// The first map that cannot be built, named (`maps.water.radius_m`).
     pub fn build(config: &MapsConfig, seed: u64) -> Result<CityMaps> {
+        let px = config.max_image_pixels;
         let opt = |m: &Option<MapSpec>, name: &str, k: u64| -> Result<Option<Arc<dyn Field>>> {
-            m.as_ref().map(|m| m.build(name, mix(seed, k))).transpose()
+            m.as_ref()
+                .map(|m| m.build_limited(name, mix(seed, k), px))
+                .transpose()
         };
         let zero = || -> Arc<dyn Field> { Arc::new(Constant(0.0)) };
         let water = opt(&config.water, "maps.water", 2)?;
@@ -445,13 +486,18 @@ impl CityMaps {
         let mut pattern_weights = Vec::with_capacity(config.pattern_weights.len());
         for (i, pm) in config.pattern_weights.iter().enumerate() {
             let name = format!("maps.pattern_weights[{i}]");
-            pattern_weights.push((pm.pattern, pm.map.build(&name, mix(seed, 100 + i as u64))?));
+            pattern_weights.push((
+                pm.pattern,
+                pm.map.build_limited(&name, mix(seed, 100 + i as u64), px)?,
+            ));
         }
         Ok(CityMaps {
             has_water: water.is_some(),
             has_parks: parks.is_some(),
             inputs: RoadInputs {
-                population: config.population.build("maps.population", mix(seed, 1))?,
+                population: config
+                    .population
+                    .build_limited("maps.population", mix(seed, 1), px)?,
                 water: water.unwrap_or_else(zero),
                 parks: parks.unwrap_or_else(zero),
                 elevation: opt(&config.elevation, "maps.elevation", 4)?.unwrap_or_else(zero),

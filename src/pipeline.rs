@@ -242,7 +242,10 @@ impl Pipeline {
     ) -> Result<City> {
         let started = Instant::now();
         let mut timings = Vec::new();
-        let mut report = SkipReport::default();
+        let mut report = SkipReport {
+            warnings: config.warnings(),
+            ..SkipReport::default()
+        };
         let mut clock = Instant::now();
         let lap = |stage: Stage, clock: &mut Instant| StageTiming {
             stage,
@@ -371,6 +374,7 @@ impl Pipeline {
             wall_time: started.elapsed(),
             ..counts
         };
+        report.warnings.extend(empty_city_warnings(&stats));
         Ok(City {
             config: config.clone(),
             maps,
@@ -529,9 +533,12 @@ impl Pipeline {
                     kind = polis_buildings::kind_from_zoning(z.as_ref(), c);
                 }
                 if let Some(h) = &maps.max_height {
-                    let v = h.sample(c);
-                    if v.is_finite() && v > 0.0 {
-                        max_height_m = v;
+                    // The map replaces the bands' limit; a limit of 0 m (or less, or
+                    // NaN) leaves the lot empty rather than falling back to the bands.
+                    max_height_m = h.sample(c);
+                    if max_height_m.is_nan() || max_height_m <= 0.0 {
+                        ticker.tick();
+                        return Ok(None);
                     }
                 }
                 let r = builder.build(&LotInput {
@@ -607,6 +614,25 @@ fn restart(clock: &mut Instant) -> std::time::Duration {
     let t = clock.elapsed();
     *clock = Instant::now();
     t
+}
+
+/// Warnings for a city without roads or buildings, naming what to change.
+fn empty_city_warnings(stats: &CityStats) -> Vec<String> {
+    let mut out = Vec::new();
+    if stats.road_segments == 0 {
+        out.push(
+            "no road was grown: check maps.population, maps.water, maps.elevation (slopes \
+             above roads.max_slope are illegal) and roads.max_segments"
+                .to_string(),
+        );
+    } else if stats.buildings == 0 {
+        out.push(
+            "no building was placed: check the lot sizes (lots), maps.parks, maps.max_height \
+             and the skipped items"
+                .to_string(),
+        );
+    }
+    out
 }
 
 /// Sums the timings of each stage (chunks report theirs separately), in stage order.

@@ -15,6 +15,13 @@ use crate::template::Template;
 /// Lowest building drawn, metres: under this the maximum-height map forbids building.
 pub const MIN_BUILDING_HEIGHT: f64 = 2.5;
 
+/// The geometric resolution of buildings, metres: before a footprint is cut, lot vertices
+/// within this distance of the chord between their neighbours (near-duplicate vertices,
+/// nearly straight runs of a finely sampled curve) are dropped, except where a street
+/// edge meets a side edge. Building meshes are `f32` (about 1 mm at 10 km from the
+/// origin), and finer detail only gives triangles of zero area after rounding.
+pub const LOT_RESOLUTION_M: f64 = 1e-3;
+
 /// Longest string a building derivation may produce (modules).
 pub const MAX_BUILDING_MODULES: usize = 100_000;
 
@@ -91,12 +98,14 @@ impl BuildingGenerator {
         kind: BuildingKind,
         max_height: f64,
     ) -> Result<Option<Plan>, BuildingsError> {
+        let lot = &*resolved_lot(lot, lot_id)?;
         Ok(self
             .plan_centred(lot, lot_id, kind, max_height)?
             .map(|(plan, _)| plan))
     }
 
-    /// [`plan`](Self::plan) with the footprint's centroid (the building's origin).
+    /// [`plan`](Self::plan) of a lot already at [`LOT_RESOLUTION_M`] ([`resolved_lot`]),
+    /// with the footprint's centroid (the building's origin).
     fn plan_centred(
         &self,
         lot: &Lot,
@@ -255,6 +264,7 @@ impl BuildingGenerator {
         last_only: bool,
         sink: &mut dyn FnMut(Building),
     ) -> Result<(), BuildingsError> {
+        let lot = &*resolved_lot(lot, lot_id)?;
         let Some((plan, origin)) = self.plan_centred(lot, lot_id, kind, max_height)? else {
             return Ok(());
         };
@@ -322,6 +332,86 @@ impl BuildingGenerator {
         LOCAL.with(|l| l.set(local));
         Ok(())
     }
+}
+
+/// `lot` at [`LOT_RESOLUTION_M`]: its vertices within the resolution of the chord between
+/// their kept neighbours dropped (never where the street flag changes), the street edges
+/// renumbered. The lot itself when nothing is dropped or when the simplified ring would
+/// not be a valid polygon.
+///
+/// # Errors
+/// [`BuildingsError::Lot`] when fewer than three vertices remain (no extent above the
+/// resolution).
+pub fn resolved_lot(lot: &Lot, lot_id: u64) -> Result<std::borrow::Cow<'_, Lot>, BuildingsError> {
+    use std::borrow::Cow;
+    let pts = lot.polygon.points();
+    let n = pts.len();
+    if n <= 3 {
+        return Ok(Cow::Borrowed(lot));
+    }
+    let mut street = vec![false; n];
+    for &e in lot.street_edges.iter().filter(|&&e| e < n) {
+        street[e] = true;
+    }
+    // Vertex i joins edge i − 1 and edge i; it stays where a street edge meets a side
+    // edge, unless one of them is shorter than the resolution (a near-duplicate vertex
+    // carries no street of its own).
+    let long = |e: usize| pts[e].distance(pts[(e + 1) % n]) >= LOT_RESOLUTION_M;
+    let fixed = |i: usize| {
+        let before = (i + n - 1) % n;
+        street[before] != street[i] && long(before) && long(i)
+    };
+    let kept = polis_geom::simplify::simplify_ring(pts, LOT_RESOLUTION_M, fixed);
+    if kept.len() == n {
+        return Ok(Cow::Borrowed(lot));
+    }
+    if kept.len() < 3 {
+        return Err(BuildingsError::Lot {
+            lot_id,
+            reason: format!(
+                "the lot has no extent above the {LOT_RESOLUTION_M} m resolution of buildings"
+            ),
+        });
+    }
+    let polygon = Polygon::new(kept.iter().map(|&i| pts[i]).collect());
+    if polygon.validate().is_err() {
+        return Ok(Cow::Borrowed(lot));
+    }
+    // Original edge e lies in the kept edge that starts at the last kept vertex ≤ e
+    // (or at the last kept vertex, for edges before the first); a kept edge faces a
+    // street when the longest original edge it covers does.
+    let edge_of = |e: usize| match kept.binary_search(&e) {
+        Ok(t) => t,
+        Err(0) => kept.len() - 1,
+        Err(t) => t - 1,
+    };
+    let k = kept.len();
+    let kept_street: Vec<bool> = (0..k)
+        .map(|t| {
+            let (from, to) = (kept[t], kept[(t + 1) % k]);
+            let span = (to + n - from) % n;
+            (0..span)
+                .map(|j| (from + j) % n)
+                .max_by(|&a, &b| {
+                    let len = |e: usize| pts[e].distance(pts[(e + 1) % n]);
+                    len(a).total_cmp(&len(b)).then(b.cmp(&a))
+                })
+                .is_some_and(|e| street[e])
+        })
+        .collect();
+    let mut street_edges: Vec<usize> = Vec::with_capacity(lot.street_edges.len());
+    for &e in lot.street_edges.iter().filter(|&&e| e < n) {
+        let t = edge_of(e);
+        if kept_street[t] && !street_edges.contains(&t) {
+            street_edges.push(t);
+        }
+    }
+    Ok(Cow::Owned(Lot {
+        area: polygon.area(),
+        polygon,
+        street_edges,
+        block_id: lot.block_id,
+    }))
 }
 
 thread_local! {

@@ -103,6 +103,7 @@ pub use error::BuildingsError;
 pub use generate::{
     BuildingGenerator, MIN_BUILDING_HEIGHT, Plan, ZoneRule, generate, kind_from_zoning, mix_seed,
 };
+pub use generate::{LOT_RESOLUTION_M, resolved_lot};
 pub use grammar::{BuildingGrammar, SHAPE_MODULES, default_text};
 pub use merge::{MergedSolid, merge_parts};
 pub use params::{

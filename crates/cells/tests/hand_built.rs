@@ -741,3 +741,40 @@ fn ring_road_inside_a_grid_cell_and_reuse_of_the_extractor() {
     let grid_only = x.extract(&grid(3, 3), &CellParams::default()).unwrap();
     assert_eq!(grid_only.cells.len(), 4);
 }
+
+/// Issue 22: a 1 m × 1000 m triangle whose base is 1,000 collinear unit edges, rebuilt by
+/// `extract_planarized` with the default 1 cm snap. The slanted side used to be pulled
+/// along the base from node to node (0.8 m off; the cell shrank from 500 m² to 99 m²);
+/// now it bends only through the base nodes within 1 cm of it, and the cell keeps its
+/// area less that sliver (5 m²).
+#[test]
+fn planarized_slanted_side_stays_within_the_snap_distance() {
+    let mut g = G::new();
+    let base: Vec<NodeId> = (0..=1000)
+        .map(|i| g.add_node(DVec2::new(f64::from(i), 0.0), i).unwrap())
+        .collect();
+    let apex = g.add_node(DVec2::new(0.0, 1.0), 2000).unwrap();
+    for w in base.windows(2) {
+        g.add_edge(w[0], w[1], 0).unwrap();
+    }
+    g.add_edge(base[0], apex, 1).unwrap();
+    let slanted = g.add_edge(base[1000], apex, 2).unwrap();
+    let snap = polis_cells::geom::SnapOptions::default();
+    let p = polis_cells::extract_planarized(&g, &CellParams::default(), &snap, |_| 0).unwrap();
+    let (a, b) = (DVec2::new(1000.0, 0.0), DVec2::new(0.0, 1.0));
+    for &e in &p.edge_map[slanted.index()] {
+        let (x, y) = p.graph.segment(e).unwrap();
+        for q in [x, y] {
+            let d = polis_cells::geom::predicates::distance_to_segment(q, a, b);
+            assert!(d <= snap.snap_distance + 1e-12, "{q} is {d} m off");
+        }
+    }
+    let areas: Vec<f64> = p
+        .cells
+        .cells
+        .iter()
+        .map(|c| c.boundary.polygon.area().abs())
+        .collect();
+    assert_eq!(areas.len(), 1, "{areas:?}");
+    assert!((areas[0] - 495.0).abs() < 1e-6, "{areas:?}");
+}

@@ -57,6 +57,7 @@ pub mod polygon;
 pub mod predicates;
 pub mod scene;
 mod simplicity;
+pub mod simplify;
 pub mod spatial;
 
 pub use bbox::Aabb2;

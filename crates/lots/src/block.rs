@@ -39,6 +39,24 @@ impl Default for BlockParams {
     }
 }
 
+impl BlockParams {
+    /// Checks every field against its documented range (`footpath_width` finite and
+    /// ≥ 0).
+    ///
+    /// # Errors
+    /// [`LotsError::InvalidParameter`] naming the field.
+    pub fn validate(&self) -> Result<(), LotsError> {
+        let fw = self.footpath_width;
+        if !(fw.is_finite() && fw >= 0.0) {
+            return Err(LotsError::InvalidParameter {
+                name: "footpath_width",
+                reason: format!("{fw} m; it must be finite and not negative"),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// A ring with the accumulated boundary length at each vertex, for texture coordinates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TexturedRing {
@@ -107,13 +125,8 @@ impl Block {
 /// An invalid cell polygon, a road width per edge that is missing or not positive, or a
 /// negative footpath width.
 pub fn blocks(cell: &Cell, params: &BlockParams) -> Result<Vec<Block>, LotsError> {
+    params.validate()?;
     let fw = params.footpath_width;
-    if !(fw.is_finite() && fw >= 0.0) {
-        return Err(LotsError::InvalidParameter {
-            name: "footpath_width",
-            reason: format!("{fw} m; it must be finite and not negative"),
-        });
-    }
     let total: usize = cell.polygon.rings().map(|(_, r)| r.len()).sum();
     if cell.road_widths.len() != total {
         return Err(LotsError::EdgeCountMismatch {

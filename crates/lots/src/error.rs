@@ -49,6 +49,22 @@ pub enum LotsError {
         /// Why it is invalid.
         reason: String,
     },
+    /// An input vertex where the ring turns back on itself: its two edges are antiparallel
+    /// to within a sine of `1e-8` (an interior angle within about `1e-6`° of 0° or 360°,
+    /// a needle or a crack one rounding error wide). The wavefront vertex there would move
+    /// more than 10⁸ times faster than its edges, which `f64` cannot follow, so the
+    /// skeleton and every inset refuse such a polygon alike.
+    #[error(
+        "vertex {vertex} of the {ring} is a needle: its edges turn back on each other (sine of the angle between them {sine:e}); remove the spike or make it at least 1e-8 radians wide"
+    )]
+    NeedleVertex {
+        /// The ring.
+        ring: Ring,
+        /// The vertex's index in the ring.
+        vertex: usize,
+        /// The sine of the angle between the two edge directions.
+        sine: f64,
+    },
     /// The wavefront simulation could not finish (a numerical breakdown on near-degenerate
     /// input). Nothing is returned rather than a wrong skeleton.
     #[error(

@@ -208,6 +208,49 @@ fn jitter(p: &Polygon, seeds: &[(f64, f64)]) -> Polygon {
     })
 }
 
+/// A wheel: a rim vertex at radius 10 every `360 / sectors` degrees and, centred between
+/// each pair, a notch `2 · half_deg` wide at radius `rim`; where `spokes` says so (bit `k`
+/// for sector `k`), the notch runs in to a spoke tip at radius `tip`. Symmetric spokes'
+/// reflex tips all reach the hub at the same moment: a vertex event of many chains.
+fn wheel(sectors: usize, spokes: u64, rim: f64, half_deg: f64, tip: f64) -> Polygon {
+    let at = |r: f64, deg: f64| {
+        let a = deg.to_radians();
+        v(r * a.cos(), r * a.sin())
+    };
+    let step = 360.0 / sectors as f64;
+    let mut pts = Vec::new();
+    for k in 0..sectors {
+        let a = step * k as f64;
+        let c = a + step / 2.0;
+        pts.push(at(10.0, a));
+        pts.push(at(rim, c - half_deg));
+        if spokes >> (k % 64) & 1 == 1 {
+            pts.push(at(tip, c));
+        }
+        pts.push(at(rim, c + half_deg));
+    }
+    Polygon::new(pts)
+}
+
+/// Reads a polygon in CGAL's `.poly` text format (`#` comments, the number of polygons,
+/// then the vertex count and coordinates); the first polygon only.
+fn read_poly(path: &str) -> Polygon {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut nums = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .flat_map(str::split_whitespace)
+        .map(|s| s.parse::<f64>().unwrap());
+    let _polygons = nums.next().unwrap();
+    let n = nums.next().unwrap() as usize;
+    let pts = (0..n)
+        .map(|_| v(nums.next().unwrap(), nums.next().unwrap()))
+        .collect();
+    let mut p = Polygon::new(pts);
+    p.make_ccw();
+    p
+}
+
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: cases(),
@@ -388,6 +431,27 @@ proptest! {
         check_insets(&p, Some(&w), &sk)?;
     }
 
+    /// Wheels with spokes in any sectors, symmetric or not, any weights.
+    #[test]
+    fn weighted_wheels(
+        sectors in 3usize..20,
+        spokes in any::<u64>(),
+        tip in 1.0f64..8.0,
+        half_deg in 0.5f64..4.0,
+        ws in prop::collection::vec(prop_oneof![Just(1.0), Just(2.0), Just(0.5), 0.3f64..3.0], 1..6),
+    ) {
+        let rim = 10.0 * (std::f64::consts::PI / sectors as f64).cos() - 0.01;
+        let p: PolygonWithHoles = wheel(sectors, spokes, rim, half_deg.min(90.0 / sectors as f64), tip).into();
+        prop_assume!(p.validate().is_ok());
+        check_weighted(&p, &ws)?;
+        // One odd weight on edge 0, the rest unit (the adversarial run's case).
+        let mut w = vec![1.0; p.outer.len()];
+        w[0] = ws[0] + 0.25;
+        let sk = StraightSkeleton::weighted(&p, &w).unwrap();
+        if let Err(e) = check_skeleton(&p, &sk, 1e-8) { prop_assert!(false, "{}", e); }
+        check_insets(&p, Some(&w), &sk)?;
+    }
+
     #[test]
     fn random_holes(n in 3usize..16, seeds in prop::collection::vec((0.0f64..1.0, 25.0f64..40.0), 1..16), holes in prop::collection::vec((-8i32..8, -8i32..8, 1i32..4, 1i32..4), 0..4)) {
         let outer = star(n, &seeds, true);
@@ -445,4 +509,34 @@ fn weighted_steps_meeting_edges_and_each_other() {
     assert!(standing.step);
     assert!([5, 11].contains(&standing.left_edge), "{standing:?}");
     assert!([7, 9].contains(&standing.right_edge), "{standing:?}");
+}
+
+/// Issue 22: on the wheel with 14 spokes (tests/data/wheel_14_spokes.poly, generated as
+/// [`wheel`] describes), any non-unit weight on edge 0 made the spoke tips arrive at the
+/// hub as separate pairwise events whose new vertices split each other at the hub
+/// without end ("too many events" from distance 0.4044 on).
+#[test]
+fn weighted_wheel_with_14_spokes() {
+    let file = read_poly(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/wheel_14_spokes.poly"
+    ));
+    let made = wheel(16, !(1 | 1 << 8), 9.816, 2.28, 5.0);
+    assert_eq!(file.len(), made.len());
+    for (a, b) in file.points().iter().zip(made.points()) {
+        assert!(a.distance(*b) < 1e-12, "{a} {b}");
+    }
+    let p: PolygonWithHoles = file.into();
+    let n = p.outer.len();
+    for w0 in [0.5, 0.9, 1.0, 1.1, 2.0, 3.0] {
+        let mut w = vec![1.0; n];
+        w[0] = w0;
+        let sk = StraightSkeleton::weighted(&p, &w).unwrap();
+        check_skeleton(&p, &sk, 1e-8).unwrap();
+        check_insets(&p, Some(&w), &sk).unwrap();
+        for d in [0.404445, 0.405, 0.6, 1.0] {
+            let inner = polis_lots::inset_weighted(&p, &w, d).unwrap();
+            assert!(!inner.is_empty(), "w0 = {w0}, d = {d}");
+        }
+    }
 }

@@ -106,9 +106,9 @@ pub struct RoadParams {
     pub legality_step_m: f64,
     /// Baseline over which the slope (grade) is measured along a segment. Default: 20 m.
     pub slope_step_m: f64,
-    /// Stop after this many accepted segments. Default: 4000.
+    /// Stop after this many accepted segments; at least 1. Default: 4000.
     pub max_segments: usize,
-    /// Stop after this many derivation steps. Default: 1000.
+    /// Stop after this many derivation steps; at least 1. Default: 1000.
     pub max_steps: usize,
     /// Smooth highway corners by corner cutting after growth (end of §3.3.1). Default: false.
     pub smooth_highways: bool,
@@ -307,6 +307,18 @@ impl RoadParams {
             self.smoothing_rounds <= 8,
             f64::from(self.smoothing_rounds),
             "0 to 8 rounds",
+        )?;
+        check(
+            "max_segments",
+            self.max_segments >= 1,
+            self.max_segments as f64,
+            "at least 1 segment (0 can only give an empty city)",
+        )?;
+        check(
+            "max_steps",
+            self.max_steps >= 1,
+            self.max_steps as f64,
+            "at least 1 derivation step (0 can only give an empty city)",
         )?;
         // Keep legality sampling bounded: at most ~10^5 samples per segment.
         let longest = self

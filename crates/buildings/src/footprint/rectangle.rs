@@ -9,7 +9,9 @@
 
 use polis_geom::{DVec2, Polygon};
 
-use super::{RECTANGLE_GRID_STEPS, RECTANGLE_REFINE_ROUNDS, rect_inside};
+use super::{
+    RECTANGLE_GRID_STEPS, RECTANGLE_MAX_VERTEX_CANDIDATES, RECTANGLE_REFINE_ROUNDS, rect_inside,
+};
 
 thread_local! {
     /// Reusable buffers of [`largest`], one set per thread.
@@ -154,6 +156,10 @@ fn rectangle_in(work: &mut RectangleWork, region: &Polygon, dir: DVec2) -> Optio
     xs.clear();
     xs.extend(strip.ring.iter().map(|p| p.x));
     xs.sort_unstable_by(f64::total_cmp);
+    xs.dedup();
+    if xs.len() > RECTANGLE_MAX_VERTEX_CANDIDATES {
+        thin_candidates(xs, strip.edges);
+    }
     us.clear();
     let mut grid = (1..RECTANGLE_GRID_STEPS)
         .map(|k| lo.x + step * k as f64)
@@ -299,6 +305,32 @@ fn placed(
     None
 }
 
+/// Thins the sorted, distinct vertex coordinates `xs` of a many-vertex region to at most
+/// about [`RECTANGLE_MAX_VERTEX_CANDIDATES`]: the coordinates of edges across the street
+/// (where the sides of an orthogonal region's optimum lie) first, then evenly spaced
+/// vertex coordinates to fill up. Each pair costs a pass over the edges, so keeping
+/// every coordinate of an `n`-vertex region made the sweep `O(n³)`; with a bounded set it
+/// is `O(n)` per pair, and the error bound (from the uniform grid) is unchanged.
+fn thin_candidates(xs: &mut Vec<f64>, edges: &[Edge]) {
+    let cap = RECTANGLE_MAX_VERTEX_CANDIDATES;
+    let mut across: Vec<f64> = edges.iter().filter(|e| e.dx == 0.0).map(|e| e.x0).collect();
+    across.sort_unstable_by(f64::total_cmp);
+    across.dedup();
+    let every = |v: &[f64], k: usize| -> Vec<f64> {
+        let stride = v.len().div_ceil(k.max(1)).max(1);
+        v.iter().step_by(stride).copied().collect()
+    };
+    let mut keep = every(&across, cap / 2);
+    let room = cap.saturating_sub(keep.len());
+    keep.extend(every(xs, room));
+    if let (Some(&first), Some(&last)) = (xs.first(), xs.last()) {
+        keep.extend([first, last]);
+    }
+    keep.sort_unstable_by(f64::total_cmp);
+    keep.dedup();
+    *xs = keep;
+}
+
 /// The spread at candidate `i`, computed on first use.
 fn spread_at(strip: &Strip<'_>, us: &[f64], spread: &mut [Option<f64>], i: usize) -> Option<f64> {
     let (u, s) = (us.get(i)?, spread.get_mut(i)?);
@@ -404,15 +436,12 @@ fn tallest_gap(
     }
 }
 
-/// A stable insertion sort of intervals by start (`total_cmp`): a strip holds a handful.
+/// A stable sort of intervals by start (`total_cmp`). The standard library's stable sort
+/// is an insertion sort on the handful of intervals of a small region's strip and
+/// `O(k log k)` on the thousands of a many-vertex region's (where an insertion sort made
+/// each strip quadratic).
 fn sort_by_start(v: &mut [(f64, f64)]) {
-    for i in 1..v.len() {
-        let mut j = i;
-        while j > 0 && v[j - 1].0.total_cmp(&v[j].0).is_gt() {
-            v.swap(j - 1, j);
-            j -= 1;
-        }
-    }
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
 }
 
 #[cfg(test)]

@@ -10,6 +10,15 @@ use crate::{Aabb2, GeomError};
 /// e.g. 16 384² grey 16-bit). Protects against headers that claim enormous sizes.
 pub const MAX_PNG_DECODED_BYTES: usize = 512 << 20;
 
+/// The default largest image, in pixels (width × height), the PNG loaders decode:
+/// 2²⁶ ≈ 67 million (8192 × 8192). A map raster keeps one `f32` per pixel (256 MiB at
+/// this size) and a texture four bytes, so the limit bounds memory by what the image
+/// decodes to, not by the file's size: a PNG of a few hundred kilobytes can claim
+/// 20,000 × 20,000 pixels. Checked from the header, before anything is allocated. Use the
+/// `*_limited` loaders ([`Raster::from_png_bytes_limited`], [`decode_png_rgba8_limited`])
+/// or `maps.max_image_pixels` of a city configuration for another limit.
+pub const DEFAULT_MAX_PNG_PIXELS: u64 = 1 << 26;
+
 /// Rec. 709 luma weights applied to RGB channel values.
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
@@ -19,15 +28,25 @@ fn png_error(e: png::DecodingError) -> GeomError {
     ))
 }
 
-/// Decodes the first frame of a PNG with `transformations`, refusing images that would
-/// decode to more than [`MAX_PNG_DECODED_BYTES`].
+/// Decodes the first frame of a PNG with `transformations`, refusing images of more than
+/// `max_pixels` pixels (read from the header, before decoding) or that would decode to
+/// more than [`MAX_PNG_DECODED_BYTES`].
 fn read_png(
     bytes: &[u8],
     transformations: png::Transformations,
+    max_pixels: u64,
 ) -> Result<(Vec<u8>, png::OutputInfo), GeomError> {
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(transformations);
     let mut reader = decoder.read_info().map_err(png_error)?;
+    let (width, height) = (reader.info().width, reader.info().height);
+    let pixels = u64::from(width) * u64::from(height);
+    if pixels > max_pixels {
+        return Err(GeomError::Image(format!(
+            "the PNG is {width} × {height} = {pixels} pixels, more than the limit of \
+             {max_pixels}; downscale it or raise the pixel limit"
+        )));
+    }
     let size = reader
         .output_buffer_size()
         .filter(|&s| s <= MAX_PNG_DECODED_BYTES)
@@ -51,17 +70,30 @@ fn read_png(
 /// palettes are expanded, 16-bit samples keep their high byte, and a missing alpha
 /// channel is opaque.
 ///
-/// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG or decode to more
-/// than [`MAX_PNG_DECODED_BYTES`].
+/// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG, have more than
+/// [`DEFAULT_MAX_PNG_PIXELS`] pixels or decode to more than [`MAX_PNG_DECODED_BYTES`].
 ///
 /// ```
 /// # use polis_geom::field::decode_png_rgba8;
 /// assert!(decode_png_rgba8(b"not a png").is_err());
 /// ```
 pub fn decode_png_rgba8(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), GeomError> {
+    decode_png_rgba8_limited(bytes, DEFAULT_MAX_PNG_PIXELS)
+}
+
+/// [`decode_png_rgba8`] with another pixel limit: images of more than `max_pixels`
+/// pixels (width × height, read from the header) are refused before decoding.
+///
+/// Errors: as [`decode_png_rgba8`], and [`GeomError::Image`] naming the size for an
+/// image over the limit.
+pub fn decode_png_rgba8_limited(
+    bytes: &[u8],
+    max_pixels: u64,
+) -> Result<(u32, u32, Vec<u8>), GeomError> {
     let (buf, out) = read_png(
         bytes,
         png::Transformations::EXPAND | png::Transformations::STRIP_16,
+        max_pixels,
     )?;
     let rgba: Vec<u8> = match out.color_type {
         png::ColorType::Rgba => buf,
@@ -103,10 +135,24 @@ impl Raster {
     ///   on the stored (gamma-encoded) channel values; alpha is ignored.
     /// * The image's top row is the raster's top row (largest `y`), as the image is shown.
     ///
-    /// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG or decode to more
-    /// than [`MAX_PNG_DECODED_BYTES`]; the errors of [`Raster::new`] for a bad `extent`.
+    /// Errors: [`GeomError::Image`] when the bytes are not a decodable PNG, have more
+    /// than [`DEFAULT_MAX_PNG_PIXELS`] pixels or decode to more than
+    /// [`MAX_PNG_DECODED_BYTES`]; the errors of [`Raster::new`] for a bad `extent`.
     pub fn from_png_bytes(bytes: &[u8], extent: Aabb2) -> Result<Raster, GeomError> {
-        let (buf, out) = read_png(bytes, png::Transformations::EXPAND)?;
+        Raster::from_png_bytes_limited(bytes, extent, DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`from_png_bytes`](Self::from_png_bytes) with another pixel limit: an image of
+    /// more than `max_pixels` pixels (width × height, read from the header) is refused
+    /// before decoding.
+    ///
+    /// Errors: as [`from_png_bytes`](Self::from_png_bytes).
+    pub fn from_png_bytes_limited(
+        bytes: &[u8],
+        extent: Aabb2,
+        max_pixels: u64,
+    ) -> Result<Raster, GeomError> {
+        let (buf, out) = read_png(bytes, png::Transformations::EXPAND, max_pixels)?;
         let channels = match out.color_type {
             png::ColorType::Grayscale => 1,
             png::ColorType::GrayscaleAlpha => 2,
@@ -166,6 +212,18 @@ impl Raster {
     /// Errors: [`GeomError::Image`] naming the path when the file cannot be read, and the
     /// errors of [`from_png_bytes`](Self::from_png_bytes).
     pub fn from_png_path(path: impl AsRef<Path>, extent: Aabb2) -> Result<Raster, GeomError> {
+        Raster::from_png_path_limited(path, extent, DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`from_png_path`](Self::from_png_path) with another pixel limit (see
+    /// [`from_png_bytes_limited`](Self::from_png_bytes_limited)).
+    ///
+    /// Errors: as [`from_png_path`](Self::from_png_path).
+    pub fn from_png_path_limited(
+        path: impl AsRef<Path>,
+        extent: Aabb2,
+        max_pixels: u64,
+    ) -> Result<Raster, GeomError> {
         let path = path.as_ref();
         let bytes = std::fs::read(path).map_err(|e| {
             GeomError::Image(format!(
@@ -173,7 +231,7 @@ impl Raster {
                 path.display()
             ))
         })?;
-        Raster::from_png_bytes(&bytes, extent)
+        Raster::from_png_bytes_limited(&bytes, extent, max_pixels)
     }
 }
 
@@ -460,5 +518,47 @@ mod tests {
         let r = Raster::from_png_path(&path, extent()).unwrap();
         assert_eq!(r.data(), &[0.0, 1.0]);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A PNG of 20,000 × 20,000 grey pixels, made as a small file (every row the same
+    /// zero bytes, deflated), is refused from its header under the default limit and
+    /// under a lowered one, without decoding.
+    #[test]
+    fn pixel_limit_refuses_decompression_bombs_from_the_header() {
+        let side = 20_000u32;
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, side, side);
+            enc.set_color(png::ColorType::Grayscale);
+            enc.set_depth(png::BitDepth::One);
+            enc.set_compression(png::Compression::Fast);
+            let mut writer = enc.write_header().unwrap();
+            let row = vec![0u8; (side as usize).div_ceil(8)];
+            let mut stream = writer.stream_writer().unwrap();
+            for _ in 0..side {
+                std::io::Write::write_all(&mut stream, &row).unwrap();
+            }
+            stream.finish().unwrap();
+        }
+        assert!(bytes.len() < 2 << 20, "{} bytes", bytes.len());
+        for err in [
+            Raster::from_png_bytes(&bytes, extent()).unwrap_err(),
+            decode_png_rgba8(&bytes).unwrap_err(),
+        ] {
+            let text = err.to_string();
+            assert!(text.contains("20000 × 20000"), "{text}");
+        }
+        // A configurable limit: a 3 × 2 image passes 6 pixels and is refused at 5.
+        let small = encode(
+            3,
+            2,
+            png::ColorType::Grayscale,
+            png::BitDepth::Eight,
+            &[0; 6],
+        );
+        assert!(Raster::from_png_bytes_limited(&small, extent(), 6).is_ok());
+        assert!(Raster::from_png_bytes_limited(&small, extent(), 5).is_err());
+        assert!(decode_png_rgba8_limited(&small, 6).is_ok());
+        assert!(decode_png_rgba8_limited(&small, 5).is_err());
     }
 }

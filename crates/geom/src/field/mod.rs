@@ -97,7 +97,9 @@ pub use combinators::{
 };
 pub use contour::{ContourOptions, MAX_CONTOUR_CELLS, contour_regions};
 #[cfg(feature = "png")]
-pub use image::{MAX_PNG_DECODED_BYTES, decode_png_rgba8};
+pub use image::{
+    DEFAULT_MAX_PNG_PIXELS, MAX_PNG_DECODED_BYTES, decode_png_rgba8, decode_png_rgba8_limited,
+};
 pub use noise::{Fbm, FbmParams, MAX_OCTAVES, SimplexNoise};
 pub use population::{Population, PopulationParams};
 pub use raster::Raster;

@@ -182,6 +182,15 @@ impl FieldSpec {
     /// [`Population::new`], [`Raster::from_png_path`]) and
     /// [`GeomError::InvalidParameter`] for a bad simplex `wavelength_m`.
     pub fn build(&self) -> Result<Box<dyn Field>, GeomError> {
+        self.build_limited(super::DEFAULT_MAX_PNG_PIXELS)
+    }
+
+    /// [`build`](Self::build) with PNG images limited to `max_pixels` pixels each
+    /// (width × height, checked from the header before decoding; see
+    /// [`Raster::from_png_bytes_limited`]).
+    ///
+    /// Errors: as [`build`](Self::build).
+    pub fn build_limited(&self, max_pixels: u64) -> Result<Box<dyn Field>, GeomError> {
         Ok(match self {
             FieldSpec::Constant { value } => Box::new(Constant(*value)),
             FieldSpec::Simplex { seed, wavelength_m } => {
@@ -201,35 +210,195 @@ impl FieldSpec {
             FieldSpec::Population(params) => Box::new(Population::new(*params)?),
             FieldSpec::Raster(raster) => Box::new(raster.clone()),
             #[cfg(feature = "png")]
-            FieldSpec::Png { path, extent } => Box::new(Raster::from_png_path(path, *extent)?),
-            FieldSpec::Scaled { field, factor } => Box::new(Scaled::new(field.build()?, *factor)),
-            FieldSpec::Offset { field, offset } => Box::new(Offset::new(field.build()?, *offset)),
-            FieldSpec::Sum { a, b } => Box::new(Sum::new(a.build()?, b.build()?)),
-            FieldSpec::Product { a, b } => Box::new(Product::new(a.build()?, b.build()?)),
-            FieldSpec::Threshold { field, threshold } => {
-                Box::new(Threshold::new(field.build()?, *threshold))
+            FieldSpec::Png { path, extent } => {
+                Box::new(Raster::from_png_path_limited(path, *extent, max_pixels)?)
             }
-            FieldSpec::Min { a, b } => Box::new(Min::new(a.build()?, b.build()?)),
-            FieldSpec::Max { a, b } => Box::new(Max::new(a.build()?, b.build()?)),
-            FieldSpec::Clamp { field, lo, hi } => Box::new(Clamp::new(field.build()?, *lo, *hi)),
+            FieldSpec::Scaled { field, factor } => {
+                Box::new(Scaled::new(field.build_limited(max_pixels)?, *factor))
+            }
+            FieldSpec::Offset { field, offset } => {
+                Box::new(Offset::new(field.build_limited(max_pixels)?, *offset))
+            }
+            FieldSpec::Sum { a, b } => Box::new(Sum::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Product { a, b } => Box::new(Product::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Threshold { field, threshold } => {
+                Box::new(Threshold::new(field.build_limited(max_pixels)?, *threshold))
+            }
+            FieldSpec::Min { a, b } => Box::new(Min::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Max { a, b } => Box::new(Max::new(
+                a.build_limited(max_pixels)?,
+                b.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Clamp { field, lo, hi } => {
+                Box::new(Clamp::new(field.build_limited(max_pixels)?, *lo, *hi))
+            }
             FieldSpec::Mask {
                 mask,
                 if_true,
                 if_false,
                 threshold,
             } => Box::new(
-                Mask::new(mask.build()?, if_true.build()?, if_false.build()?)
-                    .with_threshold(*threshold),
+                Mask::new(
+                    mask.build_limited(max_pixels)?,
+                    if_true.build_limited(max_pixels)?,
+                    if_false.build_limited(max_pixels)?,
+                )
+                .with_threshold(*threshold),
             ),
+            FieldSpec::Blend { weight, zero, one } => Box::new(Blend::new(
+                weight.build_limited(max_pixels)?,
+                zero.build_limited(max_pixels)?,
+                one.build_limited(max_pixels)?,
+            )),
+            FieldSpec::Transform {
+                field,
+                scale,
+                offset,
+            } => Box::new(DomainTransform::new(
+                field.build_limited(max_pixels)?,
+                *scale,
+                *offset,
+            )),
+        })
+    }
+}
+
+/// A closed interval `[lo, hi]` of field values, for [`FieldSpec::value_range`].
+pub type ValueRange = (f64, f64);
+
+/// `min` and `max` that keep a NaN (`f64::min` drops it).
+fn nan_min(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+fn range_union(a: ValueRange, b: ValueRange) -> ValueRange {
+    (nan_min(a.0, b.0), nan_max(a.1, b.1))
+}
+
+fn range_product(a: ValueRange, b: ValueRange) -> ValueRange {
+    let p = [a.0 * b.0, a.0 * b.1, a.1 * b.0, a.1 * b.1];
+    if p.iter().any(|v| v.is_nan()) {
+        return (f64::NAN, f64::NAN);
+    }
+    (
+        p.iter().copied().fold(f64::INFINITY, f64::min),
+        p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    )
+}
+
+fn nan_if(bad: bool, r: ValueRange) -> ValueRange {
+    if bad { (f64::NAN, f64::NAN) } else { r }
+}
+
+impl FieldSpec {
+    /// A conservative interval holding every value the built field can take at a point
+    /// whose sample is defined, computed from the description alone (no file is read):
+    /// interval arithmetic over the combinators, `[-1, 1]` for noise, `[0, 1]` for the
+    /// population and PNG images, the data's extremes for an inline raster.
+    ///
+    /// A NaN bound means a parameter is NaN (e.g. a `scaled` factor); an infinite bound
+    /// means a parameter is infinite or the arithmetic overflows. Configuration checks use
+    /// this to refuse maps that can only produce non-finite or unphysical values.
+    ///
+    /// Guarantees: for every point `p` where `build()?.sample(p)` is finite, the value
+    /// lies in the returned interval (property-tested). Limitations: the interval may be
+    /// wider than the values actually taken (e.g. `a − a` gives `[-2, 2]` for noise).
+    pub fn value_range(&self) -> ValueRange {
+        match self {
+            FieldSpec::Constant { value } => (*value, *value),
+            FieldSpec::Simplex { .. } | FieldSpec::Fbm(_) => (-1.0, 1.0),
+            FieldSpec::Population(_) => (0.0, 1.0),
+            FieldSpec::Raster(r) => r
+                .data()
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(f64::from(v)), hi.max(f64::from(v)))
+                }),
+            #[cfg(feature = "png")]
+            FieldSpec::Png { .. } => (0.0, 1.0),
+            FieldSpec::Scaled { field, factor } => {
+                range_product(field.value_range(), (*factor, *factor))
+            }
+            FieldSpec::Offset { field, offset } => {
+                let (lo, hi) = field.value_range();
+                (lo + offset, hi + offset)
+            }
+            FieldSpec::Sum { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (a.0 + b.0, a.1 + b.1)
+            }
+            FieldSpec::Product { a, b } => range_product(a.value_range(), b.value_range()),
+            FieldSpec::Threshold { field, threshold } => {
+                let (lo, hi) = field.value_range();
+                nan_if(lo.is_nan() || hi.is_nan() || threshold.is_nan(), (0.0, 1.0))
+            }
+            FieldSpec::Min { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (nan_min(a.0, b.0), nan_min(a.1, b.1))
+            }
+            FieldSpec::Max { a, b } => {
+                let (a, b) = (a.value_range(), b.value_range());
+                (nan_max(a.0, b.0), nan_max(a.1, b.1))
+            }
+            FieldSpec::Clamp { field, lo, hi } => {
+                let (a, b) = field.value_range();
+                // Bounds in either order, as `Clamp::new` takes them.
+                let (lo, hi) = if lo > hi { (hi, lo) } else { (lo, hi) };
+                let clamp = |v: f64| v.max(*lo).min(*hi);
+                nan_if(
+                    a.is_nan() || b.is_nan() || lo.is_nan() || hi.is_nan(),
+                    (clamp(a).min(clamp(b)), clamp(a).max(clamp(b))),
+                )
+            }
+            FieldSpec::Mask {
+                mask,
+                if_true,
+                if_false,
+                threshold,
+            } => {
+                let (m0, m1) = mask.value_range();
+                nan_if(
+                    m0.is_nan() || m1.is_nan() || threshold.is_nan(),
+                    range_union(if_true.value_range(), if_false.value_range()),
+                )
+            }
             FieldSpec::Blend { weight, zero, one } => {
-                Box::new(Blend::new(weight.build()?, zero.build()?, one.build()?))
+                let (w0, w1) = weight.value_range();
+                nan_if(
+                    w0.is_nan() || w1.is_nan(),
+                    range_union(zero.value_range(), one.value_range()),
+                )
             }
             FieldSpec::Transform {
                 field,
                 scale,
                 offset,
-            } => Box::new(DomainTransform::new(field.build()?, *scale, *offset)),
-        })
+            } => nan_if(
+                !(scale.is_finite() && offset.is_finite()),
+                field.value_range(),
+            ),
+        }
     }
 }
 
@@ -432,5 +601,118 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
         let missing = FieldSpec::Png { path, extent };
         assert!(matches!(missing.build(), Err(GeomError::Image(_))));
+    }
+
+    /// Random trees of combinators over noise, population and constants.
+    fn arb_spec() -> impl proptest::strategy::Strategy<Value = FieldSpec> {
+        use proptest::prelude::*;
+        let leaf = prop_oneof![
+            (-50.0f64..50.0).prop_map(|value| FieldSpec::Constant { value }),
+            (0u64..4, 50.0f64..500.0)
+                .prop_map(|(seed, wavelength_m)| FieldSpec::Simplex { seed, wavelength_m }),
+            (0u64..4)
+                .prop_map(|seed| FieldSpec::Population(PopulationParams { seed, unit_m: 50.0 })),
+        ];
+        leaf.prop_recursive(4, 24, 3, |inner| {
+            prop_oneof![
+                (inner.clone(), -10.0f64..10.0).prop_map(|(f, factor)| FieldSpec::Scaled {
+                    field: b(f),
+                    factor
+                }),
+                (inner.clone(), -10.0f64..10.0).prop_map(|(f, offset)| FieldSpec::Offset {
+                    field: b(f),
+                    offset
+                }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Sum { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Product { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Min { a: b(a), b: b(c) }),
+                (inner.clone(), inner.clone())
+                    .prop_map(|(a, c)| FieldSpec::Max { a: b(a), b: b(c) }),
+                (inner.clone(), -2.0f64..2.0, -3.0f64..3.0).prop_map(|(f, lo, w)| {
+                    FieldSpec::Clamp {
+                        field: b(f),
+                        lo,
+                        hi: lo + w,
+                    }
+                }),
+                (inner.clone(), inner.clone(), inner.clone()).prop_map(|(m, t, f)| {
+                    FieldSpec::Mask {
+                        mask: b(m),
+                        if_true: b(t),
+                        if_false: b(f),
+                        threshold: 0.2,
+                    }
+                }),
+                (inner.clone(), inner.clone(), inner).prop_map(|(w, z, o)| FieldSpec::Blend {
+                    weight: b(w),
+                    zero: b(z),
+                    one: b(o)
+                }),
+            ]
+        })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(96))]
+
+        /// Every sample of the built field lies in the range computed from the data.
+        #[test]
+        fn value_range_holds_every_sample(spec in arb_spec(), x in -3000.0f64..3000.0, y in -3000.0f64..3000.0) {
+            let (lo, hi) = spec.value_range();
+            let f = spec.build().unwrap();
+            for k in 0..8 {
+                let p = DVec2::new(x + 97.0 * f64::from(k), y - 61.0 * f64::from(k));
+                let v = f.sample(p);
+                let slack = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
+                proptest::prop_assert!(v >= lo - slack && v <= hi + slack, "{v} outside [{lo}, {hi}]");
+            }
+        }
+    }
+
+    /// Fuzzing finding (issue 22, config_maps): a clamp written with `lo > hi` (which
+    /// `Clamp::new` takes in either order) got the range `[hi, hi]`.
+    #[test]
+    fn value_range_of_a_clamp_with_bounds_swapped() {
+        let spec = FieldSpec::Clamp {
+            field: b(FieldSpec::Population(PopulationParams::default())),
+            lo: 5.0,
+            hi: 0.0,
+        };
+        assert_eq!(spec.value_range(), (0.0, 1.0));
+        let f = spec.build().unwrap();
+        for k in 0..50 {
+            let v = f.sample(DVec2::new(37.0 * f64::from(k), -53.0 * f64::from(k)));
+            assert!((0.0..=1.0).contains(&v), "{v}");
+        }
+    }
+
+    #[test]
+    fn value_range_flags_nan_and_overflow() {
+        let png = FieldSpec::Constant { value: 0.5 };
+        let nan = FieldSpec::Scaled {
+            field: b(png.clone()),
+            factor: f64::NAN,
+        };
+        let (lo, hi) = nan.value_range();
+        assert!(lo.is_nan() && hi.is_nan());
+        // NaN survives min/max/blend, which `f64::min` would drop.
+        let hidden = FieldSpec::Max {
+            a: b(nan.clone()),
+            b: b(png.clone()),
+        };
+        assert!(hidden.value_range().0.is_nan());
+        let huge = FieldSpec::Scaled {
+            field: b(FieldSpec::Fbm(FbmParams::default())),
+            factor: 1e300,
+        };
+        assert_eq!(huge.value_range(), (-1e300, 1e300));
+        let over = FieldSpec::Scaled {
+            field: b(huge),
+            factor: 1e300,
+        };
+        assert_eq!(over.value_range(), (f64::NEG_INFINITY, f64::INFINITY));
     }
 }

@@ -344,3 +344,165 @@ proptest! {
         }
     }
 }
+
+/// Every node of an insertion's route lies within the snap distance (plus rounding) of
+/// the segment as given.
+fn route_within_snap(g: &G, ins: &Insertion, p: DVec2, q: DVec2, snap: f64) -> Result<(), String> {
+    let tol = snap + 1e-9 * (1.0 + p.abs().max(q.abs()).max_element());
+    for &n in &ins.nodes {
+        let pn = g.position(n).unwrap();
+        let d = distance_to_segment(pn, p, q);
+        if d > tol {
+            return Err(format!(
+                "route node {n} at {pn} is {d} m from {p}–{q}, snap {snap}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Issue 22: a 1 m × 1000 m triangle whose base is 1,000 unit edges. The slanted side
+/// passes within the 1 cm snap distance of the last ten base nodes; it used to be
+/// re-routed from node to node along the whole base (0.8 m off, the cell shrank from
+/// 500 m² to 99 m²).
+#[test]
+fn a_slanted_edge_is_not_pulled_along_a_row_of_nodes() {
+    let opts = SnapOptions::default();
+    let mut g = G::new();
+    for i in 0..1000 {
+        g.insert_segment(v(i as f64, 0.), v(i as f64 + 1., 0.), 0, &opts)
+            .unwrap();
+    }
+    g.insert_segment(v(0., 0.), v(0., 1.), 1, &opts).unwrap();
+    let (p, q) = (v(1000., 0.), v(0., 1.));
+    let ins = g.insert_segment(p, q, 2, &opts).unwrap();
+    g.check_invariants().unwrap();
+    route_within_snap(&g, &ins, p, q, opts.snap_distance).unwrap();
+    // It passes through the base nodes within 1 cm of it (x ≥ 990) and no others.
+    assert_eq!(ins.nodes.len(), 12, "{:?}", ins.nodes);
+    // The enclosed area: the triangle less the sliver between the base and the bend,
+    // (990, 0)–(1000, 0)–(0, 1): 5 m² (at most length × snap = 10 m² by the bound).
+    let ring: Vec<DVec2> = ins
+        .nodes
+        .iter()
+        .map(|&n| g.position(n).unwrap())
+        .chain([v(0., 0.)])
+        .collect();
+    let area = crate::Polygon::new(ring).area().abs();
+    assert!((area - 495.0).abs() < 1e-6, "{area}");
+}
+
+fn chain_case() -> impl Strategy<Value = (f64, usize, f64, DVec2, DVec2, f64)> {
+    (
+        0.0f64..std::f64::consts::TAU,
+        2usize..80,
+        prop_oneof![Just(1.0), 0.001f64..3.0],
+        (-1.0f64..1.0, -0.3f64..0.3).prop_map(|(a, b)| v(a, b)),
+        (-1.0f64..1.0, -0.3f64..0.3).prop_map(|(a, b)| v(a, b)),
+        prop_oneof![Just(0.01), Just(0.0), 0.0f64..0.5],
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Chains of collinear edges (any direction, spacing and length) and segments nearly
+    /// along them, from near-degenerate offsets (touching, sub-snap, nearly parallel):
+    /// every route stays within the snap distance of its segment, and the graph stays
+    /// planar.
+    #[test]
+    fn snapping_never_moves_a_route_beyond_the_snap_distance(
+        (angle, n, step, dp, dq, snap) in chain_case(),
+        scale in prop_oneof![Just(1.0), Just(1e-3), 0.01f64..1.0],
+    ) {
+        let opts = SnapOptions { snap_distance: snap };
+        let dir = DVec2::from_angle(angle);
+        let across = dir.perp();
+        let at = |s: f64| dir * s;
+        let mut g = G::new();
+        for i in 0..n {
+            // Steps shorter than the snap distance collapse (refused as zero-length).
+            let _ = g.insert_segment(at(i as f64 * step), at((i + 1) as f64 * step), 0, &opts);
+        }
+        let len = n as f64 * step;
+        // Ends near the chain's ends (or inside it), offsets scaled toward the line.
+        let p = at(dp.x.abs() * len * 0.5) + across * dp.y * scale;
+        let q = at(len * (1.0 - dq.x.abs() * 0.5)) + across * dq.y * scale;
+        if let Ok(ins) = g.insert_segment(p, q, 1, &opts)
+            && let Err(e) = route_within_snap(&g, &ins, p, q, snap)
+        {
+            prop_assert!(false, "{}", e);
+        }
+        if let Err(e) = g.check_invariants() {
+            prop_assert!(false, "{}", e);
+        }
+    }
+}
+
+/// The fuzz target `planar_insert` (fuzz/fuzz_targets/planar_insert.rs) as a function:
+/// the same decoding of bytes into a snap distance, a collinear chain and segments;
+/// `Err` names the first broken promise.
+fn planar_insert_case(data: &[u8]) -> Result<(), String> {
+    let Some((&head, rest)) = data.split_first() else {
+        return Ok(());
+    };
+    let snap = [0.0, 1e-6, 0.01, 0.05, 0.3][usize::from(head % 5)];
+    let options = SnapOptions {
+        snap_distance: snap,
+    };
+    let mut g = G::new();
+    let dir = DVec2::from_angle(f64::from(head / 5) * 0.123);
+    for i in 0..usize::from(head % 23) {
+        let _ = g.insert_segment(dir * i as f64, dir * (i + 1) as f64, 0, &options);
+    }
+    for (k, c) in rest.chunks_exact(5).enumerate().take(40) {
+        let grid = |v: u8| f64::from(v % 16) - 4.0;
+        let nudge = f64::from(c[4]) * 1e-9;
+        let (p, q) = if c[4] % 3 == 0 {
+            (
+                dir * grid(c[0]) + dir.perp() * (f64::from(c[1]) * 1e-3 - 0.128),
+                dir * grid(c[2]) + dir.perp() * (f64::from(c[3]) * 1e-3 - 0.128),
+            )
+        } else {
+            (
+                v(grid(c[0]), grid(c[1]) + nudge),
+                v(grid(c[2]) + nudge, grid(c[3])),
+            )
+        };
+        if let Ok(ins) = g.insert_segment(p, q, k as u32 + 1, &options) {
+            route_within_snap(&g, &ins, p, q, snap)?;
+        }
+        g.check_invariants()
+            .map_err(|e| format!("not planar after {p}–{q}: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Fuzzing findings of `planar_insert`, pinned. The first: a segment nearly along a
+/// chain passed a chain node within rounding (3e-15 m) without going through it, once
+/// nodes off the caller's segment were no longer routed through; nodes within rounding
+/// of a leg are on it and are routed through whatever the snap bound says.
+#[test]
+fn planar_insert_fuzz_findings() {
+    let cases: [&str; 1] = ["7a428a2a8a8a0a8a8a9a003fe5255f5e5e0000ef00008a8a8abfe1"];
+    for hex in cases {
+        let bytes: Vec<u8> = (0..hex.len() / 2)
+            .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
+            .collect();
+        planar_insert_case(&bytes).unwrap();
+    }
+}
+
+/// Open fuzzing finding of `planar_insert` (issue 22): with snap 0, among nearly
+/// parallel grid segments nudged by 1e-9, a route node lies 8e-9 m off its segment
+/// (the bound allows rounding only, 7e-9 here). Pinned until the crossing computation
+/// for nearly parallel segments is looked into.
+#[test]
+#[ignore = "open fuzzing finding (issue 22): a route node 8e-9 m off with snap 0"]
+fn planar_insert_open_fuzz_finding() {
+    let hex = "fa215b2500004040fae5fa215b25007a00a71e00004040fae55b400025255b00004f12008d0b40ffff40e95d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d21fcffff00065b400025255b00004f8d0b40ffff40e9df03dea4daff85fca71e00004040fae55b400025255b00004f8d0b40ffff40ffff0006";
+    let bytes: Vec<u8> = (0..hex.len() / 2)
+        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
+        .collect();
+    planar_insert_case(&bytes).unwrap();
+}

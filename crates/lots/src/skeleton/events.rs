@@ -15,6 +15,11 @@
 //! incoming one. One rule therefore covers edge events, split events, vertex events
 //! (several reflex vertices meeting), multi-splits and whole lists collapsing at once.
 //!
+//! Arrivals at one point at one moment that the queue delivers as separate events (the
+//! reflex tips of a wheel's spokes reaching its hub) are resolved together: a collapse
+//! also takes every vertex an earlier collapse created at the same point and time, so the
+//! last of them applies the rule to all the rays there at once.
+//!
 //! Two wavefront edges that point in opposite directions and lie on top of each other (two
 //! parallel edges meeting, like the long sides of a rectangle) give a *fold* vertex; it is
 //! zipped closed at once, along the overlap, into a skeleton arc.
@@ -23,7 +28,7 @@
 //! never depends on anything but the input.
 
 use std::cmp::{Ordering, Reverse};
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, HashMap};
 
 use polis_geom::DVec2;
 
@@ -118,6 +123,11 @@ pub(crate) struct Engine {
     scratch_set: Vec<u32>,
     scratch_rays: Vec<Ray>,
     scratch_new: Vec<u32>,
+    /// Vertices created at the current event time, by grid cell of side `4 · eps` (only
+    /// looked up, never iterated into output): see [`Engine::join_recent`].
+    recent: HashMap<(i64, i64), Vec<u32>>,
+    /// The event time the vertices in `recent` were created at.
+    recent_t: f64,
 }
 
 impl Engine {
@@ -138,6 +148,8 @@ impl Engine {
         self.stamp = 0;
         self.now = 0.0;
         self.collapses = 0;
+        self.recent.clear();
+        self.recent_t = 0.0;
         let mut lo = DVec2::splat(f64::INFINITY);
         let mut hi = DVec2::splat(f64::NEG_INFINITY);
         for ring in rings {
@@ -434,7 +446,53 @@ impl Engine {
         let id = (self.verts.len() - 1) as u32;
         self.vert_mut(prev).next = id;
         self.vert_mut(next).prev = id;
+        if self.now > self.recent_t + self.time_eps {
+            self.recent.clear();
+            self.recent_t = self.now;
+        }
+        let cell = self.recent_cell(p);
+        self.recent.entry(cell).or_default().push(id);
         id
+    }
+
+    fn recent_cell(&self, p: DVec2) -> (i64, i64) {
+        let k = 4.0 * self.eps;
+        ((p.x / k).floor() as i64, (p.y / k).floor() as i64)
+    }
+
+    /// Adds to the collapse at `p` (time `now`) every live vertex that an earlier collapse
+    /// created at the same time within `eps` of `p`, whatever list it is in.
+    ///
+    /// Several wavefront pieces can reach one point at one moment (spokes meeting at a
+    /// wheel's hub). The event queue delivers them as separate pairwise events, each of
+    /// which joins its own chains; the vertices it creates sit on the point with the other
+    /// arrivals, and resolving the next pair without them lets wedges overlap, whose
+    /// vertices then split each other again at the same point without end. Joining them
+    /// makes the last of these events resolve every ray at the point at once, by the one
+    /// collapse rule, exactly as if all had arrived in one event.
+    fn join_recent(&mut self, p: DVec2, set: &mut Vec<u32>) {
+        if self.now > self.recent_t + self.time_eps || self.recent.is_empty() {
+            return;
+        }
+        let (cx, cy) = self.recent_cell(p);
+        let t = self.now;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let Some(list) = self.recent.get(&(cx + dx, cy + dy)) else {
+                    continue;
+                };
+                for &r in list {
+                    let x = &self.verts[r as usize];
+                    if x.alive
+                        && self.mark[r as usize] != self.stamp
+                        && x.at(t).distance(p) <= self.eps
+                    {
+                        self.mark[r as usize] = self.stamp;
+                        set.push(r);
+                    }
+                }
+            }
+        }
     }
 
     /// Schedules the collapse of the wavefront edge from `u` to its successor.
@@ -666,6 +724,7 @@ impl Engine {
                 set.push(s);
             }
         }
+        self.join_recent(p, &mut set);
         // Grow along the lists: neighbours at the same point join the collapse.
         let mut i = 0;
         while i < set.len() {

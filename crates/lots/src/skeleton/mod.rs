@@ -34,7 +34,11 @@
 //!   an input edge through its start node and one through its end node. Insets stay exact
 //!   (the step edge has no source, see [`inset_shapes`](crate::inset_shapes)).
 //! * Points closer than `1e-9` times the polygon's size at the same time are merged into
-//!   one event; nearly simultaneous events are therefore treated as simultaneous.
+//!   one event; nearly simultaneous events are therefore treated as simultaneous (an inset
+//!   within that time of the last collapse may come out empty).
+//! * A vertex whose edges turn back on each other to within a sine of `1e-8` (a needle or
+//!   crack) is refused with [`LotsError::NeedleVertex`] by the skeleton and the insets
+//!   alike: its wavefront vertex would move more than 10⁸ times faster than its edges.
 //!
 //! # References
 //!
@@ -346,6 +350,24 @@ pub(crate) fn check_input(
             return Err(LotsError::WrongOrientation {
                 ring: Ring::Hole(i),
             });
+        }
+    }
+    for (ring, r) in polygon.rings() {
+        let pts = r.points();
+        let n = pts.len();
+        for i in 0..n {
+            let (a, b, c) = (pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]);
+            let (ein, eout) = (
+                wavefront::EdgeLine::new(a, b, 1.0),
+                wavefront::EdgeLine::new(b, c, 1.0),
+            );
+            if wavefront::turns_back(&ein, &eout) {
+                return Err(LotsError::NeedleVertex {
+                    ring,
+                    vertex: i,
+                    sine: ein.dir.perp_dot(eout.dir),
+                });
+            }
         }
     }
     if let Some(w) = weights {

@@ -84,6 +84,12 @@ pub(crate) enum Motion {
     Fold,
 }
 
+/// Whether the turn from edge `a` to edge `b` goes back on itself (antiparallel within
+/// [`PARALLEL_SINE`]): the vertex between them is a fold.
+pub(crate) fn turns_back(a: &EdgeLine, b: &EdgeLine) -> bool {
+    a.dir.perp_dot(b.dir).abs() <= PARALLEL_SINE && a.dir.dot(b.dir) < 0.0
+}
+
 /// The velocity of the vertex between incoming edge `a` and outgoing edge `b`.
 pub(crate) fn motion(a: &EdgeLine, b: &EdgeLine) -> Motion {
     let (na, nb) = (a.normal, b.normal);
@@ -91,7 +97,7 @@ pub(crate) fn motion(a: &EdgeLine, b: &EdgeLine) -> Motion {
     let sine = a.dir.perp_dot(b.dir);
     let cosine = a.dir.dot(b.dir);
     if sine.abs() <= PARALLEL_SINE {
-        if cosine < 0.0 {
+        if turns_back(a, b) {
             return Motion::Fold;
         }
         let n = (na + nb).normalize();

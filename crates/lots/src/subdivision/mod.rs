@@ -86,7 +86,11 @@ impl Default for LotParams {
 }
 
 impl LotParams {
-    fn validate(&self) -> Result<(), LotsError> {
+    /// Checks every field against its documented range.
+    ///
+    /// # Errors
+    /// [`LotsError::InvalidParameter`] naming the first bad field.
+    pub fn validate(&self) -> Result<(), LotsError> {
         let positive = |name: &'static str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
