@@ -103,11 +103,7 @@ impl Mesh {
                 return Err(e);
             }
         }
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 }
 

@@ -162,11 +162,7 @@ impl Mesh {
                 Facing::Down => self.indices.extend_from_slice(&[a, c, b]),
             }
         }
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 
     /// Appends a closed prism: the polygon extruded from elevation `bottom` to `top`
@@ -200,11 +196,7 @@ impl Mesh {
         self.push_walls(&poly, bottom, top);
         self.add_cap(&poly, &triangles, |_, _| top, Facing::Up);
         self.add_cap(&poly, &triangles, |_, _| bottom, Facing::Down);
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 
     /// Appends only the walls of [`add_prism`](Self::add_prism): an open tube to close
@@ -229,11 +221,7 @@ impl Mesh {
         let mark = self.mark();
         let first_triangle = self.triangle_count();
         self.push_walls(&poly, bottom, top);
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 
     /// The wall quads of a normalised, valid polygon.
@@ -280,11 +268,7 @@ impl Mesh {
         let mark = self.mark();
         let first_triangle = self.triangle_count();
         self.add_cap(polygon, &triangles, height, facing);
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 
     /// Appends the triangulated polygon as one flat-shaded face (vertices lifted by
@@ -338,6 +322,20 @@ impl Mesh {
             }
         }
         Ok(())
+    }
+
+    /// Keeps what was appended since `mark` if no triangle from `first` on is degenerate,
+    /// and otherwise rolls the mesh back to `mark` and returns the error.
+    pub(super) fn keep_if_sound(
+        &mut self,
+        mark: (usize, usize),
+        first: usize,
+    ) -> Result<(), GeomError> {
+        let result = self.check_new_triangles(first);
+        if result.is_err() {
+            self.rollback(mark);
+        }
+        result
     }
 
     pub(super) fn mark(&self) -> (usize, usize) {

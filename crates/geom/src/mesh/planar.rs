@@ -129,11 +129,7 @@ impl Mesh {
         for t in &triangles {
             self.indices.extend(t.iter().map(|&i| base + i));
         }
-        let result = self.check_new_triangles(first_triangle);
-        if result.is_err() {
-            self.rollback(mark);
-        }
-        result
+        self.keep_if_sound(mark, first_triangle)
     }
 }
 
