@@ -61,7 +61,8 @@ pub struct CityConfig {
     /// (16 km², Citygen's test city).
     pub size_m: f64,
     /// Level of detail of the buildings (derivation steps); `None` = the grammars' full
-    /// detail (`buildings.max_lod`). Default: None.
+    /// detail (`buildings.max_lod`); a level above `buildings.max_lod` is a configuration
+    /// error. Default: None.
     pub lod: Option<usize>,
     /// Worker threads for per-cell and per-lot work; `None` = one per core, `Some(1)` =
     /// serial, at most [`MAX_THREADS`]. The output is byte-identical for any value.
@@ -451,6 +452,18 @@ impl CityConfig {
             return Err(Error::config(
                 "threads",
                 format!("{t} threads; give 1 to {MAX_THREADS}, or leave it out for one per core"),
+            ));
+        }
+        if let Some(lod) = self.lod
+            && lod > self.buildings.max_lod
+        {
+            return Err(Error::config(
+                "lod",
+                format!(
+                    "{lod} is above the most detailed level, buildings.max_lod = {}; give 0 to \
+                     {0}, raise buildings.max_lod, or leave lod out",
+                    self.buildings.max_lod
+                ),
             ));
         }
         let height_ok = |h: f64| h.is_finite() && h > 0.0 && h <= MAX_BUILDING_HEIGHT_M;

@@ -443,6 +443,12 @@ fn bad_configurations_are_errors_not_panics() {
     c.threads = Some(0);
     assert!(polis::generate(&c).is_err());
     let mut c = small("default");
+    c.lod = Some(c.buildings.max_lod + 1);
+    assert!(matches!(
+        polis::generate(&c),
+        Err(polis::Error::Config { .. })
+    ));
+    let mut c = small("default");
     c.facades.style_of.house = "no such style".into();
     let err = polis::generate(&c).unwrap_err();
     assert!(err.to_string().contains("no such style"), "{err}");
