@@ -13,6 +13,7 @@ use crate::legality::Legality;
 use crate::modules::{Proposal, RoadAttr, RuleAttr};
 use crate::network::{RoadClass, angle_diff, angle_of, dir};
 use crate::params::{Pattern, RoadParams};
+use crate::street_rules::BranchChoice;
 
 /// The `globalGoals` function of p2: given an accepted segment, propose the continuation
 /// and two branches.
@@ -412,55 +413,89 @@ impl GlobalGoals for DefaultGoals {
         } else {
             a
         };
-        let rule = RuleAttr {
-            class: RoadClass::Highway,
-            depth: 0,
-            age: 0,
-        };
         let len = self.params.highway_length_m;
         vec![
-            (rule, RoadAttr::new(p, a, len, RoadClass::Highway)),
-            (rule, RoadAttr::new(p, a + PI, len, RoadClass::Highway)),
+            (
+                RuleAttr::new(RoadClass::Highway, 0, a),
+                RoadAttr::new(p, a, len, RoadClass::Highway),
+            ),
+            (
+                RuleAttr::new(RoadClass::Highway, 0, a + PI),
+                RoadAttr::new(p, a + PI, len, RoadClass::Highway),
+            ),
         ]
     }
 
     fn successors(&self, rule: &RuleAttr, road: &RoadAttr, rng: &mut Pcg64Mcg) -> [Proposal; 3] {
+        match rule.class {
+            RoadClass::Highway => self.highway_successors(rule, road, rng),
+            RoadClass::Street => self.street_successors(rule, road, rng),
+        }
+    }
+}
+
+impl DefaultGoals {
+    /// The direction of the accepted segment and the population at its end.
+    fn segment_end(&self, road: &RoadAttr) -> (DVec2, f64, f64) {
         let p = road.end;
         let a = if road.end.distance(road.start) > 0.0 {
             angle_of(road.end - road.start)
         } else {
             road.angle
         };
-        let class = rule.class;
         let pop = self.inputs.population.sample(p);
-        let pop = if pop.is_finite() { pop } else { 0.0 };
+        (p, a, if pop.is_finite() { pop } else { 0.0 })
+    }
+
+    /// The pattern of largest weight at `p` (the first of equals, in Table 1's order).
+    pub fn dominant_pattern(&self, p: DVec2) -> Pattern {
+        let w = self.pattern_weights(p);
+        let mut best = 0;
+        for k in 1..4 {
+            if w[k] > w[best] {
+                best = k;
+            }
+        }
+        PATTERNS[best]
+    }
+
+    /// A highway goes on toward population (its turn from its first direction bounded by
+    /// `highway_max_total_turn_deg`) and branches into highways (rarely, where populated)
+    /// and streets (after the extra delay).
+    fn highway_successors(
+        &self,
+        rule: &RuleAttr,
+        road: &RoadAttr,
+        rng: &mut Pcg64Mcg,
+    ) -> [Proposal; 3] {
+        let (p, a, pop) = self.segment_end(road);
         let prm = &self.params;
         let stop = road.snapped;
-        // Continuation.
         let cont_rule = RuleAttr {
             age: rule.age.saturating_add(1),
             ..*rule
         };
-        let cont_aim = self.blend(p, a, class, false, rng);
-        let cont_delay = if stop || (class == RoadClass::Street && pop < prm.street_min_population)
-        {
-            -1
-        } else {
-            0
-        };
-        let cont = self.proposal(cont_delay, cont_rule, p, cont_aim, class);
-        // Branches, one on each side.
+        let mut cont_aim = self.blend(p, a, RoadClass::Highway, false, rng);
+        // No coiling: keep within the total turn of the highway's first direction.
+        let max_total = prm.highway_max_total_turn_deg.to_radians();
+        let off = wrap_pi(cont_aim.angle - rule.heading);
+        if off.abs() > max_total {
+            cont_aim.angle = rule.heading + max_total.copysign(off);
+        }
+        let cont = self.proposal(
+            if stop { -1 } else { 0 },
+            cont_rule,
+            p,
+            cont_aim,
+            RoadClass::Highway,
+        );
         let mut branches = [cont; 2];
         for (i, side) in [1.0f64, -1.0].into_iter().enumerate() {
             let r = unit_f64(rng);
-            let (bclass, delay) = match class {
-                // Highways branch into highways only where there is population to connect.
-                RoadClass::Highway
-                    if r < prm.highway_branch_probability && pop > prm.population_threshold =>
-                {
+            let (bclass, delay) =
+                if r < prm.highway_branch_probability && pop > prm.population_threshold {
                     (RoadClass::Highway, prm.branch_delay)
-                }
-                RoadClass::Highway => {
+                } else {
                     let r2 = unit_f64(rng);
                     if pop > prm.population_threshold && r2 < prm.street_branch_probability {
                         (
@@ -470,22 +505,13 @@ impl GlobalGoals for DefaultGoals {
                     } else {
                         (RoadClass::Street, -1)
                     }
-                }
-                RoadClass::Street => {
-                    if pop > prm.population_threshold && r < prm.street_branch_probability {
-                        (RoadClass::Street, prm.branch_delay)
-                    } else {
-                        (RoadClass::Street, -1)
-                    }
-                }
-            };
+                };
             let delay = if stop { -1 } else { delay };
-            let aim = self.blend(p, a + side * FRAC_PI_2, bclass, true, rng);
-            let brule = RuleAttr {
-                class: bclass,
-                depth: rule.depth.saturating_add(1),
-                age: 0,
-            };
+            let mut aim = self.blend(p, a + side * FRAC_PI_2, bclass, true, rng);
+            let mut brule = RuleAttr::new(bclass, rule.depth.saturating_add(1), aim.angle);
+            if bclass == RoadClass::Street {
+                self.start_link(&mut brule, &mut aim, p, rng);
+            }
             if let Some(slot) = branches.get_mut(i) {
                 *slot = self.proposal(delay, brule, p, aim, bclass);
             }
@@ -493,6 +519,78 @@ impl GlobalGoals for DefaultGoals {
         let [b1, b2] = branches;
         [cont, b1, b2]
     }
+
+    /// Draws a new street link at `p` into `rule` and sets the first segment of `aim`
+    /// to the link's segment length.
+    fn start_link(&self, rule: &mut RuleAttr, aim: &mut Aim, p: DVec2, rng: &mut Pcg64Mcg) {
+        let rules = self.params.street_rules(self.dominant_pattern(p));
+        let (turn, scale) = rules.draw_link(rng);
+        rule.turn = turn;
+        rule.scale = scale;
+        aim.length *= scale / f64::from(rules.segments_per_link.max(1));
+    }
+
+    /// A street goes on along its link (bending by the link's turn per segment); at the
+    /// link's end (a branch point) it ends, branches to one side, to both or to neither,
+    /// per the [`StreetRules`](crate::StreetRules) of the dominant pattern, and draws its
+    /// next link.
+    fn street_successors(
+        &self,
+        rule: &RuleAttr,
+        road: &RoadAttr,
+        rng: &mut Pcg64Mcg,
+    ) -> [Proposal; 3] {
+        let (p, a, pop) = self.segment_end(road);
+        let prm = &self.params;
+        let stop = road.snapped || pop < prm.street_min_population;
+        let rules = prm.street_rules(self.dominant_pattern(p));
+        let n = rules.segments_per_link.max(1);
+        let at_branch_point = rule.age.saturating_add(1) % n == 0;
+        let mut cont_rule = RuleAttr {
+            age: rule.age.saturating_add(1),
+            ..*rule
+        };
+        let (mut left, mut right, mut dead_end) = (false, false, false);
+        if at_branch_point {
+            match rules.branch(rng) {
+                BranchChoice::DeadEnd => dead_end = true,
+                BranchChoice::Go { left: l, right: r } => {
+                    let populated = pop > prm.population_threshold;
+                    left = l && populated;
+                    right = r && populated;
+                }
+            }
+        }
+        let mut cont_aim;
+        if at_branch_point {
+            cont_aim = self.blend(p, a, RoadClass::Street, false, rng);
+            self.start_link(&mut cont_rule, &mut cont_aim, p, rng);
+        } else {
+            cont_aim = self.blend(p, a + rule.turn, RoadClass::Street, false, rng);
+            cont_aim.length *= rule.scale / f64::from(n);
+        }
+        let cont_delay = if stop || dead_end { -1 } else { 0 };
+        let cont = self.proposal(cont_delay, cont_rule, p, cont_aim, RoadClass::Street);
+        let mut branches = [cont; 2];
+        for (i, (side, grow)) in [(1.0f64, left), (-1.0, right)].into_iter().enumerate() {
+            let mut aim = self.blend(p, a + side * FRAC_PI_2, RoadClass::Street, true, rng);
+            let mut brule =
+                RuleAttr::new(RoadClass::Street, rule.depth.saturating_add(1), aim.angle);
+            self.start_link(&mut brule, &mut aim, p, rng);
+            let delay = if grow && !stop { prm.branch_delay } else { -1 };
+            if let Some(slot) = branches.get_mut(i) {
+                *slot = self.proposal(delay, brule, p, aim, RoadClass::Street);
+            }
+        }
+        let [b1, b2] = branches;
+        [cont, b1, b2]
+    }
+}
+
+/// `a` wrapped into (−π, π].
+fn wrap_pi(a: f64) -> f64 {
+    let w = a.rem_euclid(std::f64::consts::TAU);
+    if w > PI { w - std::f64::consts::TAU } else { w }
 }
 
 #[cfg(test)]
@@ -552,11 +650,7 @@ mod tests {
         };
         let g = DefaultGoals::new(&params, &flat()).unwrap();
         let mut rng = Pcg64Mcg::seed_from_u64(1);
-        let rule = RuleAttr {
-            class: RoadClass::Street,
-            depth: 1,
-            age: 0,
-        };
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
         let road = RoadAttr::new(DVec2::ZERO, 0.0, 50.0, RoadClass::Street);
         let [c, b1, b2] = g.successors(&rule, &road, &mut rng);
         assert!((c.road.angle - 10f64.to_radians()).abs() < 1e-9);
@@ -592,11 +686,7 @@ mod tests {
         };
         let g = DefaultGoals::new(&params, &flat()).unwrap();
         let mut rng = Pcg64Mcg::seed_from_u64(1);
-        let rule = RuleAttr {
-            class: RoadClass::Street,
-            depth: 1,
-            age: 0,
-        };
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
         let dense = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, RoadClass::Street);
         let [_, b1, b2] = g.successors(&rule, &dense, &mut rng);
         assert!(b1.delay >= 0 && b2.delay >= 0);
@@ -604,11 +694,7 @@ mod tests {
         let [c, b1, b2] = g.successors(&rule, &empty, &mut rng);
         assert!(c.delay < 0 && b1.delay < 0 && b2.delay < 0);
         // From a highway, street branches wait the extra delay.
-        let hw = RuleAttr {
-            class: RoadClass::Highway,
-            depth: 0,
-            age: 0,
-        };
+        let hw = RuleAttr::new(RoadClass::Highway, 0, 0.0);
         let params = RoadParams {
             highway_branch_probability: 0.0,
             ..params
