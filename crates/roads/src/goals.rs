@@ -527,7 +527,22 @@ impl DefaultGoals {
         let (turn, scale) = rules.draw_link(rng);
         rule.turn = turn;
         rule.scale = scale;
-        aim.length *= scale / f64::from(rules.segments_per_link.max(1));
+        let n = rules.segments_per_link.max(1);
+        aim.angle += self.bend(p, turn, 0, n);
+        aim.length *= scale / f64::from(n);
+    }
+
+    /// How far segment `index` of a link of `n` segments with bend `turn` turns from the
+    /// pattern's direction. Basic follows the previous segment, so each segment turns by
+    /// `turn` and the turns add up; the other patterns snap back to their own direction
+    /// (grid axis, radial or concentric, contour), so the offset grows along the link,
+    /// `turn · (index − (n − 1) / 2)`: an arc about the pattern's direction.
+    fn bend(&self, p: DVec2, turn: f64, index: u32, n: u32) -> f64 {
+        if self.dominant_pattern(p) == Pattern::Basic {
+            if index == 0 { 0.0 } else { turn }
+        } else {
+            turn * (f64::from(index) - 0.5 * f64::from(n.saturating_sub(1)))
+        }
     }
 
     /// A street goes on along its link (bending by the link's turn per segment); at the
@@ -542,10 +557,12 @@ impl DefaultGoals {
     ) -> [Proposal; 3] {
         let (p, a, pop) = self.segment_end(road);
         let prm = &self.params;
-        let stop = road.snapped || pop < prm.street_min_population;
         let rules = prm.street_rules(self.dominant_pattern(p));
+        // A crossing ends the street unless it goes on through (one draw, always).
+        let through = unit_f64(rng) < rules.cross_through_probability && road.crossed;
+        let stop = (road.snapped && !through) || pop < prm.street_min_population;
         let n = rules.segments_per_link.max(1);
-        let at_branch_point = rule.age.saturating_add(1) % n == 0;
+        let at_branch_point = rule.age.saturating_add(1).is_multiple_of(n);
         let mut cont_rule = RuleAttr {
             age: rule.age.saturating_add(1),
             ..*rule
@@ -566,7 +583,11 @@ impl DefaultGoals {
             cont_aim = self.blend(p, a, RoadClass::Street, false, rng);
             self.start_link(&mut cont_rule, &mut cont_aim, p, rng);
         } else {
-            cont_aim = self.blend(p, a + rule.turn, RoadClass::Street, false, rng);
+            // The pattern proposes, then the link bends (so a grid street, a radial or
+            // concentric Paris street, or a contour, curves too).
+            cont_aim = self.blend(p, a, RoadClass::Street, false, rng);
+            let index = rule.age.saturating_add(1) % n;
+            cont_aim.angle += self.bend(p, rule.turn, index, n);
             cont_aim.length *= rule.scale / f64::from(n);
         }
         let cont_delay = if stop || dead_end { -1 } else { 0 };

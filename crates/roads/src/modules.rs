@@ -103,6 +103,10 @@ pub struct RoadAttr {
     /// Set by the local constraints: the segment was connected to an existing road or
     /// junction (a crossing); the road stops growing (§3.3.1).
     pub snapped: bool,
+    /// Set by the local constraints with `snapped`: the connection is a crossing of an
+    /// existing road (not a junction or a road reached by extension), so a street may go
+    /// on through it ([`StreetRules::cross_through_probability`](crate::StreetRules::cross_through_probability)).
+    pub crossed: bool,
 }
 
 impl RoadAttr {
@@ -116,6 +120,7 @@ impl RoadAttr {
             end: start + crate::network::dir(angle) * length,
             bridge: false,
             snapped: false,
+            crossed: false,
         }
     }
 }

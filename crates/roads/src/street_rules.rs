@@ -14,7 +14,10 @@
 //! [`branch_probability`](StreetRules::branch_probability): to both sides (a crossroads)
 //! with [`crossroads_probability`](StreetRules::crossroads_probability), else to one
 //! side drawn at random (a T); or it ends, with
-//! [`dead_end_probability`](StreetRules::dead_end_probability) (a cul-de-sac).
+//! [`dead_end_probability`](StreetRules::dead_end_probability) (a cul-de-sac). A street
+//! that crosses an existing road goes on through the crossing with
+//! [`cross_through_probability`](StreetRules::cross_through_probability), else it ends
+//! there as §3.3.1 has it.
 //!
 //! ## Guarantees
 //! * Every draw comes from the derivation's seeded generator, in a fixed order.
@@ -52,6 +55,10 @@ pub struct StreetRules {
     /// Probability that a street ends at a branch point with nothing after it (a
     /// cul-de-sac), in [0, 1]. Default: 0.
     pub dead_end_probability: f64,
+    /// Probability that a street whose segment crossed an existing road goes on through
+    /// the crossing (a four-way junction, as grid streets cross avenues) instead of
+    /// ending there (a T, §3.3.1's default), in [0, 1]. Default: 0.
+    pub cross_through_probability: f64,
     /// Segments per link (street between two branch points), 1 to 64. Default: 1.
     pub segments_per_link: u32,
     /// Largest heading change per segment of a link, degrees in [0, 60): each link draws
@@ -69,6 +76,7 @@ impl Default for StreetRules {
             branch_probability: 0.99,
             crossroads_probability: 0.82,
             dead_end_probability: 0.0,
+            cross_through_probability: 0.0,
             segments_per_link: 1,
             curve_deg: 0.0,
             length_sigma: 0.0,
@@ -123,6 +131,10 @@ impl StreetRules {
                 self.crossroads_probability,
             ),
             ("streets.dead_end_probability", self.dead_end_probability),
+            (
+                "streets.cross_through_probability",
+                self.cross_through_probability,
+            ),
         ] {
             if !(0.0..=1.0).contains(&v) {
                 return Err(bad(name, v, "a probability in [0, 1]"));
