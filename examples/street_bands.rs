@@ -11,9 +11,7 @@
 //! `--config` reads a configuration file instead of a preset. Without either: every preset whose road mode is Parish & Müller and which names a
 //! reference city. `--seeds` defaults to 1-5, `--size` to each preset's own size.
 
-use polis::stages::{ParishMullerRoads, RoadStage, StageContext};
-use polis::stats::{CityInput, StatsOptions, StreetClass, StreetGraph};
-use polis::{CityConfig, CityMaps, RoadMode};
+use polis::{CityConfig, RoadMode};
 
 struct Args {
     presets: Vec<String>,
@@ -83,27 +81,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         let mut tally: Vec<(String, usize, usize)> = Vec::new();
         for seed in args.seeds.0..=args.seeds.1 {
             config.seed = seed;
-            let maps = CityMaps::build(&config.maps, config.seed)?;
-            let cx = StageContext {
-                config: &config,
-                maps: &maps,
-            };
-            let roads = ParishMullerRoads::default().roads(&cx)?;
-            let graph = StreetGraph::from_planar(&roads.network, |r| {
-                let class = match r.class {
-                    polis::roads::RoadClass::Highway => StreetClass::Highway,
-                    polis::roads::RoadClass::Street => StreetClass::Street,
-                };
-                (class, r.width)
-            });
-            let h = config.size_m * 0.5;
-            let mut input = CityInput::streets_only(&graph);
-            input.bounds = Some(polis::geom::Aabb2::new(
-                polis::geom::DVec2::splat(-h),
-                polis::geom::DVec2::splat(h),
-            ));
-            let report =
-                polis::stats::report(&input, &StatsOptions::default())?.compare_with(&city)?;
+            let report = polis::road_statistics(&config)?;
             let mut line = format!("seed {seed}:");
             if let Some(r) = &report.realism {
                 for row in &r.rows {
@@ -126,10 +104,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             line += &format!(
-                " P3={:.3} P5+={:.3} segments={}",
-                report.streets.share_3way,
-                report.streets.share_5plus,
-                roads.network.edge_count()
+                " P3={:.3} P5+={:.3} simplified_edges={}",
+                report.streets.share_3way, report.streets.share_5plus, report.streets.streets
             );
             println!("{line}");
         }

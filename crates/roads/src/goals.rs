@@ -407,7 +407,20 @@ impl GlobalGoals for DefaultGoals {
         let w = self.pattern_weights(p);
         // Align the axiom with the dominant pattern where it has a direction.
         let a = if w[1] >= 0.5 {
-            self.new_york(p, a, RoadClass::Highway).angle
+            // The grid axis nearest the population's direction on which the axiom can be
+            // laid (either way legal): on hills the nearest axis may be too steep.
+            let g = self.new_york(p, a, RoadClass::Highway).angle;
+            let legality = Legality::new(&self.inputs, &self.params);
+            let len = self.params.highway_length_m;
+            let legal = |ang: f64| {
+                legality.segment_ok(p, p + dir(ang) * len)
+                    || legality.segment_ok(p, p - dir(ang) * len)
+            };
+            [0.0, FRAC_PI_2, -FRAC_PI_2]
+                .into_iter()
+                .map(|k| g + k)
+                .find(|&ang| legal(ang))
+                .unwrap_or(g)
         } else if w[2] >= 0.5 && p.distance(self.centre) > 1e-6 {
             angle_of(p - self.centre)
         } else {

@@ -76,7 +76,8 @@ pub struct RoadParams {
     pub streets: BTreeMap<Pattern, StreetRules>,
     /// A highway turns at most this far, in total, from the direction it started in
     /// (degrees), so highways run from population centre to population centre and on to
-    /// the map edge instead of coiling around a peak. Default: 75°.
+    /// the map edge instead of coiling around a peak; 180° sets no bound (the highways of
+    /// Kelly's Citygen mode may loop to close primary cells). Default: 180°.
     pub highway_max_total_turn_deg: f64,
     /// Delay, in derivation steps, before a branch grows. Default: 1.
     pub branch_delay: i32,
@@ -150,7 +151,7 @@ impl Default for RoadParams {
             street_branch_probability: 0.9,
             street_deviation_deg: 5.0,
             streets: BTreeMap::new(),
-            highway_max_total_turn_deg: 75.0,
+            highway_max_total_turn_deg: 180.0,
             branch_delay: 1,
             highway_street_delay: 5,
             population_threshold: 0.1,
