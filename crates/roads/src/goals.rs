@@ -739,4 +739,107 @@ mod tests {
         assert_eq!(b1.delay, params.branch_delay + params.highway_street_delay);
         assert_eq!(b1.rule.class, RoadClass::Street);
     }
+
+    #[test]
+    fn a_highway_turns_at_most_its_total_bound() {
+        let params = RoadParams {
+            highway_max_total_turn_deg: 10.0,
+            highway_branch_probability: 0.0,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        // Heading north at (1000, 0): the population (at the origin) pulls west.
+        let rule = RuleAttr::new(RoadClass::Highway, 0, FRAC_PI_2);
+        let road = RoadAttr::new(
+            DVec2::new(1000.0, -10.0),
+            FRAC_PI_2,
+            10.0,
+            RoadClass::Highway,
+        );
+        let [c, _, _] = g.successors(&rule, &road, &mut rng);
+        let off = c.road.angle - FRAC_PI_2;
+        assert!(off > 0.0 && off <= 10f64.to_radians() + 1e-12, "{off}");
+        // Without the bound it turns further.
+        let free = DefaultGoals::new(
+            &RoadParams {
+                highway_max_total_turn_deg: 180.0,
+                ..params
+            },
+            &flat(),
+        )
+        .unwrap();
+        let [c, _, _] = free.successors(&rule, &road, &mut rng);
+        assert!(
+            c.road.angle - FRAC_PI_2 > 10f64.to_radians(),
+            "{}",
+            c.road.angle
+        );
+    }
+
+    #[test]
+    fn a_street_link_bends_and_branches_only_at_its_end() {
+        let mut streets = std::collections::BTreeMap::new();
+        streets.insert(
+            Pattern::Basic,
+            crate::StreetRules {
+                branch_probability: 1.0,
+                crossroads_probability: 1.0,
+                segments_per_link: 3,
+                curve_deg: 20.0,
+                ..crate::StreetRules::default()
+            },
+        );
+        let params = RoadParams {
+            street_deviation_deg: 0.0,
+            streets,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(2);
+        let rule = RuleAttr {
+            turn: 0.2,
+            scale: 1.5,
+            ..RuleAttr::new(RoadClass::Street, 1, 0.0)
+        };
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 30.0, RoadClass::Street);
+        // Segments 1 and 2 of the link: bend by the turn, a third of the link, no branch.
+        for age in [0, 1] {
+            let [c, b1, b2] = g.successors(&RuleAttr { age, ..rule }, &road, &mut rng);
+            assert!((c.road.angle - 0.2).abs() < 1e-12, "{}", c.road.angle);
+            assert!((c.road.length - 1.5 * params.street_length_m / 3.0).abs() < 1e-9);
+            assert!(c.delay >= 0 && b1.delay < 0 && b2.delay < 0);
+        }
+        // Segment 3 ends the link: both branches, a new link drawn for the continuation.
+        let [c, b1, b2] = g.successors(&RuleAttr { age: 2, ..rule }, &road, &mut rng);
+        assert!(c.delay >= 0 && b1.delay >= 0 && b2.delay >= 0);
+        assert!(c.rule.turn.abs() <= 20f64.to_radians());
+        assert!(c.road.angle.abs() < 1e-12, "a new link starts straight on");
+    }
+
+    #[test]
+    fn a_street_goes_through_a_crossing_only_by_its_rule() {
+        let mut streets = std::collections::BTreeMap::new();
+        let rules = crate::StreetRules {
+            cross_through_probability: 1.0,
+            ..crate::StreetRules::default()
+        };
+        streets.insert(Pattern::Basic, rules);
+        let params = RoadParams {
+            streets,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
+        let mut road = RoadAttr::new(DVec2::ZERO, 0.0, 30.0, RoadClass::Street);
+        road.snapped = true;
+        road.crossed = true;
+        let [c, _, _] = g.successors(&rule, &road, &mut rng);
+        assert!(c.delay >= 0, "goes on through the crossing");
+        // A snap to a junction or a road still ends it.
+        road.crossed = false;
+        let [c, b1, b2] = g.successors(&rule, &road, &mut rng);
+        assert!(c.delay < 0 && b1.delay < 0 && b2.delay < 0);
+    }
 }
