@@ -104,3 +104,30 @@ fn san_francisco_is_in_san_franciscos_band() {
 fn old_town_is_in_romes_band() {
     check("old_town");
 }
+
+/// `road_statistics` measures the same streets as the whole city's statistics: every
+/// realism row agrees (a small `paris` and `san_francisco`, whose maps are salted per
+/// seed, so a mismatch in the maps would show).
+#[test]
+fn road_statistics_agree_with_the_whole_city() {
+    for name in ["paris", "san_francisco"] {
+        let mut c = CityConfig::preset(name).unwrap();
+        c.size_m = 1200.0;
+        c.roads.max_segments = 300;
+        c.facades.enabled = false;
+        c.seed = 4;
+        let fast = road_statistics(&c).unwrap();
+        let city = polis::Pipeline::default()
+            .with_scene(false)
+            .generate(&c)
+            .unwrap();
+        let full = city.statistics().unwrap();
+        assert!(fast.streets.streets > 0, "{name}");
+        assert_eq!(fast.streets.segments, city.roads.edge_count(), "{name}");
+        assert_eq!(
+            fast.realism.unwrap().rows,
+            full.realism.unwrap().rows,
+            "{name}"
+        );
+    }
+}
