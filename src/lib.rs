@@ -83,7 +83,7 @@ pub use error::{BoxError, Error, PolisError, Result};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
-pub use report::reference_city_name;
+pub use report::{reference_city_name, road_statistics, street_graph};
 pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

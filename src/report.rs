@@ -36,6 +36,60 @@ fn land_area(water: &dyn Field, size_m: f64) -> f64 {
     size_m * size_m * (1.0 - wet as f64 / (cells * cells) as f64)
 }
 
+/// The road network as polis-stats' [`StreetGraph`] (class and carriageway width per
+/// edge), without elevation.
+pub fn street_graph(roads: &polis_roads::RoadNetwork) -> StreetGraph {
+    StreetGraph::from_planar(roads, |r| {
+        let class = match r.class {
+            RoadClass::Highway => StreetClass::Highway,
+            RoadClass::Street => StreetClass::Street,
+        };
+        (class, r.width)
+    })
+}
+
+/// The street-network part of the report, fast: only the maps and the road stage of
+/// `config` run (no blocks, lots or buildings; the street metrics depend on the roads
+/// alone), measured over the city square and compared with the city the configuration
+/// imitates. Its street metrics and realism rows are those of
+/// [`City::statistics`] for the same configuration, except the intersection density,
+/// which is per km² of the whole square here (not of land). Only the Parish & Müller road
+/// mode is run; a Citygen configuration is an error.
+///
+/// # Errors
+/// [`Error::Config`](crate::Error::Config) for a bad configuration or the Citygen mode;
+/// the road stage's error; [`Error::Stats`](crate::Error::Stats) for an unknown
+/// reference city.
+pub fn road_statistics(config: &CityConfig) -> Result<CityReport> {
+    use crate::stages::{ParishMullerRoads, RoadStage, StageContext};
+    config.validate()?;
+    if config.road_mode != crate::RoadMode::ParishMuller {
+        return Err(crate::Error::Config {
+            field: "road_mode".into(),
+            reason: "road_statistics runs the Parish & Müller road stage only".into(),
+        });
+    }
+    // The maps exactly as the pipeline builds them (salted with the maps stage's seed).
+    let maps = crate::CityMaps::build(
+        &config.maps,
+        crate::seed::sub_seed(config.seed, crate::Stage::Maps, 0),
+    )?;
+    let cx = StageContext {
+        config,
+        maps: &maps,
+    };
+    let roads = ParishMullerRoads::default().roads(&cx)?;
+    let streets = street_graph(&roads.network);
+    let h = config.size_m * 0.5;
+    let mut input = CityInput::streets_only(&streets);
+    input.bounds = Some(Aabb2::new(DVec2::splat(-h), DVec2::splat(h)));
+    let report = polis_stats::report(&input, &StatsOptions::default())?;
+    Ok(match reference_city_name(config) {
+        Some(name) => report.compare_with(name)?,
+        None => report,
+    })
+}
+
 impl City {
     /// The statistics report ([`polis_stats::report`]) with the default options, compared
     /// with the city the configuration imitates ([`reference_city_name`]) when it names
@@ -53,14 +107,7 @@ impl City {
     /// # Errors
     /// As [`statistics`](Self::statistics).
     pub fn statistics_with(&self, options: &StatsOptions) -> Result<CityReport> {
-        let streets = StreetGraph::from_planar(&self.roads, |r| {
-            let class = match r.class {
-                RoadClass::Highway => StreetClass::Highway,
-                RoadClass::Street => StreetClass::Street,
-            };
-            (class, r.width)
-        })
-        .with_elevation(self.maps.inputs.elevation.as_ref());
+        let streets = street_graph(&self.roads).with_elevation(self.maps.inputs.elevation.as_ref());
         let blocks: Vec<_> = self.blocks.iter().map(|b| &b.polygon).collect();
         let lots: Vec<LotInput<'_>> = self
             .lots

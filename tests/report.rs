@@ -1,6 +1,6 @@
 //! The statistics report of a small city per preset: complete, finite, compared with the
 //! city the preset imitates. (Whether the presets land in their real city's bands is
-//! measured in BENCHMARKS.md, not asserted here yet.)
+//! asserted in `tests/realism_bands.rs`.)
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic on failure
 

@@ -260,6 +260,7 @@ impl LocalConstraints for DefaultConstraints {
                 road.length = len;
                 road.bridge = false;
                 road.snapped = true;
+                road.crossed = matches!(ev, SnapEvent::Cross { .. });
                 return QueryState::Succeed;
             }
         }
@@ -282,6 +283,7 @@ impl LocalConstraints for DefaultConstraints {
             self.snap_event(net, start_node, a, end, road.class)
         };
         let mut snapped = false;
+        let mut crossed = false;
         match event {
             Err(()) => {
                 self.stats.failed_angle += 1;
@@ -291,6 +293,7 @@ impl LocalConstraints for DefaultConstraints {
                 self.count_snap(&ev);
                 end = ev.point();
                 snapped = true;
+                crossed = matches!(ev, SnapEvent::Cross { .. });
             }
             Ok(None) => {}
         }
@@ -320,6 +323,7 @@ impl LocalConstraints for DefaultConstraints {
         road.length = len;
         road.bridge = bridge;
         road.snapped = snapped;
+        road.crossed = crossed;
         QueryState::Succeed
     }
 

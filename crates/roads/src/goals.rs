@@ -13,6 +13,7 @@ use crate::legality::Legality;
 use crate::modules::{Proposal, RoadAttr, RuleAttr};
 use crate::network::{RoadClass, angle_diff, angle_of, dir};
 use crate::params::{Pattern, RoadParams};
+use crate::street_rules::BranchChoice;
 
 /// The `globalGoals` function of p2: given an accepted segment, propose the continuation
 /// and two branches.
@@ -406,61 +407,108 @@ impl GlobalGoals for DefaultGoals {
         let w = self.pattern_weights(p);
         // Align the axiom with the dominant pattern where it has a direction.
         let a = if w[1] >= 0.5 {
-            self.new_york(p, a, RoadClass::Highway).angle
+            // The grid axis nearest the population's direction on which the axiom can be
+            // laid (either way legal): on hills the nearest axis may be too steep.
+            let g = self.new_york(p, a, RoadClass::Highway).angle;
+            let legality = Legality::new(&self.inputs, &self.params);
+            let len = self.params.highway_length_m;
+            let legal = |ang: f64| {
+                legality.segment_ok(p, p + dir(ang) * len)
+                    || legality.segment_ok(p, p - dir(ang) * len)
+            };
+            [0.0, FRAC_PI_2, -FRAC_PI_2]
+                .into_iter()
+                .map(|k| g + k)
+                .find(|&ang| legal(ang))
+                .unwrap_or(g)
         } else if w[2] >= 0.5 && p.distance(self.centre) > 1e-6 {
             angle_of(p - self.centre)
         } else {
             a
         };
-        let rule = RuleAttr {
-            class: RoadClass::Highway,
-            depth: 0,
-            age: 0,
-        };
         let len = self.params.highway_length_m;
         vec![
-            (rule, RoadAttr::new(p, a, len, RoadClass::Highway)),
-            (rule, RoadAttr::new(p, a + PI, len, RoadClass::Highway)),
+            (
+                RuleAttr::new(RoadClass::Highway, 0, a),
+                RoadAttr::new(p, a, len, RoadClass::Highway),
+            ),
+            (
+                RuleAttr::new(RoadClass::Highway, 0, a + PI),
+                RoadAttr::new(p, a + PI, len, RoadClass::Highway),
+            ),
         ]
     }
 
     fn successors(&self, rule: &RuleAttr, road: &RoadAttr, rng: &mut Pcg64Mcg) -> [Proposal; 3] {
+        match rule.class {
+            RoadClass::Highway => self.highway_successors(rule, road, rng),
+            RoadClass::Street => self.street_successors(rule, road, rng),
+        }
+    }
+}
+
+impl DefaultGoals {
+    /// The direction of the accepted segment and the population at its end.
+    fn segment_end(&self, road: &RoadAttr) -> (DVec2, f64, f64) {
         let p = road.end;
         let a = if road.end.distance(road.start) > 0.0 {
             angle_of(road.end - road.start)
         } else {
             road.angle
         };
-        let class = rule.class;
         let pop = self.inputs.population.sample(p);
-        let pop = if pop.is_finite() { pop } else { 0.0 };
+        (p, a, if pop.is_finite() { pop } else { 0.0 })
+    }
+
+    /// The pattern of largest weight at `p` (the first of equals, in Table 1's order).
+    pub fn dominant_pattern(&self, p: DVec2) -> Pattern {
+        let w = self.pattern_weights(p);
+        let mut best = 0;
+        for k in 1..4 {
+            if w[k] > w[best] {
+                best = k;
+            }
+        }
+        PATTERNS[best]
+    }
+
+    /// A highway goes on toward population (its turn from its first direction bounded by
+    /// `highway_max_total_turn_deg`) and branches into highways (rarely, where populated)
+    /// and streets (after the extra delay).
+    fn highway_successors(
+        &self,
+        rule: &RuleAttr,
+        road: &RoadAttr,
+        rng: &mut Pcg64Mcg,
+    ) -> [Proposal; 3] {
+        let (p, a, pop) = self.segment_end(road);
         let prm = &self.params;
         let stop = road.snapped;
-        // Continuation.
         let cont_rule = RuleAttr {
             age: rule.age.saturating_add(1),
             ..*rule
         };
-        let cont_aim = self.blend(p, a, class, false, rng);
-        let cont_delay = if stop || (class == RoadClass::Street && pop < prm.street_min_population)
-        {
-            -1
-        } else {
-            0
-        };
-        let cont = self.proposal(cont_delay, cont_rule, p, cont_aim, class);
-        // Branches, one on each side.
+        let mut cont_aim = self.blend(p, a, RoadClass::Highway, false, rng);
+        // No coiling: keep within the total turn of the highway's first direction.
+        let max_total = prm.highway_max_total_turn_deg.to_radians();
+        let off = wrap_pi(cont_aim.angle - rule.heading);
+        if off.abs() > max_total {
+            cont_aim.angle = rule.heading + max_total.copysign(off);
+        }
+        let cont = self.proposal(
+            if stop { -1 } else { 0 },
+            cont_rule,
+            p,
+            cont_aim,
+            RoadClass::Highway,
+        );
         let mut branches = [cont; 2];
         for (i, side) in [1.0f64, -1.0].into_iter().enumerate() {
             let r = unit_f64(rng);
-            let (bclass, delay) = match class {
-                // Highways branch into highways only where there is population to connect.
-                RoadClass::Highway
-                    if r < prm.highway_branch_probability && pop > prm.population_threshold =>
-                {
+            let (bclass, delay) =
+                if r < prm.highway_branch_probability && pop > prm.population_threshold {
                     (RoadClass::Highway, prm.branch_delay)
-                }
-                RoadClass::Highway => {
+                } else {
                     let r2 = unit_f64(rng);
                     if pop > prm.population_threshold && r2 < prm.street_branch_probability {
                         (
@@ -470,22 +518,13 @@ impl GlobalGoals for DefaultGoals {
                     } else {
                         (RoadClass::Street, -1)
                     }
-                }
-                RoadClass::Street => {
-                    if pop > prm.population_threshold && r < prm.street_branch_probability {
-                        (RoadClass::Street, prm.branch_delay)
-                    } else {
-                        (RoadClass::Street, -1)
-                    }
-                }
-            };
+                };
             let delay = if stop { -1 } else { delay };
-            let aim = self.blend(p, a + side * FRAC_PI_2, bclass, true, rng);
-            let brule = RuleAttr {
-                class: bclass,
-                depth: rule.depth.saturating_add(1),
-                age: 0,
-            };
+            let mut aim = self.blend(p, a + side * FRAC_PI_2, bclass, true, rng);
+            let mut brule = RuleAttr::new(bclass, rule.depth.saturating_add(1), aim.angle);
+            if bclass == RoadClass::Street {
+                self.start_link(&mut brule, &mut aim, p, rng);
+            }
             if let Some(slot) = branches.get_mut(i) {
                 *slot = self.proposal(delay, brule, p, aim, bclass);
             }
@@ -493,6 +532,99 @@ impl GlobalGoals for DefaultGoals {
         let [b1, b2] = branches;
         [cont, b1, b2]
     }
+
+    /// Draws a new street link at `p` into `rule` and sets the first segment of `aim`
+    /// to the link's segment length.
+    fn start_link(&self, rule: &mut RuleAttr, aim: &mut Aim, p: DVec2, rng: &mut Pcg64Mcg) {
+        let rules = self.params.street_rules(self.dominant_pattern(p));
+        let (turn, scale) = rules.draw_link(rng);
+        rule.turn = turn;
+        rule.scale = scale;
+        let n = rules.segments_per_link.max(1);
+        aim.angle += self.bend(p, turn, 0, n);
+        aim.length *= scale / f64::from(n);
+    }
+
+    /// How far segment `index` of a link of `n` segments with bend `turn` turns from the
+    /// pattern's direction. Basic follows the previous segment, so each segment turns by
+    /// `turn` and the turns add up; the other patterns snap back to their own direction
+    /// (grid axis, radial or concentric, contour), so the offset grows along the link,
+    /// `turn · (index − (n − 1) / 2)`: an arc about the pattern's direction.
+    fn bend(&self, p: DVec2, turn: f64, index: u32, n: u32) -> f64 {
+        if self.dominant_pattern(p) == Pattern::Basic {
+            if index == 0 { 0.0 } else { turn }
+        } else {
+            turn * (f64::from(index) - 0.5 * f64::from(n.saturating_sub(1)))
+        }
+    }
+
+    /// A street goes on along its link (bending by the link's turn per segment); at the
+    /// link's end (a branch point) it ends, branches to one side, to both or to neither,
+    /// per the [`StreetRules`](crate::StreetRules) of the dominant pattern, and draws its
+    /// next link.
+    fn street_successors(
+        &self,
+        rule: &RuleAttr,
+        road: &RoadAttr,
+        rng: &mut Pcg64Mcg,
+    ) -> [Proposal; 3] {
+        let (p, a, pop) = self.segment_end(road);
+        let prm = &self.params;
+        let rules = prm.street_rules(self.dominant_pattern(p));
+        // A crossing ends the street unless it goes on through (one draw, always).
+        let through = unit_f64(rng) < rules.cross_through_probability && road.crossed;
+        let stop = (road.snapped && !through) || pop < prm.street_min_population;
+        let n = rules.segments_per_link.max(1);
+        let at_branch_point = rule.age.saturating_add(1).is_multiple_of(n);
+        let mut cont_rule = RuleAttr {
+            age: rule.age.saturating_add(1),
+            ..*rule
+        };
+        let (mut left, mut right, mut dead_end) = (false, false, false);
+        if at_branch_point {
+            match rules.branch(rng) {
+                BranchChoice::DeadEnd => dead_end = true,
+                BranchChoice::Go { left: l, right: r } => {
+                    let populated = pop > prm.population_threshold;
+                    left = l && populated;
+                    right = r && populated;
+                }
+            }
+        }
+        let mut cont_aim;
+        if at_branch_point {
+            cont_aim = self.blend(p, a, RoadClass::Street, false, rng);
+            self.start_link(&mut cont_rule, &mut cont_aim, p, rng);
+        } else {
+            // The pattern proposes, then the link bends (so a grid street, a radial or
+            // concentric Paris street, or a contour, curves too).
+            cont_aim = self.blend(p, a, RoadClass::Street, false, rng);
+            let index = rule.age.saturating_add(1) % n;
+            cont_aim.angle += self.bend(p, rule.turn, index, n);
+            cont_aim.length *= rule.scale / f64::from(n);
+        }
+        let cont_delay = if stop || dead_end { -1 } else { 0 };
+        let cont = self.proposal(cont_delay, cont_rule, p, cont_aim, RoadClass::Street);
+        let mut branches = [cont; 2];
+        for (i, (side, grow)) in [(1.0f64, left), (-1.0, right)].into_iter().enumerate() {
+            let mut aim = self.blend(p, a + side * FRAC_PI_2, RoadClass::Street, true, rng);
+            let mut brule =
+                RuleAttr::new(RoadClass::Street, rule.depth.saturating_add(1), aim.angle);
+            self.start_link(&mut brule, &mut aim, p, rng);
+            let delay = if grow && !stop { prm.branch_delay } else { -1 };
+            if let Some(slot) = branches.get_mut(i) {
+                *slot = self.proposal(delay, brule, p, aim, RoadClass::Street);
+            }
+        }
+        let [b1, b2] = branches;
+        [cont, b1, b2]
+    }
+}
+
+/// `a` wrapped into (−π, π].
+fn wrap_pi(a: f64) -> f64 {
+    let w = a.rem_euclid(std::f64::consts::TAU);
+    if w > PI { w - std::f64::consts::TAU } else { w }
 }
 
 #[cfg(test)]
@@ -552,11 +684,7 @@ mod tests {
         };
         let g = DefaultGoals::new(&params, &flat()).unwrap();
         let mut rng = Pcg64Mcg::seed_from_u64(1);
-        let rule = RuleAttr {
-            class: RoadClass::Street,
-            depth: 1,
-            age: 0,
-        };
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
         let road = RoadAttr::new(DVec2::ZERO, 0.0, 50.0, RoadClass::Street);
         let [c, b1, b2] = g.successors(&rule, &road, &mut rng);
         assert!((c.road.angle - 10f64.to_radians()).abs() < 1e-9);
@@ -592,11 +720,7 @@ mod tests {
         };
         let g = DefaultGoals::new(&params, &flat()).unwrap();
         let mut rng = Pcg64Mcg::seed_from_u64(1);
-        let rule = RuleAttr {
-            class: RoadClass::Street,
-            depth: 1,
-            age: 0,
-        };
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
         let dense = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, RoadClass::Street);
         let [_, b1, b2] = g.successors(&rule, &dense, &mut rng);
         assert!(b1.delay >= 0 && b2.delay >= 0);
@@ -604,11 +728,7 @@ mod tests {
         let [c, b1, b2] = g.successors(&rule, &empty, &mut rng);
         assert!(c.delay < 0 && b1.delay < 0 && b2.delay < 0);
         // From a highway, street branches wait the extra delay.
-        let hw = RuleAttr {
-            class: RoadClass::Highway,
-            depth: 0,
-            age: 0,
-        };
+        let hw = RuleAttr::new(RoadClass::Highway, 0, 0.0);
         let params = RoadParams {
             highway_branch_probability: 0.0,
             ..params
@@ -618,5 +738,108 @@ mod tests {
         let [_, b1, _] = g.successors(&hw, &road, &mut rng);
         assert_eq!(b1.delay, params.branch_delay + params.highway_street_delay);
         assert_eq!(b1.rule.class, RoadClass::Street);
+    }
+
+    #[test]
+    fn a_highway_turns_at_most_its_total_bound() {
+        let params = RoadParams {
+            highway_max_total_turn_deg: 10.0,
+            highway_branch_probability: 0.0,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        // Heading north at (1000, 0): the population (at the origin) pulls west.
+        let rule = RuleAttr::new(RoadClass::Highway, 0, FRAC_PI_2);
+        let road = RoadAttr::new(
+            DVec2::new(1000.0, -10.0),
+            FRAC_PI_2,
+            10.0,
+            RoadClass::Highway,
+        );
+        let [c, _, _] = g.successors(&rule, &road, &mut rng);
+        let off = c.road.angle - FRAC_PI_2;
+        assert!(off > 0.0 && off <= 10f64.to_radians() + 1e-12, "{off}");
+        // Without the bound it turns further.
+        let free = DefaultGoals::new(
+            &RoadParams {
+                highway_max_total_turn_deg: 180.0,
+                ..params
+            },
+            &flat(),
+        )
+        .unwrap();
+        let [c, _, _] = free.successors(&rule, &road, &mut rng);
+        assert!(
+            c.road.angle - FRAC_PI_2 > 10f64.to_radians(),
+            "{}",
+            c.road.angle
+        );
+    }
+
+    #[test]
+    fn a_street_link_bends_and_branches_only_at_its_end() {
+        let mut streets = std::collections::BTreeMap::new();
+        streets.insert(
+            Pattern::Basic,
+            crate::StreetRules {
+                branch_probability: 1.0,
+                crossroads_probability: 1.0,
+                segments_per_link: 3,
+                curve_deg: 20.0,
+                ..crate::StreetRules::default()
+            },
+        );
+        let params = RoadParams {
+            street_deviation_deg: 0.0,
+            streets,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(2);
+        let rule = RuleAttr {
+            turn: 0.2,
+            scale: 1.5,
+            ..RuleAttr::new(RoadClass::Street, 1, 0.0)
+        };
+        let road = RoadAttr::new(DVec2::ZERO, 0.0, 30.0, RoadClass::Street);
+        // Segments 1 and 2 of the link: bend by the turn, a third of the link, no branch.
+        for age in [0, 1] {
+            let [c, b1, b2] = g.successors(&RuleAttr { age, ..rule }, &road, &mut rng);
+            assert!((c.road.angle - 0.2).abs() < 1e-12, "{}", c.road.angle);
+            assert!((c.road.length - 1.5 * params.street_length_m / 3.0).abs() < 1e-9);
+            assert!(c.delay >= 0 && b1.delay < 0 && b2.delay < 0);
+        }
+        // Segment 3 ends the link: both branches, a new link drawn for the continuation.
+        let [c, b1, b2] = g.successors(&RuleAttr { age: 2, ..rule }, &road, &mut rng);
+        assert!(c.delay >= 0 && b1.delay >= 0 && b2.delay >= 0);
+        assert!(c.rule.turn.abs() <= 20f64.to_radians());
+        assert!(c.road.angle.abs() < 1e-12, "a new link starts straight on");
+    }
+
+    #[test]
+    fn a_street_goes_through_a_crossing_only_by_its_rule() {
+        let mut streets = std::collections::BTreeMap::new();
+        let rules = crate::StreetRules {
+            cross_through_probability: 1.0,
+            ..crate::StreetRules::default()
+        };
+        streets.insert(Pattern::Basic, rules);
+        let params = RoadParams {
+            streets,
+            ..RoadParams::default()
+        };
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        let rule = RuleAttr::new(RoadClass::Street, 1, 0.0);
+        let mut road = RoadAttr::new(DVec2::ZERO, 0.0, 30.0, RoadClass::Street);
+        road.snapped = true;
+        road.crossed = true;
+        let [c, _, _] = g.successors(&rule, &road, &mut rng);
+        assert!(c.delay >= 0, "goes on through the crossing");
+        // A snap to a junction or a road still ends it.
+        road.crossed = false;
+        let [c, b1, b2] = g.successors(&rule, &road, &mut rng);
+        assert!(c.delay < 0 && b1.delay < 0 && b2.delay < 0);
     }
 }

@@ -22,6 +22,7 @@
 //! | [`LocalConstraints`], [`DefaultConstraints`] | `localConstraints` of p8 |
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
+//! | [`StreetRules`] | per pattern: branching, crossroads or T, culs-de-sac, curved links of several segments, spread of street lengths |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
 //! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
 //! | [`grid_builders`]: [`GridBuilderGrowth`], [`grow_grid_roads`], [`GridRules`], [`GridParams`] | the course report's grid road builders in one cell (rules from JSON; Downtown, Residential) |
@@ -92,6 +93,7 @@ pub mod primary;
 pub mod secondary;
 pub mod smooth;
 pub mod snap;
+pub mod street_rules;
 
 pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 pub use error::{Result, RoadError, RoadsError};
@@ -106,3 +108,4 @@ pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};
 pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};
+pub use street_rules::{BranchChoice, StreetRules};

@@ -58,6 +58,30 @@ pub struct RuleAttr {
     pub depth: u32,
     /// Segments grown by this road since it branched.
     pub age: u32,
+    /// The direction the road started in, radians (highways keep within
+    /// [`RoadParams::highway_max_total_turn_deg`](crate::RoadParams::highway_max_total_turn_deg)
+    /// of it).
+    pub heading: f64,
+    /// The bend of the current street link: heading change per segment, radians
+    /// ([`StreetRules`](crate::StreetRules)).
+    pub turn: f64,
+    /// The length factor of the current street link (1 = the pattern's street length).
+    pub scale: f64,
+}
+
+impl RuleAttr {
+    /// A new road of `class` at branching depth `depth`, starting in direction `heading`
+    /// (radians): age 0, a straight link of factor 1.
+    pub fn new(class: RoadClass, depth: u32, heading: f64) -> Self {
+        RuleAttr {
+            class,
+            depth,
+            age: 0,
+            heading,
+            turn: 0.0,
+            scale: 1.0,
+        }
+    }
 }
 
 /// Road attributes (`roadAttr`): one proposed or accepted segment.
@@ -79,6 +103,10 @@ pub struct RoadAttr {
     /// Set by the local constraints: the segment was connected to an existing road or
     /// junction (a crossing); the road stops growing (§3.3.1).
     pub snapped: bool,
+    /// Set by the local constraints with `snapped`: the connection is a crossing of an
+    /// existing road (not a junction or a road reached by extension), so a street may go
+    /// on through it ([`StreetRules::cross_through_probability`](crate::StreetRules::cross_through_probability)).
+    pub crossed: bool,
 }
 
 impl RoadAttr {
@@ -92,6 +120,7 @@ impl RoadAttr {
             end: start + crate::network::dir(angle) * length,
             bridge: false,
             snapped: false,
+            crossed: false,
         }
     }
 }
@@ -338,11 +367,7 @@ mod tests {
     #[test]
     fn productions_p1_to_p9() {
         let rules = road_rules(Arc::new(Stub)).unwrap();
-        let rule = RuleAttr {
-            class: crate::RoadClass::Street,
-            depth: 0,
-            age: 0,
-        };
+        let rule = RuleAttr::new(crate::RoadClass::Street, 0, 0.0);
         let road = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, crate::RoadClass::Street);
         let axiom = vec![
             RoadModule::R { del: 0, rule },
@@ -380,11 +405,7 @@ mod tests {
             }
         }
         let rules = road_rules(Arc::new(Stub)).unwrap();
-        let rule = RuleAttr {
-            class: crate::RoadClass::Street,
-            depth: 0,
-            age: 0,
-        };
+        let rule = RuleAttr::new(crate::RoadClass::Street, 0, 0.0);
         let road = RoadAttr::new(DVec2::ZERO, 0.0, 10.0, crate::RoadClass::Street);
         let axiom = vec![
             RoadModule::R { del: 0, rule },

@@ -1,9 +1,12 @@
 //! [`RoadParams`]: every knob of the generator, with units and defaults.
 
+use std::collections::BTreeMap;
+
 use polis_geom::{Aabb2, DVec2};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, RoadError};
+use crate::street_rules::StreetRules;
 
 /// The road patterns of Parish & Müller (§3.2.2, Table 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -65,6 +68,17 @@ pub struct RoadParams {
     pub street_branch_probability: f64,
     /// Random deviation of Basic streets from straight, ± degrees. Default: 5°.
     pub street_deviation_deg: f64,
+    /// The street rules of each pattern (branching, crossroads or T, culs-de-sac, curved
+    /// links, length spread; see [`StreetRules`]); in JSON an object keyed by pattern
+    /// name. A pattern without an entry branches on each side independently with
+    /// [`Self::street_branch_probability`] ([`StreetRules::per_side`]), one segment per
+    /// link. Default: empty.
+    pub streets: BTreeMap<Pattern, StreetRules>,
+    /// A highway turns at most this far, in total, from the direction it started in
+    /// (degrees), so highways run from population centre to population centre and on to
+    /// the map edge instead of coiling around a peak; 180° sets no bound (the highways of
+    /// Kelly's Citygen mode may loop to close primary cells). Default: 180°.
+    pub highway_max_total_turn_deg: f64,
     /// Delay, in derivation steps, before a branch grows. Default: 1.
     pub branch_delay: i32,
     /// Extra delay of streets branching from highways (the slides' blue segments), so
@@ -136,6 +150,8 @@ impl Default for RoadParams {
             highway_branch_probability: 0.06,
             street_branch_probability: 0.9,
             street_deviation_deg: 5.0,
+            streets: BTreeMap::new(),
+            highway_max_total_turn_deg: 180.0,
             branch_delay: 1,
             highway_street_delay: 5,
             population_threshold: 0.1,
@@ -175,6 +191,15 @@ fn check(name: &'static str, ok: bool, value: f64, want: &str) -> Result<()> {
 }
 
 impl RoadParams {
+    /// The street rules of `pattern`: its entry in [`Self::streets`], else independent
+    /// branching on each side with [`Self::street_branch_probability`].
+    pub fn street_rules(&self, pattern: Pattern) -> StreetRules {
+        self.streets
+            .get(&pattern)
+            .copied()
+            .unwrap_or_else(|| StreetRules::per_side(self.street_branch_probability))
+    }
+
     /// The map as a box.
     pub fn bounds(&self) -> Aabb2 {
         Aabb2::new(
@@ -251,6 +276,14 @@ impl RoadParams {
             )
         };
         deg("highway_max_turn_deg", self.highway_max_turn_deg, 180.0)?;
+        deg(
+            "highway_max_total_turn_deg",
+            self.highway_max_total_turn_deg,
+            180.0,
+        )?;
+        for rules in self.streets.values() {
+            rules.validate()?;
+        }
         deg("max_rotate_deg", self.max_rotate_deg, 180.0)?;
         deg("min_angle_deg", self.min_angle_deg, 89.0)?;
         check(

@@ -1,0 +1,133 @@
+//! Every Parish & Müller preset lands in its real city's bands (issue 19): φ ± 0.10,
+//! `k̄` ± 0.20, dead-end share ± 0.05, four-way share ± 0.08, median segment ± 25 %,
+//! circuity ± 0.02, wherever Boeing 2019's table has the value.
+//!
+//! Street metrics depend on the road network alone, so each check runs the maps and the
+//! road stage at the preset's own size (`polis::road_statistics`: no lots or buildings,
+//! well under a second per city in a debug build) and measures the network with
+//! polis-stats' realism comparison, as `City::statistics` does.
+//!
+//! Seeds 1–5 are checked. The presets were tuned on seeds 1–3 and checked on 4–5. The
+//! misses that remain are listed in [`KNOWN_MISSES`] and the test demands exactly them:
+//! a new miss fails it, and so does a listed miss that has gone (update the list and
+//! BENCHMARKS.md then). `default` seed 2 is a city that dies out: its start lies in a
+//! small populated pocket and the street growth goes extinct after 115 segments, so
+//! its street metrics are those of a hamlet.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use polis::{CityConfig, road_statistics};
+
+/// The banded rows out of band, as "metric = value (real)".
+fn misses(preset: &str, seed: u64) -> Vec<String> {
+    let mut config = CityConfig::preset(preset).unwrap();
+    config.seed = seed;
+    assert!(config.imitates.is_some(), "{preset} names its city");
+    let report = road_statistics(&config).unwrap();
+    let realism = report.realism.unwrap();
+    // At least φ and the four-way share (all Manhattan's row has) get a verdict.
+    assert!(realism.in_band >= 2, "{preset}: {realism:?}");
+    realism
+        .rows
+        .iter()
+        .filter(|r| r.in_band == Some(false))
+        .map(|r| {
+            format!(
+                "{} = {:.3} (real {:.3})",
+                r.metric,
+                r.polis,
+                r.real.unwrap_or(f64::NAN)
+            )
+        })
+        .collect()
+}
+
+/// (preset, seed, metric) out of band today; everything else must be in band.
+const KNOWN_MISSES: &[(&str, u64, &str)] = &[
+    ("default", 2, "phi"),
+    ("default", 2, "k_avg"),
+    ("default", 2, "P_deadend"),
+    ("default", 2, "P_4way"),
+    ("default", 3, "phi"),
+];
+
+fn check(preset: &str) {
+    let mut unexpected = Vec::new();
+    let mut gone = Vec::new();
+    for seed in 1..=5 {
+        let got = misses(preset, seed);
+        for m in &got {
+            let known = KNOWN_MISSES.iter().any(|&(p, s, metric)| {
+                p == preset && s == seed && m.starts_with(&format!("{metric} ="))
+            });
+            if !known {
+                unexpected.push(format!("seed {seed}: {m}"));
+            }
+        }
+        for &(p, s, metric) in KNOWN_MISSES {
+            if p == preset
+                && s == seed
+                && !got.iter().any(|m| m.starts_with(&format!("{metric} =")))
+            {
+                gone.push(format!("seed {seed}: {metric} is in band now"));
+            }
+        }
+    }
+    assert!(
+        unexpected.is_empty(),
+        "{preset} out of band: {unexpected:#?}"
+    );
+    assert!(gone.is_empty(), "{preset}: update KNOWN_MISSES: {gone:#?}");
+}
+
+#[test]
+fn default_is_in_the_us_canada_band() {
+    check("default");
+}
+
+#[test]
+fn manhattan_is_in_manhattans_band() {
+    check("manhattan");
+}
+
+#[test]
+fn paris_is_in_paris_band() {
+    check("paris");
+}
+
+#[test]
+fn san_francisco_is_in_san_franciscos_band() {
+    check("san_francisco");
+}
+
+#[test]
+fn old_town_is_in_romes_band() {
+    check("old_town");
+}
+
+/// `road_statistics` measures the same streets as the whole city's statistics: every
+/// realism row agrees (a small `paris` and `san_francisco`, whose maps are salted per
+/// seed, so a mismatch in the maps would show).
+#[test]
+fn road_statistics_agree_with_the_whole_city() {
+    for name in ["paris", "san_francisco"] {
+        let mut c = CityConfig::preset(name).unwrap();
+        c.size_m = 1200.0;
+        c.roads.max_segments = 300;
+        c.facades.enabled = false;
+        c.seed = 4;
+        let fast = road_statistics(&c).unwrap();
+        let city = polis::Pipeline::default()
+            .with_scene(false)
+            .generate(&c)
+            .unwrap();
+        let full = city.statistics().unwrap();
+        assert!(fast.streets.streets > 0, "{name}");
+        assert_eq!(fast.streets.segments, city.roads.edge_count(), "{name}");
+        assert_eq!(
+            fast.realism.unwrap().rows,
+            full.realism.unwrap().rows,
+            "{name}"
+        );
+    }
+}
