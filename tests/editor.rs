@@ -319,7 +319,8 @@ fn bad_edits_are_typed_errors_and_change_nothing() {
     let before = glb(ed.city());
     let config = ed.config().clone();
     let lot = ed.city().lots[0].id;
-    let cases: Vec<(Edit, fn(&Error) -> bool)> = vec![
+    type Expect = fn(&Error) -> bool;
+    let cases: Vec<(Edit, Expect)> = vec![
         (
             Edit::MoveNode {
                 node: 999_999,
