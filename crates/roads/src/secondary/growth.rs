@@ -329,9 +329,15 @@ impl SecondaryGrowth {
                 .max(1.0) as u32;
             let step = std::f64::consts::TAU / degree as f64;
             run.decided.clear();
-            for i in 0..degree {
-                let turned = rotate(dir, step * i as f64);
+            // Direction i is `dir` turned by i steps: one rotation applied i times.
+            let (sin, cos) = step.sin_cos();
+            let mut turned = dir;
+            for _ in 0..degree {
                 let new_dir = run.deviate(turned, step);
+                turned = DVec2::new(
+                    turned.x * cos - turned.y * sin,
+                    turned.x * sin + turned.y * cos,
+                );
                 if let Some(placed) = run.place_segment(source, new_dir)? {
                     queue.push_back((placed.node, new_dir));
                 }
@@ -579,19 +585,22 @@ impl Run<'_> {
 
     /// Whether the straight road `a–t` meets nothing but its root's roads at `a` and its
     /// target (the node, or the road it ends on) at `t`.
+    ///
+    /// The target lies in the last snap query's extended box, so every road that can meet
+    /// `a–t` is among that query's candidates.
     fn clear(&self, source: NodeId, a: DVec2, t: DVec2, target: &Target) -> bool {
-        use polis_geom::predicates::SegmentIntersection as X;
-        for hit in self.g.edges_crossing(a, t) {
-            let Ok((u, v)) = self.g.endpoints(hit.key) else {
+        use polis_geom::predicates::{SegmentIntersection as X, segment_intersection};
+        for &key in self.snapper.candidates() {
+            let (Ok((u, v)), Ok((pu, pv))) = (self.g.endpoints(key), self.g.segment(key)) else {
                 return false;
             };
             let at_end = |p: DVec2| p == a || p == t;
-            let ok = match (hit.kind, target) {
+            let ok = match (segment_intersection(a, t, pu, pv), target) {
                 (X::Overlap { .. }, _) | (X::Crossing { .. }, Target::Free(_)) => false,
                 (X::Crossing { .. }, Target::Node(_)) => false,
-                (X::Crossing { .. }, Target::OnEdge(e, _)) => hit.key == *e,
+                (X::Crossing { .. }, Target::OnEdge(e, _)) => key == *e,
                 (X::Touching { point, .. }, Target::OnEdge(e, _)) => {
-                    hit.key == *e || ((u == source || v == source) && point == a)
+                    key == *e || ((u == source || v == source) && point == a)
                 }
                 (X::Touching { point, .. }, Target::Node(n)) => {
                     (u == *n || v == *n || u == source || v == source) && at_end(point)

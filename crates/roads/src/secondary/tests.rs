@@ -173,10 +173,10 @@ fn presets_keep_their_character_on_the_fixed_cells() {
         );
     }
     // Bands measured on these cells and seeds (seeds 0..6 give the same picture):
-    // Manhattan 0.978 of junctions 4-way or on the boundary and no dead ends, Raster
-    // 0.987; Suburbia 0.369 dead ends (Charlotte, its real city, 0.288 on the whole
-    // simplified network), 0.225 4-way-or-boundary; Industrial in between on both:
-    // 0.353 dead ends, 0.268 4-way-or-boundary.
+    // Manhattan 0.983 of junctions 4-way or on the boundary and no dead ends, Raster
+    // 0.988; Suburbia 0.406 dead ends (Charlotte, its real city, 0.288 on the whole
+    // simplified network), 0.204 4-way-or-boundary; Industrial in between on both:
+    // 0.371 dead ends, 0.262 4-way-or-boundary.
     assert!(m.four_way_or_boundary_share() >= 0.90, "{m:?}");
     assert!(m.dead_end_share() <= 0.05, "{m:?}");
     assert!(r.four_way_or_boundary_share() >= 0.90, "{r:?}");
