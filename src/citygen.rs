@@ -427,8 +427,14 @@ pub(crate) fn citygen_network_with(
 ) -> Result<(CitygenNetwork, Option<polis_roads::GrowthReport>)> {
     let cg = &cx.config.citygen;
     cg.validate()?;
-    let (primary, growth, kelly_roads) = primary_network(cx)?;
-    let decomposition = polis_cells::extract_with(&primary, &cx.config.cells)?;
+    let (mut primary, growth, kelly_roads) = primary_network(cx)?;
+    let mut decomposition = polis_cells::extract_with(&primary, &cx.config.cells)?;
+    // P&M highways on a small map may enclose nothing: the map's edge then closes them
+    // (as it bounds the rings source), so the city has cells.
+    if decomposition.cells.is_empty() && cg.primary == PrimarySource::Highways {
+        close_with_map_edge(&mut primary, cx.config.size_m)?;
+        decomposition = polis_cells::extract_with(&primary, &cx.config.cells)?;
+    }
     // Maps: water and parks through lazily cached lattices, as the P&M stage reads them.
     let params = cx.config.effective_road_params();
     let spacing = polis_roads::procedural_lattice_m(&params);
@@ -878,6 +884,28 @@ pub fn kelly_network_of(
         polis_roads::primary::RoadSpec::default(),
     )
     .map_err(|e| Error::Roads(e.into()))
+}
+
+/// Adds the edge of the map's square (side `size_m`, centred on the origin) to `net` as
+/// highways, split where roads meet it.
+fn close_with_map_edge(net: &mut RoadNetwork, size_m: f64) -> Result<()> {
+    let h = size_m * 0.5;
+    let c = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, y)| DVec2::new(x, y));
+    let road = Road {
+        class: RoadClass::Highway,
+        width: 16.0,
+        bridge: false,
+        step: 0,
+    };
+    for i in 0..4 {
+        let (a, b) = (c[i], c[(i + 1) % 4]);
+        match net.insert_segment_with(a, b, road, &SnapOptions::default(), |_| Junction::default())
+        {
+            Ok(_) | Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {}
+            Err(e) => return Err(e.into()),
+        }
+    }
+    Ok(())
 }
 
 /// The highway edges of `net` and their junctions (same positions, new ids).

@@ -129,9 +129,13 @@ pub struct SecondaryParams {
     /// Carriageway width of the secondary roads, metres (*Road Width*). Must be > 0.
     /// Default: 9 (Manhattan).
     pub road_width_m: Deviated,
-    /// Probability that a proposal meeting an existing road or junction is joined to it
-    /// (*Connectivity*); otherwise it is dropped. Drawn values are clamped to `[0, 1]`.
-    /// Value in `[0, 1]`. Default: 1.
+    /// Probability that the growth from a node joins an existing road or junction it
+    /// meets (*Connectivity*); otherwise the proposal is dropped and the road stops short
+    /// of it (a node left with no other branch is a cul-de-sac). Drawn once per expanded
+    /// node and road or junction met, not once per direction: with degree 18 a node
+    /// aims several directions at the same neighbour, and separate draws would multiply
+    /// its chance to connect. Drawn values are clamped to `[0, 1]`. Value in `[0, 1]`.
+    /// Default: 1.
     pub connectivity: Deviated,
     /// Lot width, metres (*Lot Size* and *Lot Deviance*), for the lot stage. Must be > 0.
     /// Default: 14 ± 40 %.

@@ -22,6 +22,13 @@
 //!
 //! Events on the root's own roads (a node adjacent to `a`, a road at `a`) are reported
 //! as [`SnapEvent::Blocked`]: joining them would duplicate or fold onto an existing road.
+//! Before step 1, **test 0** (ours, not Kelly's) looks at the root's own roads only: a
+//! proposal with one of them in its snap area (the road's other end by test 1's rule, or
+//! `b` within the snap size of the road) is `Blocked` at once. With degree 18 most
+//! directions of a suburban node are such folds; answering them without the index
+//! search roughly halves the growth's time. It differs from the full search only when a
+//! non-adjacent node or road lies in the snap area nearer to the root than the fold,
+//! which the full search would have joined instead.
 
 use polis_geom::predicates::{Orientation, closest_point_on_segment, orient2d};
 use polis_geom::spatial::{Shape, SpatialIndex};
@@ -57,6 +64,7 @@ struct NodeScalars {
 #[derive(Debug, Default, Clone)]
 pub struct Snapper {
     stamp: Vec<u32>,
+    seen: Vec<u32>,
     scalars: Vec<NodeScalars>,
     query: u32,
     found: Vec<(NodeId, DVec2)>,
@@ -65,17 +73,21 @@ pub struct Snapper {
     pub exact_tests: u64,
     /// Roads that passed the extended bounding box.
     pub box_hits: u64,
+    /// Queries answered by test 0 (the proposal folds onto a road at its root).
+    pub folded: u64,
 }
 
 impl Snapper {
     fn begin(&mut self, nodes: usize) {
         if self.stamp.len() < nodes {
             self.stamp.resize(nodes, 0);
+            self.seen.resize(nodes, 0);
             self.scalars.resize(nodes, NodeScalars::default());
         }
         self.query = self.query.wrapping_add(1);
         if self.query == 0 {
             self.stamp.fill(0);
+            self.seen.fill(0);
             self.query = 1;
         }
     }
@@ -95,6 +107,12 @@ impl Snapper {
         sc
     }
 
+    /// The roads the last query gathered (those whose boxes meet its extended box), in
+    /// id order; empty after a query answered by test 0.
+    pub fn candidates(&self) -> &[EdgeId] {
+        &self.roads
+    }
+
     /// The highest-priority snap event of the proposal from node `root` (at `a`) to `b`
     /// with snap size `radius` (metres, ≥ 0).
     pub fn snap(
@@ -112,6 +130,11 @@ impl Snapper {
         }
         let len = len2.sqrt();
         let radius = radius.max(0.0);
+        if folds_onto_root(g, root, a, b, radius) {
+            self.folded += 1;
+            self.roads.clear();
+            return SnapEvent::Blocked;
+        }
         self.begin(g.node_bound());
         let ext = Aabb2::new(a, b).expanded(radius);
         // Extended bounding box exclusion: the roads whose boxes meet the extended box.
@@ -126,8 +149,8 @@ impl Snapper {
                 roads.push(e);
             }
         });
-        roads.sort_unstable();
-        roads.dedup();
+        // The index reports each road once, in an order fixed by the graph's state; every
+        // choice below breaks ties by id, so the order does not matter.
         self.box_hits += roads.len() as u64;
         // Test 1: node proximity.
         let mut best: Option<(f64, NodeId)> = None;
@@ -137,6 +160,14 @@ impl Snapper {
         for &e in &roads {
             if let Ok((u, v)) = g.endpoints(e) {
                 for n in [u, v] {
+                    // Each node once: `seen` is stamped with the query number.
+                    let Some(mark) = self.seen.get_mut(n.index()) else {
+                        continue;
+                    };
+                    if *mark == self.query {
+                        continue;
+                    }
+                    *mark = self.query;
                     if let Ok(p) = g.position(n)
                         && ext.contains(p)
                     {
@@ -145,8 +176,6 @@ impl Snapper {
                 }
             }
         }
-        found.sort_unstable_by_key(|&(n, _)| n);
-        found.dedup_by_key(|&mut (n, _)| n);
         for &(n, p) in &found {
             let sc = self.scalars(n, p, a, b);
             let r = sc.r;
@@ -157,7 +186,7 @@ impl Snapper {
             let hit = if r <= 1.0 {
                 sc.s.abs() * len <= radius
             } else {
-                p.distance(b) <= radius
+                p.distance_squared(b) <= radius * radius
             };
             if hit {
                 best_r = r;
@@ -211,9 +240,9 @@ impl Snapper {
         let cross = cross.map(|(r, e, p)| {
             let end = g.endpoints(e).ok().and_then(|(u, v)| {
                 let (pu, pv) = (g.position(u).ok()?, g.position(v).ok()?);
-                let (du, dv) = (pu.distance(p), pv.distance(p));
+                let (du, dv) = (pu.distance_squared(p), pv.distance_squared(p));
                 let (n, dn) = if (du, u) <= (dv, v) { (u, du) } else { (v, dv) };
-                (dn <= radius).then_some(n)
+                (dn <= radius * radius).then_some(n)
             });
             (r, e, p, end)
         });
@@ -243,17 +272,22 @@ impl Snapper {
             (None, Some((_, e, p, end))) => return cross_event(e, p, end),
             (None, None) => {}
         }
-        // Test 3: proximity of b to a road.
+        // Test 3: proximity of b to a road. Every road within the snap size of `b` meets
+        // the extended box, so the roads gathered for tests 1 and 2 are the candidates.
         let around = Aabb2::new(b, b).expanded(radius);
+        let r2 = radius * radius;
         let mut near: Option<(f64, EdgeId, DVec2)> = None;
-        g.edge_index().for_each_candidate(&around, |e, shape| {
-            let Shape::Segment(u, v) = *shape else { return };
+        for &e in &self.roads {
+            let Ok((u, v)) = g.segment(e) else { continue };
+            if !Aabb2::new(u, v).intersects(&around) {
+                continue;
+            }
             let (c, _) = closest_point_on_segment(b, u, v);
-            let dist = c.distance(b);
-            if dist <= radius && near.is_none_or(|(bd, be, _)| (dist, e) < (bd, be)) {
+            let dist = c.distance_squared(b);
+            if dist <= r2 && near.is_none_or(|(bd, be, _)| (dist, e) < (bd, be)) {
                 near = Some((dist, e, c));
             }
-        });
+        }
         let Some((_, e, c)) = near else {
             return SnapEvent::None;
         };
@@ -275,6 +309,32 @@ impl Snapper {
         }
         SnapEvent::Road(e, c)
     }
+}
+
+/// Test 0: whether the proposal `a–b` from `root` runs within `radius` of one of the
+/// root's own roads: that road's other end is in the snap area (test 1's condition), or
+/// `b` is within `radius` of the road (test 3's). Such a proposal can only fold onto the
+/// road it starts beside, so it is answered before the index is searched.
+fn folds_onto_root(g: &RoadNetwork, root: NodeId, a: DVec2, b: DVec2, radius: f64) -> bool {
+    let Ok(edges) = g.edges_at(root) else {
+        return false;
+    };
+    let d = b - a;
+    let len2 = d.length_squared();
+    let len = len2.sqrt();
+    edges.iter().any(|&e| {
+        let Ok(p) = g.other_end(e, root).and_then(|n| g.position(n)) else {
+            return false;
+        };
+        let ap = p - a;
+        let r = ap.dot(d) / len2;
+        let node = if r > 0.0 && r <= 1.0 {
+            (d.perp_dot(ap) / len2).abs() * len <= radius
+        } else {
+            r > 1.0 && p.distance_squared(b) <= radius * radius
+        };
+        node || closest_point_on_segment(b, a, p).0.distance_squared(b) <= radius * radius
+    })
 }
 
 /// Kelly's `r` and `s` of `p` against `a–b`, with the exact side of `p`.

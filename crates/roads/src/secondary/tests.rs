@@ -172,19 +172,26 @@ fn presets_keep_their_character_on_the_fixed_cells() {
             st.streets
         );
     }
-    // Bands measured on these cells and seeds (see the report in the commit): Manhattan
-    // 0.977 of junctions 4-way or on the boundary, no dead ends; Raster 0.984; Suburbia
-    // 0.145 dead ends, Industrial 0.347. Kelly's Suburbia values give fewer dead ends
-    // than real suburbs (19-29 %): with degree 18 and connectivity 0.05, about one in
-    // three frontier nodes still joins a neighbour instead of ending.
+    // Bands measured on these cells and seeds (seeds 0..6 give the same picture):
+    // Manhattan 0.983 of junctions 4-way or on the boundary and no dead ends, Raster
+    // 0.988; Suburbia 0.406 dead ends (Charlotte, its real city, 0.288 on the whole
+    // simplified network), 0.204 4-way-or-boundary; Industrial in between on both:
+    // 0.371 dead ends, 0.262 4-way-or-boundary.
     assert!(m.four_way_or_boundary_share() >= 0.90, "{m:?}");
     assert!(m.dead_end_share() <= 0.05, "{m:?}");
     assert!(r.four_way_or_boundary_share() >= 0.90, "{r:?}");
     assert!(r.dead_end_share() <= 0.05, "{r:?}");
-    assert!(s.dead_end_share() >= 0.12, "{s:?}");
-    assert!(s.four_way_or_boundary_share() <= 0.5, "{s:?}");
-    assert!(i.dead_end_share() >= 0.25, "{i:?}");
-    assert!(i.four_way_or_boundary_share() <= 0.4, "{i:?}");
+    assert!(s.dead_end_share() >= 0.30, "{s:?}");
+    assert!(s.four_way_or_boundary_share() <= 0.30, "{s:?}");
+    assert!(
+        i.dead_end_share() > m.dead_end_share() + 0.2 && i.dead_end_share() < s.dead_end_share(),
+        "{i:?}"
+    );
+    assert!(
+        i.four_way_or_boundary_share() > s.four_way_or_boundary_share()
+            && i.four_way_or_boundary_share() < m.four_way_or_boundary_share() - 0.3,
+        "{i:?}"
+    );
     assert!(
         o.dead_end_share() <= 0.05 && o.four_way_or_boundary_share() < 0.8,
         "{o:?}"
