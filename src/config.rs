@@ -286,9 +286,13 @@ pub struct SceneConfig {
     pub kerb_height_m: f64,
     /// Road surfaces as meshes draped on the elevation. Default: true.
     pub road_surfaces: bool,
-    /// Node structure of the glb: per building, or batched per cell and material.
-    /// Default: batched (few draw calls, as Citygen).
+    /// Node structure of the glb: tiles of merged geometry per layer and material, per
+    /// cell, or per building. Default: tiled (few draw calls; see
+    /// [`Batching`] for when to use which).
     pub batching: Batching,
+    /// Side of the glb's square tiles with [`Batching::Tiled`], metres (see
+    /// `polis_export::glb::GlbOptions::tile_size_m`). Default: 250.
+    pub tile_size_m: f64,
     /// Water bodies of the water map as flat surfaces at the level of their lowest
     /// shore point, in a node `water` of their own (false leaves them out). Default: true.
     pub water_surfaces: bool,
@@ -327,6 +331,7 @@ impl Default for SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
             batching: Batching::default(),
+            tile_size_m: 250.0,
             water_surfaces: true,
             foundations: [Foundation::Highest; 6],
         }

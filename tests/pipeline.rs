@@ -206,6 +206,17 @@ fn check_glb_hygiene(name: &str, city: &City, doc: &polis::export::gltf::Gltf) {
             }));
         }
     }
+    // Tiled (the default): the records of the city node's feature table.
+    for n in doc.nodes() {
+        if let Some(table) = extras(n.extras()).and_then(|v| v["features"].as_array().cloned()) {
+            glb_kinds.extend(
+                table
+                    .iter()
+                    .filter(|r| r["layer"] == "buildings")
+                    .filter_map(|r| r["kind"].as_str().map(str::to_string)),
+            );
+        }
+    }
     map_kinds.sort();
     map_kinds.dedup();
     glb_kinds.sort();
