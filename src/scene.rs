@@ -573,7 +573,44 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         .collect();
     let (block_parents, building_parents) = parents.split_at(blocks.len().min(parents.len()));
     insert_leaves(&mut scene, &mut blocks, block_parents)?;
+    let first_building = scene.nodes.len();
     insert_leaves(&mut scene, &mut buildings, building_parents)?;
+    let building_count = scene.nodes.len() - first_building;
+
+    // Coarse level of detail: each building's footprint extruded to its height, a child
+    // `lod 0` of the building node, whose own meshes become the finest level.
+    let fine = inp.config.effective_lod();
+    if inp.config.scene.coarse_lod && fine > 0 {
+        let boxes: Vec<Option<Mesh>> = inp
+            .buildings
+            .par_iter()
+            .take(building_count)
+            .map(|b| {
+                let mode = inp
+                    .config
+                    .scene
+                    .foundations
+                    .get(b.kind.index())
+                    .copied()
+                    .unwrap_or_default();
+                let seat = seat(elevation, b.footprint.points(), mode);
+                let local = b.footprint.translated(-b.origin);
+                let wall = pal.walls[b.kind.index().min(5)];
+                polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()
+            })
+            .collect();
+        for (k, made) in boxes.into_iter().enumerate() {
+            // A footprint that cannot be extruded keeps its one level, drawn at every
+            // distance.
+            let Some(mesh) = made else { continue };
+            let node = NodeId((first_building + k) as u32);
+            scene.set_metadata(node, "lod", fine as f64)?;
+            let child = scene.add_node(node, "lod 0")?;
+            scene.set_metadata(child, "lod", 0.0)?;
+            let mesh = scene.add_mesh(mesh);
+            scene.attach_mesh(child, mesh)?;
+        }
+    }
     Ok(scene)
 }
 

@@ -211,7 +211,7 @@ proptest! {
     fn random_scenes_export_and_read_back(scene in scene()) {
         prop_assume!(scene.validate().is_ok());
         let drawn: usize = drawn_triangles(&scene).values().sum();
-        for batching in [Batching::PerNode, Batching::PerParentAndMaterial] {
+        for batching in [Batching::PerNode, Batching::PerParentAndMaterial, Batching::Tiled] {
             let mut a = Vec::new();
             let report = write_glb(&scene, &GlbOptions::with_batching(batching), &mut a).unwrap();
             let d = decode_glb(&a);
