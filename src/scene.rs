@@ -207,6 +207,16 @@ fn lower_bottom(
     }
 }
 
+/// How buildings of `kind` are seated (the configuration's foundation mode).
+fn foundation(config: &CityConfig, kind: BuildingKind) -> Foundation {
+    config
+        .scene
+        .foundations
+        .get(kind.index())
+        .copied()
+        .unwrap_or_default()
+}
+
 /// Lowest ground under a ring of layout points.
 fn ground(elevation: &dyn Field, pts: &[DVec2]) -> f64 {
     let e = pts
@@ -410,13 +420,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
-                let mode = inp
-                    .config
-                    .scene
-                    .foundations
-                    .get(b.kind.index())
-                    .copied()
-                    .unwrap_or_default();
+                let mode = foundation(inp.config, b.kind);
                 let seat = seat(elevation, b.footprint.points(), mode);
                 let meshes = building_meshes(
                     b,
@@ -586,14 +590,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .take(building_count)
             .map(|b| {
-                let mode = inp
-                    .config
-                    .scene
-                    .foundations
-                    .get(b.kind.index())
-                    .copied()
-                    .unwrap_or_default();
-                let seat = seat(elevation, b.footprint.points(), mode);
+                let seat = seat(
+                    elevation,
+                    b.footprint.points(),
+                    foundation(inp.config, b.kind),
+                );
                 let local = b.footprint.translated(-b.origin);
                 let wall = pal.walls[b.kind.index().min(5)];
                 polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()

@@ -464,6 +464,10 @@ fn web_profile_decodes_to_the_plain_geometry() {
             .find(|n| n["mesh"] == k)
             .unwrap();
         let (scale, offset) = (f32s(&node["scale"], 1.0), f32s(&node["translation"], 0.0));
+        assert!(
+            scale[0] == scale[1] && scale[1] == scale[2],
+            "uniform: normals keep direction"
+        );
         for (pp, wp) in pm["primitives"]
             .as_array()
             .unwrap()

@@ -1,7 +1,8 @@
 //! The web profile: `KHR_mesh_quantization` + `EXT_meshopt_compression`.
 //!
 //! Per glTF mesh, positions are quantized to unsigned 16-bit integers on a grid spanning
-//! the mesh's bounds (step: the extent / 65,535 per axis; 4 mm over a 250 m tile) and the
+//! the mesh's bounds (one step for all axes: the largest extent / 65,535, 4 mm over a
+//! 250 m tile, so the dequantising scale is uniform and normals keep their directions) and the
 //! nodes drawing it dequantize with their transform (scale and offset composed into
 //! their TRS, or a child node `mesh` when they have children of their own). Normals and
 //! tangents become signed normalized bytes (1/127 steps); texture coordinates stay `f32`;
@@ -48,12 +49,19 @@ struct Grid {
 }
 
 impl Grid {
+    /// One step on all three axes (the largest extent / 65,535): a uniform scale in
+    /// the node transform leaves the normals' directions alone, where a per-axis scale
+    /// would bend them through the normal matrix.
     fn spanning(lo: Vec3, hi: Vec3) -> Grid {
-        let extent = hi - lo;
-        let step = |e: f32| if e > 0.0 { e / GRID_MAX } else { 1.0 };
+        let extent = (hi - lo).max_element();
+        let step = if extent > 0.0 && extent.is_finite() {
+            extent / GRID_MAX
+        } else {
+            1.0
+        };
         Grid {
             offset: lo,
-            scale: Vec3::new(step(extent.x), step(extent.y), step(extent.z)),
+            scale: Vec3::splat(step),
         }
     }
 
