@@ -5,7 +5,7 @@
 //!     [--size METRES] [--lod N] [--segments N] [--threads N] [--out DIR]
 //!     [--population PNG] [--water PNG] [--parks PNG] [--elevation PNG METRES]
 //!     [--zoning PNG] [--max-height PNG METRES] [--report]
-//!     [--formats glb,obj,svg,geojson] [--anchor LON,LAT]
+//!     [--formats glb,obj,svg,geojson] [--anchor LON,LAT] [--glb-profile plain|web]
 //! cargo run --release --example city -- --help
 //! ```
 //!
@@ -103,6 +103,10 @@ struct Cli {
     /// longitude/latitude (RFC 7946) instead of local metres.
     #[arg(long, value_name = "LON,LAT", allow_hyphen_values = true, value_parser = lon_lat)]
     anchor: Option<[f64; 2]>,
+    /// The glb's profile: plain (core glTF 2.0, every engine) or web (quantized and
+    /// meshopt-compressed, for three.js and glTFast).
+    #[arg(long, value_name = "PROFILE", default_value = "plain")]
+    glb_profile: polis::export::glb::GlbProfile,
 }
 
 /// `LON,LAT` in degrees, inside WGS 84 bounds.
@@ -233,6 +237,7 @@ fn configure(cli: Cli) -> Result<Args, clap::Error> {
         write: WriteOptions {
             formats: cli.formats,
             anchor_lon_lat: cli.anchor,
+            glb_profile: cli.glb_profile,
         },
     })
 }

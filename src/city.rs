@@ -221,13 +221,30 @@ impl City {
         Ok(map)
     }
 
-    /// Writes the scene as glb (batching from the configuration).
+    /// Writes the scene as glb (layout and tile size from the configuration, the plain
+    /// profile).
     ///
     /// # Errors
     /// Export and I/O errors.
     pub fn write_glb<W: Write>(&self, out: W) -> Result<glb::GlbReport> {
+        self.write_glb_with(out, glb::GlbProfile::Plain)
+    }
+
+    /// [`write_glb`](Self::write_glb) with a profile ([`glb::GlbProfile::Web`]:
+    /// quantized and meshopt-compressed).
+    ///
+    /// # Errors
+    /// Export and I/O errors.
+    pub fn write_glb_with<W: Write>(
+        &self,
+        out: W,
+        profile: glb::GlbProfile,
+    ) -> Result<glb::GlbReport> {
         let options = glb::GlbOptions {
             batching: self.config.scene.batching,
+            tile_size_m: self.config.scene.tile_size_m,
+            profile,
+            ..glb::GlbOptions::default()
         };
         Ok(glb::write_glb(&self.scene, &options, out)?)
     }
@@ -291,7 +308,9 @@ impl City {
             if !formats.glb {
                 return Ok(Vec::new());
             }
-            let path = write_file(dir.join("city.glb"), |w| self.write_glb(w).map(|_| ()))?;
+            let path = write_file(dir.join("city.glb"), |w| {
+                self.write_glb_with(w, options.glb_profile).map(|_| ())
+            })?;
             Ok(vec![path])
         };
         let obj = || -> Result<Vec<PathBuf>> {

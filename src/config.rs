@@ -286,9 +286,20 @@ pub struct SceneConfig {
     pub kerb_height_m: f64,
     /// Road surfaces as meshes draped on the elevation. Default: true.
     pub road_surfaces: bool,
-    /// Node structure of the glb: per building, or batched per cell and material.
-    /// Default: batched (few draw calls, as Citygen).
+    /// Node structure of the glb: tiles of merged geometry per layer and material, per
+    /// cell, or per building. Default: tiled (few draw calls; see
+    /// [`Batching`] for when to use which).
     pub batching: Batching,
+    /// Side of the glb's square tiles with [`Batching::Tiled`], metres (see
+    /// `polis_export::glb::GlbOptions::tile_size_m`). Default: 250.
+    pub tile_size_m: f64,
+    /// Adds a coarse level of detail to every building: its footprint extruded to its
+    /// height (one mesh in its wall colour), a child node `lod 0` of the building node,
+    /// whose own meshes are then tagged as level `lod` (the generator's level). The glb's
+    /// tiled layout writes the levels as separate nodes per tile with their switch
+    /// distances; the per-cell and per-building layouts, the OBJ and the scene itself
+    /// hold both levels, overlapping. Ignored at `lod` 0. Default: false.
+    pub coarse_lod: bool,
     /// Water bodies of the water map as flat surfaces at the level of their lowest
     /// shore point, in a node `water` of their own (false leaves them out). Default: true.
     pub water_surfaces: bool,
@@ -327,6 +338,8 @@ impl Default for SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
             batching: Batching::default(),
+            tile_size_m: 250.0,
+            coarse_lod: false,
             water_surfaces: true,
             foundations: [Foundation::Highest; 6],
         }
@@ -501,6 +514,12 @@ impl CityConfig {
             return Err(Error::config(
                 "scene.kerb_height_m",
                 "give a kerb height in [0, 5] m",
+            ));
+        }
+        if !(self.scene.tile_size_m.is_finite() && self.scene.tile_size_m > 0.0) {
+            return Err(Error::config(
+                "scene.tile_size_m",
+                "give the glb's tile side as a finite length above 0 m",
             ));
         }
         self.effective_road_params().validate()?;

@@ -4,6 +4,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+use polis_export::glb::GlbProfile;
 use serde::{Deserialize, Serialize};
 
 /// The output formats to write. `"glb,obj,svg,geojson"` parses into all four
@@ -97,6 +98,9 @@ pub struct WriteOptions {
     /// `polis_export::geojson::projection` for its error), without it local metres.
     /// Default: none.
     pub anchor_lon_lat: Option<[f64; 2]>,
+    /// Extensions the glb may use: plain glTF 2.0, or the web profile (quantized,
+    /// meshopt-compressed). Default: [`GlbProfile::Plain`].
+    pub glb_profile: GlbProfile,
 }
 
 impl From<Formats> for WriteOptions {
@@ -104,6 +108,7 @@ impl From<Formats> for WriteOptions {
         WriteOptions {
             formats,
             anchor_lon_lat: None,
+            glb_profile: GlbProfile::Plain,
         }
     }
 }

@@ -1,10 +1,15 @@
 //! Assembling the 3-D [`Scene`] of a city: block plinths, road surfaces, buildings with
 //! their facade skins, and the shared facade textures as materials.
 //!
-//! The node tree is `city → roads`, `city → cell <id> → block <id> | building <id>`;
-//! building nodes carry `kind`, `height`, `floors` and `lot` metadata, block nodes
-//! `cell`. With [`Batching::PerParentAndMaterial`](polis_export::glb::Batching) the glb
-//! writer merges each cell's leaves into one primitive per material.
+//! The node tree is `city → roads | water`, `city → cell <id> → block <id> | building
+//! <id>`; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
+//! `buildings`); building nodes carry `id` (text, exact) and `id_number`, `kind`,
+//! `type`, `height`, `floors`, `lot`, `lot_id`, `cell` and `style` (when dressed), block
+//! nodes `id` and `cell`. The glb writer's default
+//! [`Batching::Tiled`](polis_export::glb::Batching) lays these out as `city → layer →
+//! tile`, one primitive per material, with each building's and block's record in the
+//! city node's feature table; [`Batching::PerParentAndMaterial`](polis_export::glb::Batching)
+//! merges each cell's leaves instead.
 
 use polis_buildings::{Building, BuildingKind, FacadeFace, PartRole};
 use polis_export::map::{MapRoad, RoadClass as MapClass};
@@ -200,6 +205,16 @@ fn lower_bottom(
             uv.y = -p.y;
         }
     }
+}
+
+/// How buildings of `kind` are seated (the configuration's foundation mode).
+fn foundation(config: &CityConfig, kind: BuildingKind) -> Foundation {
+    config
+        .scene
+        .foundations
+        .get(kind.index())
+        .copied()
+        .unwrap_or_default()
 }
 
 /// Lowest ground under a ring of layout points.
@@ -405,13 +420,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
-                let mode = inp
-                    .config
-                    .scene
-                    .foundations
-                    .get(b.kind.index())
-                    .copied()
-                    .unwrap_or_default();
+                let mode = foundation(inp.config, b.kind);
                 let seat = seat(elevation, b.footprint.points(), mode);
                 let meshes = building_meshes(
                     b,
@@ -420,16 +429,32 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     Some((&seat, mode, elevation)),
                 )?;
                 let base = seat.base;
+                let dress = inp.dresses.get(i).and_then(Option::as_ref);
+                let style = dress
+                    .and_then(|d| inp.tile_sets.get(d.style))
+                    .map_or("", |t| t.style.as_str());
+                let mut metadata = Metadata::from([
+                    ("layer", MetaValue::from_static("buildings")),
+                    // The id as text (exact in JavaScript above 2^53) and as a number.
+                    ("id", MetaValue::from(b.id.to_string().as_str())),
+                    ("id_number", MetaValue::from(b.id as f64)),
+                    ("kind", MetaValue::from_static(kind_class(b.kind))),
+                    ("type", MetaValue::from_static(b.kind.name())),
+                    ("height", MetaValue::from(b.height)),
+                    ("floors", MetaValue::from(f64::from(b.floors))),
+                    ("lot", MetaValue::from(b.lot_id as f64)),
+                    ("lot_id", MetaValue::from(b.lot_id.to_string().as_str())),
+                ]);
+                if !style.is_empty() {
+                    metadata.insert("style", MetaValue::from(style));
+                }
+                if let Some(&cell) = inp.building_cells.get(i) {
+                    metadata.insert("cell", MetaValue::from(cell as f64));
+                }
                 let node = LeafNode {
                     name: format!("building {}", b.id),
                     translation: to_world(b.origin, base),
-                    metadata: Metadata::from([
-                        ("kind", MetaValue::from_static(kind_class(b.kind))),
-                        ("type", MetaValue::from_static(b.kind.name())),
-                        ("height", MetaValue::from(b.height)),
-                        ("floors", MetaValue::from(f64::from(b.floors))),
-                        ("lot", MetaValue::from(b.lot_id as f64)),
-                    ]),
+                    metadata,
                 };
                 Ok((node, meshes))
             })
@@ -467,7 +492,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                 let node = LeafNode {
                     name: format!("block {}", block.id()),
                     translation: DVec3::ZERO,
-                    metadata: Metadata::new(),
+                    metadata: Metadata::from([
+                        ("layer", MetaValue::from_static("blocks")),
+                        ("id", MetaValue::from(block.id().to_string().as_str())),
+                        ("cell", MetaValue::from(block.cell_id as f64)),
+                    ]),
                 };
                 Ok((node, vec![plinth]))
             })
@@ -493,6 +522,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     );
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;
+        scene.set_metadata(node, "layer", MetaValue::from_static("roads"))?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }
@@ -507,6 +537,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             mesh.add_flat_polygon(polygon, *level, Facing::Up)?;
         }
         let node = scene.add_node(root, "water")?;
+        scene.set_metadata(node, "layer", MetaValue::from_static("water"))?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }
@@ -546,7 +577,41 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         .collect();
     let (block_parents, building_parents) = parents.split_at(blocks.len().min(parents.len()));
     insert_leaves(&mut scene, &mut blocks, block_parents)?;
+    let first_building = scene.nodes.len();
     insert_leaves(&mut scene, &mut buildings, building_parents)?;
+    let building_count = scene.nodes.len() - first_building;
+
+    // Coarse level of detail: each building's footprint extruded to its height, a child
+    // `lod 0` of the building node, whose own meshes become the finest level.
+    let fine = inp.config.effective_lod();
+    if inp.config.scene.coarse_lod && fine > 0 {
+        let boxes: Vec<Option<Mesh>> = inp
+            .buildings
+            .par_iter()
+            .take(building_count)
+            .map(|b| {
+                let seat = seat(
+                    elevation,
+                    b.footprint.points(),
+                    foundation(inp.config, b.kind),
+                );
+                let local = b.footprint.translated(-b.origin);
+                let wall = pal.walls[b.kind.index().min(5)];
+                polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()
+            })
+            .collect();
+        for (k, made) in boxes.into_iter().enumerate() {
+            // A footprint that cannot be extruded keeps its one level, drawn at every
+            // distance.
+            let Some(mesh) = made else { continue };
+            let node = NodeId((first_building + k) as u32);
+            scene.set_metadata(node, "lod", fine as f64)?;
+            let child = scene.add_node(node, "lod 0")?;
+            scene.set_metadata(child, "lod", 0.0)?;
+            let mesh = scene.add_mesh(mesh);
+            scene.attach_mesh(child, mesh)?;
+        }
+    }
     Ok(scene)
 }
 

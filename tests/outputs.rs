@@ -131,6 +131,7 @@ fn anchored_geojson_is_wgs84_and_reads_back() {
         let options = WriteOptions {
             formats: only,
             anchor_lon_lat: Some(anchor),
+            ..WriteOptions::default()
         };
         city.write_all_with(&dir, &options).unwrap();
         let (n, geo) = read_geojson(&dir.join("city.geojson"));
@@ -158,6 +159,7 @@ fn anchored_geojson_is_wgs84_and_reads_back() {
     let options = WriteOptions {
         formats: only,
         anchor_lon_lat: Some([180.0, 0.0]),
+        ..WriteOptions::default()
     };
     assert!(city.write_all_with(&dir, &options).is_err());
     std::fs::remove_dir_all(&dir).unwrap();

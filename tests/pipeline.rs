@@ -206,6 +206,17 @@ fn check_glb_hygiene(name: &str, city: &City, doc: &polis::export::gltf::Gltf) {
             }));
         }
     }
+    // Tiled (the default): the records of the city node's feature table.
+    for n in doc.nodes() {
+        if let Some(table) = extras(n.extras()).and_then(|v| v["features"].as_array().cloned()) {
+            glb_kinds.extend(
+                table
+                    .iter()
+                    .filter(|r| r["layer"] == "buildings")
+                    .filter_map(|r| r["kind"].as_str().map(str::to_string)),
+            );
+        }
+    }
     map_kinds.sort();
     map_kinds.dedup();
     glb_kinds.sort();
@@ -456,6 +467,12 @@ fn bad_configurations_are_errors_not_panics() {
     c.roads.street_length_m = -1.0;
     assert!(polis::generate(&c).is_err());
     let mut c = small("default");
+    c.scene.tile_size_m = 0.0;
+    assert!(matches!(
+        polis::generate(&c),
+        Err(polis::Error::Config { .. })
+    ));
+    let mut c = small("default");
     c.maps.water = Some(polis::MapSpec::png(
         "/no/such/file.png",
         polis::geom::Aabb2::new(DVec2::ZERO, DVec2::ONE),
@@ -634,4 +651,50 @@ fn buildings_are_seated_on_slopes() {
         }
         assert_eq!(plinths, city.blocks.len());
     }
+}
+
+/// The city's glb in the default tiled layout: `city → layers → tiles`, every building
+/// a record of the feature table reached by the `_FEATURE_ID_0` of its vertices, and
+/// with `scene.coarse_lod` two LOD nodes per building tile with switch distances; the
+/// web profile is smaller and declares its extensions.
+#[test]
+fn tiled_glb_has_layers_tiles_features_and_lod_levels() {
+    use polis::export::glb::GlbProfile;
+    let mut c = small("default");
+    c.scene.coarse_lod = true;
+    let city = polis::generate(&c).unwrap();
+    let mut plain = Vec::new();
+    let report = city.write_glb(&mut plain).unwrap();
+    let doc = polis::export::gltf::Gltf::from_slice(&plain).unwrap();
+    let root = doc.scenes().next().unwrap().nodes().next().unwrap();
+    let layers: Vec<String> = root
+        .children()
+        .map(|n| n.name().unwrap_or_default().to_string())
+        .collect();
+    for want in ["roads", "blocks", "buildings"] {
+        assert!(layers.iter().any(|l| l == want), "{layers:?}");
+    }
+    let extras: serde_json::Value =
+        serde_json::from_str(root.extras().as_ref().unwrap().get()).unwrap();
+    let table = extras["features"].as_array().unwrap();
+    let buildings = table.iter().filter(|r| r["layer"] == "buildings").count();
+    assert_eq!(buildings, city.buildings.len());
+    for r in table.iter().filter(|r| r["layer"] == "buildings") {
+        assert!(r["id"].is_string() && r["id_number"].is_number() && r["kind"].is_string());
+        assert!(r["height"].is_number() && r["floors"].is_number() && r["lot"].is_number());
+    }
+    // Two levels per building tile, the finest first.
+    let lod_nodes: Vec<serde_json::Value> = doc
+        .nodes()
+        .filter_map(|n| serde_json::from_str::<serde_json::Value>(n.extras().as_ref()?.get()).ok())
+        .filter(|e| e.get("lod").is_some())
+        .collect();
+    assert!(!lod_nodes.is_empty());
+    assert!(lod_nodes.iter().any(|e| e["lod_range_m"][1].is_null()));
+    assert_eq!(report.features, table.len());
+    // Draw calls stay within 4 × materials × tiles (both levels counted).
+    assert!(report.draw_calls <= 4 * report.materials * report.tiles);
+    let mut web = Vec::new();
+    city.write_glb_with(&mut web, GlbProfile::Web).unwrap();
+    assert!(web.len() < plain.len());
 }

@@ -261,14 +261,12 @@ fn main() -> Result<(), Box<dyn Error>> {
 
     let per_node = write_glb(
         &scene,
-        &GlbOptions::default(),
+        &GlbOptions::with_batching(Batching::PerNode),
         File::create("out/demo.glb")?,
     )?;
     let batched = write_glb(
         &scene,
-        &GlbOptions {
-            batching: Batching::PerParentAndMaterial,
-        },
+        &GlbOptions::with_batching(Batching::PerParentAndMaterial),
         File::create("out/demo_batched.glb")?,
     )?;
     let obj = write_obj(

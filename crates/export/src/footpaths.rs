@@ -433,9 +433,7 @@ mod tests {
             scene.attach_mesh(node, id).unwrap();
         }
         let mut glb = Vec::new();
-        let per_node = crate::glb::GlbOptions {
-            batching: crate::glb::Batching::PerNode,
-        };
+        let per_node = crate::glb::GlbOptions::with_batching(crate::glb::Batching::PerNode);
         crate::glb::write_glb(&scene, &per_node, &mut glb).unwrap();
         let doc = crate::testing::decode_glb(&glb);
         assert_eq!((doc.meshes, doc.materials), (2, 2));

@@ -4,7 +4,7 @@
 //!
 //! | writer | input | output |
 //! |---|---|---|
-//! | [`glb::write_glb`] | [`Scene`](geom::Scene) | glTF 2.0 binary: one buffer, PBR materials, embedded PNG textures, the node tree with metadata in `extras`; one node per object or batched per (parent, material) |
+//! | [`glb::write_glb`] | [`Scene`](geom::Scene) | glTF 2.0 binary: one buffer, PBR materials, embedded PNG textures; merged per layer, tile and material with per-vertex feature ids (default), per (parent, material), or one node per object; optional web profile (quantized, meshopt-compressed) |
 //! | [`obj::write_obj`] | [`Scene`](geom::Scene) | Wavefront OBJ (one group per object, world space, triangles) + MTL + texture PNGs through a [`FileSink`](sink::FileSink) |
 //! | [`svg::write_svg`] | [`MapLayers`](map::MapLayers) | SVG plan: water, parks, blocks, lots, roads by class and width, footprints by kind; north up |
 //! | [`geojson::write_geojson`] | [`MapLayers`](map::MapLayers) | RFC 7946 FeatureCollection in a documented local metric coordinate system |
@@ -33,9 +33,9 @@
 //! let mut glb_bytes = Vec::new();
 //! glb::write_glb(&scene, &glb::GlbOptions::default(), &mut glb_bytes)?;
 //! let doc = gltf::Gltf::from_slice(&glb_bytes)?;
-//! // Batched by default: the house's mesh is merged into the city node, one primitive
-//! // per material.
-//! assert_eq!(doc.nodes().count(), 1);
+//! // Tiled by default: city → layer `house 1` → one tile, one primitive per material;
+//! // the house's record is in the city node's feature table.
+//! assert_eq!(doc.nodes().count(), 3);
 //!
 //! let (mut obj_bytes, mut side_files) = (Vec::new(), MemorySink::new());
 //! obj::write_obj(&scene, &obj::ObjOptions::default(), &mut obj_bytes, &mut side_files)?;

@@ -211,9 +211,9 @@ proptest! {
     fn random_scenes_export_and_read_back(scene in scene()) {
         prop_assume!(scene.validate().is_ok());
         let drawn: usize = drawn_triangles(&scene).values().sum();
-        for batching in [Batching::PerNode, Batching::PerParentAndMaterial] {
+        for batching in [Batching::PerNode, Batching::PerParentAndMaterial, Batching::Tiled] {
             let mut a = Vec::new();
-            let report = write_glb(&scene, &GlbOptions { batching }, &mut a).unwrap();
+            let report = write_glb(&scene, &GlbOptions::with_batching(batching), &mut a).unwrap();
             let d = decode_glb(&a);
             prop_assert_eq!(d.nodes, report.nodes);
             prop_assert_eq!(d.meshes, report.meshes);
@@ -235,7 +235,7 @@ proptest! {
                 prop_assert_eq!(stored, drawn);
             }
             let mut b = Vec::new();
-            write_glb(&scene, &GlbOptions { batching }, &mut b).unwrap();
+            write_glb(&scene, &GlbOptions::with_batching(batching), &mut b).unwrap();
             prop_assert_eq!(a, b);
         }
         let mut obj = Vec::new();

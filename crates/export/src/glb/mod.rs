@@ -27,14 +27,37 @@
 //!   matrix is decomposed when it is a TRS, else written as `matrix`) and the node metadata
 //!   as a JSON object in `extras`; one glTF scene holding the roots.
 //!
-//! ## Batching
+//! ## Layouts ([`Batching`])
 //!
-//! [`Batching::PerNode`] keeps one glTF node per scene node (picking, editing); a scene
-//! mesh is stored once however many nodes draw it. [`Batching::PerParentAndMaterial`]
-//! merges every leaf node that draws geometry into its parent, one primitive per
-//! material (few draw calls, as Citygen batched per cell); the leaves' names, metadata
-//! and triangle ranges are kept in the merged mesh's `extras.objects`
-//! (`[{"name", "metadata", "ranges": [[primitive, first triangle, triangle count], …]}]`).
+//! [`Batching::Tiled`] (the default) merges geometry per scene root, layer, square tile
+//! ([`GlbOptions::tile_size_m`]) and LOD level, one primitive per material: the node tree
+//! is `root → layer (roads, blocks, buildings, water, ground, …) → "<layer> i,j" tile →
+//! ("… lod k" level)`, so draw calls are about materials × tiles and a game can hide,
+//! stream or collide each layer tile by tile. Layers, LOD levels and feature records
+//! come from node metadata (`layer`, `lod`, anything else): see `tiles` for the rules.
+//! Every merged vertex of an object carries `_FEATURE_ID_0` (an application attribute in
+//! the style of `EXT_mesh_features`: `u16` with a stride of 4, or `f32` past 65,535
+//! records), the index of its record in the root node's `extras.features` table
+//! (`name`, `layer` and the node's metadata: a polis building's `id` as text and number,
+//! `kind`, `height`, `floors`, `lot`, `style`, …). Vertex attributes survive optimisers
+//! that reorder, merge or re-index triangles, where triangle ranges do not. LOD nodes
+//! carry `extras.lod` and `extras.lod_range_m = [near, far]` (`far` null: to infinity),
+//! the camera distances between which an engine should draw them.
+//!
+//! [`Batching::PerNode`] keeps one glTF node per scene node (picking, editing); meshes
+//! with identical bytes are stored once however many nodes draw them.
+//! [`Batching::PerParentAndMaterial`] merges every leaf node that draws geometry into its
+//! parent, one primitive per material (one mesh per cell, as Citygen batched); the
+//! leaves' names, metadata and triangle ranges are kept in the merged mesh's
+//! `extras.objects` (`[{"name", "metadata", "ranges": [[primitive, first triangle,
+//! triangle count], …]}]`).
+//!
+//! ## Profiles ([`GlbProfile`])
+//!
+//! [`GlbProfile::Plain`] (the default) is core glTF 2.0 without extensions.
+//! [`GlbProfile::Web`] quantizes (`KHR_mesh_quantization`) and compresses
+//! (`EXT_meshopt_compression`) the vertex and index arrays; see `web` for the grids and
+//! why both extensions are then required.
 //!
 //! ## Guarantees
 //!
@@ -42,7 +65,8 @@
 //!   scene is never written.
 //! * Streaming: the binary chunk is written straight from the scene's meshes through a
 //!   small buffer, never assembled in memory (batched geometry, PNG encodings and the
-//!   tangents of one geometry at a time are the only copies).
+//!   tangents of one geometry at a time are the only copies; the web profile holds its
+//!   compressed streams).
 //! * Byte-identical output for identical scenes and options.
 //! * The container is exactly what [`gltf::binary::Glb::to_writer`] writes for the same
 //!   chunks (tested byte for byte). It is written here rather than by `Glb::to_writer`
@@ -57,43 +81,29 @@
 //!   Khronos validator reports as not decomposable. Scenes built with
 //!   [`Transform::Trs`] never hit this.
 
+mod layout;
+mod options;
 mod plan;
 mod tangents;
+mod tiles;
+#[cfg(feature = "web")]
+mod web;
 
-use std::borrow::Cow;
+pub use options::{Batching, GlbOptions, GlbProfile};
+
 use std::collections::BTreeMap;
 use std::io::Write;
 
 use gltf::json;
 use gltf::json::validation::{Checked, USize64};
-use polis_geom::Mesh;
 use polis_geom::glam::{DMat4, Vec3};
-use polis_geom::scene::{Filter, Material, Scene, Transform, Wrap};
-use serde::{Deserialize, Serialize};
+use polis_geom::scene::{Filter, Scene, Transform, Wrap};
+use serde::Serialize;
 
 use crate::ExportError;
 use crate::images::png_bytes;
+use layout::{Chunked, Layout, Slot, pad4, write_geometry};
 use plan::Plan;
-
-/// How scene nodes become glTF nodes and meshes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-pub enum Batching {
-    /// One glTF node per scene node, each with its own metadata (picking, editing).
-    PerNode,
-    /// Leaf nodes merged into their parent, one primitive per material (few draw calls).
-    /// The default, here and in `polis::SceneConfig`.
-    #[default]
-    PerParentAndMaterial,
-}
-
-/// Options of [`write_glb`].
-#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct GlbOptions {
-    /// Node structure: one node per object, or batched per parent and material.
-    /// Default: [`Batching::PerParentAndMaterial`].
-    pub batching: Batching,
-}
 
 /// What [`write_glb`] wrote.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -118,6 +128,15 @@ pub struct GlbReport {
     pub unused_meshes: usize,
     /// Bytes written.
     pub bytes: u64,
+    /// Draw calls of the whole file: the primitives of every node's mesh, summed over
+    /// nodes (every LOD level counted; an engine draws one level per tile at a time).
+    pub draw_calls: usize,
+    /// Records in the feature tables ([`Batching::Tiled`]).
+    pub features: usize,
+    /// Tile nodes ([`Batching::Tiled`]).
+    pub tiles: usize,
+    /// Stored geometries drawn by two or more nodes (shared, not copied).
+    pub shared_geometries: usize,
 }
 
 /// Writes `scene` as a glTF 2.0 binary file to `out`.
@@ -144,10 +163,12 @@ pub fn write_glb<W: Write>(
     options: &GlbOptions,
     mut out: W,
 ) -> Result<GlbReport, ExportError> {
+    options.validate()?;
     scene.validate()?;
     let plan = match options.batching {
         Batching::PerNode => plan::per_node(scene),
         Batching::PerParentAndMaterial => plan::batched(scene)?,
+        Batching::Tiled => tiles::tiled(scene, options)?,
     };
     let used = Used::new(scene, &plan);
     let pngs = used
@@ -155,9 +176,22 @@ pub fn write_glb<W: Write>(
         .iter()
         .map(|&i| png_bytes(i, &scene.images[i]))
         .collect::<Result<Vec<_>, _>>()?;
-    let layout = Layout::new(scene, &plan.geometries, &pngs);
+    let layout = match options.profile {
+        GlbProfile::Plain => layout::plain(scene, &plan, &pngs)?,
+        #[cfg(feature = "web")]
+        GlbProfile::Web => web::layout(scene, &plan, &pngs)?,
+        #[cfg(not(feature = "web"))]
+        GlbProfile::Web => layout::plain(scene, &plan, &pngs)?,
+    };
     let root = document(scene, &plan, &layout, &used)?;
-    let json_bytes = json::serialize::to_vec(&root).map_err(ExportError::json("glTF JSON"))?;
+    let json_bytes = if layout.fallback_len.is_some() {
+        let mut doc = serde_json::to_value(&root).map_err(ExportError::json("glTF JSON"))?;
+        #[cfg(feature = "web")]
+        web::add_extensions(&mut doc, &layout);
+        serde_json::to_vec(&doc).map_err(ExportError::json("glTF JSON"))?
+    } else {
+        json::serialize::to_vec(&root).map_err(ExportError::json("glTF JSON"))?
+    };
 
     let json_len = pad4(json_bytes.len() as u64);
     let mut total = 12 + 8 + json_len;
@@ -186,8 +220,15 @@ pub fn write_glb<W: Write>(
         if layout.bin_len > 0 {
             w.put(&(layout.bin_len as u32).to_le_bytes())?;
             w.put(b"BIN\0")?;
-            for (g, gl) in plan.geometries.iter().zip(&layout.geometries) {
-                write_geometry(&mut w, g, gl)?;
+            if layout.fallback_len.is_some() {
+                for s in &layout.streams {
+                    w.put(s)?;
+                    w.pad4()?;
+                }
+            } else {
+                for (g, gl) in plan.geometries.iter().zip(&layout.geometries) {
+                    write_geometry(&mut w, g, gl)?;
+                }
             }
             for png in &pngs {
                 w.put(png)?;
@@ -199,11 +240,29 @@ pub fn write_glb<W: Write>(
         out.flush()
     })();
     result.map_err(io)?;
+    let mut drawers = vec![0usize; plan.geometries.len()];
+    let mut draw_calls = 0;
+    for n in &plan.nodes {
+        if let Some(m) = n.mesh.and_then(|m| plan.meshes.get(m)) {
+            draw_calls += m.primitives.len();
+            for &(g, _) in &m.primitives {
+                drawers[g] += 1;
+            }
+        }
+    }
     Ok(GlbReport {
-        nodes: plan.nodes.len(),
+        nodes: plan.nodes.len() + layout.extra_nodes(&plan),
         meshes: plan.meshes.len(),
         primitives: plan.meshes.iter().map(|m| m.primitives.len()).sum(),
-        triangles: plan.geometries.iter().map(|g| g.triangle_count()).sum(),
+        triangles: plan
+            .geometries
+            .iter()
+            .map(|g| g.mesh.triangle_count())
+            .sum(),
+        draw_calls,
+        features: plan.features,
+        tiles: plan.tiles,
+        shared_geometries: drawers.iter().filter(|&&d| d >= 2).count(),
         materials: used.materials.len(),
         textures: used.textures.len(),
         images: used.images.len(),
@@ -211,10 +270,6 @@ pub fn write_glb<W: Write>(
         unused_meshes: plan.unused_meshes,
         bytes: total,
     })
-}
-
-fn pad4(n: u64) -> u64 {
-    n.div_ceil(4) * 4
 }
 
 /// The materials, textures and images the written primitives use (scene indices in
@@ -300,93 +355,6 @@ impl Used {
     }
 }
 
-/// Whether a geometry drawn with `material` writes `TEXCOORD_0`.
-fn writes_uvs(scene: &Scene, material: Option<polis_geom::scene::MaterialId>) -> bool {
-    material
-        .and_then(|m| scene.materials.get(m.index()))
-        .is_some_and(Material::uses_texture_coordinates)
-}
-
-/// Where one geometry's four arrays lie in the binary chunk.
-#[derive(Debug)]
-struct GeometryLayout {
-    vertices: usize,
-    indices: usize,
-    wide: bool,
-    min: Vec3,
-    max: Vec3,
-    /// Whether tangents are written (the material has a normal texture).
-    tangents: bool,
-    /// Whether texture coordinates are written (the material uses them).
-    uvs: bool,
-    /// Byte offsets of positions, normals, uvs, indices, tangents.
-    offsets: [u64; 5],
-    /// Byte lengths of the same.
-    lengths: [u64; 5],
-}
-
-#[derive(Debug)]
-struct Layout {
-    geometries: Vec<GeometryLayout>,
-    /// (offset, length) of each image.
-    images: Vec<(u64, u64)>,
-    bin_len: u64,
-}
-
-/// The largest vertex count whose indices fit `u16` (65,535 is reserved for primitive
-/// restart and must not appear).
-const U16_VERTEX_LIMIT: usize = 65_535;
-
-impl Layout {
-    fn new(scene: &Scene, geometries: &[Cow<'_, Mesh>], pngs: &[Cow<'_, [u8]>]) -> Layout {
-        let mut off = 0u64;
-        let mut out = Vec::with_capacity(geometries.len());
-        for g in geometries {
-            let n = g.vertex_count();
-            let wide = n > U16_VERTEX_LIMIT;
-            let tangents = g
-                .material
-                .and_then(|m| scene.materials.get(m.index()))
-                .is_some_and(|m| m.normal_texture.is_some());
-            let uvs = writes_uvs(scene, g.material);
-            let lengths = [
-                12 * n as u64,
-                12 * n as u64,
-                if uvs { 8 * n as u64 } else { 0 },
-                g.indices.len() as u64 * if wide { 4 } else { 2 },
-                if tangents { 16 * n as u64 } else { 0 },
-            ];
-            let mut offsets = [0; 5];
-            for (o, len) in offsets.iter_mut().zip(lengths) {
-                *o = off;
-                off = pad4(off + len);
-            }
-            let b = g.bbox();
-            out.push(GeometryLayout {
-                vertices: n,
-                indices: g.indices.len(),
-                wide,
-                tangents,
-                uvs,
-                min: b.min,
-                max: b.max,
-                offsets,
-                lengths,
-            });
-        }
-        let mut images = Vec::with_capacity(pngs.len());
-        for p in pngs {
-            images.push((off, p.len() as u64));
-            off = pad4(off + p.len() as u64);
-        }
-        Layout {
-            geometries: out,
-            images,
-            bin_len: off,
-        }
-    }
-}
-
 /// The glTF JSON document for a plan and its layout.
 fn document(
     scene: &Scene,
@@ -410,86 +378,82 @@ fn document(
             extras: None,
         });
     }
-    let view =
-        |root: &mut json::Root, offset: u64, length: u64, target: Option<json::buffer::Target>| {
-            root.push(json::buffer::View {
-                buffer: json::Index::new(0),
-                byte_length: USize64(length),
-                byte_offset: Some(USize64(offset)),
-                byte_stride: None,
-                name: None,
-                target: target.map(Checked::Valid),
+    // Web profile: the vertex and index views lie in a second buffer without data (the
+    // fallback of EXT_meshopt_compression); their compressed streams are in buffer 0.
+    let geometry_buffer = match layout.fallback_len {
+        Some(len) => {
+            root.buffers.push(json::Buffer {
+                byte_length: USize64(len.max(4)),
+                name: Some("meshopt fallback".to_string()),
+                uri: None,
                 extensions: None,
                 extras: None,
-            })
-        };
-    // Three to five accessors per geometry, in order: position, normal, uv (when the
-    // material uses it), indices, tangents (for normal-mapped materials).
-    let mut accessors = Vec::with_capacity(layout.geometries.len());
+            });
+            json::Index::new(root.buffers.len() as u32 - 1)
+        }
+        None => json::Index::new(0),
+    };
+    let view = |root: &mut json::Root,
+                buffer: json::Index<json::Buffer>,
+                offset: u64,
+                length: u64,
+                stride: Option<usize>,
+                target: Option<json::buffer::Target>| {
+        root.push(json::buffer::View {
+            buffer,
+            byte_length: USize64(length),
+            byte_offset: Some(USize64(offset)),
+            byte_stride: stride.map(json::buffer::Stride),
+            name: None,
+            target: target.map(Checked::Valid),
+            extensions: None,
+            extras: None,
+        })
+    };
+    // One accessor per array, in layout order: position, normal, uv (when the material
+    // uses it), indices, tangents (normal-mapped materials), feature ids (tiled).
+    let mut accessors: Vec<Vec<(Slot, json::Index<json::Accessor>)>> =
+        Vec::with_capacity(layout.geometries.len());
     for gl in &layout.geometries {
-        let arrays = if gl.tangents { 5 } else { 4 };
-        let mut ids = [json::Index::new(0); 5];
-        for (k, id) in ids.iter_mut().enumerate().take(arrays) {
-            if k == 2 && !gl.uvs {
-                continue;
-            }
-            let target = if k == 3 {
-                json::buffer::Target::ElementArrayBuffer
+        let mut ids = Vec::with_capacity(gl.arrays.len());
+        for a in &gl.arrays {
+            let stride = if a.slot == Slot::Index {
+                None
             } else {
-                json::buffer::Target::ArrayBuffer
+                a.stride
             };
-            let v = view(&mut root, gl.offsets[k], gl.lengths[k], Some(target));
-            let (count, ty, component) = match k {
-                0 | 1 => (
-                    gl.vertices,
-                    json::accessor::Type::Vec3,
-                    json::accessor::ComponentType::F32,
+            let v = view(
+                &mut root,
+                geometry_buffer,
+                a.offset,
+                a.length,
+                stride,
+                Some(a.target()),
+            );
+            let (min, max) = match a.bounds {
+                Some((lo, hi)) => (
+                    Some(json::Value::from(lo.to_vec())),
+                    Some(json::Value::from(hi.to_vec())),
                 ),
-                2 => (
-                    gl.vertices,
-                    json::accessor::Type::Vec2,
-                    json::accessor::ComponentType::F32,
-                ),
-                4 => (
-                    gl.vertices,
-                    json::accessor::Type::Vec4,
-                    json::accessor::ComponentType::F32,
-                ),
-                _ if gl.wide => (
-                    gl.indices,
-                    json::accessor::Type::Scalar,
-                    json::accessor::ComponentType::U32,
-                ),
-                _ => (
-                    gl.indices,
-                    json::accessor::Type::Scalar,
-                    json::accessor::ComponentType::U16,
-                ),
+                None => (None, None),
             };
-            let (min, max) = if k == 0 {
-                (
-                    Some(json::Value::from(gl.min.to_array().to_vec())),
-                    Some(json::Value::from(gl.max.to_array().to_vec())),
-                )
-            } else {
-                (None, None)
-            };
-            *id = root.push(json::Accessor {
+            let id = root.push(json::Accessor {
                 buffer_view: Some(v),
                 byte_offset: None,
-                count: USize64(count as u64),
-                component_type: Checked::Valid(json::accessor::GenericComponentType(component)),
+                count: USize64(a.count as u64),
+                component_type: Checked::Valid(json::accessor::GenericComponentType(a.component)),
                 extensions: None,
                 extras: None,
-                type_: Checked::Valid(ty),
+                type_: Checked::Valid(a.ty),
                 min,
                 max,
                 name: None,
-                normalized: false,
+                normalized: a.normalized,
                 sparse: None,
             });
+            ids.push((a.slot, id));
         }
-        accessors.push((ids, gl.tangents, gl.uvs));
+        accessors.push(ids);
     }
     for (i, (img, &(offset, length))) in used
         .images
@@ -498,7 +462,7 @@ fn document(
         .zip(&layout.images)
         .enumerate()
     {
-        let v = view(&mut root, offset, length, None);
+        let v = view(&mut root, json::Index::new(0), offset, length, None, None);
         root.push(json::Image {
             buffer_view: Some(v),
             mime_type: Some(json::image::MimeType("image/png".to_string())),
@@ -598,27 +562,39 @@ fn document(
             ..json::Material::default()
         });
     }
-    for m in &plan.meshes {
+    for (mi, m) in plan.meshes.iter().enumerate() {
         let primitives = m
             .primitives
             .iter()
-            .map(|&(g, material)| {
-                let ([pos, nrm, uv, idx, tan], has_tangents, has_uvs) = accessors[g];
-                let mut attributes = BTreeMap::from([
-                    (Checked::Valid(json::mesh::Semantic::Positions), pos),
-                    (Checked::Valid(json::mesh::Semantic::Normals), nrm),
-                ]);
-                if has_uvs {
-                    attributes.insert(Checked::Valid(json::mesh::Semantic::TexCoords(0)), uv);
-                }
-                if has_tangents {
-                    attributes.insert(Checked::Valid(json::mesh::Semantic::Tangents), tan);
+            .enumerate()
+            .map(|(k, &(g, material))| {
+                let g = layout
+                    .primitive_geometry
+                    .get(mi)
+                    .and_then(|p| p.get(k))
+                    .copied()
+                    .unwrap_or(g);
+                let mut attributes = BTreeMap::new();
+                let mut indices = None;
+                for &(slot, id) in accessors.get(g).map(Vec::as_slice).unwrap_or_default() {
+                    let semantic = match slot {
+                        Slot::Position => json::mesh::Semantic::Positions,
+                        Slot::Normal => json::mesh::Semantic::Normals,
+                        Slot::Uv => json::mesh::Semantic::TexCoords(0),
+                        Slot::Tangent => json::mesh::Semantic::Tangents,
+                        Slot::Feature => json::mesh::Semantic::Extras("FEATURE_ID_0".to_string()),
+                        Slot::Index => {
+                            indices = Some(id);
+                            continue;
+                        }
+                    };
+                    attributes.insert(Checked::Valid(semantic), id);
                 }
                 json::mesh::Primitive {
                     attributes,
                     extensions: None,
                     extras: None,
-                    indices: Some(idx),
+                    indices,
                     material: material.map(|m| {
                         json::Index::new(
                             used.material_index
@@ -645,22 +621,72 @@ fn document(
             weights: None,
         });
     }
+    // Nodes whose quantized mesh needs a dequantising transform they cannot take (they
+    // have children) get a child node holding the mesh, appended after the plan's nodes.
+    let mut holders: Vec<json::Node> = Vec::new();
+    let first_holder = plan.nodes.len() as u32;
     for pn in &plan.nodes {
-        let node = &scene.nodes[pn.source.index()];
+        let source = pn.source.and_then(|s| scene.nodes.get(s.index()));
+        let mut extras = match source {
+            Some(node) if !node.metadata.is_empty() => {
+                match serde_json::to_value(&node.metadata).map_err(ExportError::json("extras"))? {
+                    serde_json::Value::Object(m) => m,
+                    _ => serde_json::Map::new(),
+                }
+            }
+            _ => serde_json::Map::new(),
+        };
+        if let Some(more) = &pn.extras {
+            for (k, v) in more {
+                extras.insert(k.clone(), v.clone());
+            }
+        }
+        let name = match source {
+            Some(node) => named(&node.name),
+            None => named(&pn.name),
+        };
+        let mut children: Vec<json::Index<json::Node>> =
+            pn.children.iter().map(|&c| json::Index::new(c)).collect();
+        let mut mesh = pn.mesh.map(|m| json::Index::new(m as u32));
+        let dequantize = pn
+            .mesh
+            .and_then(|m| layout.dequantize.get(m).copied().flatten());
         let mut out = json::Node {
-            children: (!pn.children.is_empty())
-                .then(|| pn.children.iter().map(|&c| json::Index::new(c)).collect()),
-            extras: if node.metadata.is_empty() {
+            extras: if extras.is_empty() {
                 None
             } else {
-                Some(raw(&node.metadata)?)
+                Some(raw(&extras)?)
             },
-            mesh: pn.mesh.map(|m| json::Index::new(m as u32)),
-            name: named(&node.name),
+            name,
             ..json::Node::default()
         };
-        set_transform(&mut out, &node.transform);
+        let transform = source.map_or(Transform::IDENTITY, |n| n.transform);
+        match dequantize {
+            Some((offset, scale)) if children.is_empty() => {
+                set_transform(&mut out, &compose_dequantize(&transform, offset, scale));
+            }
+            Some((offset, scale)) => {
+                set_transform(&mut out, &transform);
+                let mut holder = json::Node {
+                    mesh: mesh.take(),
+                    name: Some("mesh".to_string()),
+                    ..json::Node::default()
+                };
+                set_transform(
+                    &mut holder,
+                    &compose_dequantize(&Transform::IDENTITY, offset, scale),
+                );
+                children.push(json::Index::new(first_holder + holders.len() as u32));
+                holders.push(holder);
+            }
+            None => set_transform(&mut out, &transform),
+        }
+        out.mesh = mesh;
+        out.children = (!children.is_empty()).then_some(children);
         root.push(out);
+    }
+    for h in holders {
+        root.push(h);
     }
     // glTF forbids a scene without nodes: a scene without roots has no glTF scene.
     if !plan.roots.is_empty() {
@@ -709,6 +735,26 @@ fn filter_key(f: Filter) -> u8 {
 /// Relative tolerance under which a matrix counts as a TRS composition.
 const TRS_TOLERANCE: f64 = 1e-9;
 
+/// `t` followed (inside) by the dequantisation `q ↦ offset + scale ⊙ q` of quantized
+/// positions: a TRS stays a TRS (the scale multiplies, the offset moves the translation).
+fn compose_dequantize(t: &Transform, offset: Vec3, scale: Vec3) -> Transform {
+    let (o, s) = (offset.as_dvec3(), scale.as_dvec3());
+    match *t {
+        Transform::Trs {
+            translation,
+            rotation,
+            scale: sc,
+        } => Transform::Trs {
+            translation: translation + rotation * (sc * o),
+            rotation,
+            scale: sc * s,
+        },
+        Transform::Matrix(m) => Transform::Matrix(
+            m * DMat4::from_scale_rotation_translation(s, polis_geom::glam::DQuat::IDENTITY, o),
+        ),
+    }
+}
+
 fn set_transform(node: &mut json::Node, t: &Transform) {
     let (translation, rotation, scale) = match *t {
         Transform::Trs {
@@ -745,112 +791,7 @@ fn set_transform(node: &mut json::Node, t: &Transform) {
     }
 }
 
-/// Buffered little-endian output that counts bytes.
-struct Chunked<'w, W: Write> {
-    out: &'w mut W,
-    buf: Vec<u8>,
-    written: u64,
-}
-
-const CHUNK: usize = 1 << 16;
-
-impl<'w, W: Write> Chunked<'w, W> {
-    fn new(out: &'w mut W) -> Self {
-        Chunked {
-            out,
-            buf: Vec::with_capacity(CHUNK + 64),
-            written: 0,
-        }
-    }
-
-    #[inline]
-    fn put(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        if self.buf.len() + bytes.len() > CHUNK {
-            self.drain()?;
-            if bytes.len() > CHUNK {
-                self.written += bytes.len() as u64;
-                return self.out.write_all(bytes);
-            }
-        }
-        self.buf.extend_from_slice(bytes);
-        self.written += bytes.len() as u64;
-        Ok(())
-    }
-
-    fn pad4(&mut self) -> std::io::Result<()> {
-        while !self.written.is_multiple_of(4) {
-            self.put(&[0])?;
-        }
-        Ok(())
-    }
-
-    fn drain(&mut self) -> std::io::Result<()> {
-        if !self.buf.is_empty() {
-            self.out.write_all(&self.buf)?;
-            self.buf.clear();
-        }
-        Ok(())
-    }
-
-    fn finish(&mut self) -> std::io::Result<()> {
-        self.drain()
-    }
-}
-
-fn write_geometry<W: Write>(
-    w: &mut Chunked<'_, W>,
-    g: &Mesh,
-    gl: &GeometryLayout,
-) -> std::io::Result<()> {
-    // 12 (header) + 8 + json + 8 (bin header) is a multiple of 4, so relative alignment
-    // in the chunk equals absolute alignment in the file; pad after each array.
-    for p in &g.positions {
-        let mut b = [0u8; 12];
-        b[0..4].copy_from_slice(&p.x.to_le_bytes());
-        b[4..8].copy_from_slice(&p.y.to_le_bytes());
-        b[8..12].copy_from_slice(&p.z.to_le_bytes());
-        w.put(&b)?;
-    }
-    w.pad4()?;
-    for n in &g.normals {
-        let n = n.normalize_or_zero();
-        let mut b = [0u8; 12];
-        b[0..4].copy_from_slice(&n.x.to_le_bytes());
-        b[4..8].copy_from_slice(&n.y.to_le_bytes());
-        b[8..12].copy_from_slice(&n.z.to_le_bytes());
-        w.put(&b)?;
-    }
-    w.pad4()?;
-    if gl.uvs {
-        for t in &g.uvs {
-            let mut b = [0u8; 8];
-            b[0..4].copy_from_slice(&t.x.to_le_bytes());
-            b[4..8].copy_from_slice(&t.y.to_le_bytes());
-            w.put(&b)?;
-        }
-        w.pad4()?;
-    }
-    if gl.wide {
-        for &i in &g.indices {
-            w.put(&i.to_le_bytes())?;
-        }
-    } else {
-        for &i in &g.indices {
-            w.put(&(i as u16).to_le_bytes())?;
-        }
-    }
-    w.pad4()?;
-    if gl.tangents {
-        for t in tangents::tangents(g) {
-            let mut b = [0u8; 16];
-            for (k, c) in t.to_array().into_iter().enumerate() {
-                b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-            }
-            w.put(&b)?;
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tiled_tests;

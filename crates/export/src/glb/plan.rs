@@ -1,8 +1,9 @@
 //! Which glTF nodes, meshes and primitives a scene becomes: one node per scene node, or
-//! geometry batched per (parent node, material).
+//! geometry batched per (parent node, material); the tiled layout is in `tiles`.
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::hash::{Hash, Hasher};
 
 use polis_geom::Mesh;
 use polis_geom::scene::{MaterialId, MeshId, Metadata, NodeId, Scene};
@@ -13,8 +14,8 @@ use crate::ExportError;
 /// The glTF document's geometry and node structure, before bytes are laid out.
 #[derive(Debug)]
 pub(crate) struct Plan<'a> {
-    /// Vertex and index data; each becomes four accessors (position, normal, uv, indices).
-    pub geometries: Vec<Cow<'a, Mesh>>,
+    /// Vertex and index data; each becomes one accessor per array.
+    pub geometries: Vec<Geometry<'a>>,
     /// glTF meshes.
     pub meshes: Vec<PlannedMesh<'a>>,
     /// glTF nodes.
@@ -25,6 +26,47 @@ pub(crate) struct Plan<'a> {
     pub skipped_empty_meshes: usize,
     /// Scene meshes that no node draws (left out).
     pub unused_meshes: usize,
+    /// Records in the roots' feature tables (tiled layout).
+    pub features: usize,
+    /// Tile nodes (tiled layout).
+    pub tiles: usize,
+}
+
+impl Plan<'_> {
+    pub fn empty() -> Self {
+        Plan {
+            geometries: Vec::new(),
+            meshes: Vec::new(),
+            nodes: Vec::new(),
+            roots: Vec::new(),
+            skipped_empty_meshes: 0,
+            unused_meshes: 0,
+            features: 0,
+            tiles: 0,
+        }
+    }
+
+    /// Fills the skipped and unused mesh counts from which scene meshes were `used`.
+    pub fn count_meshes(&mut self, scene: &Scene, used: &[bool]) {
+        (self.skipped_empty_meshes, self.unused_meshes) = counts(scene, used);
+    }
+}
+
+/// One geometry: a mesh and, in the tiled layout, the feature index of every vertex.
+#[derive(Debug)]
+pub(crate) struct Geometry<'a> {
+    pub mesh: Cow<'a, Mesh>,
+    /// `_FEATURE_ID_0` per vertex.
+    pub features: Option<Vec<u32>>,
+}
+
+impl<'a> Geometry<'a> {
+    fn plain(mesh: Cow<'a, Mesh>) -> Self {
+        Geometry {
+            mesh,
+            features: None,
+        }
+    }
 }
 
 /// One glTF mesh.
@@ -40,10 +82,41 @@ pub(crate) struct PlannedMesh<'a> {
 /// One glTF node.
 #[derive(Debug)]
 pub(crate) struct PlannedNode {
-    /// The scene node it comes from (name, transform, metadata).
-    pub source: NodeId,
+    /// The scene node it comes from (name, transform, metadata); `None` for a node the
+    /// layout adds (a layer, a tile, a LOD level).
+    pub source: Option<NodeId>,
+    /// The name of an added node.
+    pub name: String,
+    /// Entries added to the extras (after the scene node's metadata).
+    pub extras: Option<serde_json::Map<String, serde_json::Value>>,
     pub mesh: Option<usize>,
     pub children: Vec<u32>,
+}
+
+impl PlannedNode {
+    pub fn from_scene(source: NodeId) -> Self {
+        PlannedNode {
+            source: Some(source),
+            name: String::new(),
+            extras: None,
+            mesh: None,
+            children: Vec::new(),
+        }
+    }
+
+    /// An added node with a name and extras (a JSON object).
+    pub fn synthetic(name: String, extras: serde_json::Value) -> Self {
+        PlannedNode {
+            source: None,
+            name,
+            extras: match extras {
+                serde_json::Value::Object(m) => Some(m),
+                _ => None,
+            },
+            mesh: None,
+            children: Vec::new(),
+        }
+    }
 }
 
 /// A leaf node whose geometry was merged into its parent's mesh (batched mode), recorded in
@@ -76,58 +149,90 @@ fn counts(scene: &Scene, used: &[bool]) -> (usize, usize) {
     (empty, unused)
 }
 
-/// One glTF node per scene node; a scene mesh is stored once however many nodes draw it,
-/// and nodes drawing the same list of meshes share one glTF mesh (instancing).
+/// A hash of everything a mesh writes (geometry bytes and material), to find identical
+/// meshes; equal hashes are confirmed by comparing the meshes.
+fn content_hash(m: &Mesh) -> u64 {
+    let mut h = std::hash::DefaultHasher::new();
+    m.material.hash(&mut h);
+    m.positions.len().hash(&mut h);
+    for p in &m.positions {
+        p.to_array().map(f32::to_bits).hash(&mut h);
+    }
+    for n in &m.normals {
+        n.to_array().map(f32::to_bits).hash(&mut h);
+    }
+    for t in &m.uvs {
+        t.to_array().map(f32::to_bits).hash(&mut h);
+    }
+    m.indices.hash(&mut h);
+    h.finish()
+}
+
+/// One glTF node per scene node. Scene meshes with identical content (the same
+/// vertices, indices and material, e.g. a template placed many times) are stored once
+/// however many nodes draw them, and nodes drawing the same list of meshes share one
+/// glTF mesh.
 pub(crate) fn per_node(scene: &Scene) -> Plan<'_> {
     let mut geometry_of: Vec<Option<usize>> = vec![None; scene.meshes.len()];
-    let mut geometries: Vec<Cow<'_, Mesh>> = Vec::new();
-    let mut mesh_of: BTreeMap<Vec<MeshId>, usize> = BTreeMap::new();
+    let mut by_content: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
+    let mut geometries: Vec<Geometry<'_>> = Vec::new();
+    let mut mesh_of: BTreeMap<Vec<usize>, usize> = BTreeMap::new();
     let mut meshes: Vec<PlannedMesh<'_>> = Vec::new();
     let mut nodes = Vec::with_capacity(scene.nodes.len());
     for (i, node) in scene.nodes.iter().enumerate() {
         let ids = drawn(scene, &node.meshes);
-        let mesh = if ids.is_empty() {
+        let mut gs = Vec::with_capacity(ids.len());
+        for &id in &ids {
+            let g = match geometry_of[id.index()] {
+                Some(g) => g,
+                None => {
+                    let mesh = &scene.meshes[id.index()];
+                    let same = by_content.entry(content_hash(mesh)).or_default();
+                    let g = match same.iter().find(|&&g| *geometries[g].mesh == *mesh) {
+                        Some(&g) => g,
+                        None => {
+                            geometries.push(Geometry::plain(Cow::Borrowed(mesh)));
+                            same.push(geometries.len() - 1);
+                            geometries.len() - 1
+                        }
+                    };
+                    geometry_of[id.index()] = Some(g);
+                    g
+                }
+            };
+            gs.push(g);
+        }
+        let mesh = if gs.is_empty() {
             None
-        } else if let Some(&m) = mesh_of.get(&ids) {
+        } else if let Some(&m) = mesh_of.get(&gs) {
             Some(m)
         } else {
-            let mut primitives = Vec::with_capacity(ids.len());
-            for &id in &ids {
-                let g = match geometry_of[id.index()] {
-                    Some(g) => g,
-                    None => {
-                        let g = geometries.len();
-                        geometries.push(Cow::Borrowed(&scene.meshes[id.index()]));
-                        geometry_of[id.index()] = Some(g);
-                        g
-                    }
-                };
-                primitives.push((g, scene.meshes[id.index()].material));
-            }
+            let primitives = gs
+                .iter()
+                .map(|&g| (g, geometries[g].mesh.material))
+                .collect();
             meshes.push(PlannedMesh {
                 name: node.name.clone(),
                 primitives,
                 objects: Vec::new(),
             });
-            mesh_of.insert(ids, meshes.len() - 1);
+            mesh_of.insert(gs, meshes.len() - 1);
             Some(meshes.len() - 1)
         };
         nodes.push(PlannedNode {
-            source: NodeId(i as u32),
             mesh,
             children: node.children.iter().map(|c| c.0).collect(),
+            ..PlannedNode::from_scene(NodeId(i as u32))
         });
     }
     let used: Vec<bool> = geometry_of.iter().map(Option::is_some).collect();
-    let (skipped_empty_meshes, unused_meshes) = counts(scene, &used);
-    Plan {
-        geometries,
-        meshes,
-        nodes,
-        roots: scene.roots.iter().map(|r| r.0).collect(),
-        skipped_empty_meshes,
-        unused_meshes,
-    }
+    let mut plan = Plan::empty();
+    plan.geometries = geometries;
+    plan.meshes = meshes;
+    plan.nodes = nodes;
+    plan.roots = scene.roots.iter().map(|r| r.0).collect();
+    plan.count_meshes(scene, &used);
+    plan
 }
 
 /// Geometry batched per (parent node, material): every leaf node that draws something and
@@ -160,7 +265,7 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
         }
     }
     let mut used = vec![false; scene.meshes.len()];
-    let mut geometries: Vec<Cow<'_, Mesh>> = Vec::new();
+    let mut geometries: Vec<Geometry<'_>> = Vec::new();
     let mut meshes = Vec::new();
     let mut nodes = Vec::new();
     for (i, node) in scene.nodes.iter().enumerate() {
@@ -213,7 +318,7 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
                     }
                 }
                 primitives.push((geometries.len(), material));
-                geometries.push(Cow::Owned(merged));
+                geometries.push(Geometry::plain(Cow::Owned(merged)));
             }
             for o in &mut objects {
                 o.ranges.sort_unstable();
@@ -226,7 +331,6 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
             Some(meshes.len() - 1)
         };
         nodes.push(PlannedNode {
-            source: NodeId(i as u32),
             mesh,
             children: node
                 .children
@@ -234,15 +338,14 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
                 .filter(|c| !absorbed[c.index()])
                 .map(|c| new_index[c.index()])
                 .collect(),
+            ..PlannedNode::from_scene(NodeId(i as u32))
         });
     }
-    let (skipped_empty_meshes, unused_meshes) = counts(scene, &used);
-    Ok(Plan {
-        geometries,
-        meshes,
-        nodes,
-        roots: scene.roots.iter().map(|r| new_index[r.index()]).collect(),
-        skipped_empty_meshes,
-        unused_meshes,
-    })
+    let mut plan = Plan::empty();
+    plan.geometries = geometries;
+    plan.meshes = meshes;
+    plan.nodes = nodes;
+    plan.roots = scene.roots.iter().map(|r| new_index[r.index()]).collect();
+    plan.count_meshes(scene, &used);
+    Ok(plan)
 }

@@ -1,11 +1,12 @@
 use super::*;
 use crate::testing::{decode_glb, drawn_triangles, grid_scene, metadata_json, sample_scene};
+use polis_geom::Mesh;
 use polis_geom::glam::{DQuat, DVec3, Vec2};
 use polis_geom::scene::{MeshId, NodeId};
 
 fn glb(scene: &Scene, batching: Batching) -> (Vec<u8>, GlbReport) {
     let mut out = Vec::new();
-    let report = write_glb(scene, &GlbOptions { batching }, &mut out).unwrap();
+    let report = write_glb(scene, &GlbOptions::with_batching(batching), &mut out).unwrap();
     assert_eq!(report.bytes as usize, out.len());
     (out, report)
 }

@@ -1,0 +1,547 @@
+//! Tests of the tiled layout, feature ids, shared meshes, LOD nodes and the profiles.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::*;
+use polis_geom::glam::{DVec3, Vec2};
+use polis_geom::hash::splitmix64;
+use polis_geom::mesh::prism;
+use polis_geom::scene::{Material, MetaValue};
+use polis_geom::{DVec2, Mesh, Polygon};
+
+const TILE: f64 = 250.0;
+
+/// A town 1 km across: a road sheet over all of it (cut into tiles), and `n` buildings
+/// (wall and roof materials, three wall colours) and blocks spread over it, under cells.
+fn town(n: usize) -> Scene {
+    let mut s = Scene::new();
+    let asphalt = s.add_material(Material::new("asphalt", [0.2, 0.2, 0.2, 1.0]));
+    let pavement = s.add_material(Material::new("pavement", [0.5, 0.5, 0.5, 1.0]));
+    let walls = [0.3, 0.5, 0.7].map(|c| s.add_material(Material::new("wall", [c, 0.4, 0.4, 1.0])));
+    let roof = s.add_material(Material::new("roof", [0.5, 0.2, 0.1, 1.0]));
+    let root = s.add_root("town");
+    s.set_metadata(root, "seed", 7.0).unwrap();
+    // Roads: a 20 × 20 grid of 50 m quads, y = 0.
+    let mut sheet = Mesh::new(Some(asphalt));
+    for i in 0..20 {
+        for j in 0..20 {
+            let (x, z) = (i as f64 * 50.0, j as f64 * 50.0);
+            let c = [[x, z], [x, z + 50.0], [x + 50.0, z + 50.0], [x + 50.0, z]]
+                .map(|[x, z]| DVec3::new(x, 0.0, z));
+            sheet
+                .add_quad(c, [DVec2::ZERO, DVec2::Y, DVec2::ONE, DVec2::X])
+                .unwrap();
+        }
+    }
+    let roads = s.add_node(root, "roads").unwrap();
+    let sheet = s.add_mesh(sheet);
+    s.attach_mesh(roads, sheet).unwrap();
+    for cell in 0..4 {
+        let c = s.add_node(root, format!("cell {cell}")).unwrap();
+        s.set_metadata(c, "cell", cell as f64).unwrap();
+    }
+    for i in 0..n {
+        let h = splitmix64(i as u64);
+        let (x, z) = ((h % 970) as f64 + 5.0, ((h >> 20) % 970) as f64 + 5.0);
+        let cell = polis_geom::scene::NodeId(1 + 1 + (i % 4) as u32);
+        let fp = Polygon::rect(DVec2::ZERO, DVec2::new(8.0 + (i % 4) as f64, 10.0));
+        let block = s.add_node(cell, format!("block {i}")).unwrap();
+        s.set_metadata(block, "layer", "blocks").unwrap();
+        s.set_metadata(block, "id", format!("{i}").as_str())
+            .unwrap();
+        let plinth = s.add_mesh(prism(&fp.clone().into(), -0.5, 0.15, Some(pavement)).unwrap());
+        s.attach_mesh(block, plinth).unwrap();
+        s.node_mut(block).unwrap().transform = Transform::from_translation(DVec3::new(x, 0.0, z));
+        let b = s.add_node(cell, format!("building {i}")).unwrap();
+        s.set_metadata(b, "layer", "buildings").unwrap();
+        s.set_metadata(b, "id", format!("{}", u64::MAX - i as u64).as_str())
+            .unwrap();
+        s.set_metadata(b, "height", 6.0 + (i % 7) as f64).unwrap();
+        let body = prism(&fp.clone().into(), 0.0, 6.0, Some(walls[i % 3])).unwrap();
+        let top = prism(&fp.into(), 6.0, 6.5, Some(roof)).unwrap();
+        for m in [body, top] {
+            let m = s.add_mesh(m);
+            s.attach_mesh(b, m).unwrap();
+        }
+        s.node_mut(b).unwrap().transform = Transform::from_translation(DVec3::new(x, 0.15, z));
+    }
+    s
+}
+
+fn write(scene: &Scene, options: &GlbOptions) -> (Vec<u8>, GlbReport) {
+    let mut out = Vec::new();
+    let report = write_glb(scene, options, &mut out).unwrap();
+    assert_eq!(report.bytes as usize, out.len());
+    (out, report)
+}
+
+fn tiled() -> GlbOptions {
+    GlbOptions {
+        tile_size_m: TILE,
+        ..GlbOptions::default()
+    }
+}
+
+/// The JSON chunk and the binary chunk of a glb.
+fn chunks(bytes: &[u8]) -> (serde_json::Value, &[u8]) {
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin = bytes.get(20 + json_len + 8..).unwrap_or_default();
+    (json, bin)
+}
+
+/// One accessor's values as f64, read by hand from a plain-profile binary chunk.
+fn read(json: &serde_json::Value, bin: &[u8], accessor: u64) -> Vec<Vec<f64>> {
+    let a = &json["accessors"][accessor as usize];
+    let v = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let count = a["count"].as_u64().unwrap() as usize;
+    let comps = match a["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        _ => 4,
+    };
+    let size = match a["componentType"].as_u64().unwrap() {
+        5121 => 1,
+        5123 => 2,
+        _ => 4,
+    };
+    let stride = v["byteStride"]
+        .as_u64()
+        .map_or(comps * size, |s| s as usize);
+    let base = v["byteOffset"].as_u64().unwrap_or(0) as usize;
+    (0..count)
+        .map(|i| {
+            (0..comps)
+                .map(|k| {
+                    let o = base + i * stride + k * size;
+                    let b = &bin[o..o + size];
+                    match (a["componentType"].as_u64().unwrap(), size) {
+                        (5126, _) => f32::from_le_bytes(b.try_into().unwrap()) as f64,
+                        (_, 1) => b[0] as f64,
+                        (_, 2) => u16::from_le_bytes(b.try_into().unwrap()) as f64,
+                        _ => u32::from_le_bytes(b.try_into().unwrap()) as f64,
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn tiled_draw_calls_are_materials_per_layer_tile_and_tree_has_layers_and_tiles() {
+    let scene = town(200);
+    let (bytes, report) = write(&scene, &tiled());
+    gltf::Gltf::from_slice(&bytes).unwrap();
+    let (json, _) = chunks(&bytes);
+    let nodes = json["nodes"].as_array().unwrap();
+    // root → layers → tiles.
+    let root = &nodes[json["scenes"][0]["nodes"][0].as_u64().unwrap() as usize];
+    assert_eq!(root["name"], "town");
+    assert_eq!(root["extras"]["seed"], 7.0);
+    let layer_names: Vec<&str> = root["children"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            nodes[c.as_u64().unwrap() as usize]["name"]
+                .as_str()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(layer_names, ["roads", "blocks", "buildings"]);
+    let mut tiles = 0;
+    let mut expected_calls = 0;
+    for c in root["children"].as_array().unwrap() {
+        let layer = &nodes[c.as_u64().unwrap() as usize];
+        assert!(
+            layer.get("mesh").is_none(),
+            "a layer node draws nothing itself"
+        );
+        let name = layer["name"].as_str().unwrap();
+        for t in layer["children"].as_array().unwrap() {
+            let tile = &nodes[t.as_u64().unwrap() as usize];
+            let [i, j] = [0, 1].map(|k| tile["extras"]["tile"][k].as_i64().unwrap());
+            assert_eq!(tile["name"], format!("{name} {i},{j}"));
+            assert!((0..4).contains(&i) && (0..4).contains(&j), "{i},{j}");
+            let mesh = &json["meshes"][tile["mesh"].as_u64().unwrap() as usize];
+            let materials: BTreeSet<u64> = mesh["primitives"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p["material"].as_u64().unwrap())
+                .collect();
+            assert_eq!(
+                materials.len(),
+                mesh["primitives"].as_array().unwrap().len()
+            );
+            expected_calls += materials.len();
+            tiles += 1;
+        }
+    }
+    // Roads cut into all 16 tiles; 200 buildings fill most of the 16.
+    assert_eq!(report.tiles, tiles);
+    assert!(tiles > 40, "{tiles} tiles");
+    assert_eq!(report.draw_calls, expected_calls);
+    let materials = report.materials;
+    assert_eq!(materials, 6);
+    assert!(report.draw_calls <= materials * tiles);
+    // Per cell it is one mesh per cell and material: fewer, larger cells here.
+    let (_, per_node) = write(&scene, &GlbOptions::with_batching(Batching::PerNode));
+    assert!(per_node.draw_calls > 4 * report.draw_calls);
+    // Every triangle is drawn exactly once.
+    assert_eq!(report.triangles, scene.triangle_count());
+}
+
+/// Every building and block triangle carries its object's feature id; the table holds
+/// the records; after shuffling the triangles of every primitive, grouping by feature id
+/// still gives back each building's exact triangles.
+#[test]
+fn feature_ids_cover_every_object_triangle_and_survive_a_shuffle() {
+    let scene = town(120);
+    let (bytes, report) = write(&scene, &tiled());
+    let (json, bin) = chunks(&bytes);
+    let root = &json["nodes"][json["scenes"][0]["nodes"][0].as_u64().unwrap() as usize];
+    let table = root["extras"]["features"].as_array().unwrap();
+    assert_eq!(table.len(), 240, "120 buildings and 120 blocks");
+    assert_eq!(report.features, 240);
+    let null = root["extras"]["null_feature_id"].as_u64().unwrap();
+    assert_eq!(null, 240);
+    let b7 = table.iter().find(|r| r["name"] == "building 7").unwrap();
+    assert_eq!(b7["layer"], "buildings");
+    assert_eq!(
+        b7["id"],
+        (u64::MAX - 7).to_string(),
+        "ids above 2^53 kept as text"
+    );
+    assert_eq!(b7["height"], 6.0);
+    // Triangles per feature, as sorted world-space vertex triples, after a shuffle.
+    let mut found: BTreeMap<u64, Vec<[[i64; 3]; 3]>> = BTreeMap::new();
+    let mut seed = 1u64;
+    for mesh in json["meshes"].as_array().unwrap() {
+        for p in mesh["primitives"].as_array().unwrap() {
+            let a = &p["attributes"];
+            let pos = read(&json, bin, a["POSITION"].as_u64().unwrap());
+            let idx = read(&json, bin, p["indices"].as_u64().unwrap());
+            let Some(f) = a.get("_FEATURE_ID_0") else {
+                continue;
+            };
+            let fid = read(&json, bin, f.as_u64().unwrap());
+            let mut tris: Vec<[usize; 3]> = idx
+                .chunks_exact(3)
+                .map(|t| [0, 1, 2].map(|k| t[k][0] as usize))
+                .collect();
+            // Fisher–Yates with splitmix64: the order an optimiser might leave.
+            for i in (1..tris.len()).rev() {
+                seed = splitmix64(seed);
+                tris.swap(i, (seed % (i as u64 + 1)) as usize);
+            }
+            for t in tris {
+                let ids: BTreeSet<u64> = t.iter().map(|&v| fid[v][0] as u64).collect();
+                assert_eq!(ids.len(), 1, "a triangle's vertices share their feature");
+                let id = *ids.first().unwrap();
+                assert!(id < null, "object geometry never gets the null id");
+                let mut tri = t.map(|v| [0, 1, 2].map(|k| (pos[v][k] * 1000.0).round() as i64));
+                tri.sort();
+                found.entry(id).or_default().push(tri);
+            }
+        }
+    }
+    let world = scene.world_matrices();
+    for (k, record) in table.iter().enumerate() {
+        let name = record["name"].as_str().unwrap();
+        let node = scene.nodes.iter().position(|n| n.name == name).unwrap();
+        let mut expect = Vec::new();
+        for &m in &scene.nodes[node].meshes {
+            let mut mesh = scene.meshes[m.index()].clone();
+            mesh.transform(&world[node]).unwrap();
+            for t in mesh.indices.chunks_exact(3) {
+                let mut tri = [0, 1, 2].map(|c| {
+                    let p = mesh.positions[t[c] as usize];
+                    [p.x, p.y, p.z].map(|x| (x as f64 * 1000.0).round() as i64)
+                });
+                tri.sort();
+                expect.push(tri);
+            }
+        }
+        let mut got = found.remove(&(k as u64)).unwrap_or_default();
+        got.sort();
+        expect.sort();
+        assert_eq!(got, expect, "{name}");
+    }
+    assert!(found.is_empty());
+}
+
+#[test]
+fn identical_meshes_are_stored_once_and_referenced_by_many_nodes() {
+    let mut s = Scene::new();
+    let brick = s.add_material(Material::new("brick", [0.6, 0.3, 0.2, 1.0]));
+    let root = s.add_root("street");
+    for i in 0..5 {
+        // Five separate but identical scene meshes (a template placed five times).
+        let m = prism(
+            &Polygon::rect(DVec2::ZERO, DVec2::new(6.0, 9.0)).into(),
+            0.0,
+            7.0,
+            Some(brick),
+        )
+        .unwrap();
+        let m = s.add_mesh(m);
+        let n = s.add_node(root, format!("house {i}")).unwrap();
+        s.attach_mesh(n, m).unwrap();
+        s.node_mut(n).unwrap().transform =
+            Transform::from_translation(DVec3::new(10.0 * i as f64, 0.0, 0.0));
+    }
+    let (bytes, report) = write(&s, &GlbOptions::with_batching(Batching::PerNode));
+    let doc = gltf::Gltf::from_slice(&bytes).unwrap();
+    assert_eq!(doc.meshes().count(), 1);
+    assert_eq!(report.shared_geometries, 1);
+    assert_eq!(report.triangles, 12, "stored once");
+    let users = doc.nodes().filter(|n| n.mesh().is_some()).count();
+    assert!(users >= 2);
+    assert_eq!(users, 5);
+}
+
+#[test]
+fn lod_levels_become_nodes_per_tile_with_switch_distances() {
+    let mut s = town(30);
+    // Give each building a coarse LOD 0 box beside its detailed LOD 1 meshes.
+    let buildings: Vec<usize> = (0..s.nodes.len())
+        .filter(|&i| s.nodes[i].name.starts_with("building"))
+        .collect();
+    for b in buildings {
+        let meshes = std::mem::take(&mut s.nodes[b].meshes);
+        let fine = s
+            .add_node(polis_geom::scene::NodeId(b as u32), "lod 1")
+            .unwrap();
+        s.set_metadata(fine, "lod", MetaValue::Number(1.0)).unwrap();
+        s.nodes[fine.index()].meshes = meshes;
+        let coarse = s
+            .add_node(polis_geom::scene::NodeId(b as u32), "lod 0")
+            .unwrap();
+        s.set_metadata(coarse, "lod", 0.0).unwrap();
+        let m = s.add_mesh(
+            prism(
+                &Polygon::rect(DVec2::ZERO, DVec2::new(8.0, 10.0)).into(),
+                0.0,
+                6.5,
+                None,
+            )
+            .unwrap(),
+        );
+        s.attach_mesh(coarse, m).unwrap();
+    }
+    let (bytes, report) = write(&s, &tiled());
+    gltf::Gltf::from_slice(&bytes).unwrap();
+    let (json, _) = chunks(&bytes);
+    let nodes = json["nodes"].as_array().unwrap();
+    let mut levels = 0;
+    for n in nodes {
+        if let Some(l) = n["extras"].get("lod") {
+            levels += 1;
+            let range = &n["extras"]["lod_range_m"];
+            if l == 1 {
+                assert_eq!(range, &serde_json::json!([0.0, 300.0]));
+            } else {
+                assert_eq!(range, &serde_json::json!([300.0, null]));
+            }
+            assert!(n["name"].as_str().unwrap().starts_with("buildings "));
+        }
+    }
+    assert!(levels >= 4 && levels % 2 == 0, "{levels}");
+    // One feature per building (its LOD children share it), one per block.
+    assert_eq!(report.features, 60);
+}
+
+#[test]
+fn every_layout_and_profile_reads_back_with_the_gltf_crate() {
+    let scene = town(60);
+    for batching in [
+        Batching::Tiled,
+        Batching::PerParentAndMaterial,
+        Batching::PerNode,
+    ] {
+        for profile in [GlbProfile::Plain, GlbProfile::Web] {
+            let options = GlbOptions {
+                batching,
+                profile,
+                ..tiled()
+            };
+            let (bytes, report) = write(&scene, &options);
+            let (a, _) = write(&scene, &options);
+            assert_eq!(a, bytes, "deterministic");
+            let doc = match profile {
+                GlbProfile::Plain => gltf::Gltf::from_slice(&bytes).unwrap(),
+                GlbProfile::Web => {
+                    let doc = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
+                    let mut errors = Vec::new();
+                    let root = doc.document.as_json();
+                    gltf::json::validation::Validate::validate(
+                        root,
+                        root,
+                        gltf::json::Path::new,
+                        &mut |path, error| errors.push((path(), error)),
+                    );
+                    // The only complaint: the gltf crate does not decode these extensions.
+                    for (path, error) in &errors {
+                        assert_eq!(*error, gltf::json::validation::Error::Unsupported);
+                        assert!(path.as_str().starts_with("extensionsRequired"), "{path}");
+                    }
+                    assert_eq!(errors.len(), 2);
+                    doc
+                }
+            };
+            let drawn: usize = doc
+                .nodes()
+                .filter_map(|n| n.mesh())
+                .map(|m| m.primitives().len())
+                .sum();
+            assert_eq!(drawn, report.draw_calls);
+        }
+    }
+}
+
+/// The web profile decodes (meshoptimizer-rs's decoder) to the plain profile's
+/// triangles on the quantisation grid, at a fraction of its size.
+#[cfg(feature = "web")]
+#[test]
+fn web_profile_decodes_to_the_plain_geometry() {
+    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
+    let scene = town(80);
+    let (plain, _) = write(&scene, &tiled());
+    let web_options = GlbOptions {
+        profile: GlbProfile::Web,
+        ..tiled()
+    };
+    let (web, _) = write(&scene, &web_options);
+    let (pj, pbin) = chunks(&plain);
+    let (wj, wbin) = chunks(&web);
+    // The binary chunk (the JSON, mostly the feature table here, is the same).
+    assert!(
+        wbin.len() * 3 < pbin.len(),
+        "{} vs {}",
+        wbin.len(),
+        pbin.len()
+    );
+    assert_eq!(wj["extensionsRequired"], serde_json::json!(web::EXTENSIONS));
+    assert!(
+        pj.get("extensionsUsed").is_none(),
+        "plain uses no extension"
+    );
+    let mut ws = meshoptimizer_rs::Workspace::default();
+    let decode = |accessor: u64, ws: &mut meshoptimizer_rs::Workspace| {
+        let a = &wj["accessors"][accessor as usize];
+        let v = &wj["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+        let e = &v["extensions"]["EXT_meshopt_compression"];
+        let (o, l) = (
+            e["byteOffset"].as_u64().unwrap() as usize,
+            e["byteLength"].as_u64().unwrap() as usize,
+        );
+        let mode = Mode::parse(e["mode"].as_str().unwrap()).unwrap();
+        let stride = e["byteStride"].as_u64().unwrap() as usize;
+        let count = e["count"].as_u64().unwrap() as usize;
+        let raw =
+            decode_buffer_view(mode, Filter::None, count, stride, &wbin[o..o + l], ws).unwrap();
+        (raw, stride)
+    };
+    let f32s = |v: &serde_json::Value, default: f32| {
+        v.as_array().map_or([default; 3], |s| {
+            [0, 1, 2].map(|i| s[i].as_f64().unwrap() as f32)
+        })
+    };
+    for (k, (pm, wm)) in pj["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(wj["meshes"].as_array().unwrap())
+        .enumerate()
+    {
+        // The node drawing mesh k: its scale and translation dequantize.
+        let node = wj["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|n| n["mesh"] == k)
+            .unwrap();
+        let (scale, offset) = (f32s(&node["scale"], 1.0), f32s(&node["translation"], 0.0));
+        assert!(
+            scale[0] == scale[1] && scale[1] == scale[2],
+            "uniform: normals keep direction"
+        );
+        for (pp, wp) in pm["primitives"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(wm["primitives"].as_array().unwrap())
+        {
+            // Plain triangles snapped to the grid the way the writer snaps them.
+            let pos = read(&pj, pbin, pp["attributes"]["POSITION"].as_u64().unwrap());
+            let idx = read(&pj, pbin, pp["indices"].as_u64().unwrap());
+            let mut expect: Vec<[[u16; 3]; 3]> = idx
+                .chunks_exact(3)
+                .map(|t| {
+                    let mut c = [0, 1, 2].map(|j| {
+                        let p = &pos[t[j][0] as usize];
+                        [0, 1, 2].map(|a| {
+                            ((p[a] as f32 - offset[a]) / scale[a])
+                                .round()
+                                .clamp(0.0, 65535.0) as u16
+                        })
+                    });
+                    c.sort();
+                    c
+                })
+                .collect();
+            let (qpos, stride) = decode(wp["attributes"]["POSITION"].as_u64().unwrap(), &mut ws);
+            assert_eq!(stride, 8);
+            let (qidx, isize) = decode(wp["indices"].as_u64().unwrap(), &mut ws);
+            let index = |i: usize| -> usize {
+                if isize == 2 {
+                    u16::from_le_bytes([qidx[2 * i], qidx[2 * i + 1]]) as usize
+                } else {
+                    u32::from_le_bytes(qidx[4 * i..4 * i + 4].try_into().unwrap()) as usize
+                }
+            };
+            let mut got: Vec<[[u16; 3]; 3]> = (0..qidx.len() / isize / 3)
+                .map(|t| {
+                    let mut c = [0, 1, 2].map(|j| {
+                        let v = index(3 * t + j);
+                        [0, 1, 2].map(|a| {
+                            u16::from_le_bytes([qpos[8 * v + 2 * a], qpos[8 * v + 2 * a + 1]])
+                        })
+                    });
+                    c.sort();
+                    c
+                })
+                .collect();
+            expect.sort();
+            got.sort();
+            assert_eq!(got, expect, "mesh {k}");
+        }
+    }
+}
+
+#[test]
+fn bad_options_are_typed_errors() {
+    let scene = town(3);
+    for bad in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+        let o = GlbOptions {
+            tile_size_m: bad,
+            ..GlbOptions::default()
+        };
+        assert!(matches!(
+            write_glb(&scene, &o, Vec::new()),
+            Err(ExportError::InvalidOption { .. })
+        ));
+    }
+    let mut s = town(3);
+    let b = s.nodes.iter().position(|n| n.name == "building 1").unwrap();
+    s.nodes[b].metadata.insert("lod", 1.5);
+    assert!(matches!(
+        write_glb(&s, &tiled(), Vec::new()),
+        Err(ExportError::InvalidOption { name: "lod", .. })
+    ));
+    assert_eq!("web".parse::<GlbProfile>().unwrap(), GlbProfile::Web);
+    assert!("zip".parse::<GlbProfile>().is_err());
+    let _ = Vec2::ZERO;
+}

@@ -1,0 +1,394 @@
+//! The tiled layout ([`Batching::Tiled`](super::Batching::Tiled)): geometry merged per
+//! (root, layer, tile, LOD level, material), with a feature id per vertex.
+//!
+//! Rules, applied per scene root (each root keeps its own glTF node, transform and
+//! metadata; everything below is expressed in the root's frame):
+//!
+//! * An **object** is a node that draws a non-empty mesh (the root itself included).
+//! * Its **layer** is the nearest `layer` text entry in the metadata of the object or an
+//!   ancestor below the root; without one, the name of its ancestor directly under the
+//!   root (so a node `roads`, `water` or `ground` under the city is a layer by its name).
+//! * Its **LOD level** is the nearest `lod` number (a whole number ≥ 0, higher = more
+//!   detail) on the same path; without one it is drawn at every distance.
+//! * Its **feature** is the nearest node on the path (the object or an ancestor below the
+//!   root) whose metadata has an entry other than `layer` and `lod`: each such node is one
+//!   record of the root's `extras.features` table (its `name`, `layer` and metadata), and
+//!   the record's index is the `_FEATURE_ID_0` of every vertex it contributed. Geometry of
+//!   no feature gets the table's length (`extras.null_feature_id`); a primitive with no
+//!   feature at all has no `_FEATURE_ID_0`.
+//! * Its **tile** is the square of side `tile_size_m` on the root's x–z plane holding the
+//!   centre of its bounding box, `(⌊x / s⌋, ⌊z / s⌋)`; an object wider or deeper than a
+//!   tile (a layer-wide surface: the road network, water, ground) is cut instead, each
+//!   triangle going to the tile of its centroid.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+
+use polis_geom::Mesh;
+use polis_geom::glam::{DMat4, Vec3};
+use polis_geom::scene::{MaterialId, NodeId, Scene};
+use serde_json::{Map, Value, json};
+
+use super::options::GlbOptions;
+use super::plan::{Geometry, Plan, PlannedMesh, PlannedNode};
+use crate::ExportError;
+
+/// No feature yet (replaced by the table's length once it is known).
+const NO_FEATURE: u32 = u32::MAX;
+
+/// A tile index on the x–z plane.
+type Tile = (i64, i64);
+
+/// Merged geometry of one (layer, tile, LOD level), per material.
+#[derive(Default)]
+struct Group {
+    by_material: BTreeMap<Option<MaterialId>, (Mesh, Vec<u32>)>,
+}
+
+impl Group {
+    fn target(&mut self, material: Option<MaterialId>) -> &mut (Mesh, Vec<u32>) {
+        self.by_material
+            .entry(material)
+            .or_insert_with(|| (Mesh::new(material), Vec::new()))
+    }
+}
+
+/// What the walk down one root knows about the path to a node.
+#[derive(Clone, Copy)]
+struct PathInfo {
+    layer: usize,
+    lod: Option<u32>,
+    /// The node whose record the path's geometry belongs to, and that node's layer.
+    feature: Option<(NodeId, usize)>,
+}
+
+/// The tile of a point.
+fn tile_of(x: f32, z: f32, size: f64) -> Tile {
+    (
+        (f64::from(x) / size).floor() as i64,
+        (f64::from(z) / size).floor() as i64,
+    )
+}
+
+/// Appends the triangles `tris` of `m` to `target`, with feature `feature` per vertex;
+/// `remap` (all `u32::MAX`, one per vertex of `m`) maps old to new vertices and is reset.
+fn append_triangles(
+    target: &mut (Mesh, Vec<u32>),
+    m: &Mesh,
+    tris: &[u32],
+    feature: u32,
+    remap: &mut [u32],
+) {
+    let (out, features) = target;
+    let mut touched = Vec::new();
+    for &t in tris {
+        for k in 0..3 {
+            let v = m.indices[3 * t as usize + k] as usize;
+            if remap[v] == u32::MAX {
+                remap[v] = out.positions.len() as u32;
+                touched.push(v);
+                out.positions.push(m.positions[v]);
+                out.normals.push(m.normals[v]);
+                if let Some(&uv) = m.uvs.get(v) {
+                    out.uvs.push(uv);
+                }
+                features.push(feature);
+            }
+            out.indices.push(remap[v]);
+        }
+    }
+    for v in touched {
+        remap[v] = u32::MAX;
+    }
+}
+
+/// The layout described in the [module docs](self).
+pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'a>, ExportError> {
+    let size = options.tile_size_m;
+    let mut plan = Plan::empty();
+    let mut used = vec![false; scene.meshes.len()];
+    for &root in &scene.roots {
+        let root_index = plan.nodes.len() as u32;
+        plan.roots.push(root_index);
+        plan.nodes.push(PlannedNode::from_scene(root));
+
+        // Walk the subtree in pre-order: objects, their frame, path info.
+        let mut layers: Vec<String> = Vec::new();
+        let mut features: Vec<Value> = Vec::new();
+        let mut record_of: BTreeMap<NodeId, u32> = BTreeMap::new();
+        let mut groups: BTreeMap<(usize, Tile, Option<u32>), Group> = BTreeMap::new();
+        let mut levels: Vec<u32> = Vec::new();
+        let mut stack: Vec<(NodeId, DMat4, Option<PathInfo>)> = vec![(root, DMat4::IDENTITY, None)];
+        let mut remap: Vec<u32> = Vec::new();
+        while let Some((id, frame, path)) = stack.pop() {
+            let node = &scene.nodes[id.index()];
+            let is_root = id == root;
+            let layer_name = node.metadata.get("layer").and_then(|v| v.as_str());
+            let info = if is_root {
+                None
+            } else {
+                let inherited = path;
+                let layer = match (layer_name, inherited) {
+                    (Some(name), _) => Some(name),
+                    (None, Some(p)) => layers.get(p.layer).map(String::as_str),
+                    (None, None) => Some(node.name.as_str()),
+                }
+                .unwrap_or_default()
+                .to_string();
+                let layer = match layers.iter().position(|l| *l == layer) {
+                    Some(k) => k,
+                    None => {
+                        layers.push(layer);
+                        layers.len() - 1
+                    }
+                };
+                let lod = match node.metadata.get("lod").and_then(|v| v.as_f64()) {
+                    Some(l) if l >= 0.0 && l.fract() == 0.0 && l <= f64::from(u16::MAX) => {
+                        Some(l as u32)
+                    }
+                    Some(l) => {
+                        return Err(ExportError::InvalidOption {
+                            name: "lod",
+                            reason: format!(
+                                "node {} ({:?}) has lod {l}; give a whole number from 0",
+                                id.0, node.name
+                            ),
+                        });
+                    }
+                    None => inherited.and_then(|p| p.lod),
+                };
+                let own_feature = node.metadata.keys().any(|k| k != "layer" && k != "lod");
+                let feature = if own_feature {
+                    Some((id, layer))
+                } else {
+                    inherited.and_then(|p| p.feature)
+                };
+                if let Some(l) = lod
+                    && !levels.contains(&l)
+                {
+                    levels.push(l);
+                }
+                Some(PathInfo {
+                    layer,
+                    lod,
+                    feature,
+                })
+            };
+            for &c in node.children.iter().rev() {
+                let m = frame * scene.nodes[c.index()].transform.matrix();
+                stack.push((c, m, info));
+            }
+            let drawn: Vec<&Mesh> = node
+                .meshes
+                .iter()
+                .filter_map(|m| {
+                    let mesh = scene.meshes.get(m.index())?;
+                    used[m.index()] = true;
+                    (!mesh.is_empty()).then_some(mesh)
+                })
+                .collect();
+            if drawn.is_empty() {
+                continue;
+            }
+            let info = match info {
+                Some(i) => i,
+                None => {
+                    // Geometry on the root itself: a layer named after the root.
+                    let name = node.name.clone();
+                    let layer = layers.iter().position(|l| *l == name).unwrap_or_else(|| {
+                        layers.push(name);
+                        layers.len() - 1
+                    });
+                    PathInfo {
+                        layer,
+                        lod: None,
+                        feature: None,
+                    }
+                }
+            };
+            // The record of the feature, made when its first geometry is met.
+            let feature = match info.feature {
+                None => NO_FEATURE,
+                Some((owner, layer)) => match record_of.get(&owner) {
+                    Some(&k) => k,
+                    None => {
+                        let owner_node = &scene.nodes[owner.index()];
+                        let mut record = Map::new();
+                        record.insert("name".into(), Value::from(owner_node.name.as_str()));
+                        record.insert("layer".into(), Value::from(layers[layer].as_str()));
+                        if let Value::Object(meta) = serde_json::to_value(&owner_node.metadata)
+                            .map_err(ExportError::json("feature table"))?
+                        {
+                            for (k, v) in meta {
+                                record.entry(k).or_insert(v);
+                            }
+                        }
+                        features.push(Value::Object(record));
+                        let k = features.len() as u32 - 1;
+                        record_of.insert(owner, k);
+                        k
+                    }
+                },
+            };
+            let placed: Vec<Cow<'_, Mesh>> = if frame == DMat4::IDENTITY {
+                drawn.into_iter().map(Cow::Borrowed).collect()
+            } else {
+                let mut out = Vec::with_capacity(drawn.len());
+                for m in drawn {
+                    let mut m = m.clone();
+                    m.transform(&frame)?;
+                    out.push(Cow::Owned(m));
+                }
+                out
+            };
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for m in &placed {
+                let b = m.bbox();
+                lo = lo.min(b.min);
+                hi = hi.max(b.max);
+            }
+            let whole = f64::from(hi.x - lo.x) <= size && f64::from(hi.z - lo.z) <= size;
+            for m in &placed {
+                if remap.len() < m.vertex_count() {
+                    remap.resize(m.vertex_count(), u32::MAX);
+                }
+                if whole {
+                    let c = (lo + hi) * 0.5;
+                    let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
+                    let target = groups.entry(key).or_default().target(m.material);
+                    let all: Vec<u32> = (0..m.triangle_count() as u32).collect();
+                    append_triangles(target, m, &all, feature, &mut remap);
+                    continue;
+                }
+                // Cut: triangles sorted by the tile of their centroid.
+                let mut by_tile: Vec<(Tile, u32)> = m
+                    .indices
+                    .chunks_exact(3)
+                    .enumerate()
+                    .map(|(t, tri)| {
+                        let c = (m.positions[tri[0] as usize]
+                            + m.positions[tri[1] as usize]
+                            + m.positions[tri[2] as usize])
+                            / 3.0;
+                        (tile_of(c.x, c.z, size), t as u32)
+                    })
+                    .collect();
+                by_tile.sort_unstable();
+                for run in by_tile.chunk_by(|a, b| a.0 == b.0) {
+                    let tris: Vec<u32> = run.iter().map(|&(_, t)| t).collect();
+                    let key = (info.layer, run[0].0, info.lod);
+                    let target = groups.entry(key).or_default().target(m.material);
+                    append_triangles(target, m, &tris, feature, &mut remap);
+                }
+            }
+        }
+
+        // Nodes: root → layers (first-seen order) → tiles (sorted) → LOD levels.
+        levels.sort_unstable_by(|a, b| b.cmp(a));
+        let null_id = features.len() as u32;
+        let mut layer_nodes: Vec<Option<u32>> = vec![None; layers.len()];
+        let mut tile_nodes: BTreeMap<(usize, Tile), u32> = BTreeMap::new();
+        for ((layer, tile, lod), group) in groups {
+            let layer_node = match layer_nodes[layer] {
+                Some(n) => n,
+                None => {
+                    let n = plan.nodes.len() as u32;
+                    plan.nodes.push(PlannedNode::synthetic(
+                        layers[layer].clone(),
+                        json!({ "layer": layers[layer] }),
+                    ));
+                    plan.nodes[root_index as usize].children.push(n);
+                    layer_nodes[layer] = Some(n);
+                    n
+                }
+            };
+            let tile_node = match tile_nodes.get(&(layer, tile)) {
+                Some(&n) => n,
+                None => {
+                    let n = plan.nodes.len() as u32;
+                    let (x, z) = (tile.0 as f64 * size, tile.1 as f64 * size);
+                    plan.nodes.push(PlannedNode::synthetic(
+                        format!("{} {},{}", layers[layer], tile.0, tile.1),
+                        json!({
+                            "layer": layers[layer],
+                            "tile": [tile.0, tile.1],
+                            "tile_bounds_m": [x, z, x + size, z + size],
+                        }),
+                    ));
+                    plan.nodes[layer_node as usize].children.push(n);
+                    tile_nodes.insert((layer, tile), n);
+                    n
+                }
+            };
+            let mut primitives = Vec::with_capacity(group.by_material.len());
+            for (material, (mesh, mut ids)) in group.by_material {
+                let features = if ids.iter().all(|&f| f == NO_FEATURE) {
+                    None
+                } else {
+                    for f in &mut ids {
+                        if *f == NO_FEATURE {
+                            *f = null_id;
+                        }
+                    }
+                    Some(ids)
+                };
+                primitives.push((plan.geometries.len(), material));
+                plan.geometries.push(Geometry {
+                    mesh: Cow::Owned(mesh),
+                    features,
+                });
+            }
+            let tile_name = format!("{} {},{}", layers[layer], tile.0, tile.1);
+            let mesh = plan.meshes.len();
+            match lod {
+                None => {
+                    plan.meshes.push(PlannedMesh {
+                        name: tile_name,
+                        primitives,
+                        objects: Vec::new(),
+                    });
+                    plan.nodes[tile_node as usize].mesh = Some(mesh);
+                }
+                Some(level) => {
+                    let rank = levels.iter().position(|&l| l == level).unwrap_or(0);
+                    let near = options.lod_near_m;
+                    let from = if rank == 0 {
+                        0.0
+                    } else {
+                        near * f64::from(1u32 << (rank - 1).min(30))
+                    };
+                    let to =
+                        (rank + 1 < levels.len()).then(|| near * f64::from(1u32 << rank.min(30)));
+                    let name = format!("{tile_name} lod {level}");
+                    plan.meshes.push(PlannedMesh {
+                        name: name.clone(),
+                        primitives,
+                        objects: Vec::new(),
+                    });
+                    let n = plan.nodes.len() as u32;
+                    let mut node = PlannedNode::synthetic(
+                        name,
+                        json!({ "lod": level, "lod_range_m": [from, to] }),
+                    );
+                    node.mesh = Some(mesh);
+                    plan.nodes.push(node);
+                    plan.nodes[tile_node as usize].children.push(n);
+                }
+            }
+        }
+        plan.tiles += tile_nodes.len();
+        let mut extras = Map::new();
+        extras.insert("feature_id_attribute".into(), json!("_FEATURE_ID_0"));
+        extras.insert("null_feature_id".into(), json!(null_id));
+        extras.insert("tile_size_m".into(), json!(size));
+        if !levels.is_empty() {
+            extras.insert("lod_levels".into(), json!(levels));
+        }
+        extras.insert("layers".into(), json!(layers));
+        plan.features += features.len();
+        extras.insert("features".into(), Value::Array(features));
+        plan.nodes[root_index as usize].extras = Some(extras);
+    }
+    plan.count_meshes(scene, &used);
+    Ok(plan)
+}

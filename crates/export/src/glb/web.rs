@@ -1,0 +1,331 @@
+//! The web profile: `KHR_mesh_quantization` + `EXT_meshopt_compression`.
+//!
+//! Per glTF mesh, positions are quantized to unsigned 16-bit integers on a grid spanning
+//! the mesh's bounds (one step for all axes: the largest extent / 65,535, 4 mm over a
+//! 250 m tile, so the dequantising scale is uniform and normals keep their directions) and the
+//! nodes drawing it dequantize with their transform (scale and offset composed into
+//! their TRS, or a child node `mesh` when they have children of their own). Normals and
+//! tangents become signed normalized bytes (1/127 steps); texture coordinates stay `f32`;
+//! feature ids stay exact. Every vertex and index array is then encoded with
+//! meshoptimizer's codecs (vertex codec version 0, index codec version 1, as the
+//! extension specifies) and stored in the binary chunk; the views point into a fallback
+//! buffer without data, so both extensions are required.
+//!
+//! References: Khronos, *KHR_mesh_quantization*; *EXT_meshopt_compression* (2021);
+//! A. Kapoulkine, meshoptimizer (vertex and index codecs).
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+
+use gltf::json::accessor::{ComponentType as C, Type as T};
+use meshoptimizer_rs::codec::{
+    IndexEncoding, VertexEncoding, encode_index_buffer, encode_vertex_buffer,
+};
+use meshoptimizer_rs::{Limits, Workspace, optimize_vertex_cache};
+use polis_geom::glam::Vec3;
+use polis_geom::scene::Scene;
+use rayon::prelude::*;
+use serde_json::{Value, json};
+
+use super::layout::{
+    ArrayLayout, GeometryLayout, Layout, Slot, U16_VERTEX_LIMIT, feature_component, pad4,
+    writes_tangents, writes_uvs,
+};
+use super::plan::{Geometry, Plan};
+use super::tangents;
+use crate::ExportError;
+
+/// The extensions a web-profile file uses and requires.
+pub(crate) const EXTENSIONS: [&str; 2] = ["EXT_meshopt_compression", "KHR_mesh_quantization"];
+
+/// Largest value of the 16-bit position grid.
+const GRID_MAX: f32 = 65_535.0;
+
+/// A quantisation grid: position = offset + scale ⊙ q.
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    offset: Vec3,
+    scale: Vec3,
+}
+
+impl Grid {
+    /// One step on all three axes (the largest extent / 65,535): a uniform scale in
+    /// the node transform leaves the normals' directions alone, where a per-axis scale
+    /// would bend them through the normal matrix.
+    fn spanning(lo: Vec3, hi: Vec3) -> Grid {
+        let extent = (hi - lo).max_element();
+        let step = if extent > 0.0 && extent.is_finite() {
+            extent / GRID_MAX
+        } else {
+            1.0
+        };
+        Grid {
+            offset: lo,
+            scale: Vec3::splat(step),
+        }
+    }
+
+    fn key(&self) -> [u32; 6] {
+        let (o, s) = (self.offset, self.scale);
+        [o.x, o.y, o.z, s.x, s.y, s.z].map(f32::to_bits)
+    }
+
+    fn quantize(&self, p: Vec3) -> [u16; 3] {
+        let q = ((p - self.offset) / self.scale).round();
+        [q.x, q.y, q.z].map(|c| c.clamp(0.0, GRID_MAX) as u16)
+    }
+}
+
+fn snorm8(x: f32) -> u8 {
+    ((x.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8
+}
+
+/// One array before offsets are known: its accessor, the raw byte length, the stream.
+struct Encoded {
+    array: ArrayLayout,
+    stream: Vec<u8>,
+}
+
+fn codec(e: meshoptimizer_rs::Error) -> ExportError {
+    ExportError::InvalidOption {
+        name: "profile",
+        reason: format!("meshopt encoding failed: {e:?}"),
+    }
+}
+
+/// Quantizes and encodes one geometry on `grid`.
+fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, ExportError> {
+    let m = &g.mesh;
+    let mut ws = Workspace::new(Limits::default());
+    // Triangles in vertex-cache order (Forsyth's method, meshoptimizer's), then vertices
+    // in first-use order: what the codecs compress best.
+    let cached = optimize_vertex_cache(&m.indices, m.vertex_count(), &mut ws).map_err(codec)?;
+    let mut remap = vec![u32::MAX; m.vertex_count()];
+    let mut order: Vec<usize> = Vec::with_capacity(m.vertex_count());
+    let indices: Vec<u32> = cached
+        .iter()
+        .map(|&v| {
+            let r = &mut remap[v as usize];
+            if *r == u32::MAX {
+                *r = order.len() as u32;
+                order.push(v as usize);
+            }
+            *r
+        })
+        .collect();
+    let n = order.len();
+    let vertex = |bytes: Vec<u8>, stride: usize, ws: &mut Workspace| {
+        encode_vertex_buffer(
+            &bytes,
+            n,
+            stride,
+            VertexEncoding::new(0, 0).map_err(codec)?,
+            ws,
+        )
+        .map_err(codec)
+    };
+    let array = |slot, ty, component, normalized, stride: usize, bounds| ArrayLayout {
+        slot,
+        count: n,
+        ty,
+        component,
+        normalized,
+        bounds,
+        stride: Some(stride),
+        offset: 0,
+        length: (n * stride) as u64,
+        compressed: None,
+    };
+    let mut out = Vec::with_capacity(6);
+
+    let mut bytes = Vec::with_capacity(8 * n);
+    let (mut lo, mut hi) = ([u16::MAX; 3], [0u16; 3]);
+    for &p in order.iter().map(|&v| &m.positions[v]) {
+        let q = grid.quantize(p);
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+            bytes.extend_from_slice(&q[k].to_le_bytes());
+        }
+        bytes.extend_from_slice(&[0, 0]);
+    }
+    let bounds = Some((lo.map(f64::from), hi.map(f64::from)));
+    out.push(Encoded {
+        array: array(Slot::Position, T::Vec3, C::U16, false, 8, bounds),
+        stream: vertex(bytes, 8, &mut ws)?,
+    });
+
+    let mut bytes = Vec::with_capacity(4 * n);
+    for nrm in order.iter().map(|&v| &m.normals[v]) {
+        let v = nrm.normalize_or_zero();
+        bytes.extend_from_slice(&[snorm8(v.x), snorm8(v.y), snorm8(v.z), 0]);
+    }
+    out.push(Encoded {
+        array: array(Slot::Normal, T::Vec3, C::I8, true, 4, None),
+        stream: vertex(bytes, 4, &mut ws)?,
+    });
+
+    if writes_uvs(scene, m.material) {
+        let mut bytes = Vec::with_capacity(8 * n);
+        for t in order.iter().filter_map(|&v| m.uvs.get(v)) {
+            bytes.extend_from_slice(&t.x.to_le_bytes());
+            bytes.extend_from_slice(&t.y.to_le_bytes());
+        }
+        out.push(Encoded {
+            array: array(Slot::Uv, T::Vec2, C::F32, false, 8, None),
+            stream: vertex(bytes, 8, &mut ws)?,
+        });
+    }
+
+    let wide = n > U16_VERTEX_LIMIT;
+    let isize = if wide { 4 } else { 2 };
+    out.push(Encoded {
+        array: ArrayLayout {
+            slot: Slot::Index,
+            count: indices.len(),
+            ty: T::Scalar,
+            component: if wide { C::U32 } else { C::U16 },
+            normalized: false,
+            bounds: None,
+            stride: None,
+            offset: 0,
+            length: (indices.len() * isize) as u64,
+            compressed: None,
+        },
+        stream: encode_index_buffer(&indices, IndexEncoding::new(1).map_err(codec)?, &mut ws)
+            .map_err(codec)?,
+    });
+
+    if writes_tangents(scene, m.material) {
+        let mut bytes = Vec::with_capacity(4 * n);
+        let all = tangents::tangents(m);
+        for t in order.iter().filter_map(|&v| all.get(v)) {
+            bytes.extend_from_slice(&t.to_array().map(snorm8));
+        }
+        out.push(Encoded {
+            array: array(Slot::Tangent, T::Vec4, C::I8, true, 4, None),
+            stream: vertex(bytes, 4, &mut ws)?,
+        });
+    }
+
+    if let Some(ids) = &g.features {
+        let c = feature_component(ids)?;
+        let mut bytes = Vec::with_capacity(4 * n);
+        for &f in order.iter().filter_map(|&v| ids.get(v)) {
+            if c == C::F32 {
+                bytes.extend_from_slice(&(f as f32).to_le_bytes());
+            } else {
+                let [a, b] = (f as u16).to_le_bytes();
+                bytes.extend_from_slice(&[a, b, 0, 0]);
+            }
+        }
+        out.push(Encoded {
+            array: array(Slot::Feature, T::Scalar, c, false, 4, None),
+            stream: vertex(bytes, 4, &mut ws)?,
+        });
+    }
+    Ok(out)
+}
+
+/// The web layout: one grid per glTF mesh, each (geometry, grid) encoded once, in
+/// parallel; streams in the binary chunk, then the images.
+pub(crate) fn layout(
+    scene: &Scene,
+    plan: &Plan<'_>,
+    pngs: &[Cow<'_, [u8]>],
+) -> Result<Layout, ExportError> {
+    let mut jobs: Vec<(usize, Grid)> = Vec::new();
+    let mut job_of: BTreeMap<(usize, [u32; 6]), usize> = BTreeMap::new();
+    let mut primitive_geometry = Vec::with_capacity(plan.meshes.len());
+    let mut dequantize = Vec::with_capacity(plan.meshes.len());
+    for m in &plan.meshes {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for &(g, _) in &m.primitives {
+            let b = plan.geometries[g].mesh.bbox();
+            lo = lo.min(b.min);
+            hi = hi.max(b.max);
+        }
+        let grid = Grid::spanning(lo, hi);
+        let mut prims = Vec::with_capacity(m.primitives.len());
+        for &(g, _) in &m.primitives {
+            let job = *job_of.entry((g, grid.key())).or_insert_with(|| {
+                jobs.push((g, grid));
+                jobs.len() - 1
+            });
+            prims.push(job);
+        }
+        primitive_geometry.push(prims);
+        dequantize.push(Some((grid.offset, grid.scale)));
+    }
+    let encoded: Vec<Vec<Encoded>> = jobs
+        .par_iter()
+        .map(|&(g, grid)| encode(scene, &plan.geometries[g], grid))
+        .collect::<Result<_, _>>()?;
+    let (mut fallback, mut bin) = (0u64, 0u64);
+    let mut streams = Vec::new();
+    let mut geometries = Vec::with_capacity(encoded.len());
+    for arrays in encoded {
+        let mut out = Vec::with_capacity(arrays.len());
+        for Encoded { mut array, stream } in arrays {
+            array.offset = fallback;
+            fallback = pad4(fallback + array.length);
+            array.compressed = Some((bin, stream.len() as u64));
+            bin = pad4(bin + stream.len() as u64);
+            streams.push(stream);
+            out.push(array);
+        }
+        geometries.push(GeometryLayout { arrays: out });
+    }
+    let mut images = Vec::with_capacity(pngs.len());
+    for p in pngs {
+        images.push((bin, p.len() as u64));
+        bin = pad4(bin + p.len() as u64);
+    }
+    Ok(Layout {
+        geometries,
+        primitive_geometry,
+        dequantize,
+        images,
+        bin_len: bin,
+        fallback_len: Some(fallback),
+        streams,
+    })
+}
+
+/// Adds the extension objects the typed JSON cannot hold: `EXT_meshopt_compression` on
+/// the geometry views (created first, one per array in layout order) and on the
+/// fallback buffer (index 1), and both extensions as used and required.
+pub(crate) fn add_extensions(doc: &mut Value, layout: &Layout) {
+    let arrays = layout.geometries.iter().flat_map(|g| &g.arrays);
+    if let Some(views) = doc.get_mut("bufferViews").and_then(Value::as_array_mut) {
+        for (view, a) in views.iter_mut().zip(arrays) {
+            if let (Some((offset, length)), Some(v)) = (a.compressed, view.as_object_mut()) {
+                v.insert(
+                    "extensions".into(),
+                    json!({ "EXT_meshopt_compression": {
+                        "buffer": 0,
+                        "byteOffset": offset,
+                        "byteLength": length,
+                        "byteStride": a.element_size(),
+                        "count": a.count,
+                        "mode": a.meshopt_mode(),
+                    }}),
+                );
+            }
+        }
+    }
+    if let Some(b) = doc
+        .get_mut("buffers")
+        .and_then(|b| b.get_mut(1))
+        .and_then(Value::as_object_mut)
+    {
+        b.insert(
+            "extensions".into(),
+            json!({ "EXT_meshopt_compression": { "fallback": true } }),
+        );
+    }
+    if let Some(root) = doc.as_object_mut() {
+        root.insert("extensionsUsed".into(), json!(EXTENSIONS));
+        root.insert("extensionsRequired".into(), json!(EXTENSIONS));
+    }
+}

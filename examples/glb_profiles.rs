@@ -1,0 +1,143 @@
+//! The glb's layouts and profiles side by side: file size, draw calls and write time.
+//!
+//! ```text
+//! cargo run --release --example glb_profiles -- [PRESET ...] [--runs N] [--only LAYOUT:PROFILE]
+//! ```
+//!
+//! Generates each preset (default: `default` and `citygen`) once, then writes its glb
+//! into memory `--runs` times (default 5) per layout (`tiled`, the default; `cell`, the
+//! layout before tiles; `building`) and profile (`plain`, `web`) and prints, per row, the
+//! bytes, the draw calls (primitives drawn by nodes, every LOD level counted), the
+//! materials and tiles, the feature records, shared geometries and the median write time
+//! in milliseconds. The last lines check the targets of issue 26: tiled draw calls ≤ 4 ×
+//! materials × tiles; the web profile ≤ 25 % of the per-cell plain bytes; the tiled plain
+//! write no slower than the per-cell plain write. `--only tiled:plain` writes that one
+//! row once (for whole-process timings of one configuration).
+
+use std::time::Instant;
+
+use polis::CityConfig;
+use polis::export::glb::{Batching, GlbOptions, GlbProfile, write_glb};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+const LAYOUTS: [(&str, Batching); 3] = [
+    ("tiled", Batching::Tiled),
+    ("cell", Batching::PerParentAndMaterial),
+    ("building", Batching::PerNode),
+];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut presets = Vec::new();
+    let mut runs = 5usize;
+    let mut only: Option<(String, String)> = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--runs" => runs = args.next().ok_or("--runs N")?.parse()?,
+            "--only" => {
+                let v = args.next().ok_or("--only LAYOUT:PROFILE")?;
+                let (l, p) = v.split_once(':').ok_or("--only LAYOUT:PROFILE")?;
+                only = Some((l.to_string(), p.to_string()));
+                runs = 1;
+            }
+            _ => presets.push(a),
+        }
+    }
+    if presets.is_empty() {
+        presets = vec!["default".into(), "citygen".into()];
+    }
+    let runs = runs.max(1);
+    for name in &presets {
+        let config = CityConfig::preset(name)?;
+        let city = polis::generate(&config)?;
+        println!(
+            "{name}: {} buildings, {} triangles, {} scene materials",
+            city.stats.buildings,
+            city.scene.triangle_count(),
+            city.scene.materials.len()
+        );
+        println!(
+            "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9}",
+            "layout",
+            "profile",
+            "bytes",
+            "draws",
+            "mats",
+            "tiles",
+            "features",
+            "shared",
+            "write ms"
+        );
+        let mut rows = Vec::new();
+        for (lname, batching) in LAYOUTS {
+            for profile in [GlbProfile::Plain, GlbProfile::Web] {
+                if let Some((l, p)) = &only
+                    && (l != lname || *p != profile.to_string())
+                {
+                    continue;
+                }
+                let options = GlbOptions {
+                    batching,
+                    tile_size_m: config.scene.tile_size_m,
+                    profile,
+                    ..GlbOptions::default()
+                };
+                let mut times = Vec::with_capacity(runs);
+                let mut report = None;
+                for _ in 0..runs {
+                    let mut out = Vec::new();
+                    let t = Instant::now();
+                    let r = write_glb(&city.scene, &options, &mut out)?;
+                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                    report = Some(r);
+                }
+                times.sort_by(f64::total_cmp);
+                let ms = times[times.len() / 2];
+                let Some(r) = report else { continue };
+                println!(
+                    "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9.1}",
+                    lname,
+                    profile.to_string(),
+                    r.bytes,
+                    r.draw_calls,
+                    r.materials,
+                    r.tiles,
+                    r.features,
+                    r.shared_geometries,
+                    ms
+                );
+                rows.push((lname, profile, r, ms));
+            }
+        }
+        let find = |l: &str, p: GlbProfile| rows.iter().find(|r| r.0 == l && r.1 == p);
+        if let (Some(tiled), Some(cell), Some(web)) = (
+            find("tiled", GlbProfile::Plain),
+            find("cell", GlbProfile::Plain),
+            find("tiled", GlbProfile::Web),
+        ) {
+            let bound = 4 * tiled.2.materials * tiled.2.tiles;
+            println!(
+                "  draw calls {} ≤ 4 × {} materials × {} tiles = {bound}: {}",
+                tiled.2.draw_calls,
+                tiled.2.materials,
+                tiled.2.tiles,
+                tiled.2.draw_calls <= bound
+            );
+            println!(
+                "  web {} bytes = {:.1} % of the per-cell plain {} bytes",
+                web.2.bytes,
+                100.0 * web.2.bytes as f64 / cell.2.bytes as f64,
+                cell.2.bytes
+            );
+            println!(
+                "  tiled plain write {:.1} ms vs per-cell {:.1} ms ({:+.0} %)",
+                tiled.3,
+                cell.3,
+                100.0 * (tiled.3 / cell.3 - 1.0)
+            );
+        }
+    }
+    Ok(())
+}
