@@ -128,6 +128,7 @@ impl RoadStage for GridRoads {
             network,
             growth: None,
             skipped: Vec::new(),
+            districts: Vec::new(),
         })
     }
 }

@@ -37,9 +37,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
+mod edits;
 mod kelly;
+mod traits;
 use crate::stages::{ParishMullerRoads, RoadStage, RoadsOutput, Skip, Stage, StageContext};
+pub use edits::{
+    CellParam, CellSettings, LotOverride, MapPaint, PaintLayer, lot_override, paint_maps,
+};
 pub use kelly::{InlinePrimary, PATH_TOLERANCE_M};
+pub use traits::{LotPlan, block_ids, district_at, hint_kind, lot_params_of, lot_plan};
 
 /// How the city's roads are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -216,6 +222,18 @@ pub struct CitygenConfig {
     /// Carriageway widths of secondary roads are multiplied by this (Kelly's widths in
     /// Citygen units come out narrow in metres). Must be in (0, 10]. Default: 1.
     pub road_width_factor: f64,
+    /// Whether every cell's lot size, building height (with deviances) and building hint
+    /// reach the lot and building stages (Kelly §5.5.1); when false only cells whose
+    /// settings set one of them do, and the `lots` options and zoning bands decide
+    /// elsewhere. Default: false.
+    pub cell_traits: bool,
+    /// Per-cell settings (pattern, parameters, seed) by stable cell id, as the editor
+    /// writes them. Default: none.
+    pub cells: Vec<CellSettings>,
+    /// Per-lot and per-building overrides, anchored to lot ids. Default: none.
+    pub lots: Vec<LotOverride>,
+    /// Rectangles painted onto the population, zoning and park maps. Default: none.
+    pub paint: Vec<MapPaint>,
 }
 
 impl Default for CitygenConfig {
@@ -227,6 +245,10 @@ impl Default for CitygenConfig {
             by_population: Vec::new(),
             overrides: Vec::new(),
             road_width_factor: 1.0,
+            cell_traits: false,
+            cells: Vec::new(),
+            lots: Vec::new(),
+            paint: Vec::new(),
         }
     }
 }
@@ -262,6 +284,28 @@ impl CitygenConfig {
                     "must be finite",
                 ));
             }
+        }
+        for (i, c) in self.cells.iter().enumerate() {
+            for q in &c.params {
+                q.validate().map_err(|e| {
+                    Error::config(format!("citygen.cells[{i}].params"), e.to_string())
+                })?;
+            }
+        }
+        for (i, o) in self.lots.iter().enumerate() {
+            let ok = o.at.iter().all(|c| c.is_finite())
+                && o.height_m
+                    .is_none_or(|h| h.is_finite() && h > 0.0 && h <= crate::MAX_BUILDING_HEIGHT_M);
+            if !ok {
+                return Err(Error::config(
+                    format!("citygen.lots[{i}]"),
+                    "a finite anchor and a height in (0, 1000] m",
+                ));
+            }
+        }
+        for (i, p) in self.paint.iter().enumerate() {
+            p.validate(f64::INFINITY)
+                .map_err(|e| Error::config(format!("citygen.paint[{i}]"), e.to_string()))?;
         }
         for (i, o) in self.overrides.iter().enumerate() {
             if !(o.at[0].is_finite() && o.at[1].is_finite()) {
@@ -307,6 +351,8 @@ pub struct CitygenNetwork {
     pub primary: RoadNetwork,
     /// Every grown cell's secondary roads, in cell order.
     pub cells: Vec<SecondaryRoads>,
+    /// Every grown cell's id, region, pattern and traits (parallel to `cells`).
+    pub districts: Vec<District>,
     /// The union: primary and secondary roads in one planar graph.
     pub network: RoadNetwork,
     /// Cells that could not be grown (too small, invalid boundary), with why.
@@ -326,6 +372,7 @@ impl RoadStage for CitygenRoads {
             network: net.network,
             growth,
             skipped: net.skipped,
+            districts: net.districts,
         })
     }
 }
@@ -370,9 +417,17 @@ pub fn stable_cell_id(cell: &Cell) -> u64 {
 pub fn citygen_network(
     cx: &StageContext<'_>,
 ) -> Result<(CitygenNetwork, Option<polis_roads::GrowthReport>)> {
+    citygen_network_with(cx, None)
+}
+
+/// [`citygen_network`] with the editor's memo of grown cells.
+pub(crate) fn citygen_network_with(
+    cx: &StageContext<'_>,
+    memo: Option<&dyn GrowthMemo>,
+) -> Result<(CitygenNetwork, Option<polis_roads::GrowthReport>)> {
     let cg = &cx.config.citygen;
     cg.validate()?;
-    let (primary, growth) = primary_network(cx)?;
+    let (primary, growth, kelly_roads) = primary_network(cx)?;
     let decomposition = polis_cells::extract_with(&primary, &cx.config.cells)?;
     // Maps: water and parks through lazily cached lattices, as the P&M stage reads them.
     let params = cx.config.effective_road_params();
@@ -409,13 +464,34 @@ pub fn citygen_network(
         p.road_width_m.value *= cg.road_width_factor;
         presets.push((n, p));
     }
-    let seed = cx.seed(Stage::Roads, 1);
+    let preset = |n: Neighbourhood| {
+        presets
+            .iter()
+            .find(|(m, _)| *m == n)
+            .map(|(_, p)| p.clone())
+            .unwrap_or_default()
+    };
+    let city_seed = cx.seed(Stage::Roads, 1);
+    // What every cell's growth reads besides its own inputs (for the editor's memo).
+    let shared = memo.map(|_| {
+        let parks: Vec<_> = cg
+            .paint
+            .iter()
+            .filter(|p| p.layer == PaintLayer::Park)
+            .collect();
+        let text = format!(
+            "{:?}|{:?}|{:?}|{}",
+            cx.config.maps, parks, params, cx.config.size_m
+        );
+        crate::editor::key::Key::new(0x6772_6F77).bytes(text.as_bytes())
+    });
+    let ids = cell_ids(&decomposition, &primary, kelly_roads.as_deref());
     let started = crate::clock::Instant::now();
-    let grown: Vec<Result<std::result::Result<SecondaryRoads, Skip>>> = decomposition
+    let grown: Vec<Result<std::result::Result<(SecondaryRoads, District), Skip>>> = decomposition
         .cells
         .par_iter()
-        .map(|cell| {
-            let id = stable_cell_id(cell);
+        .zip(ids.par_iter())
+        .map(|(cell, &id)| {
             let skip = |reason: String| Skip {
                 stage: Stage::Roads,
                 id,
@@ -425,48 +501,78 @@ pub fn citygen_network(
                 Ok(r) => r,
                 Err(e) => return Ok(Err(skip(format!("cell {id}: {e}")))),
             };
-            let preset = |n: Neighbourhood| {
-                presets
-                    .iter()
-                    .find(|(m, _)| *m == n)
-                    .map(|(_, p)| p.clone())
-                    .unwrap_or_default()
+            let settings = cg.cells.iter().find(|s| s.cell == id);
+            let pattern = settings
+                .and_then(|s| s.pattern)
+                .unwrap_or_else(|| neighbourhood_of(cx, &region));
+            let mut p = match pattern {
+                CellPatternChoice::Kelly(n) => preset(n),
+                CellPatternChoice::Grid(g) => preset(g.traits_from()),
             };
+            let explicit = settings.is_some_and(|s| {
+                s.params.iter().any(|q| {
+                    matches!(
+                        q,
+                        CellParam::LotSize(_)
+                            | CellParam::BuildingHeight(_)
+                            | CellParam::BuildingHint(_)
+                    )
+                })
+            });
+            for q in settings.map(|s| s.params.as_slice()).unwrap_or_default() {
+                q.apply(&mut p);
+            }
+            let seed = settings
+                .and_then(|s| s.seed)
+                .map_or(city_seed, |s| splitmix64(s ^ 0x0CE1_15EE_D000_0001));
             let input = SecondaryCell {
                 id,
                 region,
                 filaments: filament_segments(cell),
             };
-            match neighbourhood_of(cx, &input.region) {
-                CellPatternChoice::Kelly(n) => {
-                    let result = SecondaryGrowth::new(preset(n))
-                        .and_then(|mut g| g.grow(&input, &maps, seed));
-                    match result {
-                        Ok(r) => Ok(Ok(r)),
-                        Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
-                        Err(e) => Err(secondary_error(e)),
+            let district = District {
+                id,
+                region: input.region.clone(),
+                pattern,
+                traits: polis_roads::secondary::CellTraits {
+                    lot_size_m: p.lot_size_m,
+                    building_height_m: p.building_height_m,
+                    building_hint: p.building_hint,
+                },
+                traits_apply: cg.cell_traits || explicit,
+            };
+            let grow = || -> Result<std::result::Result<SecondaryRoads, Skip>> {
+                grow_cell(&input, &maps, pattern, &p, seed, &skip)
+            };
+            let roads = match (memo, shared) {
+                (Some(m), Some(shared)) => {
+                    let key = crate::editor::key::Key::new(0x6365_6C6C)
+                        .key(shared)
+                        .u64(id)
+                        .u64(seed)
+                        .region(&input.region)
+                        .bytes(format!("{pattern:?}|{p:?}").as_bytes());
+                    let mut key = key.u64(input.filaments.len() as u64);
+                    for [a, b] in &input.filaments {
+                        key = key.point(*a).point(*b);
                     }
+                    m.grow(id, key, &grow)?
                 }
-                CellPatternChoice::Grid(g) => {
-                    match grow_grid(&input, &maps, g, &preset(g.traits_from()), seed) {
-                        Ok(r) => Ok(Ok(r)),
-                        Err(
-                            e @ (GridError::NoStart { .. }
-                            | GridError::InvalidCell(_)
-                            | GridError::TooManyLatticePoints { .. }),
-                        ) => Ok(Err(skip(format!("cell {id}: {e}")))),
-                        Err(e) => Err(Error::config("citygen.neighbourhood", e.to_string())),
-                    }
-                }
-            }
+                _ => grow()?,
+            };
+            Ok(roads.map(|r| (r, district)))
         })
         .collect();
     let secondary_s = started.elapsed().as_secs_f64();
     let mut cells = Vec::with_capacity(grown.len());
+    let mut districts = Vec::with_capacity(grown.len());
     let mut skipped = Vec::new();
     for g in grown {
         match g? {
-            Ok(r) => cells.push(r),
+            Ok((r, d)) => {
+                cells.push(r);
+                districts.push(d);
+            }
             Err(s) => skipped.push(s),
         }
     }
@@ -475,12 +581,121 @@ pub fn citygen_network(
         CitygenNetwork {
             primary,
             cells,
+            districts,
             network,
             skipped,
             secondary_s,
         },
         growth,
     ))
+}
+
+/// Grows one cell with its pattern and parameters; a cell too small or invalid for its
+/// pattern is skipped with the reason.
+fn grow_cell(
+    input: &SecondaryCell,
+    maps: &CellMaps<'_>,
+    pattern: CellPatternChoice,
+    p: &polis_roads::secondary::SecondaryParams,
+    seed: u64,
+    skip: &dyn Fn(String) -> Skip,
+) -> Result<std::result::Result<SecondaryRoads, Skip>> {
+    let id = input.id;
+    match pattern {
+        CellPatternChoice::Kelly(_) => {
+            let result =
+                SecondaryGrowth::new(p.clone()).and_then(|mut g| g.grow(input, maps, seed));
+            match result {
+                Ok(r) => Ok(Ok(r)),
+                Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
+                Err(e) => Err(secondary_error(e)),
+            }
+        }
+        CellPatternChoice::Grid(g) => match grow_grid(input, maps, g, p, seed) {
+            Ok(r) => Ok(Ok(r)),
+            Err(
+                e @ (GridError::NoStart { .. }
+                | GridError::InvalidCell(_)
+                | GridError::TooManyLatticePoints { .. }),
+            ) => Ok(Err(skip(format!("cell {id}: {e}")))),
+            Err(e) => Err(Error::config("citygen.neighbourhood", e.to_string())),
+        },
+    }
+}
+
+/// The Citygen road stage's memo of grown cells (the editor's): returns the cell's
+/// secondary roads for input key `key`, growing them with `grow` only when the key is
+/// new.
+pub(crate) trait GrowthMemo: Send + Sync {
+    /// The cell `id`'s roads for inputs `key`.
+    ///
+    /// # Errors
+    /// `grow`'s.
+    fn grow(
+        &self,
+        id: u64,
+        key: crate::editor::key::Key,
+        grow: &(dyn Fn() -> Result<std::result::Result<SecondaryRoads, Skip>> + Sync),
+    ) -> Result<std::result::Result<SecondaryRoads, Skip>>;
+}
+
+/// A city cell as the later stages see it: its stable id, region, pattern and the lot
+/// and building traits of its parameters (Kelly §5.5.1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct District {
+    /// The cell's stable id.
+    pub id: u64,
+    /// Its region.
+    pub region: polis_geom::PolygonWithHoles,
+    /// Its pattern.
+    pub pattern: CellPatternChoice,
+    /// Lot size, building height and hint of its parameters.
+    pub traits: polis_roads::secondary::CellTraits,
+    /// Whether the traits reach the lot and building stages
+    /// ([`CitygenConfig::cell_traits`], or set on this cell by a cell edit).
+    pub traits_apply: bool,
+}
+
+/// The stable id of every cell of the primary decomposition: for a Kelly primary
+/// network, a hash of the sorted ids of the primary roads along its outer boundary
+/// (unchanged by any edit that does not touch those roads, even one that moves the
+/// cell's corners); otherwise [`stable_cell_id`] (its boundary positions). Two cells
+/// with the same key (degenerate) get the position hash mixed in, in cell order.
+fn cell_ids(
+    decomposition: &polis_cells::CellDecomposition,
+    primary: &RoadNetwork,
+    kelly_roads: Option<&[Option<u64>]>,
+) -> Vec<u64> {
+    let mut ids: Vec<u64> = decomposition
+        .cells
+        .iter()
+        .map(|cell| {
+            let Some(roads) = kelly_roads else {
+                return stable_cell_id(cell);
+            };
+            let mut r: Vec<u64> = cell
+                .boundary
+                .edges
+                .iter()
+                .filter(|e| primary.contains_edge(**e))
+                .filter_map(|e| roads.get(e.index()).copied().flatten())
+                .collect();
+            r.sort_unstable();
+            r.dedup();
+            if r.is_empty() {
+                return stable_cell_id(cell);
+            }
+            r.iter().fold(0x0052_0AD5_u64, |h, &x| splitmix64(h ^ x))
+        })
+        .collect();
+    let mut seen = std::collections::BTreeSet::new();
+    for (id, cell) in ids.iter_mut().zip(&decomposition.cells) {
+        if !seen.insert(*id) {
+            *id = splitmix64(*id ^ stable_cell_id(cell));
+            seen.insert(*id);
+        }
+    }
+    ids
 }
 
 /// One cell grown by the grid road builders, in the shape of Kelly's cell graph
@@ -573,10 +788,14 @@ fn union(primary: &RoadNetwork, cells: &[SecondaryRoads]) -> Result<RoadNetwork>
 }
 
 /// The primary network of the configured source.
+type KellyRoads = Option<Vec<Option<u64>>>;
+
+/// The primary network of the configured source; for Kelly sources, the primary road id
+/// of each edge too.
 fn primary_network(
     cx: &StageContext<'_>,
-) -> Result<(RoadNetwork, Option<polis_roads::GrowthReport>)> {
-    match &cx.config.citygen.primary {
+) -> Result<(RoadNetwork, Option<polis_roads::GrowthReport>, KellyRoads)> {
+    let (net, growth) = match &cx.config.citygen.primary {
         PrimarySource::Highways => {
             let mut config = cx.config.clone();
             config.roads.street_branch_probability = 0.0;
@@ -585,7 +804,7 @@ fn primary_network(
                 maps: cx.maps,
             };
             let out = ParishMullerRoads::default().roads(&scx)?;
-            Ok((highways_of(&out.network)?, out.growth))
+            (highways_of(&out.network)?, out.growth)
         }
         PrimarySource::Rings {
             centre,
@@ -593,7 +812,7 @@ fn primary_network(
             spacing_m,
             spokes,
             piece_m,
-        } => Ok((
+        } => (
             rings_network(
                 cx.config.size_m,
                 DVec2::new(centre[0], centre[1]),
@@ -603,7 +822,7 @@ fn primary_network(
                 *piece_m,
             )?,
             None,
-        )),
+        ),
         PrimarySource::Graph { path } => {
             let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
                 path: path.clone(),
@@ -614,20 +833,51 @@ fn primary_network(
                 message: e.to_string(),
             })?;
             net.check_invariants()?;
-            Ok((net, None))
+            (net, None)
         }
-        PrimarySource::Kelly { network } => Ok((kelly::low_level(&network.0)?, None)),
+        PrimarySource::Kelly { network } => {
+            let (net, roads) = kelly::low_level(&network.0)?;
+            return Ok((net, None, Some(roads)));
+        }
         PrimarySource::KellyFile { path } => {
             let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
                 path: path.clone(),
                 source,
             })?;
-            Ok((
-                kelly::low_level(&kelly::kelly_from_text(cx, &text, path)?)?,
-                None,
-            ))
+            let (net, roads) = kelly::low_level(&kelly::kelly_from_text(cx, &text, path)?)?;
+            return Ok((net, None, Some(roads)));
         }
+    };
+    Ok((net, growth, None))
+}
+
+/// The configured primary network as a Kelly network on `terrain`
+/// ([`PrimaryNetwork::from_highways`](polis_roads::primary::PrimaryNetwork::from_highways)
+/// of its highway edges, primary road spec), for the editor.
+///
+/// # Errors
+/// As [`citygen_network`]; a network the Kelly network cannot hold (outside the terrain).
+pub fn kelly_network_of(
+    cx: &StageContext<'_>,
+    terrain: &polis_roads::primary::Terrain,
+) -> Result<polis_roads::primary::PrimaryNetwork> {
+    if let PrimarySource::Kelly { network } = &cx.config.citygen.primary {
+        return Ok((*network.0).clone());
     }
+    if let PrimarySource::KellyFile { path } = &cx.config.citygen.primary {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.clone(),
+            source,
+        })?;
+        return kelly::kelly_from_text(cx, &text, path);
+    }
+    let (net, _, _) = primary_network(cx)?;
+    polis_roads::primary::PrimaryNetwork::from_highways(
+        &net,
+        terrain,
+        polis_roads::primary::RoadSpec::default(),
+    )
+    .map_err(|e| Error::Roads(e.into()))
 }
 
 /// The highway edges of `net` and their junctions (same positions, new ids).

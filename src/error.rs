@@ -79,6 +79,27 @@ pub enum Error {
         #[source]
         source: BoxError,
     },
+    /// An edit names a node, road, cell or lot that does not exist
+    /// ([`CityEditor`](crate::editor::CityEditor)); nothing was changed.
+    #[error("no {kind} with id {id}: pick one of the city's current {kind}s")]
+    UnknownId {
+        /// What kind of item (`node`, `road`, `cell`, `lot`).
+        kind: &'static str,
+        /// The id asked for.
+        id: u64,
+    },
+    /// An edit's value is out of range, not finite or outside the map; nothing was
+    /// changed.
+    #[error("invalid edit: {field}: {reason}")]
+    InvalidEdit {
+        /// The offending field of the edit.
+        field: String,
+        /// What is wrong and what to do.
+        reason: String,
+    },
+    /// Undo or redo with nothing to undo or redo; nothing was changed.
+    #[error("nothing to {0}")]
+    NothingTo(&'static str),
     /// The thread pool for parallel work could not be built.
     #[error("cannot start {threads} worker threads: {message}")]
     Threads {

@@ -60,6 +60,7 @@ mod city;
 pub mod citygen;
 mod clock;
 mod config;
+pub mod editor;
 mod error;
 mod maps;
 mod output;

@@ -5,7 +5,7 @@ use crate::clock::Instant;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use polis_geom::{Field, SpatialIndex};
+use polis_geom::SpatialIndex;
 use rayon::prelude::*;
 
 use polis_buildings::Building;
@@ -253,10 +253,11 @@ impl Pipeline {
         };
 
         self.report(Stage::Maps, 0.0);
-        let maps = CityMaps::build(
+        let mut maps = CityMaps::build(
             &config.maps,
             crate::seed::sub_seed(config.seed, Stage::Maps, 0),
         )?;
+        crate::citygen::paint_maps(&mut maps, &config.citygen.paint);
         let cx = StageContext {
             config,
             maps: &maps,
@@ -304,6 +305,8 @@ impl Pipeline {
         let mut counts = CityStats::default();
         let total = cells.cells.len();
         let mut kept = CityChunk::default();
+        let ids = crate::citygen::block_ids(config, &cells);
+        let districts = &roads.districts;
         for (k, chunk) in cells.cells.chunks(cells_per_chunk).enumerate() {
             let span = Span {
                 first: k * cells_per_chunk,
@@ -312,6 +315,9 @@ impl Pipeline {
             };
             let (out, chunk_timings) = self.chunk(
                 chunk,
+                ids.get(span.first..span.first + span.len)
+                    .unwrap_or_default(),
+                districts,
                 span,
                 &network,
                 &cx,
@@ -399,6 +405,8 @@ impl Pipeline {
     fn chunk(
         &self,
         cells: &[Cell],
+        ids: &[u64],
+        districts: &[crate::citygen::District],
         span: Span,
         network: &RoadNetwork,
         cx: &StageContext<'_>,
@@ -412,7 +420,7 @@ impl Pipeline {
             time: restart(&mut clock),
         };
         let mut out = CityChunk {
-            cells: cells.iter().map(|c| c.id.index() as u64).collect(),
+            cells: ids.to_vec(),
             ..CityChunk::default()
         };
 
@@ -425,8 +433,8 @@ impl Pipeline {
             .fold(0.0, f64::max);
         let per_cell: Vec<Result<std::result::Result<(u64, CellLots), Skip>>> = cells
             .par_iter()
-            .map(|cell| {
-                let id = cell.id.index() as u64;
+            .zip(ids)
+            .map(|(cell, &id)| {
                 let mut widths = Vec::new();
                 for ring in std::iter::once(&cell.boundary).chain(cell.holes.iter()) {
                     for &e in &ring.edges {
@@ -467,6 +475,7 @@ impl Pipeline {
                     },
                     seed: cx.seed(Stage::Lots, id),
                     nearby_roads,
+                    lot_params: crate::citygen::lot_params_of(cx.config, districts, cell),
                 };
                 let lots = self.lots.lots(&input, cx);
                 ticker.tick();
@@ -518,48 +527,46 @@ impl Pipeline {
         self.report(Stage::Lots, span.done());
 
         // Buildings, lot by lot in parallel.
-        let config = cx.config;
-        let maps = cx.maps;
-        let lod = config.effective_lod();
+        let lod = cx.config.effective_lod();
         let ticker = self.ticker(Stage::Buildings, out.lots.len(), span);
+        let lot_ids: std::collections::BTreeSet<u64> = out.lots.iter().map(|l| l.id).collect();
         let built: Vec<Result<Option<_>>> = out
             .lots
             .par_iter()
             .map(|l| {
-                let c = l.lot.polygon.centroid();
-                let (mut kind, mut max_height_m) =
-                    config.zoning.zone(maps.inputs.population.sample(c));
-                if let Some(z) = &maps.zoning {
-                    kind = polis_buildings::kind_from_zoning(z.as_ref(), c);
-                }
-                if let Some(h) = &maps.max_height {
-                    // The map replaces the bands' limit; a limit of 0 m (or less, or
-                    // NaN) leaves the lot empty rather than falling back to the bands.
-                    max_height_m = h.sample(c);
-                    if max_height_m.is_nan() || max_height_m <= 0.0 {
-                        ticker.tick();
-                        return Ok(None);
-                    }
-                }
+                // Zoning, the cell's traits, the height map and the lot's overrides.
+                let Some(plan) = crate::citygen::lot_plan(cx, districts, l, &lot_ids) else {
+                    ticker.tick();
+                    return Ok(None);
+                };
                 let r = builder.build(&LotInput {
-                    id: l.id,
+                    id: plan.build_id,
                     lot: &l.lot,
-                    kind,
-                    max_height_m,
+                    kind: plan.kind,
+                    max_height_m: plan.max_height_m,
                     lod,
                 });
                 ticker.tick();
-                r
+                // A reseeded lot's building was drawn under another id: give it its own.
+                r.map(|b| {
+                    b.map(|mut b| {
+                        b.id = l.id;
+                        b.lot_id = l.id;
+                        (b, plan.style)
+                    })
+                })
             })
             .collect();
         let n_built = built.iter().filter(|b| matches!(b, Ok(Some(_)))).count();
         out.buildings.reserve_exact(n_built);
         out.building_cells.reserve_exact(n_built);
+        let mut styles = Vec::with_capacity(n_built);
         for (l, b) in out.lots.iter().zip(built) {
             match b {
-                Ok(Some(b)) => {
+                Ok(Some((b, style))) => {
                     out.buildings.push(b);
                     out.building_cells.push(l.cell);
+                    styles.push(style);
                 }
                 Ok(None) => {}
                 Err(e) => report.skipped.push(Skip {
@@ -577,8 +584,9 @@ impl Pipeline {
         let dressed: Vec<Result<Option<_>>> = out
             .buildings
             .par_iter()
-            .map(|b| {
-                let r = dresser.dress(b, cx.seed(Stage::Facades, b.id));
+            .zip(&styles)
+            .map(|(b, style)| {
+                let r = dresser.dress_styled(b, cx.seed(Stage::Facades, b.id), style.as_deref());
                 ticker.tick();
                 r
             })

@@ -120,6 +120,9 @@ pub struct RoadsOutput {
     /// Items the road stage skipped (the Citygen mode's cells too small for secondary
     /// roads), for the city's skip report.
     pub skipped: Vec<Skip>,
+    /// The Citygen mode's city cells with their traits, which reach the lot and
+    /// building stages ([`District`](crate::citygen::District)); empty otherwise.
+    pub districts: Vec<crate::citygen::District>,
 }
 
 /// Makes the road network of the whole map.
@@ -176,6 +179,7 @@ impl RoadStage for ParishMullerRoads {
             network: generated.network,
             growth: Some(generated.report),
             skipped: Vec::new(),
+            districts: Vec::new(),
         })
     }
 }
@@ -220,6 +224,9 @@ pub struct CellInput<'a> {
     /// along) and other cells' roads passing close by. No lot may enter their corridors
     /// (centreline ± width / 2).
     pub nearby_roads: Vec<(DVec2, DVec2, f64)>,
+    /// Lot options of this cell replacing the configuration's `lots` (a Citygen cell's
+    /// lot size); none: the configuration's.
+    pub lot_params: Option<polis_lots::LotParams>,
 }
 
 /// What the lot stage makes of one cell.
@@ -265,8 +272,9 @@ impl LotStage for KellyLots {
             }
         };
         let mut rng = Pcg64Mcg::seed_from_u64(input.seed);
+        let params = input.lot_params.as_ref().unwrap_or(&cx.config.lots);
         for block in blocks {
-            match polis_lots::subdivide_block(&block, &cx.config.lots, &mut rng) {
+            match polis_lots::subdivide_block(&block, params, &mut rng) {
                 Ok(sub) => {
                     out.lots.extend(
                         sub.lots
@@ -445,6 +453,21 @@ pub trait DressBuilding: Send + Sync {
     /// # Errors
     /// Failures of this building: the pipeline skips its skin and reports the error.
     fn dress(&self, building: &Building, seed: u64) -> Result<Option<Dress>>;
+
+    /// The skin of `building` in the style named `style` (a lot override) instead of its
+    /// kind's; `None` is [`dress`](Self::dress). Default: ignores the style.
+    ///
+    /// # Errors
+    /// As [`dress`](Self::dress).
+    fn dress_styled(
+        &self,
+        building: &Building,
+        seed: u64,
+        style: Option<&str>,
+    ) -> Result<Option<Dress>> {
+        let _ = style;
+        self.dress(building, seed)
+    }
 }
 
 /// The facade stage: textures (once per city), then skins per building.
@@ -487,6 +510,14 @@ struct Tiler {
 
 impl FacadeStage for TiledFacades {
     fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn DressBuilding + 'a>> {
+        Ok(tiler(cx)?)
+    }
+}
+
+/// The default facade stage's dresser, owning everything it holds (the editor keeps it
+/// between edits).
+pub(crate) fn tiler(cx: &StageContext<'_>) -> Result<Box<dyn DressBuilding + 'static>> {
+    {
         let fc = &cx.config.facades;
         let opts = RasterOptions {
             pixels_per_metre: fc.pixels_per_metre,
@@ -496,10 +527,21 @@ impl FacadeStage for TiledFacades {
         let mut sets = Vec::new();
         let mut style_of = [None; 6];
         if fc.enabled {
-            for kind in BuildingKind::ALL {
-                let name = fc.style_of.get(kind);
+            // The kinds' styles, then styles pinned on lots (Citygen lot overrides).
+            let pinned = cx
+                .config
+                .citygen
+                .lots
+                .iter()
+                .filter_map(|o| o.style.as_deref());
+            let kinds = BuildingKind::ALL
+                .iter()
+                .map(|&k| (Some(k), fc.style_of.get(k)));
+            for (kind, name) in kinds.chain(pinned.map(|s| (None, s))) {
                 if let Some(i) = styles.iter().position(|s| s.style().name == name) {
-                    style_of[kind.index()] = Some(i);
+                    if let Some(kind) = kind {
+                        style_of[kind.index()] = Some(i);
+                    }
                     continue;
                 }
                 let style = fc
@@ -510,7 +552,9 @@ impl FacadeStage for TiledFacades {
                     .or_else(|| polis_facades::builtin::builtin_style(name))
                     .ok_or_else(|| {
                         Error::config(
-                            format!("facades.style_of.{}", kind.name()),
+                            kind.map_or("citygen.lots.style".to_string(), |k| {
+                                format!("facades.style_of.{}", k.name())
+                            }),
                             format!(
                                 "no style named {name:?}: neither built in ({}) nor in \
                                  facades.styles",
@@ -524,7 +568,9 @@ impl FacadeStage for TiledFacades {
                     })?;
                 let prepared = PreparedStyle::new(style)?;
                 sets.push(TileSet::build(&prepared, &opts)?);
-                style_of[kind.index()] = Some(styles.len());
+                if let Some(kind) = kind {
+                    style_of[kind.index()] = Some(styles.len());
+                }
                 styles.push(prepared);
             }
         }
@@ -547,7 +593,15 @@ impl DressBuilding for Tiler {
     }
 
     fn dress(&self, b: &Building, seed: u64) -> Result<Option<Dress>> {
-        let Some(style) = self.style_of.get(b.kind.index()).copied().flatten() else {
+        self.dress_styled(b, seed, None)
+    }
+
+    fn dress_styled(&self, b: &Building, seed: u64, name: Option<&str>) -> Result<Option<Dress>> {
+        let style = match name {
+            Some(name) => self.styles.iter().position(|s| s.style().name == name),
+            None => self.style_of.get(b.kind.index()).copied().flatten(),
+        };
+        let Some(style) = style else {
             return Ok(None);
         };
         let (Some(prepared), Some(set)) = (self.styles.get(style), self.sets.get(style)) else {

@@ -43,14 +43,17 @@ impl PartialEq for InlinePrimary {
 /// sampled every few metres would otherwise give its cells sides of a few metres, too
 /// short for Kelly's growth to start on (it starts at the longest sides).
 ///
+/// Returns the graph and, per edge index, the id of the primary road it lies on.
+///
 /// Limitations: the simplified path may move up to the tolerance off the plotted one; a
 /// simplification that would break planarity is a geometry error.
-pub(super) fn low_level(net: &PrimaryNetwork) -> Result<RoadNetwork> {
+pub(super) fn low_level(net: &PrimaryNetwork) -> Result<(RoadNetwork, Vec<Option<u64>>)> {
     let g = net
         .to_road_network()
         .map_err(polis_roads::RoadError::from)?;
     let gn = &g.network;
     let mut out = RoadNetwork::new();
+    let mut road_of: Vec<Option<u64>> = Vec::new();
     let mut ids = vec![None; gn.node_bound()];
     let keep = |n: polis_geom::NodeId| -> Result<bool> {
         if g.control_of(n).is_some() {
@@ -117,13 +120,18 @@ pub(super) fn low_level(net: &PrimaryNetwork) -> Result<RoadNetwork> {
                 }
             };
             if let Some(p) = prev {
-                out.add_edge(p, m, *road)?;
+                let e = out.add_edge(p, m, *road)?;
+                if road_of.len() <= e.index() {
+                    road_of.resize(e.index() + 1, None);
+                }
+                road_of[e.index()] = g.road_of(e0).map(|r| r.0);
             }
             prev = Some(m);
         }
     }
     out.check_invariants()?;
-    Ok(out)
+    road_of.resize(out.edge_bound(), None);
+    Ok((out, road_of))
 }
 
 /// How far a simplified Kelly path may leave its plotted path, metres.

@@ -90,6 +90,12 @@ impl PrimaryEditor {
         &self.terrain
     }
 
+    /// Replaces the terrain later edits are checked and plotted on (the maps changed);
+    /// the network and the log stay as they are (existing roads are not re-plotted).
+    pub fn set_terrain(&mut self, terrain: Terrain) {
+        self.terrain = terrain;
+    }
+
     /// The edit options.
     pub fn options(&self) -> &EditOptions {
         &self.options

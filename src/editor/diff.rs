@@ -1,0 +1,191 @@
+//! What changed between two states of an edited city, by stable id: the
+//! [`ChangeEvents`] a host applies to its meshes.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use polis_geom::DVec2;
+
+use super::edit::{ChangeEvents, Delta, Regenerated};
+use super::memo::Redone;
+use crate::City;
+use crate::CityConfig;
+use crate::citygen::{District, LotOverride};
+
+/// Removed, added and changed keys between two maps (values compared with `==`).
+fn delta<K: Ord + Clone, V: PartialEq>(old: &BTreeMap<K, V>, new: &BTreeMap<K, V>) -> Delta<K> {
+    let mut d = Delta {
+        removed: Vec::new(),
+        added: Vec::new(),
+        changed: Vec::new(),
+    };
+    for (k, v) in old {
+        match new.get(k) {
+            None => d.removed.push(k.clone()),
+            Some(w) if w != v => d.changed.push(k.clone()),
+            Some(_) => {}
+        }
+    }
+    d.added = new
+        .keys()
+        .filter(|k| !old.contains_key(*k))
+        .cloned()
+        .collect();
+    d
+}
+
+/// Per road-graph cell: its blocks and lots.
+type CellContent<'a> = (Vec<&'a polis_lots::Block>, Vec<&'a crate::CityLot>);
+
+fn by_cell(city: &City) -> BTreeMap<u64, CellContent<'_>> {
+    let mut m: BTreeMap<u64, CellContent<'_>> = BTreeMap::new();
+    for b in &city.blocks {
+        m.entry(b.cell_id).or_default().0.push(b);
+    }
+    for l in &city.lots {
+        m.entry(l.cell).or_default().1.push(l);
+    }
+    m
+}
+
+/// Whether the two road graphs have the same edges (positions and payloads) in order.
+fn same_roads(a: &polis_roads::RoadNetwork, b: &polis_roads::RoadNetwork) -> bool {
+    a.edge_count() == b.edge_count()
+        && a.node_count() == b.node_count()
+        && a.edges()
+            .zip(b.edges())
+            .all(|(x, y)| x.3 == y.3 && a.segment(x.0).ok() == b.segment(y.0).ok())
+}
+
+/// A city's buildings with their skins, by id.
+fn buildings_of(
+    c: &City,
+) -> BTreeMap<u64, (&polis_buildings::Building, Option<&crate::stages::Dress>)> {
+    c.buildings
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.id, (b, c.dresses.get(i).and_then(Option::as_ref))))
+        .collect()
+}
+
+/// The change events from `old` to `new`.
+pub(super) fn changes(
+    old: &City,
+    new: &City,
+    old_cells: &[District],
+    new_cells: &[District],
+    redone: &Redone,
+) -> ChangeEvents {
+    let ids = |d: &[District]| d.iter().map(|c| c.id).collect::<BTreeSet<u64>>();
+    let (oc, nc) = (ids(old_cells), ids(new_cells));
+    let cells = Delta {
+        removed: oc.difference(&nc).copied().collect(),
+        added: nc.difference(&oc).copied().collect(),
+        changed: redone
+            .cells
+            .iter()
+            .copied()
+            .filter(|c| oc.contains(c) && nc.contains(c))
+            .collect(),
+    };
+    let lots = delta(
+        &old.lots.iter().map(|l| (l.id, l)).collect(),
+        &new.lots.iter().map(|l| (l.id, l)).collect(),
+    );
+    let buildings = delta(&buildings_of(old), &buildings_of(new));
+    let blocks = delta(&by_cell(old), &by_cell(new));
+    let block_nodes = delta(
+        &old.blocks.iter().map(|b| (b.id(), b)).collect(),
+        &new.blocks.iter().map(|b| (b.id(), b)).collect(),
+    );
+    // Scene nodes: `cell <c>` groups its blocks and buildings.
+    let mut scene = Delta::<String>::default();
+    let name = |kind: &str, id: &u64| format!("{kind} {id}");
+    scene
+        .removed
+        .extend(blocks.removed.iter().map(|c| name("cell", c)));
+    scene
+        .added
+        .extend(blocks.added.iter().map(|c| name("cell", c)));
+    let mut touched: BTreeSet<u64> = blocks.changed.iter().copied().collect();
+    let cells_of = |c: &City| -> BTreeMap<u64, u64> {
+        c.buildings
+            .iter()
+            .zip(&c.building_cells)
+            .map(|(b, &cell)| (b.id, cell))
+            .collect()
+    };
+    let (old_of, new_of) = (cells_of(old), cells_of(new));
+    for id in buildings.changed.iter().chain(&buildings.added) {
+        touched.extend(new_of.get(id).copied());
+    }
+    for id in &buildings.removed {
+        touched.extend(old_of.get(id).copied());
+    }
+    let gone: BTreeSet<u64> = blocks
+        .removed
+        .iter()
+        .chain(&blocks.added)
+        .copied()
+        .collect();
+    scene
+        .changed
+        .extend(touched.difference(&gone).map(|c| name("cell", c)));
+    scene
+        .removed
+        .extend(block_nodes.removed.iter().map(|b| name("block", b)));
+    scene
+        .added
+        .extend(block_nodes.added.iter().map(|b| name("block", b)));
+    scene
+        .changed
+        .extend(block_nodes.changed.iter().map(|b| name("block", b)));
+    scene
+        .removed
+        .extend(buildings.removed.iter().map(|b| name("building", b)));
+    scene
+        .added
+        .extend(buildings.added.iter().map(|b| name("building", b)));
+    scene
+        .changed
+        .extend(buildings.changed.iter().map(|b| name("building", b)));
+    if !same_roads(&old.roads, &new.roads) {
+        scene.changed.push("roads".to_string());
+    }
+    scene.removed.sort();
+    scene.added.sort();
+    scene.changed.sort();
+    ChangeEvents {
+        primary: None,
+        cells,
+        blocks,
+        lots,
+        buildings,
+        scene_nodes: scene,
+        orphaned: Vec::new(),
+        regenerated: Regenerated {
+            cells: redone.cells.len(),
+            blocks: redone.blocks.len(),
+            buildings: redone.buildings,
+            dresses: redone.dresses,
+        },
+    }
+}
+
+/// The lot overrides of `config` that find no lot of `city`, by id or anchor.
+pub(super) fn orphans(config: &CityConfig, city: &City) -> Vec<LotOverride> {
+    let ids: BTreeSet<u64> = city.lots.iter().map(|l| l.id).collect();
+    config
+        .citygen
+        .lots
+        .iter()
+        .filter(|o| {
+            let at = DVec2::new(o.at[0], o.at[1]);
+            !ids.contains(&o.lot)
+                && !city
+                    .lots
+                    .iter()
+                    .any(|l| l.lot.polygon.bbox().contains(at) && l.lot.polygon.contains(at))
+        })
+        .cloned()
+        .collect()
+}

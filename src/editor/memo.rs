@@ -1,0 +1,372 @@
+//! The editor's memo: the pipeline's own stages wrapped so that each piece of per-item
+//! work (a city cell's secondary growth, a road-graph cell's blocks and lots, a lot's
+//! building, a building's skin) is looked up by the exact digest of everything it reads
+//! ([`Key`]) and done only when that digest is new.
+//!
+//! Because every stage is a deterministic function of those inputs, a reused result is
+//! bit for bit what the stage would make again: the edited city is the city
+//! [`generate`](crate::generate) makes of the same configuration, and the dirty set of an
+//! edit is exactly the work whose inputs it changed. After each run the memo keeps what
+//! that run used (the current city), so memory stays one city's worth of results.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use polis_buildings::Building;
+use polis_roads::secondary::SecondaryRoads;
+
+use super::key::Key;
+use crate::citygen::{ConfiguredRoads, GrowthMemo, RoadMode, citygen_network_with};
+use crate::error::Result;
+use crate::stages::{
+    BuildLot, BuildingStage, CellInput, CellLots, Dress, DressBuilding, FacadeStage, KellyLots,
+    LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
+};
+
+/// Results of one kind: those the last run used, and those this run used so far.
+struct Store<T> {
+    last: BTreeMap<Key, T>,
+    this: BTreeMap<Key, T>,
+}
+
+impl<T> Default for Store<T> {
+    fn default() -> Self {
+        Store {
+            last: BTreeMap::new(),
+            this: BTreeMap::new(),
+        }
+    }
+}
+
+impl<T: Clone> Store<T> {
+    /// The result for `key`, if any run kept it (moved into this run's set).
+    fn get(&mut self, key: Key) -> Option<T> {
+        if let Some(v) = self.this.get(&key) {
+            return Some(v.clone());
+        }
+        let v = self.last.remove(&key)?;
+        self.this.insert(key, v.clone());
+        Some(v)
+    }
+
+    fn put(&mut self, key: Key, v: T) {
+        self.this.insert(key, v);
+    }
+
+    /// Ends a run: keep what it used (or, after a failed run, everything).
+    fn finish(&mut self, ok: bool) {
+        if ok {
+            self.last = std::mem::take(&mut self.this);
+        } else {
+            let this = std::mem::take(&mut self.this);
+            self.last.extend(this);
+        }
+    }
+}
+
+/// What one run redid: the ids of the items whose work was done again.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub(crate) struct Redone {
+    /// City cells grown.
+    pub cells: BTreeSet<u64>,
+    /// Road-graph cells subdivided.
+    pub blocks: BTreeSet<u64>,
+    /// Buildings built (by the id the grammar was seeded with).
+    pub buildings: usize,
+    /// Buildings dressed.
+    pub dresses: usize,
+}
+
+/// Fingerprints of the configuration parts each stage reads besides its item.
+#[derive(Debug, Clone, Copy)]
+struct Fingerprints {
+    lots: Key,
+    buildings: Key,
+    facades: Key,
+}
+
+/// The memo shared by the wrapped stages of one editor.
+#[derive(Default)]
+pub(crate) struct Memo {
+    growth: Mutex<Store<std::result::Result<SecondaryRoads, Skip>>>,
+    lots: Mutex<Store<CellLots>>,
+    buildings: Mutex<Store<Option<Building>>>,
+    dresses: Mutex<Store<Option<Dress>>>,
+    dresser: Mutex<Option<(Key, Arc<dyn DressBuilding>)>>,
+    redone: Mutex<Redone>,
+    districts: Mutex<Vec<crate::citygen::District>>,
+    fingerprints: Mutex<Option<Fingerprints>>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    // A panic while holding a lock cannot leave a store half-written (each operation is
+    // one insert or remove), so a poisoned lock is still usable.
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Feeds std `Hash` values into a [`Key`].
+struct KeyHasher(Key);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.0 = self.0.bytes(bytes);
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = self.0.u64(v);
+    }
+}
+
+fn hashed(k: Key, v: &impl Hash) -> Key {
+    let mut h = KeyHasher(k);
+    v.hash(&mut h);
+    h.0
+}
+
+impl Memo {
+    /// Starts a run on `config`: fingerprints of what the stages read globally.
+    pub(crate) fn begin(&self, config: &crate::CityConfig) {
+        let text = |salt: u64, s: String| Key::new(salt).bytes(s.as_bytes());
+        let pinned: Vec<&str> = config
+            .citygen
+            .lots
+            .iter()
+            .filter_map(|o| o.style.as_deref())
+            .collect();
+        *lock(&self.fingerprints) = Some(Fingerprints {
+            lots: text(
+                1,
+                format!("{:?}|{:?}|{}", config.blocks, config.lots, config.seed),
+            ),
+            buildings: text(
+                2,
+                format!("{:?}|{}", config.effective_building_params(), config.seed),
+            ),
+            facades: text(
+                3,
+                format!("{:?}|{:?}|{}", config.facades, pinned, config.seed),
+            ),
+        });
+        *lock(&self.redone) = Redone::default();
+    }
+
+    /// Ends a run (see [`Store::finish`]) and returns what it redid and the city cells
+    /// its road stage made.
+    pub(crate) fn finish(&self, ok: bool) -> (Redone, Vec<crate::citygen::District>) {
+        lock(&self.growth).finish(ok);
+        lock(&self.lots).finish(ok);
+        lock(&self.buildings).finish(ok);
+        lock(&self.dresses).finish(ok);
+        (
+            std::mem::take(&mut *lock(&self.redone)),
+            std::mem::take(&mut *lock(&self.districts)),
+        )
+    }
+
+    fn fingerprints(&self) -> Fingerprints {
+        lock(&self.fingerprints).unwrap_or(Fingerprints {
+            lots: Key::new(1),
+            buildings: Key::new(2),
+            facades: Key::new(3),
+        })
+    }
+
+    /// The pipeline with every stage wrapped.
+    pub(crate) fn pipeline(self: &Arc<Self>) -> crate::Pipeline {
+        crate::Pipeline::default()
+            .with_roads(MemoRoads(Arc::clone(self)))
+            .with_lots(MemoLots(Arc::clone(self)))
+            .with_buildings(MemoBuildings(Arc::clone(self)))
+            .with_facades(MemoFacades(Arc::clone(self)))
+    }
+}
+
+impl GrowthMemo for Memo {
+    fn grow(
+        &self,
+        id: u64,
+        key: Key,
+        grow: &(dyn Fn() -> Result<std::result::Result<SecondaryRoads, Skip>> + Sync),
+    ) -> Result<std::result::Result<SecondaryRoads, Skip>> {
+        if let Some(v) = lock(&self.growth).get(key) {
+            return Ok(v);
+        }
+        let v = grow()?;
+        lock(&self.growth).put(key, v.clone());
+        lock(&self.redone).cells.insert(id);
+        Ok(v)
+    }
+}
+
+struct MemoRoads(Arc<Memo>);
+
+impl RoadStage for MemoRoads {
+    fn roads(&self, cx: &StageContext<'_>) -> Result<RoadsOutput> {
+        if cx.config.road_mode != RoadMode::Citygen {
+            return ConfiguredRoads::default().roads(cx);
+        }
+        let (net, growth) = citygen_network_with(cx, Some(&*self.0))?;
+        lock(&self.0.districts).clone_from(&net.districts);
+        Ok(RoadsOutput {
+            network: net.network,
+            growth,
+            skipped: net.skipped,
+            districts: net.districts,
+        })
+    }
+}
+
+struct MemoLots(Arc<Memo>);
+
+impl LotStage for MemoLots {
+    fn lots(&self, input: &CellInput<'_>, cx: &StageContext<'_>) -> Result<CellLots> {
+        let r = &input.region;
+        let mut key = Key::new(0x6C6F_7473)
+            .key(self.0.fingerprints().lots)
+            .u64(r.id)
+            .u64(input.seed)
+            .region(&r.polygon)
+            .u64(r.road_widths.len() as u64);
+        for &w in &r.road_widths {
+            key = key.f64(w);
+        }
+        key = key.u64(input.nearby_roads.len() as u64);
+        for &(a, b, w) in &input.nearby_roads {
+            key = key.point(a).point(b).f64(w);
+        }
+        if let Some(p) = &input.lot_params {
+            key = key.bytes(format!("{p:?}").as_bytes());
+        }
+        if let Some(v) = lock(&self.0.lots).get(key) {
+            return Ok(v);
+        }
+        let v = KellyLots.lots(input, cx)?;
+        lock(&self.0.lots).put(key, v.clone());
+        lock(&self.0.redone).blocks.insert(r.id);
+        Ok(v)
+    }
+}
+
+struct MemoBuildings(Arc<Memo>);
+
+impl BuildingStage for MemoBuildings {
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn BuildLot + 'a>> {
+        Ok(Box::new(MemoBuild {
+            memo: &self.0,
+            inner: Box::new(polis_buildings::BuildingGenerator::new(
+                cx.config.effective_building_params(),
+            )?),
+            fingerprint: self.0.fingerprints().buildings,
+        }))
+    }
+}
+
+struct MemoBuild<'a> {
+    memo: &'a Memo,
+    inner: Box<dyn BuildLot>,
+    fingerprint: Key,
+}
+
+impl BuildLot for MemoBuild<'_> {
+    fn build(&self, lot: &LotInput<'_>) -> Result<Option<Building>> {
+        let l = lot.lot;
+        let mut key = Key::new(0x626C_6467)
+            .key(self.fingerprint)
+            .u64(lot.id)
+            .f64(lot.max_height_m)
+            .u64(lot.lod as u64)
+            .ring(&l.polygon)
+            .u64(l.block_id)
+            .f64(l.area)
+            .u64(l.street_edges.len() as u64);
+        for &e in &l.street_edges {
+            key = key.u64(e as u64);
+        }
+        let key = hashed(key, &lot.kind);
+        if let Some(v) = lock(&self.memo.buildings).get(key) {
+            return Ok(v);
+        }
+        let v = self.inner.build(lot)?;
+        lock(&self.memo.buildings).put(key, v.clone());
+        lock(&self.memo.redone).buildings += 1;
+        Ok(v)
+    }
+}
+
+struct MemoFacades(Arc<Memo>);
+
+impl FacadeStage for MemoFacades {
+    fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn DressBuilding + 'a>> {
+        let fingerprint = self.0.fingerprints().facades;
+        let mut cached = lock(&self.0.dresser);
+        let inner = match &*cached {
+            Some((k, d)) if *k == fingerprint => Arc::clone(d),
+            _ => {
+                let d: Arc<dyn DressBuilding> = Arc::from(crate::stages::tiler(cx)?);
+                *cached = Some((fingerprint, Arc::clone(&d)));
+                d
+            }
+        };
+        Ok(Box::new(MemoDress {
+            memo: &self.0,
+            inner,
+            fingerprint,
+        }))
+    }
+}
+
+struct MemoDress<'a> {
+    memo: &'a Memo,
+    inner: Arc<dyn DressBuilding>,
+    fingerprint: Key,
+}
+
+impl DressBuilding for MemoDress<'_> {
+    fn tile_sets(&self) -> &[polis_facades::TileSet] {
+        self.inner.tile_sets()
+    }
+
+    fn into_tile_sets(self: Box<Self>) -> Vec<polis_facades::TileSet> {
+        self.inner.tile_sets().to_vec()
+    }
+
+    fn dress(&self, b: &Building, seed: u64) -> Result<Option<Dress>> {
+        self.dress_styled(b, seed, None)
+    }
+
+    fn dress_styled(&self, b: &Building, seed: u64, style: Option<&str>) -> Result<Option<Dress>> {
+        let mut key = Key::new(0x6472_6573)
+            .key(self.fingerprint)
+            .u64(seed)
+            .bytes(style.unwrap_or("\0").as_bytes())
+            .u64(b.facades.len() as u64);
+        key = hashed(key, &b.kind);
+        for f in &b.facades {
+            key = key
+                .f64(f.origin.x)
+                .f64(f.origin.y)
+                .f64(f.origin.z)
+                .f64(f.u.x)
+                .f64(f.u.y)
+                .f64(f.u.z)
+                .f64(f.v.x)
+                .f64(f.v.y)
+                .f64(f.v.z)
+                .f64(f.width)
+                .f64(f.height)
+                .u64(u64::from(f.floors))
+                .u64(u64::from(f.part));
+            key = hashed(key, &f.role);
+        }
+        if let Some(v) = lock(&self.memo.dresses).get(key) {
+            return Ok(v);
+        }
+        let v = self.inner.dress_styled(b, seed, style)?;
+        lock(&self.memo.dresses).put(key, v.clone());
+        lock(&self.memo.redone).dresses += 1;
+        Ok(v)
+    }
+}

@@ -1,0 +1,85 @@
+//! The editable city (Kelly 2008 §4.1, §5, §6.5): a [`CityEditor`] holds a Citygen
+//! city, its configuration and its primary network, takes [`Edit`]s (primary nodes and
+//! roads, per-cell presets and parameters, per-lot and per-building overrides, map
+//! paint, global settings), regenerates only the work an edit touches, reports what
+//! changed ([`ChangeEvents`]), undoes and redoes, and saves its history as an
+//! [`EditingFile`].
+//!
+//! ```no_run
+//! use polis::editor::{CityEditor, Edit};
+//!
+//! let mut config = polis::CityConfig::preset("citygen")?;
+//! config.size_m = 1500.0;
+//! let mut editor = CityEditor::new(config)?;
+//! let cell = editor.cells()[0].id;
+//! let events = editor.apply(Edit::SetCellPattern {
+//!     cell,
+//!     pattern: polis::roads::secondary::Neighbourhood::Suburbia.into(),
+//! })?;
+//! println!("{} cells regrown, {} buildings changed", events.cells.len(), events.buildings.len());
+//! editor.undo()?;
+//! # Ok::<(), polis::Error>(())
+//! ```
+//!
+//! # How only the affected work is redone
+//!
+//! Every edit changes the editor's state, which is plain configuration: the primary
+//! network inline in [`CitygenConfig::primary`](crate::CitygenConfig), per-cell settings
+//! ([`CitygenConfig::cells`](crate::CitygenConfig)), lot overrides and map paint. The
+//! city is then made by the pipeline with each per-item stage wrapped in a memo (see
+//! `memo.rs`): a city cell's secondary growth, a road-graph cell's blocks and lots, a
+//! lot's building and a building's skin are keyed by a 128-bit digest of the exact bits
+//! of everything they read, and redone only when that digest is new. The dirty set of an
+//! edit is therefore exactly the work whose inputs it changed: cells whose boundary,
+//! parameters, seed or maps changed, cells created, split or merged, and, downstream,
+//! road-graph cells whose ring or nearby roads changed.
+//!
+//! # Stable identity
+//!
+//! A city cell's id (and so its growth seed) is a hash of the ids of the primary roads
+//! around it: moving a node re-plots its roads but keeps their ids, so the cells around
+//! it keep their ids and seeds and cells elsewhere are untouched. A road-graph cell's id
+//! is a hash of its ring, so a lot (`cell id << 24 | index`) and its building keep id
+//! and seed unless their cell was regenerated. Lot overrides are anchored to the lot id
+//! and a point ([`LotOverride`]); an override whose lot is gone is re-anchored by point
+//! or reported orphaned.
+//!
+//! # Guarantees
+//!
+//! * The edited city is byte for byte the city [`generate`](crate::generate) makes of
+//!   [`CityEditor::config`] (glb, GeoJSON and every layer; tested on random edit
+//!   sequences).
+//! * A rejected edit (unknown id, NaN, out of range, outside the map, refused by the
+//!   primary network's validity checks) or undo with nothing to undo returns a typed
+//!   error and leaves the editor unchanged.
+//! * Replaying an [`EditingFile`] gives the identical city and history.
+//!
+//! # Limitations
+//!
+//! * The road graph's union, its cell decomposition and the 3-D scene are rebuilt whole
+//!   after each edit (their inputs are the whole city); the per-item work is reused.
+//!   BENCHMARKS.md gives the cost per edit.
+//! * Painting parks or water-like values does not re-check existing primary roads; it
+//!   changes where later road edits are legal.
+//! * Only Citygen-mode cities are editable ([`RoadMode::Citygen`](crate::RoadMode)).
+//!
+//! # References
+//!
+//! Kelly, *An Interactive System for Procedural City Generation* (2008): §4.1 (editing
+//! any stage, results propagating), §5.3–5.5 (node, road and cell modes, the property
+//! inspector, presets), §6.5–6.7 (per-cell regeneration). Lipp et al., *Interactive
+//! Modeling of City Layouts using Layers of Procedural Content* (2011): anchored
+//! assignments.
+
+mod diff;
+mod edit;
+mod file;
+pub(crate) mod key;
+mod memo;
+mod state;
+
+pub use edit::{ChangeEvents, Delta, Edit, End, Preview, PreviewRoad, Regenerated};
+pub use file::EditingFile;
+pub use state::{CellInfo, CityEditor};
+
+pub use crate::citygen::{CellParam, CellSettings, LotOverride, MapPaint, PaintLayer};

@@ -1,0 +1,703 @@
+//! [`CityEditor`]: the state (configuration + primary network), applying edits, undo and
+//! redo.
+
+use std::sync::Arc;
+
+use polis_geom::{Aabb2, DVec2};
+use polis_roads::primary::{EditOptions, PrimaryEditor, PrimaryNetwork, Terrain};
+use serde::{Deserialize, Serialize};
+
+use super::diff::{changes, orphans};
+use super::edit::{ChangeEvents, Edit, Preview, PreviewRoad};
+use super::memo::Memo;
+use crate::citygen::{
+    CellPatternChoice, CellSettings, District, InlinePrimary, LotOverride, PrimarySource, RoadMode,
+};
+use crate::error::{Error, Result};
+use crate::{City, CityConfig, CityMaps, KindStyles};
+
+/// A city cell as an editor shows it: its stable id, outline and pattern.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CellInfo {
+    /// The stable id ([`Edit`]s name cells by it).
+    pub id: u64,
+    /// The outer ring, metres, counter-clockwise.
+    pub outline: Vec<[f64; 2]>,
+    /// Its pattern.
+    pub pattern: CellPatternChoice,
+}
+
+/// The settings an edit other than a primary one changes (what undo restores).
+#[derive(Debug, Clone, PartialEq)]
+struct Settings {
+    cells: Vec<CellSettings>,
+    lots: Vec<LotOverride>,
+    paint: Vec<crate::citygen::MapPaint>,
+    style_of: KindStyles,
+    lod: Option<usize>,
+}
+
+impl Settings {
+    fn of(c: &CityConfig) -> Self {
+        Settings {
+            cells: c.citygen.cells.clone(),
+            lots: c.citygen.lots.clone(),
+            paint: c.citygen.paint.clone(),
+            style_of: c.facades.style_of.clone(),
+            lod: c.lod,
+        }
+    }
+
+    fn write(self, c: &mut CityConfig) {
+        c.citygen.cells = self.cells;
+        c.citygen.lots = self.lots;
+        c.citygen.paint = self.paint;
+        c.facades.style_of = self.style_of;
+        c.lod = self.lod;
+    }
+}
+
+/// One step of the history: the edit, and for non-primary edits the settings on the
+/// other side of it (before it on the undo stack, after it on the redo stack).
+#[derive(Debug, Clone)]
+struct Step {
+    edit: Edit,
+    settings: Option<Settings>,
+}
+
+/// An editable Citygen city: see the [module docs](super).
+pub struct CityEditor {
+    base: CityConfig,
+    config: CityConfig,
+    primary: PrimaryEditor,
+    city: City,
+    districts: Vec<District>,
+    memo: Arc<Memo>,
+    undo: Vec<Step>,
+    redo: Vec<Step>,
+    orphans: Vec<LotOverride>,
+}
+
+impl std::fmt::Debug for CityEditor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CityEditor")
+            .field("cells", &self.districts.len())
+            .field("undo", &self.undo.len())
+            .field("redo", &self.redo.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// The map's square.
+fn bounds(config: &CityConfig) -> Aabb2 {
+    let h = config.size_m * 0.5;
+    Aabb2::new(DVec2::splat(-h), DVec2::splat(h))
+}
+
+/// The maps of `config` as the pipeline builds them (paint included).
+fn maps_of(config: &CityConfig) -> Result<CityMaps> {
+    let mut maps = CityMaps::build(
+        &config.maps,
+        crate::seed::sub_seed(config.seed, crate::Stage::Maps, 0),
+    )?;
+    crate::citygen::paint_maps(&mut maps, &config.citygen.paint);
+    Ok(maps)
+}
+
+fn terrain_of(config: &CityConfig, maps: &CityMaps) -> Result<Terrain> {
+    Terrain::new(&maps.inputs, bounds(config))
+        .map_err(|e| Error::Roads(polis_roads::RoadError::from(e)))
+}
+
+fn road_error(e: polis_roads::PrimaryError) -> Error {
+    match e {
+        polis_roads::PrimaryError::UnknownNode(n) => Error::UnknownId {
+            kind: "node",
+            id: n.0,
+        },
+        polis_roads::PrimaryError::UnknownRoad(r) => Error::UnknownId {
+            kind: "road",
+            id: r.0,
+        },
+        e => Error::Roads(polis_roads::RoadError::from(e)),
+    }
+}
+
+impl CityEditor {
+    /// An editor of the city of `config`, which must be in the Citygen road mode. A
+    /// primary network that is not a Kelly network (P&M highways, rings, a road graph)
+    /// becomes one first ([`PrimaryNetwork::from_highways`]: every chain of highway
+    /// segments between junctions a primary road), so the editor's city is the city of
+    /// that network, [`config`](Self::config).
+    ///
+    /// # Errors
+    /// [`Error::Config`] for a bad configuration or another road mode; a failing stage.
+    pub fn new(mut config: CityConfig) -> Result<Self> {
+        config.validate()?;
+        if config.road_mode != RoadMode::Citygen {
+            return Err(Error::config(
+                "road_mode",
+                "the editor edits Citygen cities: set road_mode to \"citygen\"",
+            ));
+        }
+        let maps = maps_of(&config)?;
+        let terrain = terrain_of(&config, &maps)?;
+        let network = match &config.citygen.primary {
+            PrimarySource::Kelly { network } => (*network.0).clone(),
+            _ => {
+                let cx = crate::stages::StageContext {
+                    config: &config,
+                    maps: &maps,
+                };
+                crate::citygen::kelly_network_of(&cx, &terrain)?
+            }
+        };
+        config.citygen.primary = PrimarySource::Kelly {
+            network: InlinePrimary(Box::new(network.clone())),
+        };
+        let primary = PrimaryEditor::with_network(network, terrain, EditOptions::default())
+            .map_err(road_error)?;
+        let memo = Arc::new(Memo::default());
+        let (city, districts, _) = build(&memo, &config)?;
+        let orphans = orphans(&config, &city);
+        Ok(CityEditor {
+            base: config.clone(),
+            config,
+            primary,
+            city,
+            districts,
+            memo,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            orphans,
+        })
+    }
+
+    /// The city as it stands.
+    pub fn city(&self) -> &City {
+        &self.city
+    }
+
+    /// The configuration of the city as it stands (primary network inline, cell
+    /// settings, overrides, paint): [`generate`](crate::generate) of it gives
+    /// [`city`](Self::city).
+    pub fn config(&self) -> &CityConfig {
+        &self.config
+    }
+
+    /// The configuration the editor started from (its primary network converted to a
+    /// Kelly network).
+    pub fn base(&self) -> &CityConfig {
+        &self.base
+    }
+
+    /// The primary network.
+    pub fn network(&self) -> &PrimaryNetwork {
+        self.primary.network()
+    }
+
+    /// The city cells (grown ones), in the order the road stage made them.
+    pub fn cells(&self) -> Vec<CellInfo> {
+        self.districts
+            .iter()
+            .map(|d| CellInfo {
+                id: d.id,
+                outline: d.region.outer.points().iter().map(|p| [p.x, p.y]).collect(),
+                pattern: d.pattern,
+            })
+            .collect()
+    }
+
+    /// The city cell containing `p`, if any.
+    pub fn cell_at(&self, p: DVec2) -> Option<u64> {
+        crate::citygen::district_at(&self.districts, p).map(|d| d.id)
+    }
+
+    /// The lot containing `p`, if any.
+    pub fn lot_at(&self, p: DVec2) -> Option<u64> {
+        self.city
+            .lots
+            .iter()
+            .find(|l| l.lot.polygon.bbox().contains(p) && l.lot.polygon.contains(p))
+            .map(|l| l.id)
+    }
+
+    /// Lot overrides that find no lot (neither by id nor by anchor point).
+    pub fn orphans(&self) -> &[LotOverride] {
+        &self.orphans
+    }
+
+    /// Whether there is an edit to undo.
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    /// Whether there is an edit to redo.
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// The edits in effect, in order.
+    pub fn edits(&self) -> Vec<Edit> {
+        self.undo.iter().map(|s| s.edit.clone()).collect()
+    }
+
+    /// The undone edits that [`redo`](Self::redo) would apply, next first.
+    pub fn undone(&self) -> Vec<Edit> {
+        self.redo.iter().rev().map(|s| s.edit.clone()).collect()
+    }
+
+    /// The editing file of this session: base configuration and edit log.
+    pub fn editing_file(&self) -> super::EditingFile {
+        super::EditingFile {
+            base: self.base.clone(),
+            edits: self.edits(),
+            undone: self.undone(),
+        }
+    }
+
+    /// What `edit` would do, without doing it (for a red/green cursor): validity,
+    /// corrections, the roads as they would be, the cells touched.
+    pub fn propose(&self, edit: &Edit) -> Preview {
+        let refused = |e: Error| Preview {
+            valid: false,
+            refusal: Some(e.to_string()),
+            ..Preview::default()
+        };
+        match edit.to_primary() {
+            Err(e) => refused(e),
+            Ok(Some(pe)) => match self.primary.propose(&pe) {
+                Err(e) => refused(road_error(e)),
+                Ok(p) => {
+                    let mut touched = Vec::new();
+                    let roads = p
+                        .roads()
+                        .iter()
+                        .map(|(id, r)| {
+                            if let Some(r) = r {
+                                touched.extend(r.path.points.iter().copied());
+                            }
+                            if let Ok(old) = self.primary.network().road(*id) {
+                                touched.extend(old.path.points.iter().copied());
+                            }
+                            PreviewRoad {
+                                road: id.0,
+                                path: r
+                                    .as_ref()
+                                    .map(|r| r.path.points.iter().map(|q| [q.x, q.y]).collect()),
+                            }
+                        })
+                        .collect();
+                    for (_, n) in p.nodes() {
+                        if let Some(n) = n {
+                            touched.push(n.pos);
+                        }
+                    }
+                    Preview {
+                        valid: true,
+                        refusal: None,
+                        corrections: p.corrections().to_vec(),
+                        roads,
+                        end_node: p.end_node().map(|n| n.0),
+                        cells: self.cells_near(&touched),
+                    }
+                }
+            },
+            Ok(None) => match self.settings_after(edit) {
+                Err(e) => refused(e),
+                Ok(_) => Preview {
+                    valid: true,
+                    cells: self.cells_named(edit),
+                    ..Preview::default()
+                },
+            },
+        }
+    }
+
+    /// Applies `edit`: the city is regenerated where the edit touches it.
+    ///
+    /// # Errors
+    /// [`Error::UnknownId`], [`Error::InvalidEdit`], a primary-network refusal
+    /// ([`Error::Roads`]), or a failing stage; the editor is then unchanged.
+    pub fn apply(&mut self, edit: Edit) -> Result<ChangeEvents> {
+        let mut config = self.config.clone();
+        let (preview, before) = match edit.to_primary()? {
+            Some(pe) => {
+                let preview = self.primary.propose(&pe).map_err(road_error)?;
+                let mut net = self.primary.network().clone();
+                net.commit(&preview).map_err(road_error)?;
+                config.citygen.primary = PrimarySource::Kelly {
+                    network: InlinePrimary(Box::new(net)),
+                };
+                (Some(preview), None)
+            }
+            None => {
+                let after = self.settings_after(&edit)?;
+                let before = Settings::of(&config);
+                after.write(&mut config);
+                (None, Some(before))
+            }
+        };
+        let mut events = self.rebuild(config)?;
+        if let Some(p) = &preview {
+            events.primary = Some(self.primary.commit(p).map_err(road_error)?);
+        }
+        self.undo.push(Step {
+            edit,
+            settings: before,
+        });
+        self.redo.clear();
+        Ok(events)
+    }
+
+    /// Undoes the last edit in effect.
+    ///
+    /// # Errors
+    /// [`Error::NothingTo`] when no edit is in effect; a failing stage (the editor is
+    /// then unchanged).
+    pub fn undo(&mut self) -> Result<ChangeEvents> {
+        let step = self.undo.pop().ok_or(Error::NothingTo("undo"))?;
+        match self.step(step, true) {
+            Ok((events, step)) => {
+                self.redo.push(step);
+                Ok(events)
+            }
+            Err((e, step)) => {
+                self.undo.push(step);
+                Err(e)
+            }
+        }
+    }
+
+    /// Redoes the last undone edit.
+    ///
+    /// # Errors
+    /// [`Error::NothingTo`] when nothing is undone; a failing stage (the editor is then
+    /// unchanged).
+    pub fn redo(&mut self) -> Result<ChangeEvents> {
+        let step = self.redo.pop().ok_or(Error::NothingTo("redo"))?;
+        match self.step(step, false) {
+            Ok((events, step)) => {
+                self.undo.push(step);
+                Ok(events)
+            }
+            Err((e, step)) => {
+                self.redo.push(step);
+                Err(e)
+            }
+        }
+    }
+
+    /// Undoes (`back`) or redoes one step; returns the step for the other stack, or the
+    /// error and the step unchanged.
+    fn step(
+        &mut self,
+        step: Step,
+        back: bool,
+    ) -> std::result::Result<(ChangeEvents, Step), (Error, Step)> {
+        let mut config = self.config.clone();
+        match &step.settings {
+            Some(other) => {
+                let here = Settings::of(&config);
+                other.clone().write(&mut config);
+                match self.rebuild(config) {
+                    Ok(events) => Ok((
+                        events,
+                        Step {
+                            edit: step.edit,
+                            settings: Some(here),
+                        },
+                    )),
+                    Err(e) => Err((e, step)),
+                }
+            }
+            None => {
+                let moved = if back {
+                    self.primary.undo()
+                } else {
+                    self.primary.redo()
+                };
+                let changes = match moved {
+                    Ok(c) => c,
+                    Err(e) => return Err((road_error(e), step)),
+                };
+                config.citygen.primary = PrimarySource::Kelly {
+                    network: InlinePrimary(Box::new(self.primary.network().clone())),
+                };
+                match self.rebuild(config) {
+                    Ok(mut events) => {
+                        events.primary = Some(changes);
+                        Ok((events, step))
+                    }
+                    Err(e) => {
+                        // Put the network back where the city is.
+                        let _ = if back {
+                            self.primary.redo()
+                        } else {
+                            self.primary.undo()
+                        };
+                        Err((e, step))
+                    }
+                }
+            }
+        }
+    }
+
+    /// Builds the city of `config` through the memo and, on success, makes it the
+    /// editor's; returns what changed.
+    fn rebuild(&mut self, config: CityConfig) -> Result<ChangeEvents> {
+        let maps_changed = self.maps_changed(&config);
+        let (city, districts, redone) = build(&self.memo, &config)?;
+        let mut events = changes(&self.city, &city, &self.districts, &districts, &redone);
+        let orphans = orphans(&config, &city);
+        events.orphaned.clone_from(&orphans);
+        if maps_changed {
+            // New legality for later road edits (the maps were painted).
+            let maps = maps_of(&config)?;
+            self.primary.set_terrain(terrain_of(&config, &maps)?);
+        }
+        self.city = city;
+        self.districts = districts;
+        self.config = config;
+        self.orphans = orphans;
+        Ok(events)
+    }
+
+    fn maps_changed(&self, config: &CityConfig) -> bool {
+        config.citygen.paint != self.config.citygen.paint
+    }
+
+    /// The settings after a non-primary edit, validated against the city as it stands.
+    fn settings_after(&self, edit: &Edit) -> Result<Settings> {
+        let mut s = Settings::of(&self.config);
+        match edit {
+            Edit::SetCellPattern { cell, pattern } => {
+                self.check_cell(*cell)?;
+                cell_settings(&mut s.cells, *cell).pattern = Some(*pattern);
+            }
+            Edit::SetCellParam { cell, param } => {
+                self.check_cell(*cell)?;
+                param.validate()?;
+                cell_settings(&mut s.cells, *cell).set(*param);
+            }
+            Edit::SetCellSeed { cell, seed } => {
+                self.check_cell(*cell)?;
+                cell_settings(&mut s.cells, *cell).seed = Some(*seed);
+            }
+            Edit::ResetCell { cell } => {
+                self.check_cell(*cell)?;
+                s.cells.retain(|c| c.cell != *cell);
+            }
+            Edit::PinKind { lot, kind } => {
+                self.lot_override(&mut s.lots, *lot)?.kind = Some(*kind);
+            }
+            Edit::PinHeight { lot, height_m } => {
+                let h = *height_m;
+                if !(h.is_finite() && h > 0.0 && h <= crate::MAX_BUILDING_HEIGHT_M) {
+                    return Err(Error::InvalidEdit {
+                        field: "height_m".into(),
+                        reason: format!("{h}: give a height in (0, 1000] m"),
+                    });
+                }
+                self.lot_override(&mut s.lots, *lot)?.height_m = Some(h);
+            }
+            Edit::PinStyle { lot, style } => {
+                self.check_style(style)?;
+                self.lot_override(&mut s.lots, *lot)?.style = Some(style.clone());
+            }
+            Edit::RemoveBuilding { lot } => {
+                self.lot_override(&mut s.lots, *lot)?.removed = true;
+            }
+            Edit::ReseedLot { lot, seed } => {
+                self.lot_override(&mut s.lots, *lot)?.seed = Some(*seed);
+            }
+            Edit::ClearLot { lot } => {
+                self.check_lot(*lot)?;
+                s.lots.retain(|o| o.lot != *lot);
+            }
+            Edit::Paint {
+                layer,
+                min,
+                max,
+                value,
+            } => {
+                let p = crate::citygen::MapPaint {
+                    layer: *layer,
+                    min: *min,
+                    max: *max,
+                    value: *value,
+                };
+                p.validate(self.config.size_m)?;
+                s.paint.push(p);
+            }
+            Edit::SetFacadeStyle { kind, style } => {
+                self.check_style(style)?;
+                set_style(&mut s.style_of, *kind, style.clone());
+            }
+            Edit::SetLod { lod } => {
+                let max = self.config.buildings.max_lod;
+                if lod.is_some_and(|l| l > max) {
+                    return Err(Error::InvalidEdit {
+                        field: "lod".into(),
+                        reason: format!("give a level of detail up to buildings.max_lod ({max})"),
+                    });
+                }
+                s.lod = *lod;
+            }
+            _ => {
+                return Err(Error::InvalidEdit {
+                    field: "op".into(),
+                    reason: "not a settings edit".into(),
+                });
+            }
+        }
+        Ok(s)
+    }
+
+    fn check_cell(&self, id: u64) -> Result<()> {
+        if self.districts.iter().any(|d| d.id == id) {
+            Ok(())
+        } else {
+            Err(Error::UnknownId { kind: "cell", id })
+        }
+    }
+
+    fn check_lot(&self, id: u64) -> Result<&crate::CityLot> {
+        self.city
+            .lots
+            .iter()
+            .find(|l| l.id == id)
+            .ok_or(Error::UnknownId { kind: "lot", id })
+    }
+
+    fn check_style(&self, style: &str) -> Result<()> {
+        let known = self.config.facades.styles.iter().any(|s| s.name == style)
+            || polis_facades::builtin::builtin_style(style).is_some();
+        if known {
+            Ok(())
+        } else {
+            Err(Error::InvalidEdit {
+                field: "style".into(),
+                reason: format!("no style named {style:?} (built in or in facades.styles)"),
+            })
+        }
+    }
+
+    /// The override of lot `id` in `lots`, made (anchored at the lot) if new.
+    fn lot_override<'a>(
+        &self,
+        lots: &'a mut Vec<LotOverride>,
+        id: u64,
+    ) -> Result<&'a mut LotOverride> {
+        let lot = self.check_lot(id)?;
+        let i = match lots.iter().position(|o| o.lot == id) {
+            Some(i) => i,
+            None => {
+                lots.push(LotOverride::new(id, anchor(&lot.lot.polygon)));
+                lots.len() - 1
+            }
+        };
+        lots.get_mut(i).ok_or(Error::UnknownId { kind: "lot", id })
+    }
+
+    /// Cells within reach of `points` (their outer box holds one), ids increasing.
+    fn cells_near(&self, points: &[DVec2]) -> Vec<u64> {
+        let mut out: Vec<u64> = self
+            .districts
+            .iter()
+            .filter(|d| {
+                let bb = d.region.outer.bbox();
+                points.iter().any(|&p| bb.contains(p))
+            })
+            .map(|d| d.id)
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Cells a non-primary edit names.
+    fn cells_named(&self, edit: &Edit) -> Vec<u64> {
+        let lot_cell = |lot: u64| {
+            self.city
+                .lots
+                .iter()
+                .find(|l| l.id == lot)
+                .and_then(|l| self.cell_at(anchor(&l.lot.polygon)))
+        };
+        match edit {
+            Edit::SetCellPattern { cell, .. }
+            | Edit::SetCellParam { cell, .. }
+            | Edit::SetCellSeed { cell, .. }
+            | Edit::ResetCell { cell } => vec![*cell],
+            Edit::PinKind { lot, .. }
+            | Edit::PinHeight { lot, .. }
+            | Edit::PinStyle { lot, .. }
+            | Edit::RemoveBuilding { lot }
+            | Edit::ReseedLot { lot, .. }
+            | Edit::ClearLot { lot } => lot_cell(*lot).into_iter().collect(),
+            Edit::Paint { min, max, .. } => {
+                let r = Aabb2::new(DVec2::new(min[0], min[1]), DVec2::new(max[0], max[1]));
+                let mut v: Vec<u64> = self
+                    .districts
+                    .iter()
+                    .filter(|d| d.region.outer.bbox().intersects(&r))
+                    .map(|d| d.id)
+                    .collect();
+                v.sort_unstable();
+                v
+            }
+            _ => self.districts.iter().map(|d| d.id).collect(),
+        }
+    }
+}
+
+/// A point inside a lot to anchor its override at: the centroid if inside, else the
+/// centroid of the first ear that is.
+pub(crate) fn anchor(polygon: &polis_geom::Polygon) -> DVec2 {
+    let c = polygon.centroid();
+    if polygon.contains(c) {
+        return c;
+    }
+    let pts = polygon.points();
+    let n = pts.len();
+    (0..n)
+        .map(|i| (pts[(i + n - 1) % n] + pts[i] + pts[(i + 1) % n]) / 3.0)
+        .find(|&q| polygon.contains(q))
+        .unwrap_or(c)
+}
+
+/// The settings of `cell` in `cells`, made if new.
+fn cell_settings(cells: &mut Vec<CellSettings>, cell: u64) -> &mut CellSettings {
+    let i = match cells.iter().position(|c| c.cell == cell) {
+        Some(i) => i,
+        None => {
+            cells.push(CellSettings::new(cell));
+            cells.len() - 1
+        }
+    };
+    &mut cells[i]
+}
+
+fn set_style(styles: &mut KindStyles, kind: polis_buildings::BuildingKind, style: String) {
+    use polis_buildings::BuildingKind as K;
+    match kind {
+        K::Skyscraper => styles.skyscraper = style,
+        K::Office => styles.office = style,
+        K::MidRise => styles.mid_rise = style,
+        K::House => styles.house = style,
+        K::Apartment => styles.apartment = style,
+        K::Industrial => styles.industrial = style,
+    }
+}
+
+/// Runs the memoised pipeline on `config`.
+fn build(
+    memo: &Arc<Memo>,
+    config: &CityConfig,
+) -> Result<(City, Vec<District>, super::memo::Redone)> {
+    memo.begin(config);
+    let result = memo.pipeline().generate(config);
+    let (redone, districts) = memo.finish(result.is_ok());
+    Ok((result?, districts, redone))
+}
