@@ -152,6 +152,18 @@ pub fn parse_edit(body: &[u8]) -> Result<Edit, ApiError> {
         .ok_or_else(|| ApiError::bad("an edit needs an \"op\" string (e.g. \"move_node\")"))?
         .to_string();
     check_numbers(&value, 0)?;
+    let mut value = value;
+    if let Some(o) = value.as_object_mut() {
+        // 64-bit ids travel as decimal strings (see `wire`).
+        for key in ["cell", "lot"] {
+            if let Some(serde_json::Value::String(t)) = o.get(key) {
+                let n: u64 = t
+                    .parse()
+                    .map_err(|_| ApiError::bad(format!("{key}: {t:?} is not an id")))?;
+                o.insert(key.to_string(), serde_json::Value::from(n));
+            }
+        }
+    }
     serde_json::from_value(value).map_err(|e| ApiError::bad(format!("bad {op} edit: {e}")))
 }
 

@@ -18,12 +18,14 @@ pub const WORKERS: usize = 4;
 pub struct Running {
     /// The bound address (with the port the system chose when asked for port 0).
     pub addr: SocketAddr,
+    #[cfg_attr(not(test), allow(dead_code))]
     server: Arc<tiny_http::Server>,
     workers: Vec<JoinHandle<()>>,
 }
 
 impl Running {
     /// Stops accepting requests and waits for the workers to finish their current one.
+    #[cfg(test)]
     pub fn stop(self) {
         for _ in &self.workers {
             self.server.unblock();
@@ -94,7 +96,10 @@ fn answer(api: &Api, mut request: tiny_http::Request) {
         }
     };
     let close = reply.status == 413;
-    let mut response = tiny_http::Response::from_data(reply.body).with_status_code(reply.status);
+    // The length is known: always a Content-Length, never chunked.
+    let mut response = tiny_http::Response::from_data(reply.body)
+        .with_status_code(reply.status)
+        .with_chunked_threshold(usize::MAX);
     let mut headers = vec![
         ("Content-Type", reply.content_type.to_string()),
         ("Cache-Control", "no-store".to_string()),

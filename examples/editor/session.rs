@@ -42,9 +42,9 @@ fn api_error(e: polis::Error) -> ApiError {
     match e {
         polis::Error::UnknownId { .. } => ApiError::not_found(e.to_string()),
         polis::Error::NothingTo(_) => ApiError::conflict(e.to_string()),
-        polis::Error::InvalidEdit { .. }
-        | polis::Error::Roads(_)
-        | polis::Error::Config { .. } => ApiError::refused(e.to_string()),
+        polis::Error::InvalidEdit { .. } | polis::Error::Roads(_) | polis::Error::Config { .. } => {
+            ApiError::refused(e.to_string())
+        }
         e => ApiError::internal(e.to_string()),
     }
 }
@@ -142,7 +142,7 @@ impl Session {
             .zip(&outlines)
             .zip(streets.iter_mut())
             .map(|((c, o), s)| CellWire {
-                id: c.id,
+                id: wire::id(c.id),
                 ring: wire::flat(o),
                 pattern: pattern_name(&c.pattern),
                 streets: std::mem::take(s),
@@ -156,7 +156,9 @@ impl Session {
         let nodes: Vec<NodeWire> = net.nodes().map(|(id, n)| NodeWire::new(id, n)).collect();
         let roads: Vec<RoadWire> = net.roads().map(|(id, r)| RoadWire::new(id, r)).collect();
         let h = self.editor.config().size_m * 0.5;
-        let blocks: Vec<_> = wire::block_groups(self.city(), None).into_values().collect();
+        let blocks: Vec<_> = wire::block_groups(self.city(), None)
+            .into_values()
+            .collect();
         let presets: Vec<String> = Neighbourhood::ALL
             .iter()
             .map(pattern_name)
@@ -192,7 +194,10 @@ impl Session {
             }
             Edit::MoveNode { node, to } => {
                 for r in net.roads_at(ControlId(*node)) {
-                    let other = net.road(*r).ok().and_then(|r| r.other_end(ControlId(*node)));
+                    let other = net
+                        .road(*r)
+                        .ok()
+                        .and_then(|r| r.other_end(ControlId(*node)));
                     if let Some(o) = other.and_then(|o| pos(o.0)) {
                         proposed.push(vec![at(to), o]);
                     }
@@ -230,7 +235,7 @@ impl Session {
                 Some(json!({ "w": wire::round(w), "pts": wire::flat(&pts) }))
             })
             .collect();
-        let proposed: Vec<Vec<f64>> = proposed.iter().map(|s| wire::flat(s)).collect();
+        let proposed: Vec<Vec<f64>> = proposed.iter().map(wire::flat).collect();
         let nodes: Vec<_> = nodes
             .iter()
             .map(|n| json!({ "x": wire::round(n.x), "y": wire::round(n.y) }))
@@ -241,7 +246,7 @@ impl Session {
             "proposed": proposed,
             "roads": roads,
             "nodes": nodes,
-            "cells": p.cells,
+            "cells": p.cells.iter().map(|c| wire::id(*c)).collect::<Vec<_>>(),
             "end_node": p.end_node,
         }))
     }
@@ -341,16 +346,17 @@ impl Session {
         for id in &events.blocks.removed {
             block_ids.remove(id);
         }
-        let blocks: Vec<_> = wire::block_groups(self.city(), Some(&block_ids))
-            .into_values()
-            .collect();
+        let groups = wire::block_groups(self.city(), Some(&block_ids));
         // A group that lost everything (its lots and buildings removed) is removed.
-        let mut blocks_removed: Vec<u64> = events.blocks.removed.clone();
+        let mut blocks_removed: Vec<String> =
+            events.blocks.removed.iter().map(|b| wire::id(*b)).collect();
         blocks_removed.extend(
             block_ids
                 .iter()
-                .filter(|id| !blocks.iter().any(|b| b.id == **id)),
+                .filter(|id| !groups.contains_key(id))
+                .map(|b| wire::id(*b)),
         );
+        let blocks: Vec<_> = groups.into_values().collect();
         let r = &events.regenerated;
         let line = format!(
             "{what}: {edit_ms:.1} ms; regrown {} cells, {} blocks, {} buildings, {} dressed; sent {} nodes, {} roads, {} cells, {} block groups",
@@ -378,7 +384,7 @@ impl Session {
             "roads": roads,
             "roads_removed": roads_removed,
             "cells": cells,
-            "cells_removed": events.cells.removed,
+            "cells_removed": events.cells.removed.iter().map(|c| wire::id(*c)).collect::<Vec<_>>(),
             "blocks": blocks,
             "blocks_removed": blocks_removed,
             "log": log,
@@ -396,41 +402,51 @@ impl Session {
             .find(|c| c.id == id)
             .ok_or_else(|| ApiError::not_found(format!("no city cell with id {id}")))?;
         let params = self.cell_params(id, &cell.pattern)?;
-        let d = |name: &str, label: &str, v: polis::roads::secondary::Deviated| {
-            json!({ "name": name, "label": label, "value": v.value, "deviance": v.deviance })
-        };
-        let plain = |name: &str, label: &str, v: f64, integer: bool| {
-            json!({ "name": name, "label": label, "value": v, "deviance": null, "integer": integer })
-        };
+        let d = |name: &str, label: &str, v: polis::roads::secondary::Deviated| json!({ "name": name, "label": label, "value": v.value, "deviance": v.deviance });
+        let plain = |name: &str, label: &str, v: f64, integer: bool| json!({ "name": name, "label": label, "value": v, "deviance": null, "integer": integer });
         let list = vec![
             d("segment_size", "Segment size (m)", params.segment_size_m),
             plain("degree", "Degree", f64::from(params.degree), true),
-            plain("degree_deviance", "Degree deviance", params.degree_deviance, false),
+            plain(
+                "degree_deviance",
+                "Degree deviance",
+                params.degree_deviance,
+                false,
+            ),
             d("snap_size", "Snap size (m)", params.snap_size_m),
             d("road_width", "Road width (m)", params.road_width_m),
             d("connectivity", "Connectivity", params.connectivity),
             d("lot_size", "Lot size (m)", params.lot_size_m),
-            d("building_height", "Building height (m)", params.building_height_m),
+            d(
+                "building_height",
+                "Building height (m)",
+                params.building_height_m,
+            ),
         ];
         let city = self.city();
-        let blocks = wire::block_groups(city, None);
-        let outline: Vec<DVec2> = cell.outline.iter().map(|p| DVec2::new(p[0], p[1])).collect();
-        let streets = wire::streets_in(city, std::slice::from_ref(&outline), &[outline.clone()]);
-        let inside = |ring: &[f64]| {
-            ring.len() >= 2 && wire::ring_contains(&outline, DVec2::new(ring[0], ring[1]))
+        let outline: Vec<DVec2> = cell
+            .outline
+            .iter()
+            .map(|p| DVec2::new(p[0], p[1]))
+            .collect();
+        let one = std::slice::from_ref(&outline);
+        let streets = wire::streets_in(city, one, one);
+        let bbox = polis::geom::Aabb2::from_points(outline.iter().copied());
+        let inside = |p: Option<&DVec2>| {
+            p.is_some_and(|p| bbox.contains(*p) && wire::ring_contains(&outline, *p))
         };
-        let lots: usize = blocks
-            .values()
-            .flat_map(|b| &b.lots)
-            .filter(|l| inside(l))
+        let lots = city
+            .lots
+            .iter()
+            .filter(|l| inside(l.lot.polygon.points().first()))
             .count();
-        let buildings: usize = blocks
-            .values()
-            .flat_map(|b| &b.buildings)
-            .filter(|b| inside(&b.ring))
+        let buildings = city
+            .buildings
+            .iter()
+            .filter(|b| inside(b.footprint.points().first()))
             .count();
         to_json(&json!({
-            "id": id,
+            "id": wire::id(id),
             "pattern": pattern_name(&cell.pattern),
             "params": list,
             "lots": lots,

@@ -16,7 +16,7 @@ use crate::session::Session;
 /// A small Citygen city (fast in a debug build).
 fn small_api() -> Api {
     let mut config = polis::CityConfig::preset("citygen").expect("preset");
-    config.size_m = 900.0;
+    config.size_m = 1200.0;
     Api::new(Session::new(config, false).expect("session"))
 }
 
@@ -33,7 +33,10 @@ fn json_of(r: &Reply) -> Value {
 }
 
 fn error_of(r: &Reply) -> String {
-    json_of(r)["error"].as_str().expect("error message").to_string()
+    json_of(r)["error"]
+        .as_str()
+        .expect("error message")
+        .to_string()
 }
 
 /// A free point far from every primary road and node, inside the map.
@@ -83,7 +86,11 @@ fn the_page_and_every_endpoint_answer() {
     ] {
         let r = call(&api, "GET", path, "");
         assert_eq!(r.status, 200, "{path}");
-        assert!(r.content_type.starts_with(kind), "{path}: {}", r.content_type);
+        assert!(
+            r.content_type.starts_with(kind),
+            "{path}: {}",
+            r.content_type
+        );
         assert!(!r.body.is_empty());
     }
     // The scene: nodes, roads, cells with outlines, block groups with buildings.
@@ -103,7 +110,7 @@ fn the_page_and_every_endpoint_answer() {
         assert!(c["ring"].as_array().expect("ring").len() >= 6);
     }
     // The cell inspector names Kelly's parameters, each with its deviance.
-    let cell = cells[0]["id"].as_u64().expect("cell id");
+    let cell = cells[0]["id"].as_str().expect("cell id");
     let r = call(&api, "GET", &format!("/api/cell/{cell}"), "");
     assert_eq!(r.status, 200);
     let info = json_of(&r);
@@ -113,7 +120,15 @@ fn the_page_and_every_endpoint_answer() {
         .iter()
         .map(|p| p["name"].as_str().expect("name"))
         .collect();
-    for want in ["segment_size", "degree", "snap_size", "road_width", "connectivity", "lot_size", "building_height"] {
+    for want in [
+        "segment_size",
+        "degree",
+        "snap_size",
+        "road_width",
+        "connectivity",
+        "lot_size",
+        "building_height",
+    ] {
         assert!(names.contains(&want), "{want} in {names:?}");
     }
     // Preview, apply, undo, redo, log.
@@ -132,7 +147,10 @@ fn the_page_and_every_endpoint_answer() {
     assert!(r.server_ms.is_some());
     let d = json_of(&r);
     let moved = d["nodes"].as_array().expect("nodes");
-    assert!(moved.iter().any(|n| n["id"] == node), "the moved node is in the delta");
+    assert!(
+        moved.iter().any(|n| n["id"] == node),
+        "the moved node is in the delta"
+    );
     // Incremental: far fewer cells than the scene has.
     assert!(d["cells"].as_array().expect("cells").len() < cells.len().max(2));
     assert_eq!(d["revision"], scene["revision"].as_u64().expect("rev") + 1);
@@ -167,7 +185,12 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
             [c[0] + r * a.cos(), c[1] + r * a.sin()]
         })
         .collect();
-    let add = call(&api, "POST", "/api/apply", &json!({"op": "add_node", "at": pts[0]}).to_string());
+    let add = call(
+        &api,
+        "POST",
+        "/api/apply",
+        &json!({"op": "add_node", "at": pts[0]}).to_string(),
+    );
     assert_eq!(add.status, 200, "{}", String::from_utf8_lossy(&add.body));
     let first = json_of(&add)["end_node"].as_u64().expect("the new node");
     let mut from = first;
@@ -201,7 +224,7 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
             })
         })
         .expect("a cell bounded by the loop");
-    let id = tri["id"].as_u64().expect("id");
+    let id = tri["id"].as_str().expect("id");
     let r = call(
         &api,
         "POST",
@@ -211,8 +234,15 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
     assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
     let d = json_of(&r);
     let changed = d["cells"].as_array().expect("cells");
-    assert!(changed.iter().any(|c| c["id"] == id && c["pattern"] == "suburbia"));
-    assert_eq!(json_of(&call(&api, "GET", &format!("/api/cell/{id}"), ""))["pattern"], "suburbia");
+    assert!(
+        changed
+            .iter()
+            .any(|c| c["id"] == id && c["pattern"] == "suburbia")
+    );
+    assert_eq!(
+        json_of(&call(&api, "GET", &format!("/api/cell/{id}"), ""))["pattern"],
+        "suburbia"
+    );
     // A parameter with its deviance.
     let e = json!({"op": "set_cell_param", "cell": id,
                    "param": {"building_height": {"value": 9.0, "deviance": 0.2}}});
@@ -226,7 +256,10 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
         .find(|p| p["name"] == "building_height")
         .expect("building height")
         .clone();
-    assert_eq!((h["value"].as_f64(), h["deviance"].as_f64()), (Some(9.0), Some(0.2)));
+    assert_eq!(
+        (h["value"].as_f64(), h["deviance"].as_f64()),
+        (Some(9.0), Some(0.2))
+    );
 }
 
 #[test]
@@ -243,19 +276,99 @@ fn bad_requests_get_4xx_with_a_message_and_change_nothing() {
         ("POST", "/api/apply", "\"move_node\"".into(), 400),
         ("POST", "/api/apply", r#"{"node": 1}"#.into(), 400),
         ("POST", "/api/apply", r#"{"op": "explode"}"#.into(), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [1, 2], "extra": 1}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [NaN, 2]}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [null, 2]}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [1e999, 2]}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [1e300, 2]}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": [1e7, 2]}}"#), 422),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": {node}, "to": ["1", 2]}}"#), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "move_node", "node": -1, "to": [1, 2]}}"#), 400),
-        ("POST", "/api/apply", r#"{"op": "move_node", "node": 987654321, "to": [1, 2]}"#.into(), 404),
-        ("POST", "/api/apply", r#"{"op": "delete_road", "road": 987654321}"#.into(), 404),
-        ("POST", "/api/apply", r#"{"op": "set_cell_pattern", "cell": 5, "pattern": "suburbia"}"#.into(), 404),
-        ("POST", "/api/apply", r#"{"op": "set_cell_pattern", "cell": 5, "pattern": "atlantis"}"#.into(), 400),
-        ("POST", "/api/apply", format!(r#"{{"op": "set_node_label", "node": {node}, "label": "{}"}}"#, "x".repeat(5000)), 400),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [1, 2], "extra": 1}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [NaN, 2]}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [null, 2]}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [1e999, 2]}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [1e300, 2]}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": [1e7, 2]}}"#),
+            422,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(r#"{{"op": "move_node", "node": {node}, "to": ["1", 2]}}"#),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "move_node", "node": -1, "to": [1, 2]}"#.to_string(),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "move_node", "node": 987654321, "to": [1, 2]}"#.into(),
+            404,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "delete_road", "road": 987654321}"#.into(),
+            404,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "set_cell_pattern", "cell": 5, "pattern": "suburbia"}"#.into(),
+            404,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "set_cell_pattern", "cell": "5", "pattern": "suburbia"}"#.into(),
+            404,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "set_cell_pattern", "cell": "5x", "pattern": "suburbia"}"#.into(),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            r#"{"op": "set_cell_pattern", "cell": 5, "pattern": "atlantis"}"#.into(),
+            400,
+        ),
+        (
+            "POST",
+            "/api/apply",
+            format!(
+                r#"{{"op": "set_node_label", "node": {node}, "label": "{}"}}"#,
+                "x".repeat(5000)
+            ),
+            400,
+        ),
         ("POST", "/api/preview", "{".into(), 400),
         ("POST", "/api/redo", String::new(), 409),
         ("POST", "/api/undo", String::new(), 409),
@@ -271,7 +384,12 @@ fn bad_requests_get_4xx_with_a_message_and_change_nothing() {
     for (method, url, body, status) in bad {
         let r = call(&api, method, url, &body);
         let short: String = body.chars().take(80).collect();
-        assert_eq!(r.status, status, "{method} {url} {short}: {}", String::from_utf8_lossy(&r.body));
+        assert_eq!(
+            r.status,
+            status,
+            "{method} {url} {short}: {}",
+            String::from_utf8_lossy(&r.body)
+        );
         assert!(!error_of(&r).is_empty());
     }
     // Nothing changed: the scene is the same bytes (its log aside: refusals are logged).
@@ -299,7 +417,11 @@ fn exports_are_files_in_their_formats() {
         assert_eq!(r.status, 200, "{f}: {}", String::from_utf8_lossy(&r.body));
         assert!(r.content_type.starts_with(kind), "{f}");
         assert!(r.download.is_some(), "{f}");
-        assert!(r.body.len() > 50 && r.body.starts_with(magic), "{f}: {} bytes", r.body.len());
+        assert!(
+            r.body.len() > 50 && r.body.starts_with(magic),
+            "{f}: {} bytes",
+            r.body.len()
+        );
     }
 }
 
@@ -307,7 +429,8 @@ fn exports_are_files_in_their_formats() {
 
 fn http(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> (u16, Vec<u8>) {
     let mut s = TcpStream::connect(addr).expect("connect");
-    s.set_read_timeout(Some(Duration::from_secs(120))).expect("timeout");
+    s.set_read_timeout(Some(Duration::from_secs(120)))
+        .expect("timeout");
     let head = format!(
         "{method} {path} HTTP/1.1\r\nHost: test\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
         body.len()
@@ -333,8 +456,8 @@ fn http(addr: SocketAddr, method: &str, path: &str, body: &[u8]) -> (u16, Vec<u8
 #[test]
 fn sockets_serve_concurrent_requests_and_refuse_huge_bodies() {
     let api = Arc::new(small_api());
-    let running = crate::http::serve(Arc::clone(&api), "127.0.0.1:0".parse().expect("addr"))
-        .expect("bind");
+    let running =
+        crate::http::serve(Arc::clone(&api), "127.0.0.1:0".parse().expect("addr")).expect("bind");
     let addr = running.addr;
     assert!(addr.ip().is_loopback());
     let (status, body) = http(addr, "GET", "/api/scene", b"");
@@ -342,7 +465,10 @@ fn sockets_serve_concurrent_requests_and_refuse_huge_bodies() {
     let scene: Value = serde_json::from_slice(&body).expect("scene");
     let node = scene["nodes"][0].clone();
     let id = node["id"].as_u64().expect("id");
-    let (x, y) = (node["x"].as_f64().expect("x"), node["y"].as_f64().expect("y"));
+    let (x, y) = (
+        node["x"].as_f64().expect("x"),
+        node["y"].as_f64().expect("y"),
+    );
     // Eight clients at once: reads, previews and edits interleave; every edit lands.
     let threads: Vec<_> = (0..8)
         .map(|k| {

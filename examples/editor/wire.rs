@@ -5,6 +5,11 @@
 //!
 //! A scene sends everything; an edit's delta sends only the nodes, roads, cells and
 //! block groups its change events name (see [`crate::session`]).
+//!
+//! Ids of city cells, block groups and buildings are 64-bit hashes, beyond the 2⁵³ a
+//! JavaScript number holds exactly, so they travel as decimal strings ([`id`]); the
+//! API turns them back into numbers ([`crate::api::parse_edit`]). Node and road ids are
+//! small counters and stay numbers.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -13,6 +18,11 @@ use polis::geom::{Aabb2, DVec2, PolygonWithHoles};
 use polis::roads::RoadClass;
 use polis::roads::primary::{ControlId, ControlNode, PrimaryRoad, RoadId, RoadSpec};
 use serde::Serialize;
+
+/// A 64-bit id as the page keeps it: a decimal string.
+pub fn id(v: u64) -> String {
+    v.to_string()
+}
 
 /// Centimetres: the page draws at most a few pixels per metre.
 pub fn round(v: f64) -> f64 {
@@ -95,8 +105,8 @@ pub struct StreetWire {
 /// A city cell (a region of the primary network).
 #[derive(Debug, Serialize)]
 pub struct CellWire {
-    /// Its stable id.
-    pub id: u64,
+    /// Its stable id (a decimal string).
+    pub id: String,
     /// Outer ring.
     pub ring: Vec<f64>,
     /// Its neighbourhood preset or grid pattern (`suburbia`, `downtown`, …).
@@ -108,8 +118,8 @@ pub struct CellWire {
 /// A building footprint for the plan and 3-D views.
 #[derive(Debug, Serialize)]
 pub struct BuildingWire {
-    /// Its id (its lot's).
-    pub id: u64,
+    /// Its id (its lot's; a decimal string).
+    pub id: String,
     /// Footprint ring.
     pub ring: Vec<f64>,
     /// Height, metres.
@@ -121,8 +131,8 @@ pub struct BuildingWire {
 /// The blocks, lots and buildings of one road-graph cell (id = `lot id >> 24`).
 #[derive(Debug, Default, Serialize)]
 pub struct BlockWire {
-    /// The road-graph cell's stable id.
-    pub id: u64,
+    /// The road-graph cell's stable id (a decimal string).
+    pub id: String,
     /// Block rings: outer rings and holes (filled even-odd).
     pub rings: Vec<Vec<f64>>,
     /// Lot outer rings.
@@ -139,24 +149,26 @@ fn rings(p: &PolygonWithHoles) -> impl Iterator<Item = Vec<f64>> + '_ {
 pub fn block_groups(city: &City, want: Option<&BTreeSet<u64>>) -> BTreeMap<u64, BlockWire> {
     let pick = |id: u64| want.is_none_or(|w| w.contains(&id));
     let mut out: BTreeMap<u64, BlockWire> = BTreeMap::new();
-    let mut group = |id: u64| -> &mut BlockWire {
+    fn group(out: &mut BTreeMap<u64, BlockWire>, id: u64) -> &mut BlockWire {
         out.entry(id).or_insert_with(|| BlockWire {
-            id,
+            id: self::id(id),
             ..BlockWire::default()
         })
-    };
+    }
     for b in city.blocks.iter().filter(|b| pick(b.cell_id)) {
-        group(b.cell_id).rings.extend(rings(&b.polygon));
+        group(&mut out, b.cell_id).rings.extend(rings(&b.polygon));
     }
     for l in city.lots.iter().filter(|l| pick(l.cell)) {
-        group(l.cell).lots.push(flat(l.lot.polygon.outer.points()));
+        group(&mut out, l.cell)
+            .lots
+            .push(flat(l.lot.polygon.points()));
     }
     for (b, &cell) in city.buildings.iter().zip(&city.building_cells) {
         if !pick(cell) {
             continue;
         }
-        group(cell).buildings.push(BuildingWire {
-            id: b.id,
+        group(&mut out, cell).buildings.push(BuildingWire {
+            id: id(b.id),
             ring: flat(b.footprint.points()),
             h: round(b.height),
             kind: format!("{:?}", b.kind).to_lowercase(),

@@ -454,11 +454,15 @@ function wrap(el, text, input, cls = 'wide') {
   el.appendChild(l);
   return input;
 }
+// A number as the inspector shows it: six significant digits.
+function shown(v) {
+  return typeof v === 'number' ? +v.toPrecision(6) : v;
+}
 function field(el, text, value, _d, cls) {
   const i = document.createElement('input');
   i.type = 'number';
   i.step = 'any';
-  i.value = value;
+  i.value = shown(value);
   return wrap(el, text, i, cls);
 }
 function textField(el, text, value) {
@@ -474,7 +478,7 @@ function pair(el, text, value, deviance, name) {
   const v = document.createElement('input');
   v.type = 'number';
   v.step = 'any';
-  v.value = value;
+  v.value = shown(value);
   v.dataset.param = name;
   l.appendChild(v);
   let d = null;
@@ -482,7 +486,7 @@ function pair(el, text, value, deviance, name) {
     d = document.createElement('input');
     d.type = 'number';
     d.step = 'any';
-    d.value = deviance;
+    d.value = shown(deviance);
     d.dataset.deviance = name;
     l.appendChild(d);
   } else l.appendChild(document.createElement('span'));

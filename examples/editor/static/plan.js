@@ -123,20 +123,27 @@ export class Plan {
       for (const b of blocks) for (const r of b.rings) addRing(ctx, r);
       ctx.fill('evenodd');
       // Lots and footprints only where they are bigger than a few pixels.
-      if (k > 0.25) {
+      if (k > 0.6) {
         ctx.strokeStyle = 'rgba(90,80,60,0.35)';
         ctx.lineWidth = px;
         ctx.beginPath();
         for (const b of blocks) for (const l of b.lots) addRing(ctx, l);
         ctx.stroke();
       }
-      if (k > 0.08) {
+      if (k > 0.2) {
+        // One path per kind: a few fills instead of one per building.
+        const byKind = new Map();
         for (const c of blocks) {
           for (const b of c.buildings) {
-            ctx.fillStyle = kindColour(b.kind);
-            ringPath(ctx, b.ring);
-            ctx.fill();
+            if (!byKind.has(b.kind)) byKind.set(b.kind, []);
+            byKind.get(b.kind).push(b.ring);
           }
+        }
+        for (const [kind, rings] of byKind) {
+          ctx.fillStyle = kindColour(kind);
+          ctx.beginPath();
+          for (const r of rings) addRing(ctx, r);
+          ctx.fill();
         }
       }
     }
@@ -144,12 +151,23 @@ export class Plan {
       ctx.strokeStyle = '#8a8f96';
       ctx.lineCap = 'round';
       ctx.lineJoin = 'round';
+      // One path per width.
+      const byWidth = new Map();
       for (const c of cells) {
         for (const st of c.streets) {
-          ctx.lineWidth = Math.max(px, st.w);
-          linePath(ctx, st.pts);
-          ctx.stroke();
+          const w = Math.max(px, st.w);
+          if (!byWidth.has(w)) byWidth.set(w, []);
+          byWidth.get(w).push(st.pts);
         }
+      }
+      for (const [w, lines] of byWidth) {
+        ctx.lineWidth = w;
+        ctx.beginPath();
+        for (const p of lines) {
+          ctx.moveTo(p[0], p[1]);
+          for (let i = 2; i < p.length; i += 2) ctx.lineTo(p[i], p[i + 1]);
+        }
+        ctx.stroke();
       }
     }
     // Primary roads.

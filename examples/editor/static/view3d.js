@@ -84,7 +84,7 @@ export class View3d {
     for (const k of removedKeys) this.drop(k);
     const layer = this.state.layer;
     for (const k of keys) {
-      const id = Number(k.slice(1));
+      const id = k.slice(1);
       if (k[0] === 'c') {
         const c = this.state.cells.get(id);
         if (c && layer !== 'primary') this.upload(k, roadsMesh(c.streets, 0.25, [0.47, 0.49, 0.52]));
