@@ -20,7 +20,7 @@ use std::sync::Mutex;
 use polis::editor::Edit;
 use serde::Deserialize;
 
-use crate::session::Session;
+use crate::session::{Session, Timing};
 
 /// The largest request body accepted, bytes. Edits are a few hundred bytes.
 pub const MAX_BODY_BYTES: usize = 64 * 1024;
@@ -46,8 +46,8 @@ pub struct Reply {
     pub body: Vec<u8>,
     /// A file name to offer as a download.
     pub download: Option<&'static str>,
-    /// The server's time for an edit, milliseconds (sent as `Server-Timing`).
-    pub server_ms: Option<f64>,
+    /// The server's time for an edit (sent as `Server-Timing`).
+    pub timing: Option<Timing>,
 }
 
 const JSON: &str = "application/json";
@@ -59,7 +59,7 @@ impl Reply {
             content_type,
             body,
             download: None,
-            server_ms: None,
+            timing: None,
         }
     }
 
@@ -259,7 +259,7 @@ impl Api {
                     content_type: e.content_type,
                     body: e.body,
                     download: Some(e.file_name),
-                    server_ms: None,
+                    timing: None,
                 })
             }
             (_, p) if known_path(p) => Err(ApiError {
@@ -273,9 +273,9 @@ impl Api {
 }
 
 /// A committed edit's reply with the server's time in `Server-Timing`.
-fn timed((body, ms): (Vec<u8>, f64)) -> Reply {
+fn timed((body, timing): (Vec<u8>, Timing)) -> Reply {
     let mut r = Reply::json(body);
-    r.server_ms = Some(ms);
+    r.timing = Some(timing);
     r
 }
 

@@ -111,8 +111,11 @@ fn answer(api: &Api, mut request: tiny_http::Request) {
             format!("attachment; filename=\"{name}\""),
         ));
     }
-    if let Some(ms) = reply.server_ms {
-        headers.push(("Server-Timing", format!("edit;dur={ms:.3}")));
+    if let Some(t) = reply.timing {
+        headers.push((
+            "Server-Timing",
+            format!("edit;dur={:.3}, total;dur={:.3}", t.edit_ms, t.total_ms),
+        ));
     }
     if close {
         // The unread rest of a refused body must not be taken for the next request.

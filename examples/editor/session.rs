@@ -29,6 +29,15 @@ pub struct Export {
     pub file_name: &'static str,
 }
 
+/// The server's time for one committed edit, milliseconds.
+#[derive(Debug, Clone, Copy)]
+pub struct Timing {
+    /// The editor's share: applying the edit and regenerating what it touched.
+    pub edit_ms: f64,
+    /// Everything: the edit plus building the delta's JSON.
+    pub total_ms: f64,
+}
+
 /// The editor session: the city, its revision and the output log.
 pub struct Session {
     editor: CityEditor,
@@ -251,8 +260,8 @@ impl Session {
         }))
     }
 
-    /// Commits `edit`; returns the delta and the server's time in milliseconds.
-    pub fn apply(&mut self, edit: &Edit) -> Result<(Vec<u8>, f64), ApiError> {
+    /// Commits `edit`; returns the delta and the server's time.
+    pub fn apply(&mut self, edit: &Edit) -> Result<(Vec<u8>, Timing), ApiError> {
         let started = Instant::now();
         let end_node = match edit {
             Edit::Chain { .. } | Edit::AddRoad { .. } => self.editor.propose(edit).end_node,
@@ -278,14 +287,14 @@ impl Session {
     }
 
     /// Undoes the last edit.
-    pub fn undo(&mut self) -> Result<(Vec<u8>, f64), ApiError> {
+    pub fn undo(&mut self) -> Result<(Vec<u8>, Timing), ApiError> {
         let started = Instant::now();
         let events = self.editor.undo().map_err(api_error)?;
         self.delta(&events, "undo", None, started)
     }
 
     /// Redoes the last undone edit.
-    pub fn redo(&mut self) -> Result<(Vec<u8>, f64), ApiError> {
+    pub fn redo(&mut self) -> Result<(Vec<u8>, Timing), ApiError> {
         let started = Instant::now();
         let events = self.editor.redo().map_err(api_error)?;
         self.delta(&events, "redo", None, started)
@@ -299,7 +308,7 @@ impl Session {
         what: &str,
         end_node: Option<u64>,
         started: Instant,
-    ) -> Result<(Vec<u8>, f64), ApiError> {
+    ) -> Result<(Vec<u8>, Timing), ApiError> {
         self.revision += 1;
         let edit_ms = started.elapsed().as_secs_f64() * 1e3;
         let net = self.editor.network();
@@ -389,7 +398,11 @@ impl Session {
             "blocks_removed": blocks_removed,
             "log": log,
         }))?;
-        Ok((body, started.elapsed().as_secs_f64() * 1e3))
+        let timing = Timing {
+            edit_ms,
+            total_ms: started.elapsed().as_secs_f64() * 1e3,
+        };
+        Ok((body, timing))
     }
 
     /// The cell inspector: the cell's pattern and its generation parameters with their

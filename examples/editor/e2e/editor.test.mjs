@@ -239,6 +239,10 @@ try {
     await page.mouse.down();
     await page.mouse.move(tx, ty, { steps: 8 });
     await page.waitForFunction(() => window.polis.state.preview !== null, null, { timeout: STEP_TIMEOUT });
+    // Fig. 69 while dragging: the proposed roads in red, the corrected ones in green.
+    const pv = await page.evaluate(() => window.polis.state.preview);
+    check(pv.ok && pv.proposed.length === 2 && pv.roads.length === 2, 'dragging previews both roads of the node');
+    await page.screenshot({ path: join(OUT, '3-drag-preview.png') });
     await page.mouse.up();
   }
   await waitRevision(rev);
@@ -308,7 +312,7 @@ async function bench(page, node, tri) {
       await new Promise((r) => requestAnimationFrame(() => r()));
       draws.push(p.plan.drawMs);
     }
-    return { rt: p.state.roundTrips.slice(first), server: p.state.serverMs.slice(first), draws, errors: p.state.errors };
+    return { rt: p.state.roundTrips.slice(first), server: p.state.serverMs.slice(first), edit: p.state.editMs.slice(first), draws, errors: p.state.errors };
   }, [node, BENCH, tri.centre]);
   const q = (xs, f) => {
     const s = [...xs].sort((x, y) => x - y);
@@ -319,6 +323,8 @@ async function bench(page, node, tri) {
     `${result.rt.length} edits (${ARGS.join(' ')})`,
     row('round trip', result.rt),
     row('server', result.server),
+    row('  of which the editor (apply + regenerate)', result.edit),
+    row('  of which the page (round trip − server)', result.rt.map((x, i) => x - result.server[i])),
     row('plan redraw', result.draws),
   ];
   for (const l of lines) console.log(`bench ${l}`);

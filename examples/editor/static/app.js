@@ -27,6 +27,7 @@ const state = {
   log: [],
   roundTrips: [], // ms from request to the page's state updated, per committed edit
   serverMs: [], // the server's share (Server-Timing), per committed edit
+  editMs: [], // the editor's part of it (applying and regenerating)
   errors: 0,
   busy: false,
 };
@@ -73,14 +74,20 @@ async function call(method, url, body) {
   } catch (_) {
     data = { error: text };
   }
-  const timing = res.headers.get('Server-Timing');
-  const serverMs = timing ? parseFloat(timing.split('dur=')[1]) : NaN;
+  // `edit;dur=…, total;dur=…`: the editor's share and the server's whole time.
+  const timing = res.headers.get('Server-Timing') || '';
+  const dur = (name) => {
+    const m = timing.match(new RegExp(`${name};dur=([0-9.]+)`));
+    return m ? parseFloat(m[1]) : NaN;
+  };
+  const serverMs = dur('total');
+  const editMs = dur('edit');
   if (!res.ok) {
     const err = new Error((data && data.error) || `${res.status} ${res.statusText}`);
     err.status = res.status;
     throw err;
   }
-  return { data, serverMs };
+  return { data, serverMs, editMs };
 }
 
 function cellFromWire(c) {
@@ -152,11 +159,12 @@ async function run(method, url, body) {
   state.busy = true;
   const t0 = performance.now();
   try {
-    const { data, serverMs } = await call(method, url, body);
+    const { data, serverMs, editMs } = await call(method, url, body);
     const { changed, removed } = applyDelta(data);
     view.update(changed, removed);
     state.roundTrips.push(performance.now() - t0);
     state.serverMs.push(serverMs);
+    state.editMs.push(editMs);
     state.preview = null;
     plan.requestDraw();
     updateInspector();
@@ -187,6 +195,7 @@ async function pumpPreview() {
     try {
       const { data } = await call('POST', '/api/preview', action);
       state.preview = data;
+      if (!data.ok && data.message) $('status').textContent = `would be refused: ${data.message}`;
     } catch (e) {
       state.preview = null;
     }

@@ -200,18 +200,11 @@ export class Plan {
     this.drawMs = performance.now() - t0;
   }
 
-  // Fig. 69: the proposed action in red, the corrected network in green.
+  // Fig. 69: the corrected network in green, the proposed action over it in red
+  // (dashed, so both show where they coincide).
   drawPreview(ctx, px) {
     const p = this.state.preview;
     if (!p) return;
-    ctx.lineWidth = 3 * px;
-    ctx.setLineDash([8 * px, 6 * px]);
-    ctx.strokeStyle = '#e02020';
-    for (const seg of p.proposed) {
-      linePath(ctx, seg);
-      ctx.stroke();
-    }
-    ctx.setLineDash([]);
     if (p.ok) {
       ctx.strokeStyle = '#20b040';
       for (const r of p.roads) {
@@ -222,6 +215,14 @@ export class Plan {
       ctx.fillStyle = '#20b040';
       for (const n of p.nodes) disc(ctx, n.x, n.y, 6 * px);
     }
+    ctx.lineWidth = 2.5 * px;
+    ctx.setLineDash([8 * px, 6 * px]);
+    ctx.strokeStyle = '#e02020';
+    for (const seg of p.proposed) {
+      linePath(ctx, seg);
+      ctx.stroke();
+    }
+    ctx.setLineDash([]);
   }
 
   // The nearest node within `radiusPx` CSS pixels of a world point.
