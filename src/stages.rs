@@ -510,7 +510,7 @@ struct Tiler {
 
 impl FacadeStage for TiledFacades {
     fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn DressBuilding + 'a>> {
-        Ok(tiler(cx)?)
+        tiler(cx).map(|t| t as Box<dyn DressBuilding + 'a>)
     }
 }
 

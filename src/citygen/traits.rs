@@ -82,7 +82,7 @@ pub fn lot_params_of(
     if !d.traits_apply {
         return None;
     }
-    let mut p = config.lots.clone();
+    let mut p = config.lots;
     let size = d.traits.lot_size_m;
     if !(size.value.is_finite() && size.value > 0.0) {
         return None;

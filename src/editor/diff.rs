@@ -168,6 +168,8 @@ pub(super) fn changes(
             buildings: redone.buildings,
             dresses: redone.dresses,
         },
+        dirty_cells: redone.cells.iter().copied().collect(),
+        dirty_blocks: redone.blocks.iter().copied().collect(),
     }
 }
 

@@ -354,6 +354,14 @@ pub struct ChangeEvents {
     /// Counts of the work redone: cells grown, road-graph cells subdivided, buildings
     /// built, buildings dressed.
     pub regenerated: Regenerated,
+    /// The dirty set of the road stage: city cells whose secondary roads were grown
+    /// again (new inputs), increasing. Every other city cell was reused bit for bit.
+    pub dirty_cells: Vec<u64>,
+    /// The dirty set of the lot stage: road-graph cells whose blocks and lots were made
+    /// again, increasing. Every other road-graph cell kept its blocks and lots bit for
+    /// bit (and its buildings and skins, unless an override or global edit changed
+    /// their inputs).
+    pub dirty_blocks: Vec<u64>,
 }
 
 /// How much work an edit redid (the rest was reused bit for bit).

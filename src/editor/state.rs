@@ -362,7 +362,8 @@ impl CityEditor {
                 self.redo.push(step);
                 Ok(events)
             }
-            Err((e, step)) => {
+            Err(b) => {
+                let (e, step) = *b;
                 self.undo.push(step);
                 Err(e)
             }
@@ -381,7 +382,8 @@ impl CityEditor {
                 self.undo.push(step);
                 Ok(events)
             }
-            Err((e, step)) => {
+            Err(b) => {
+                let (e, step) = *b;
                 self.redo.push(step);
                 Err(e)
             }
@@ -394,7 +396,7 @@ impl CityEditor {
         &mut self,
         step: Step,
         back: bool,
-    ) -> std::result::Result<(ChangeEvents, Step), (Error, Step)> {
+    ) -> std::result::Result<(ChangeEvents, Step), Box<(Error, Step)>> {
         let mut config = self.config.clone();
         match &step.settings {
             Some(other) => {
@@ -408,7 +410,7 @@ impl CityEditor {
                             settings: Some(here),
                         },
                     )),
-                    Err(e) => Err((e, step)),
+                    Err(e) => Err(Box::new((e, step))),
                 }
             }
             None => {
@@ -419,7 +421,7 @@ impl CityEditor {
                 };
                 let changes = match moved {
                     Ok(c) => c,
-                    Err(e) => return Err((road_error(e), step)),
+                    Err(e) => return Err(Box::new((road_error(e), step))),
                 };
                 config.citygen.primary = PrimarySource::Kelly {
                     network: InlinePrimary(Box::new(self.primary.network().clone())),
@@ -436,7 +438,7 @@ impl CityEditor {
                         } else {
                             self.primary.undo()
                         };
-                        Err((e, step))
+                        Err(Box::new((e, step)))
                     }
                 }
             }

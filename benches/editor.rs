@@ -1,0 +1,161 @@
+//! The editable city's benchmark (issue 20): random edits of three kinds on a Citygen
+//! city — move a primary node, change a cell's preset, pin a building — with the wall
+//! time of each committed edit (regeneration, change events and the scene included),
+//! printed as p50 / p95 / max per edit and per dirty cell.
+//!
+//! ```text
+//! cargo bench --bench editor                       # citygen preset, 20 edits per kind
+//! cargo bench --bench editor -- --edits 1000 --size 1500
+//! ```
+//!
+//! Per dirty cell = the edit's wall time divided by the number of city cells it regrew
+//! (at least 1; a pin regrows none). Refused edits (a move whose re-plotted roads would
+//! cross) are counted, not timed.
+
+use std::time::Instant;
+
+use polis::CityConfig;
+use polis::editor::{CityEditor, Edit};
+use polis::geom::hash::splitmix64;
+use polis::roads::secondary::Neighbourhood;
+
+/// CPU seconds used by this process so far (Linux; `None` elsewhere).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let i = ((sorted.len() - 1) as f64 * q).round() as usize;
+    sorted[i.min(sorted.len() - 1)]
+}
+
+struct Stats {
+    per_edit_ms: Vec<f64>,
+    per_cell_ms: Vec<f64>,
+    dirty_cells: usize,
+    refused: usize,
+    cpu_s: f64,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut edits = 20usize;
+    let mut size = None;
+    let mut preset = "citygen".to_string();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--edits" => edits = args.next().ok_or("--edits N")?.parse()?,
+            "--size" => size = Some(args.next().ok_or("--size METRES")?.parse()?),
+            "--preset" => preset = args.next().ok_or("--preset NAME")?,
+            "--bench" => {}
+            other => return Err(format!("unknown argument {other:?}").into()),
+        }
+    }
+    let mut config = CityConfig::preset(&preset)?;
+    if let Some(s) = size {
+        config.size_m = s;
+    }
+    let t = Instant::now();
+    let mut ed = CityEditor::new(config)?;
+    println!(
+        "{preset} ({} m): {} cells, {} lots, {} buildings; editor made in {:.2} s",
+        ed.config().size_m,
+        ed.cells().len(),
+        ed.city().lots.len(),
+        ed.city().buildings.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let mut h = 0x0BE0_C4ED_u64;
+    let mut next = move || {
+        h = splitmix64(h);
+        h
+    };
+    println!(
+        "{:<14} {:>6} {:>8} {:>9} {:>9} {:>9} {:>11} {:>11} {:>11} {:>8}",
+        "edit",
+        "done",
+        "refused",
+        "p50 ms",
+        "p95 ms",
+        "max ms",
+        "p50 ms/cell",
+        "p95 ms/cell",
+        "dirty cells",
+        "CPU s"
+    );
+    for kind in ["move node", "cell preset", "pin building"] {
+        let mut s = Stats {
+            per_edit_ms: Vec::new(),
+            per_cell_ms: Vec::new(),
+            dirty_cells: 0,
+            refused: 0,
+            cpu_s: 0.0,
+        };
+        while s.per_edit_ms.len() < edits && s.refused < edits * 20 {
+            let r = next();
+            let edit = match kind {
+                "move node" => {
+                    let nodes: Vec<_> = ed.network().nodes().map(|(id, n)| (id.0, n.pos)).collect();
+                    let (node, p) = nodes[(r % nodes.len() as u64) as usize];
+                    let dx = (next() % 41) as f64 - 20.0;
+                    let dy = (next() % 41) as f64 - 20.0;
+                    Edit::MoveNode {
+                        node,
+                        to: [p.x + dx, p.y + dy],
+                    }
+                }
+                "cell preset" => {
+                    let cells = ed.cells();
+                    let n = Neighbourhood::ALL[(next() % Neighbourhood::ALL.len() as u64) as usize];
+                    Edit::SetCellPattern {
+                        cell: cells[(r % cells.len() as u64) as usize].id,
+                        pattern: n.into(),
+                    }
+                }
+                _ => {
+                    let lots = &ed.city().lots;
+                    Edit::PinHeight {
+                        lot: lots[(r % lots.len() as u64) as usize].id,
+                        height_m: 40.0 + (next() % 160) as f64,
+                    }
+                }
+            };
+            let cpu = cpu_seconds();
+            let t = Instant::now();
+            match ed.apply(edit) {
+                Ok(ev) => {
+                    let ms = t.elapsed().as_secs_f64() * 1e3;
+                    s.cpu_s += cpu_seconds().zip(cpu).map_or(0.0, |(b, a)| b - a);
+                    s.per_edit_ms.push(ms);
+                    s.per_cell_ms.push(ms / ev.dirty_cells.len().max(1) as f64);
+                    s.dirty_cells += ev.dirty_cells.len();
+                }
+                Err(_) => s.refused += 1,
+            }
+        }
+        s.per_edit_ms.sort_by(f64::total_cmp);
+        s.per_cell_ms.sort_by(f64::total_cmp);
+        println!(
+            "{:<14} {:>6} {:>8} {:>9.1} {:>9.1} {:>9.1} {:>11.1} {:>11.1} {:>11.2} {:>8.1}",
+            kind,
+            s.per_edit_ms.len(),
+            s.refused,
+            quantile(&s.per_edit_ms, 0.5),
+            quantile(&s.per_edit_ms, 0.95),
+            quantile(&s.per_edit_ms, 1.0),
+            quantile(&s.per_cell_ms, 0.5),
+            quantile(&s.per_cell_ms, 0.95),
+            s.dirty_cells as f64 / s.per_edit_ms.len().max(1) as f64,
+            s.cpu_s,
+        );
+    }
+    Ok(())
+}
