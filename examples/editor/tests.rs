@@ -263,6 +263,46 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
 }
 
 #[test]
+fn road_and_node_tools_edit_the_primary_network() {
+    let api = small_api();
+    let scene = json_of(&call(&api, "GET", "/api/scene", ""));
+    let roads = scene["roads"].as_array().expect("roads").len();
+    let nodes = scene["nodes"].as_array().expect("nodes").len();
+    let c = free_point(&scene);
+    let apply = |e: Value| {
+        let r = call(&api, "POST", "/api/apply", &e.to_string());
+        assert_eq!(r.status, 200, "{e}: {}", String::from_utf8_lossy(&r.body));
+        json_of(&r)
+    };
+    // Two free nodes, then Add Road between them (the road tool).
+    let a = apply(json!({"op": "add_node", "at": [c[0] - 50.0, c[1]]}))["end_node"].clone();
+    let b = apply(json!({"op": "add_node", "at": [c[0] + 50.0, c[1]]}))["end_node"].clone();
+    let d = apply(json!({"op": "add_road", "from": {"node": a}, "to": {"node": b}}));
+    let road = d["roads"][0].clone();
+    assert_eq!(
+        (road["a"].clone(), road["b"].clone()),
+        (a.clone(), b.clone())
+    );
+    // The road inspector: a narrower road, re-plotted with the straight strategy.
+    let mut spec = road["spec"].clone();
+    spec["width_m"] = json!(7.5);
+    spec["params"]["strategy"] = json!("Straight");
+    let d = apply(json!({"op": "set_road", "road": road["id"], "spec": spec}));
+    assert_eq!(d["roads"][0]["w"], json!(7.5));
+    assert_eq!(d["roads"][0]["spec"]["params"]["strategy"], "Straight");
+    // A label, then Delete Road and Delete Node.
+    let d = apply(json!({"op": "set_node_label", "node": a, "label": "north gate"}));
+    assert_eq!(d["nodes"][0]["label"], "north gate");
+    let d = apply(json!({"op": "delete_road", "road": road["id"]}));
+    assert_eq!(d["roads_removed"][0], road["id"]);
+    apply(json!({"op": "delete_node", "node": a}));
+    apply(json!({"op": "delete_node", "node": b}));
+    let after = json_of(&call(&api, "GET", "/api/scene", ""));
+    assert_eq!(after["roads"].as_array().expect("roads").len(), roads);
+    assert_eq!(after["nodes"].as_array().expect("nodes").len(), nodes);
+}
+
+#[test]
 fn bad_requests_get_4xx_with_a_message_and_change_nothing() {
     let api = small_api();
     let scene = call(&api, "GET", "/api/scene", "").body;
