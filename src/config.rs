@@ -5,6 +5,7 @@ use std::path::Path;
 
 use polis_buildings::{BuildingKind, BuildingParams};
 use polis_cells::CellParams;
+#[cfg(feature = "gltf")]
 use polis_export::glb::Batching;
 use polis_facades::FacadeStyle;
 use polis_lots::{BlockParams, LotParams};
@@ -287,7 +288,8 @@ pub struct SceneConfig {
     /// Road surfaces as meshes draped on the elevation. Default: true.
     pub road_surfaces: bool,
     /// Node structure of the glb: per building, or batched per cell and material.
-    /// Default: batched (few draw calls, as Citygen).
+    /// Default: batched (few draw calls, as Citygen). Only with the feature `gltf`.
+    #[cfg(feature = "gltf")]
     pub batching: Batching,
     /// Water bodies of the water map as flat surfaces at the level of their lowest
     /// shore point, in a node `water` of their own (false leaves them out). Default: true.
@@ -326,6 +328,7 @@ impl Default for SceneConfig {
         SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
+            #[cfg(feature = "gltf")]
             batching: Batching::default(),
             water_surfaces: true,
             foundations: [Foundation::Highest; 6],

@@ -35,8 +35,26 @@ impl Formats {
         svg: false,
         geojson: false,
     };
+    /// The formats this build can write: each needs the polis-city feature of its name
+    /// (`gltf` for glb), all on by default.
+    pub const AVAILABLE: Formats = Formats {
+        glb: cfg!(feature = "gltf"),
+        obj: cfg!(feature = "obj"),
+        svg: cfg!(feature = "svg"),
+        geojson: cfg!(feature = "geojson"),
+    };
     /// The format names, in the order [`Display`](fmt::Display) lists them.
     pub const NAMES: [&'static str; 4] = ["glb", "obj", "svg", "geojson"];
+    /// The cargo feature of polis-city each format needs, in [`NAMES`](Self::NAMES) order.
+    pub const FEATURES: [&'static str; 4] = ["gltf", "obj", "svg", "geojson"];
+
+    /// The first format asked for that this build cannot write, with the feature it
+    /// needs; `None` when every one asked for is [`AVAILABLE`](Self::AVAILABLE).
+    pub fn not_compiled(self) -> Option<(&'static str, &'static str)> {
+        (0..4)
+            .find(|&i| self.flags()[i] && !Formats::AVAILABLE.flags()[i])
+            .map(|i| (Formats::NAMES[i], Formats::FEATURES[i]))
+    }
 
     fn flags(self) -> [bool; 4] {
         [self.glb, self.obj, self.svg, self.geojson]
@@ -44,8 +62,9 @@ impl Formats {
 }
 
 impl Default for Formats {
+    /// [`Formats::AVAILABLE`]: all four with the default features.
     fn default() -> Self {
-        Formats::ALL
+        Formats::AVAILABLE
     }
 }
 
@@ -69,7 +88,8 @@ impl FromStr for Formats {
     type Err = UnknownFormat;
 
     /// A comma-separated list of `glb`, `obj`, `svg`, `geojson` (case-insensitive,
-    /// spaces ignored, repeats allowed); `all` for every format.
+    /// spaces ignored, repeats allowed); `all` for every format this build can write
+    /// ([`Formats::AVAILABLE`]).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let mut out = Formats::NONE;
         for part in s.split(',').map(str::trim) {
@@ -78,7 +98,7 @@ impl FromStr for Formats {
                 "obj" => out.obj = true,
                 "svg" => out.svg = true,
                 "geojson" => out.geojson = true,
-                "all" => out = Formats::ALL,
+                "all" => out = Formats::AVAILABLE,
                 _ => return Err(UnknownFormat(part.to_string())),
             }
         }
@@ -90,7 +110,8 @@ impl FromStr for Formats {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct WriteOptions {
-    /// Which files to write. Default: [`Formats::ALL`].
+    /// Which files to write. Default: [`Formats::AVAILABLE`] (all four with the default
+    /// features).
     pub formats: Formats,
     /// `[longitude, latitude]` (degrees, WGS 84) of the layout origin: with it the
     /// GeoJSON holds RFC 7946 longitude/latitude (a local tangent-plane projection; see
