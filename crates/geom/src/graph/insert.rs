@@ -480,10 +480,15 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                     let (a, b) = self.endpoints(hit.key)?;
                     let (pa, pb) = (self.position(a)?, self.position(b)?);
                     // An end of the crossed edge close to the crossing: go through it.
+                    // Within rounding of the crossing, the end is where the edges meet
+                    // (the leg passes the end on the wrong side by a few ulps), whatever
+                    // the snap bound says: a node split off beside it would make a
+                    // zero-length edge that other edges cross.
                     let (da, db) = (point.distance(pa), point.distance(pb));
                     if da.min(db) <= snap {
                         let (n, pn) = if da <= db { (a, pa) } else { (b, pb) };
-                        if fresh(n) && near_line(pn) {
+                        let coincident = da.min(db) <= rounding_eps(pn);
+                        if fresh(n) && (coincident || near_line(pn)) {
                             offer(hit.t, Event::Node(n));
                             continue;
                         }

@@ -481,10 +481,18 @@ fn planar_insert_case(data: &[u8]) -> Result<(), String> {
 /// Fuzzing findings of `planar_insert`, pinned. The first: a segment nearly along a
 /// chain passed a chain node within rounding (3e-15 m) without going through it, once
 /// nodes off the caller's segment were no longer routed through; nodes within rounding
-/// of a leg are on it and are routed through whatever the snap bound says.
+/// of a leg are on it and are routed through whatever the snap bound says. The second
+/// (session 8): a leg along a not-quite-collinear chain crossed an edge 1e-15 m from
+/// that edge's end, which lay just beyond the snap distance of the caller's segment, so
+/// the edge was split there instead of routed through its end: a 1e-15 m edge that the
+/// crossed edge then met away from a node (`GraphCorrupt`). A crossing within rounding of
+/// an end now goes through the end.
 #[test]
 fn planar_insert_fuzz_findings() {
-    let cases: [&str; 1] = ["7a428a2a8a8a0a8a8a9a003fe5255f5e5e0000ef00008a8a8abfe1"];
+    let cases: [&str; 2] = [
+        "7a428a2a8a8a0a8a8a9a003fe5255f5e5e0000ef00008a8a8abfe1",
+        "2bc0fc070000f90206af000005b9277eefffffb2b37ab2b2b2ff",
+    ];
     for hex in cases {
         let bytes: Vec<u8> = (0..hex.len() / 2)
             .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
