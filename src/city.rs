@@ -7,17 +7,25 @@ use std::time::Duration;
 
 use polis_buildings::Building;
 use polis_cells::CellDecomposition;
+#[cfg(feature = "geojson")]
+use polis_export::geojson;
+#[cfg(feature = "gltf")]
+use polis_export::glb;
 use polis_export::map::{MapBlock, MapFootprint, MapLayers, MapLot};
+#[cfg(feature = "obj")]
+use polis_export::obj;
+#[cfg(feature = "obj")]
 use polis_export::sink::{DirSink, FileSink};
-use polis_export::{geojson, glb, obj, svg};
+#[cfg(feature = "svg")]
+use polis_export::svg;
 use polis_facades::TileSet;
-use polis_geom::{DVec2, Field, Polygon, PolygonWithHoles, Scene};
+use polis_geom::{DVec2, Field, Polygon, PolygonWithHoles, Scene, par};
 use polis_lots::{Block, Lot};
 use polis_roads::{GrowthReport, RoadNetwork};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::output::{Formats, TEXTURE_DIR, WriteOptions};
+use crate::output::{Formats, WriteOptions};
 use crate::stages::{Dress, Skip, Stage};
 use crate::{CityConfig, CityMaps};
 
@@ -161,6 +169,15 @@ pub struct Written {
 }
 
 /// Creates `path`, lets `write` fill it through a buffer, flushes, and returns the path.
+#[cfg_attr(
+    not(any(
+        feature = "gltf",
+        feature = "obj",
+        feature = "svg",
+        feature = "geojson"
+    )),
+    allow(dead_code)
+)]
 fn write_file(
     path: PathBuf,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
@@ -226,6 +243,7 @@ impl City {
     ///
     /// # Errors
     /// Export and I/O errors.
+    #[cfg(feature = "gltf")]
     pub fn write_glb<W: Write>(&self, out: W) -> Result<glb::GlbReport> {
         self.write_glb_with(out, glb::GlbProfile::Plain)
     }
@@ -235,6 +253,7 @@ impl City {
     ///
     /// # Errors
     /// Export and I/O errors.
+    #[cfg(feature = "gltf")]
     pub fn write_glb_with<W: Write>(
         &self,
         out: W,
@@ -270,24 +289,33 @@ impl City {
     pub fn write_all_with(&self, dir: impl AsRef<Path>, options: &WriteOptions) -> Result<Written> {
         let dir = dir.as_ref();
         let formats = options.formats;
+        if let Some((format, feature)) = formats.not_compiled() {
+            return Err(Error::config(
+                "formats",
+                format!("{format} needs the feature {feature} of polis-city"),
+            ));
+        }
         std::fs::create_dir_all(dir).map_err(|source| Error::Io {
             path: dir.into(),
             source,
         })?;
         // The files are written at the same time (the OBJ text is also formatted in
         // parallel); the first error in the order below is returned.
+        #[cfg(any(feature = "svg", feature = "geojson"))]
         let maps = || -> Result<Vec<PathBuf>> {
             if !(formats.svg || formats.geojson) {
                 return Ok(Vec::new());
             }
             let map = self.map_layers()?;
             let mut files = Vec::new();
+            #[cfg(feature = "svg")]
             if formats.svg {
                 files.push(write_file(dir.join("city.svg"), |w| {
                     svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
                     Ok(())
                 })?);
             }
+            #[cfg(feature = "geojson")]
             if formats.geojson {
                 let geo = geojson::GeoJsonOptions {
                     anchor_lon_lat: options.anchor_lon_lat,
@@ -304,6 +332,9 @@ impl City {
             }
             Ok(files)
         };
+        #[cfg(not(any(feature = "svg", feature = "geojson")))]
+        let maps = || -> Result<Vec<PathBuf>> { Ok(Vec::new()) };
+        #[cfg(feature = "gltf")]
         let glb = || -> Result<Vec<PathBuf>> {
             if !formats.glb {
                 return Ok(Vec::new());
@@ -313,6 +344,9 @@ impl City {
             })?;
             Ok(vec![path])
         };
+        #[cfg(not(feature = "gltf"))]
+        let glb = || -> Result<Vec<PathBuf>> { Ok(Vec::new()) };
+        #[cfg(feature = "obj")]
         let obj = || -> Result<Vec<PathBuf>> {
             if !formats.obj {
                 return Ok(Vec::new());
@@ -324,7 +358,7 @@ impl City {
             let path = write_file(dir.join("city.obj"), |w| {
                 let options = obj::ObjOptions {
                     stem: "city".into(),
-                    texture_dir: TEXTURE_DIR.into(),
+                    texture_dir: crate::output::TEXTURE_DIR.into(),
                 };
                 obj::write_obj(&self.scene, &options, w, &mut sink)?;
                 Ok(())
@@ -336,7 +370,9 @@ impl City {
             files.extend(sink.names.iter().map(|n| dir.join(n)));
             Ok(files)
         };
-        let (maps, (glb, obj)) = rayon::join(maps, || rayon::join(glb, obj));
+        #[cfg(not(feature = "obj"))]
+        let obj = || -> Result<Vec<PathBuf>> { Ok(Vec::new()) };
+        let (maps, (glb, obj)) = par::join(maps, || par::join(glb, obj));
         let mut files = maps?;
         files.extend(glb?);
         files.extend(obj?);
@@ -345,11 +381,13 @@ impl City {
 }
 
 /// A [`DirSink`] that remembers the names of the files it wrote.
+#[cfg(feature = "obj")]
 struct RecordingSink {
     inner: DirSink,
     names: Vec<String>,
 }
 
+#[cfg(feature = "obj")]
 impl FileSink for RecordingSink {
     fn write_file(&mut self, name: &str, contents: &[u8]) -> std::io::Result<()> {
         self.inner.write_file(name, contents)?;

@@ -26,13 +26,13 @@ use std::sync::Arc;
 use polis_cells::Cell;
 use polis_geom::graph::SnapOptions;
 use polis_geom::hash::splitmix64;
+use polis_geom::par::prelude::*;
 use polis_geom::{DVec2, Field};
 use polis_roads::grid_builders::{GridBuilderGrowth, GridError, GridMaps, GridParams};
 use polis_roads::secondary::{
     CellMaps, Neighbourhood, SecondaryCell, SecondaryError, SecondaryGrowth, SecondaryRoads,
 };
 use polis_roads::{Junction, Road, RoadClass, RoadNetwork};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use polis_buildings::{BuildingKind, BuildingParams};
 use polis_cells::CellParams;
+#[cfg(feature = "gltf")]
 use polis_export::glb::Batching;
 use polis_facades::FacadeStyle;
 use polis_lots::{BlockParams, LotParams};
@@ -288,7 +289,8 @@ pub struct SceneConfig {
     pub road_surfaces: bool,
     /// Node structure of the glb: tiles of merged geometry per layer and material, per
     /// cell, or per building. Default: tiled (few draw calls; see
-    /// [`Batching`] for when to use which).
+    /// [`Batching`] for when to use which). Only with the feature `gltf`.
+    #[cfg(feature = "gltf")]
     pub batching: Batching,
     /// Side of the glb's square tiles with [`Batching::Tiled`], metres (see
     /// `polis_export::glb::GlbOptions::tile_size_m`). Default: 250.
@@ -337,6 +339,7 @@ impl Default for SceneConfig {
         SceneConfig {
             kerb_height_m: 0.15,
             road_surfaces: true,
+            #[cfg(feature = "gltf")]
             batching: Batching::default(),
             tile_size_m: 250.0,
             coarse_lod: false,

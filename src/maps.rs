@@ -138,6 +138,7 @@ impl From<Shape> for MapSpec {
 impl MapSpec {
     /// A grey-scale PNG covering `extent` (metres): the image's top row is the extent's
     /// north edge. Values are in [0, 1].
+    #[cfg(feature = "png")]
     pub fn png(path: impl Into<std::path::PathBuf>, extent: polis_geom::Aabb2) -> Self {
         MapSpec::Field(FieldSpec::Png {
             path: path.into(),

@@ -4,6 +4,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+#[cfg(feature = "gltf")]
 use polis_export::glb::GlbProfile;
 use serde::{Deserialize, Serialize};
 
@@ -36,8 +37,26 @@ impl Formats {
         svg: false,
         geojson: false,
     };
+    /// The formats this build can write: each needs the polis-city feature of its name
+    /// (`gltf` for glb), all on by default.
+    pub const AVAILABLE: Formats = Formats {
+        glb: cfg!(feature = "gltf"),
+        obj: cfg!(feature = "obj"),
+        svg: cfg!(feature = "svg"),
+        geojson: cfg!(feature = "geojson"),
+    };
     /// The format names, in the order [`Display`](fmt::Display) lists them.
     pub const NAMES: [&'static str; 4] = ["glb", "obj", "svg", "geojson"];
+    /// The cargo feature of polis-city each format needs, in [`NAMES`](Self::NAMES) order.
+    pub const FEATURES: [&'static str; 4] = ["gltf", "obj", "svg", "geojson"];
+
+    /// The first format asked for that this build cannot write, with the feature it
+    /// needs; `None` when every one asked for is [`AVAILABLE`](Self::AVAILABLE).
+    pub fn not_compiled(self) -> Option<(&'static str, &'static str)> {
+        (0..4)
+            .find(|&i| self.flags()[i] && !Formats::AVAILABLE.flags()[i])
+            .map(|i| (Formats::NAMES[i], Formats::FEATURES[i]))
+    }
 
     fn flags(self) -> [bool; 4] {
         [self.glb, self.obj, self.svg, self.geojson]
@@ -45,8 +64,9 @@ impl Formats {
 }
 
 impl Default for Formats {
+    /// [`Formats::AVAILABLE`]: all four with the default features.
     fn default() -> Self {
-        Formats::ALL
+        Formats::AVAILABLE
     }
 }
 
@@ -70,7 +90,8 @@ impl FromStr for Formats {
     type Err = UnknownFormat;
 
     /// A comma-separated list of `glb`, `obj`, `svg`, `geojson` (case-insensitive,
-    /// spaces ignored, repeats allowed); `all` for every format.
+    /// spaces ignored, repeats allowed); `all` for every format this build can write
+    /// ([`Formats::AVAILABLE`]).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let mut out = Formats::NONE;
         for part in s.split(',').map(str::trim) {
@@ -79,7 +100,7 @@ impl FromStr for Formats {
                 "obj" => out.obj = true,
                 "svg" => out.svg = true,
                 "geojson" => out.geojson = true,
-                "all" => out = Formats::ALL,
+                "all" => out = Formats::AVAILABLE,
                 _ => return Err(UnknownFormat(part.to_string())),
             }
         }
@@ -91,7 +112,8 @@ impl FromStr for Formats {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct WriteOptions {
-    /// Which files to write. Default: [`Formats::ALL`].
+    /// Which files to write. Default: [`Formats::AVAILABLE`] (all four with the default
+    /// features).
     pub formats: Formats,
     /// `[longitude, latitude]` (degrees, WGS 84) of the layout origin: with it the
     /// GeoJSON holds RFC 7946 longitude/latitude (a local tangent-plane projection; see
@@ -99,7 +121,8 @@ pub struct WriteOptions {
     /// Default: none.
     pub anchor_lon_lat: Option<[f64; 2]>,
     /// Extensions the glb may use: plain glTF 2.0, or the web profile (quantized,
-    /// meshopt-compressed). Default: [`GlbProfile::Plain`].
+    /// meshopt-compressed). Default: [`GlbProfile::Plain`]. Only with the feature `gltf`.
+    #[cfg(feature = "gltf")]
     pub glb_profile: GlbProfile,
 }
 
@@ -108,6 +131,7 @@ impl From<Formats> for WriteOptions {
         WriteOptions {
             formats,
             anchor_lon_lat: None,
+            #[cfg(feature = "gltf")]
             glb_profile: GlbProfile::Plain,
         }
     }

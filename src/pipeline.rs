@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use polis_geom::SpatialIndex;
-use rayon::prelude::*;
+use polis_geom::par::{self, prelude::*};
 
 use polis_buildings::Building;
 use polis_cells::Cell;
@@ -218,14 +218,10 @@ impl Pipeline {
     /// Runs `job` on the configured thread pool.
     fn install<T: Send>(&self, config: &CityConfig, job: impl FnOnce() -> T + Send) -> Result<T> {
         match config.threads {
-            Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| Error::Threads {
-                    threads: n,
-                    message: e.to_string(),
-                })?
-                .install(job)),
+            Some(n) => par::install(n, job).map_err(|e| Error::Threads {
+                threads: e.threads,
+                message: e.message,
+            }),
             None => Ok(job()),
         }
     }
@@ -269,7 +265,7 @@ impl Pipeline {
         // grammars prepared on the other thread meanwhile. Each stage's time is its own
         // elapsed time, so these overlap.
         self.report(Stage::Roads, 0.0);
-        let (roads, prepared) = rayon::join(
+        let (roads, prepared) = par::join(
             || timed(|| self.roads.roads(&cx)),
             || {
                 let builder = timed(|| self.buildings.prepare(&cx))?;

@@ -16,6 +16,7 @@ use polis_export::map::{MapRoad, RoadClass as MapClass};
 use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
 use polis_facades::TileSet;
 
+use polis_geom::par::{self, prelude::*};
 use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, Node, NodeId, Texture};
 use polis_geom::{
     DVec2, DVec3, Facing, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene, Transform,
@@ -23,7 +24,6 @@ use polis_geom::{
 };
 use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
-use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::stages::{Dress, SkinQuad};
@@ -516,9 +516,9 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect())
     };
-    let ((road, water), (blocks, buildings)) = rayon::join(
-        || rayon::join(road_mesh, water_job),
-        || rayon::join(blocks_job, buildings_job),
+    let ((road, water), (blocks, buildings)) = par::join(
+        || par::join(road_mesh, water_job),
+        || par::join(blocks_job, buildings_job),
     );
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;

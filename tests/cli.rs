@@ -157,3 +157,79 @@ fn the_custom_road_stage_makes_a_whole_city() {
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).starts_with("error: stage roads: spacing 5 m"));
 }
+
+/// The GeoJSON of `city --anchor`, read back by an independent RFC 7946 reader (the
+/// `geojson` crate): every position is a WGS 84 longitude/latitude inside the valid
+/// ranges and within the city's reach of the anchor; the same run without `--anchor`
+/// writes local metres.
+#[test]
+fn anchored_geojson_from_the_cli_is_wgs84() {
+    fn positions(value: &geojson::Value, out: &mut Vec<Vec<f64>>) {
+        match value {
+            geojson::Value::Point(p) => out.push(p.clone()),
+            geojson::Value::MultiPoint(ps) | geojson::Value::LineString(ps) => {
+                out.extend(ps.iter().cloned())
+            }
+            geojson::Value::Polygon(rings) | geojson::Value::MultiLineString(rings) => {
+                rings.iter().for_each(|r| out.extend(r.iter().cloned()))
+            }
+            geojson::Value::MultiPolygon(polys) => polys
+                .iter()
+                .flatten()
+                .for_each(|r| out.extend(r.iter().cloned())),
+            geojson::Value::GeometryCollection(gs) => {
+                gs.iter().for_each(|g| positions(&g.value, out))
+            }
+        }
+    }
+    fn read(path: &std::path::Path) -> Vec<Vec<f64>> {
+        let text = std::fs::read_to_string(path).expect("the GeoJSON was written");
+        let parsed: geojson::GeoJson = text.parse().expect("valid GeoJSON");
+        let geojson::GeoJson::FeatureCollection(fc) = parsed else {
+            panic!("a FeatureCollection");
+        };
+        let mut all = Vec::new();
+        for f in &fc.features {
+            if let Some(g) = &f.geometry {
+                positions(&g.value, &mut all);
+            }
+        }
+        all
+    }
+    let dir = std::env::temp_dir().join(format!("polis-cli-geo-{}", std::process::id()));
+    let dir_arg = dir.to_str().expect("utf-8 path");
+    let common = ["--size=400", "--formats=geojson", "--out", dir_arg];
+    let out = run("city", &[&common[..], &["--anchor=-73.98,40.75"]].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let geo = read(&dir.join("city.geojson"));
+    assert!(
+        !dir.join("city.glb").exists(),
+        "only the GeoJSON was asked for"
+    );
+    let out = run("city", &common);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let local = read(&dir.join("city.geojson"));
+    let _ = std::fs::remove_dir_all(&dir);
+
+    assert!(
+        geo.len() > 100,
+        "a city has features: {} positions",
+        geo.len()
+    );
+    assert_eq!(geo.len(), local.len(), "the same features in both systems");
+    // 400 m of layout is about 0.005° of longitude and 0.004° of latitude at 40.75° N.
+    for (g, l) in geo.iter().zip(&local) {
+        let [lon, lat] = [g[0], g[1]];
+        assert!((-180.0..=180.0).contains(&lon) && (-90.0..=90.0).contains(&lat));
+        assert!(
+            (lon + 73.98).abs() < 0.01 && (lat - 40.75).abs() < 0.01,
+            "{g:?}"
+        );
+        // Local metres: the same point (within the projection's scale, well under 1 %).
+        let north_m = (lat - 40.75).to_radians() * 6_378_137.0;
+        assert!(
+            (north_m - l[1]).abs() < 0.01 * l[1].abs() + 1.0,
+            "{g:?} vs {l:?}"
+        );
+    }
+}

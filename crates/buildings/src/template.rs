@@ -63,6 +63,7 @@ impl Template {
 
     /// A template from OBJ text (all objects merged; materials ignored; polygons
     /// triangulated by `tobj`).
+    #[cfg(feature = "obj")]
     pub fn from_obj_str(name: &str, obj: &str) -> Result<Self, BuildingsError> {
         let options = tobj::LoadOptions {
             triangulate: true,

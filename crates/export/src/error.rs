@@ -68,6 +68,16 @@ pub enum ExportError {
     },
 }
 
+// With some writers switched off (features) some helpers have no caller.
+#[cfg_attr(
+    not(all(
+        feature = "gltf",
+        feature = "obj",
+        feature = "svg",
+        feature = "geojson"
+    )),
+    allow(dead_code)
+)]
 impl ExportError {
     /// An [`Io`](Self::Io) error about `what`.
     pub(crate) fn io(what: impl Into<String>) -> impl FnOnce(std::io::Error) -> ExportError {

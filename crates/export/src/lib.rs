@@ -43,6 +43,14 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! ## Features
+//!
+//! All on by default: `gltf` ([`glb`]), `obj` ([`obj`]), `svg` ([`svg`]), `geojson`
+//! ([`geojson`]) — one per writer —, `png` (PNG encoding of raw scene images, needed by
+//! the glb and OBJ writers) and `parallel` (the OBJ text formatted on rayon through
+//! [`geom::par`]; the same bytes without). [`map`], [`surfaces`], [`footpaths`] and
+//! [`sink`] are always there.
+//!
 //! ## Guarantees
 //!
 //! * **Nothing invalid is written.** Scenes pass [`Scene::validate`](geom::Scene::validate)
@@ -75,19 +83,27 @@
 //! * G. Kelly, *An Interactive System for Procedural City Generation* (2008): batching
 //!   geometry per cell and material for few draw calls.
 
+#[cfg(feature = "gltf")]
 pub use gltf;
 pub use polis_geom as geom;
 
 mod error;
 pub mod footpaths;
+#[cfg(feature = "geojson")]
 pub mod geojson;
+#[cfg(feature = "gltf")]
 pub mod glb;
+#[cfg(feature = "png")]
+#[cfg_attr(not(all(feature = "gltf", feature = "obj")), allow(dead_code))]
 mod images;
 pub mod map;
+#[cfg(feature = "obj")]
 pub mod obj;
 pub mod sink;
 pub mod surfaces;
+#[cfg(feature = "svg")]
 pub mod svg;
+#[cfg(feature = "obj")]
 mod text;
 
 pub use error::ExportError;

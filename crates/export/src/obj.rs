@@ -39,8 +39,8 @@ use std::io::Write;
 
 use polis_geom::Mesh;
 use polis_geom::glam::{DMat3, DMat4};
+use polis_geom::par::{self, prelude::*};
 use polis_geom::scene::{Material, Scene};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
@@ -237,18 +237,17 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     };
     let mut ready = batches.first().map(&format).unwrap_or_default();
     for k in 0..batches.len() {
-        let mut next = None;
-        let written = rayon::in_place_scope(|s| {
-            if let Some(range) = batches.get(k + 1) {
-                s.spawn(|_| next = Some(format(range)));
-            }
-            ready.iter().try_for_each(|text| {
-                bytes += text.len() as u64;
-                obj.write_all(text)
-            })
-        });
+        let (written, next) = par::run_beside(
+            || batches.get(k + 1).map(&format).unwrap_or_default(),
+            || {
+                ready.iter().try_for_each(|text| {
+                    bytes += text.len() as u64;
+                    obj.write_all(text)
+                })
+            },
+        );
         written.map_err(ExportError::io("obj"))?;
-        ready = next.unwrap_or_default();
+        ready = next;
     }
     obj.flush().map_err(ExportError::io("obj"))?;
     report.bytes = bytes;

@@ -107,6 +107,7 @@ impl MaterialImage {
     ///
     /// # Errors
     /// [`FacadeError::Png`] for undecodable data or images too large to decode.
+    #[cfg(feature = "png")]
     pub fn from_png(bytes: &[u8], base: FacadeSample) -> Result<Self> {
         let (w, h, rgba) = polis_geom::field::decode_png_rgba8(bytes).map_err(|e| match e {
             polis_geom::GeomError::Image(message) => FacadeError::Png(message),

@@ -126,7 +126,9 @@ pub use image::{ImageSet, ImageStyle, MaterialImage};
 pub use interval::{Hit, Interval, IntervalGroup, Part};
 pub use layer::{CellRole, Eval, EvalFn, Layer, Probe};
 pub use profile::Profile;
-pub use raster::{FacadeTextures, RasterOptions, encode_png};
+#[cfg(feature = "png")]
+pub use raster::encode_png;
+pub use raster::{FacadeTextures, RasterOptions};
 pub use sample::FacadeSample;
 pub use stack::{Influence, LayerStack, Relation};
 pub use style::{AxisRef, EvalStyle, InfluenceStyle, LayerStyle, Pick, Select, StackStyle};

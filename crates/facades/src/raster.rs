@@ -73,6 +73,7 @@ impl FacadeTextures {
     ///
     /// # Errors
     /// [`FacadeError::Png`].
+    #[cfg(feature = "png")]
     pub fn albedo_png(&self) -> Result<Vec<u8>> {
         encode_png(self.width, self.height, png::ColorType::Rgba, &self.albedo)
     }
@@ -81,6 +82,7 @@ impl FacadeTextures {
     ///
     /// # Errors
     /// [`FacadeError::Png`].
+    #[cfg(feature = "png")]
     pub fn normal_png(&self) -> Result<Vec<u8>> {
         encode_png(self.width, self.height, png::ColorType::Rgba, &self.normal)
     }
@@ -89,6 +91,7 @@ impl FacadeTextures {
     ///
     /// # Errors
     /// [`FacadeError::Png`].
+    #[cfg(feature = "png")]
     pub fn metallic_roughness_png(&self) -> Result<Vec<u8>> {
         encode_png(
             self.width,
@@ -103,6 +106,7 @@ impl FacadeTextures {
 ///
 /// # Errors
 /// [`FacadeError::Png`] if the data does not match the size or encoding fails.
+#[cfg(feature = "png")]
 pub fn encode_png(width: u32, height: u32, color: png::ColorType, data: &[u8]) -> Result<Vec<u8>> {
     let mut out = Vec::new();
     {

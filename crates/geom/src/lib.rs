@@ -17,6 +17,7 @@
 //! | [`measure`] | minimum enclosing circle (Welzl), segment–segment and segment–polygon distances |
 //! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks |
 //! | [`scene`] | [`Scene`]: node tree, materials, textures, images — the contract between generators and exporters |
+//! | [`par`] | the one parallel-or-serial switch (rayon with feature `parallel`, plain iterators without) used by every crate that runs loops in parallel |
 //! | [`metadata`] | [`Metadata`](metadata::Metadata): a node's small ordered map of [`MetaValue`]s (glTF `extras`, GeoJSON properties) |
 //!
 //! ## Numeric policy
@@ -53,6 +54,7 @@ pub mod lines;
 pub mod measure;
 pub mod mesh;
 pub mod metadata;
+pub mod par;
 pub mod polygon;
 pub mod predicates;
 pub mod scene;

@@ -26,7 +26,7 @@ use crate::boxgrid::BoxGrid;
 use crate::input::CityInput;
 use crate::simplify::SimpleGraph;
 use crate::{StatsOptions, summary::ratio};
-use rayon::prelude::*;
+use polis_geom::par::{self, prelude::*};
 
 /// The plan-defect counters.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -87,7 +87,7 @@ fn build_indexes(city: &CityInput<'_>) -> Indexes {
     let max_half_width = g.edges.iter().map(|e| e.width_m * 0.5).fold(0.0, f64::max);
     let lots = city.lots.iter().map(|l| l.polygon.bbox()).collect();
     let blocks = city.blocks.iter().map(|b| b.outer.bbox()).collect();
-    let (lots, (roads, blocks)) = rayon::join(
+    let (lots, (roads, blocks)) = par::join(
         || BoxGrid::new(lots, GRID_CELL_M),
         || {
             (

@@ -49,6 +49,7 @@ pub(crate) struct ArrayLayout {
     pub offset: u64,
     pub length: u64,
     /// Web profile: `(offset, length)` of the meshopt stream in the binary chunk.
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
     pub compressed: Option<(u64, u64)>,
 }
 
@@ -62,6 +63,7 @@ impl ArrayLayout {
     }
 
     /// The `EXT_meshopt_compression` mode of the view.
+    #[cfg(feature = "web")]
     pub fn meshopt_mode(&self) -> &'static str {
         if self.slot == Slot::Index {
             "TRIANGLES"
@@ -71,6 +73,7 @@ impl ArrayLayout {
     }
 
     /// The element size the codec sees (the stride, or the index size).
+    #[cfg(feature = "web")]
     pub fn element_size(&self) -> usize {
         self.stride.unwrap_or(match self.component {
             json::accessor::ComponentType::U32 | json::accessor::ComponentType::F32 => 4,

@@ -185,6 +185,7 @@ pub fn write_glb<W: Write>(
     };
     let root = document(scene, &plan, &layout, &used)?;
     let json_bytes = if layout.fallback_len.is_some() {
+        #[cfg_attr(not(feature = "web"), allow(unused_mut))]
         let mut doc = serde_json::to_value(&root).map_err(ExportError::json("glTF JSON"))?;
         #[cfg(feature = "web")]
         web::add_extensions(&mut doc, &layout);

@@ -23,8 +23,8 @@ use meshoptimizer_rs::codec::{
 };
 use meshoptimizer_rs::{Limits, Workspace, optimize_vertex_cache};
 use polis_geom::glam::Vec3;
+use polis_geom::par::prelude::*;
 use polis_geom::scene::Scene;
-use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use super::layout::{

@@ -10,14 +10,7 @@ use crate::{Aabb2, GeomError};
 /// e.g. 16 384² grey 16-bit). Protects against headers that claim enormous sizes.
 pub const MAX_PNG_DECODED_BYTES: usize = 512 << 20;
 
-/// The default largest image, in pixels (width × height), the PNG loaders decode:
-/// 2²⁶ ≈ 67 million (8192 × 8192). A map raster keeps one `f32` per pixel (256 MiB at
-/// this size) and a texture four bytes, so the limit bounds memory by what the image
-/// decodes to, not by the file's size: a PNG of a few hundred kilobytes can claim
-/// 20,000 × 20,000 pixels. Checked from the header, before anything is allocated. Use the
-/// `*_limited` loaders ([`Raster::from_png_bytes_limited`], [`decode_png_rgba8_limited`])
-/// or `maps.max_image_pixels` of a city configuration for another limit.
-pub const DEFAULT_MAX_PNG_PIXELS: u64 = 1 << 26;
+use super::DEFAULT_MAX_PNG_PIXELS;
 
 /// Rec. 709 luma weights applied to RGB channel values.
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];

@@ -97,13 +97,20 @@ pub use combinators::{
 };
 pub use contour::{ContourOptions, MAX_CONTOUR_CELLS, contour_regions};
 #[cfg(feature = "png")]
-pub use image::{
-    DEFAULT_MAX_PNG_PIXELS, MAX_PNG_DECODED_BYTES, decode_png_rgba8, decode_png_rgba8_limited,
-};
+pub use image::{MAX_PNG_DECODED_BYTES, decode_png_rgba8, decode_png_rgba8_limited};
 pub use noise::{Fbm, FbmParams, MAX_OCTAVES, SimplexNoise};
 pub use population::{Population, PopulationParams};
 pub use raster::Raster;
 pub use spec::FieldSpec;
+
+/// The default largest image, in pixels (width × height), the PNG loaders decode:
+/// 2²⁶ ≈ 67 million (8192 × 8192). A map raster keeps one `f32` per pixel (256 MiB at
+/// this size) and a texture four bytes, so the limit bounds memory by what the image
+/// decodes to, not by the file's size: a PNG of a few hundred kilobytes can claim
+/// 20,000 × 20,000 pixels. Checked from the header, before anything is allocated. Use the
+/// `*_limited` loaders (`Raster::from_png_bytes_limited`, `decode_png_rgba8_limited`)
+/// or `maps.max_image_pixels` of a city configuration for another limit.
+pub const DEFAULT_MAX_PNG_PIXELS: u64 = 1 << 26;
 
 /// Step, in metres, of the central differences used by the default [`Field::gradient`].
 ///

@@ -190,6 +190,8 @@ impl FieldSpec {
     /// [`Raster::from_png_bytes_limited`]).
     ///
     /// Errors: as [`build`](Self::build).
+    // Without the feature `png` no variant reads an image, so the limit only recurses.
+    #[cfg_attr(not(feature = "png"), allow(clippy::only_used_in_recursion))]
     pub fn build_limited(&self, max_pixels: u64) -> Result<Box<dyn Field>, GeomError> {
         Ok(match self {
             FieldSpec::Constant { value } => Box::new(Constant(*value)),
