@@ -61,6 +61,7 @@ pub mod citygen;
 mod clock;
 mod config;
 mod error;
+mod ground;
 mod maps;
 mod output;
 mod pipeline;
@@ -84,6 +85,7 @@ pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::reference_city_name;
+pub use scene::CORRIDOR_CUT_M;
 pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

@@ -53,6 +53,7 @@ pub mod lines;
 pub mod measure;
 pub mod mesh;
 pub mod metadata;
+pub mod paint;
 pub mod polygon;
 pub mod predicates;
 pub mod scene;
