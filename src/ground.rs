@@ -163,3 +163,72 @@ pub(crate) fn validate(scene: &SceneConfig) -> std::result::Result<(), (&'static
     }
     Ok(())
 }
+
+/// Thickness of a bridge deck under its road surface, metres.
+pub const BRIDGE_DECK_M: f64 = 1.2;
+/// Spacing of a bridge's piers along it, metres (at least one pier per bridge).
+pub const BRIDGE_PIER_SPACING_M: f64 = 40.0;
+/// Side of a square pier, metres.
+const PIER_SIDE_M: f64 = 2.0;
+/// How far a pier reaches into the ground below it, metres.
+const PIER_FOOT_M: f64 = 1.0;
+
+/// The decks and piers of the network's bridges (roads flagged `bridge` by the road
+/// generator), as closed solids in one mesh: each deck a slab of the road's width,
+/// [`BRIDGE_DECK_M`] thick, its top just under the road surface (which runs straight
+/// between the bridge's ends at the ground's height there, as the road surfaces do),
+/// and square piers every [`BRIDGE_PIER_SPACING_M`] from below the ground (or water bed)
+/// up to the deck. `None` when there is no bridge.
+pub(crate) fn bridge_mesh(
+    network: &polis_roads::RoadNetwork,
+    ground: &dyn Field,
+) -> Result<Option<polis_geom::Mesh>> {
+    use polis_geom::mesh::RefineOptions;
+    use polis_geom::{Mesh, Polygon};
+    let mut mesh = Mesh::new(None);
+    // Under the road surface's lift (5 cm and the class lifts).
+    let top = -0.04;
+    let refine = RefineOptions {
+        max_area: 1e9,
+        ..RefineOptions::default()
+    };
+    for (e, _, _, road) in network.edges() {
+        if !road.bridge || road.width <= 0.0 {
+            continue;
+        }
+        let (a, b) = network.segment(e)?;
+        let len = a.distance(b);
+        if len <= 0.0 {
+            continue;
+        }
+        let (ha, hb) = (ground.sample(a), ground.sample(b));
+        if !(ha.is_finite() && hb.is_finite()) {
+            continue;
+        }
+        let dir = (b - a) / len;
+        let side = dir.perp() * (0.5 * road.width);
+        let deck = PolygonWithHoles::new(
+            Polygon::new(vec![a - side, a + side, b + side, b - side]),
+            vec![],
+        );
+        let mut deck = deck;
+        deck.normalize();
+        let along = |p: DVec2| ha + (hb - ha) * ((p - a).dot(dir) / len).clamp(0.0, 1.0);
+        mesh.add_draped_slab(&deck, &refine, along, top - BRIDGE_DECK_M, top)?;
+        let piers = ((len / BRIDGE_PIER_SPACING_M).floor() as usize).max(1);
+        for k in 1..=piers {
+            let c = a + dir * (len * k as f64 / (piers + 1) as f64);
+            let h = PIER_SIDE_M * 0.5;
+            let square = PolygonWithHoles::new(
+                Polygon::rect(c - DVec2::splat(h), c + DVec2::splat(h)),
+                vec![],
+            );
+            let deck_bottom = along(c) + top - BRIDGE_DECK_M;
+            let floor = ground.sample(c) - PIER_FOOT_M;
+            if floor.is_finite() && floor < deck_bottom {
+                mesh.add_prism(&square, floor, deck_bottom)?;
+            }
+        }
+    }
+    Ok((!mesh.is_empty()).then_some(mesh))
+}

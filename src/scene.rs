@@ -556,6 +556,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }
+    // Bridges: closed decks on piers under the road surfaces.
+    if let Some(mut mesh) = crate::ground::bridge_mesh(inp.network, elevation)? {
+        let concrete = Material::new("bridge", [0.62, 0.60, 0.57, 1.0]);
+        mesh.material = Some(scene.add_material(concrete));
+        let node = scene.add_node(root, "bridges")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
     if !water.is_empty() {
         let material = scene.add_material(Material {
             roughness: 0.1,

@@ -133,23 +133,43 @@ fn nothing_floats_and_nothing_is_buried_on_a_hilly_map() {
     );
     assert_eq!(buried, 0, "road vertices buried (worst {worst_buried} m)");
     assert!(roads > 1000, "{roads} road vertices");
-    // Bridges stand above the ground on purpose; elsewhere the lift is 5–13 cm.
-    let floating = |limit: f64| {
-        node_meshes(scene, &worlds, "roads")
-            .flat_map(|(m, w)| {
-                m.positions
-                    .iter()
-                    .map(move |p| to_layout(w.transform_point3(p.as_dvec3())))
-            })
-            .filter(|&(q, h)| sheet.height(q).is_some_and(|g| h - g > limit))
-            .count()
+    // Above it by at most the terrain's allowance (2 e), the corridor cut, the lifts
+    // (5–13 cm) and, where a terrain leaf at the smallest size could not meet the bound
+    // (the foot of a 1:2 bank) and was lowered, the bank's rise over one such leaf.
+    // Bridges are left out: their surfaces stand above the ground on purpose.
+    let grading = city.config.scene.road_grading;
+    let leaf = city.config.scene.terrain_mesh.min_cell_m;
+    let limit = 2.0 * e + polis::CORRIDOR_CUT_M + 0.15 + leaf * grading.embankment_slope;
+    let bridges: Vec<(DVec2, DVec2, f64)> = city
+        .roads
+        .edges()
+        .filter(|(_, _, _, r)| r.bridge)
+        .map(|(e, _, _, r)| {
+            let (a, b) = city.roads.segment(e).unwrap();
+            (a, b, r.width)
+        })
+        .collect();
+    let near_bridge = |q: DVec2| {
+        bridges.iter().any(|&(a, b, w)| {
+            let d = b - a;
+            let t = ((q - a).dot(d) / d.length_squared().max(1e-12)).clamp(0.0, 1.0);
+            q.distance(a + d * t) <= w
+        })
     };
-    // The terrain allowance, the corridor cut and the lifts.
-    let limit = 2.0 * e + polis::CORRIDOR_CUT_M + 0.15;
-    let over = floating(limit + tol);
-    assert!(
-        (over as f64) < 0.02 * roads as f64,
-        "{over} of {roads} road vertices float more than {limit} m (worst {worst_float})"
+    let mut over = 0;
+    for (mesh, w) in node_meshes(scene, &worlds, "roads") {
+        for p in &mesh.positions {
+            let (q, h) = to_layout(w.transform_point3(p.as_dvec3()));
+            let Some(g) = sheet.height(q) else { continue };
+            if h - g > limit + tol && !near_bridge(q) {
+                over += 1;
+            }
+        }
+    }
+    eprintln!("worst float {worst_float} m (limit {limit} m off bridges)");
+    assert_eq!(
+        over, 0,
+        "{over} of {roads} road vertices float more than {limit} m"
     );
 
     // Block plinths: the top above the terrain, the bottom below it.

@@ -15,11 +15,14 @@
 //!    on every edge, so their mean does too; where the target already keeps it,
 //!    `U = L = target` and the road follows the (smoothed) ground exactly. Points inside
 //!    bridges are no sources: a bridge deck runs at the grade its land ends allow.
-//! 3. **Conformed ground** ([`GradedGround`], a [`Field`]): inside a road's corridor (half
-//!    its width from the centre line) the road's height; beyond it, embankments: where
-//!    the road runs above the ground (fill) the ground rises to it, where below (cut) it
-//!    falls to it, at [`GradeParams::embankment_slope`] (rise per metre), until they meet
-//!    the natural ground. Bridges leave the ground alone (decks on piers).
+//! 3. **Conformed ground** ([`GradedGround`], a [`Field`]): the ground clamped into every
+//!    nearby road's cone — the road's height inside its corridor (half its width from
+//!    the centre line), and beyond it heights within
+//!    [`GradeParams::embankment_slope`] (rise per metre) times the distance: where the
+//!    road runs above the ground (fill) the ground rises to it, where below (cut) it falls
+//!    to it, until the banks meet the natural ground. Where two roads' cones leave no
+//!    common height, their meeting height. Bridges leave the ground alone (decks on
+//!    piers).
 //! 4. **Volumes**: per profile edge the cross-section `2·w/2·Δ + Δ²/s` (corridor plus two
 //!    embankment wedges, `Δ` the road's height above the ground on the centre line, `s` the
 //!    embankment slope) integrated along the road (trapezoids); positive parts are fill,
@@ -33,10 +36,10 @@
 //! * Deterministic: a pure function of the network, the ground and the parameters.
 //!
 //! # Limitations
-//! * Where corridors and embankments of several roads overlap (junctions, parallel
-//!   roads) the nearest road's corridor wins and embankments combine by the larger
-//!   change; the volumes count each road's cross-section on its own, so overlaps at
-//!   junctions are counted twice.
+//! * Where corridors of roads at different heights overlap (junction corners) the ground
+//!   takes the cones' meeting height, a little off both roads; the volumes count each
+//!   road's cross-section on its own, so overlaps at junctions are counted twice. A bank
+//!   wider than [`GradeParams::max_embankment_m`] ends in a step (a retaining wall).
 //! * The ground is sampled at the profile points; bumps shorter than `sample_m` between
 //!   them are neither smoothed nor cut.
 //!
@@ -170,6 +173,19 @@ impl GradedPiece {
     /// The road height at parameter `t ∈ [0, 1]`.
     pub fn height_at(&self, t: f64) -> f64 {
         self.ha + (self.hb - self.ha) * t
+    }
+
+    /// The parameter `t ∈ [0, 1]` of the centre-line point nearest `p`, and the distance
+    /// to it, metres.
+    pub fn project(&self, p: DVec2) -> (f64, f64) {
+        let ab = self.b - self.a;
+        let l2 = ab.length_squared();
+        let t = if l2 > 0.0 {
+            ((p - self.a).dot(ab) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (t, p.distance(self.a + ab * t))
     }
 }
 
@@ -416,8 +432,8 @@ pub fn grade_roads<'a>(
                 works.moved_length_m += len;
             }
             if da.abs().max(db.abs()) > 1e-9 && len > 0.0 {
-                let bank = (da.abs().max(db.abs()) / s).min(params.max_embankment_m);
-                reach = reach.max(half_width + bank);
+                // A cone binds wherever the ground leaves it, up to the widest bank.
+                reach = reach.max(half_width + params.max_embankment_m);
                 index.insert(pieces.len() as u32, Shape::Segment(piece.a, piece.b))?;
             }
         }
@@ -479,14 +495,8 @@ impl Field for CutIn<'_> {
             let Some(piece) = self.graded.pieces.get(k as usize) else {
                 return;
             };
-            let ab = piece.b - piece.a;
-            let l2 = ab.length_squared();
-            let t = if l2 > 0.0 {
-                ((p - piece.a).dot(ab) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let beyond = p.distance(piece.a + ab * t) - piece.half_width - self.margin;
+            let (_, d) = piece.project(p);
+            let beyond = d - piece.half_width - self.margin;
             let share = if beyond <= 0.0 {
                 1.0
             } else if self.margin > 0.0 {
@@ -501,51 +511,37 @@ impl Field for CutIn<'_> {
 }
 
 impl Field for GradedGround<'_> {
+    /// The ground clamped into every nearby road's *cone*: a road piece at height `r`
+    /// allows heights within `r ± slope · b` at `b` metres beyond its corridor (so `r`
+    /// itself inside it), up to [`GradeParams::max_embankment_m`] beyond. Where two cones
+    /// leave no common height (roads at different heights side by side), their meeting
+    /// height is taken. Continuous except where a bank would run past its widest
+    /// (a retaining wall).
     fn sample(&self, p: DVec2) -> f64 {
         let g = self.ground.sample(p);
         if self.index.is_empty() || !g.is_finite() {
             return g;
         }
-        // Nearest corridor (by distance beyond the half width, then key), and the
-        // strongest fill and cut embankments.
-        let mut corridor: Option<(f64, u32, f64)> = None;
-        let (mut fill, mut cut) = (g, g);
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         let b = Aabb2::new(p, p).expanded(self.reach);
         self.index.for_each_candidate(&b, |k, _| {
             let Some(piece) = self.pieces.get(k as usize) else {
                 return;
             };
-            let ab = piece.b - piece.a;
-            let l2 = ab.length_squared();
-            let t = if l2 > 0.0 {
-                ((p - piece.a).dot(ab) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let d = p.distance(piece.a + ab * t);
-            let r = piece.height_at(t);
-            let beyond = d - piece.half_width;
-            if beyond <= 0.0 {
-                let better = match corridor {
-                    None => true,
-                    Some((bd, bk, _)) => beyond < bd || (beyond == bd && k < bk),
-                };
-                if better {
-                    corridor = Some((beyond, k, r));
-                }
-            } else if beyond <= self.max_bank {
+            let (t, d) = piece.project(p);
+            let beyond = (d - piece.half_width).max(0.0);
+            if beyond <= self.max_bank {
+                let r = piece.height_at(t);
                 let rise = self.slope * beyond;
-                if r > g {
-                    fill = fill.max(r - rise);
-                } else {
-                    cut = cut.min(r + rise);
-                }
+                lo = lo.max(r - rise);
+                hi = hi.min(r + rise);
             }
         });
-        if let Some((_, _, r)) = corridor {
-            return r;
+        if lo <= hi {
+            g.clamp(lo, hi)
+        } else {
+            0.5 * (lo + hi)
         }
-        if fill - g >= g - cut { fill } else { cut }
     }
 }
 

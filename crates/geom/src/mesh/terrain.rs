@@ -20,9 +20,11 @@
 //!
 //! # Guarantees
 //! * At every check point of every leaf, `field − 2·max_error_m ≤ surface ≤ field`,
-//!   unless [`TerrainReport::unresolved_leaves`] is non-zero (leaves at the minimum size or
-//!   beyond the leaf budget that still miss the bound; their largest miss is
-//!   [`TerrainReport::max_error_m`]).
+//!   except in [`TerrainReport::unresolved_leaves`] (leaves at the minimum size or
+//!   beyond the leaf budget that still miss the bound — cliffs, steps; their largest miss
+//!   is [`TerrainReport::max_error_m`]). Those leaves' vertices are lowered to the lowest
+//!   field value at their check points, so `surface ≤ field` holds at every check point
+//!   of every leaf (the one side that keeps things standing on the field unburied).
 //! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
 //!   directions), every triangle faces up, and it covers the rectangle exactly.
 //! * Deterministic: a pure function of the field, the rectangle and the options.
@@ -243,6 +245,8 @@ impl Terrain {
         let mut leaves = Vec::with_capacity(work.len());
         let mut worst = 0.0f64;
         let mut unresolved = 0usize;
+        // Leaves that miss the bound for good: lowered below the field at the end.
+        let mut flagged: Vec<Leaf> = Vec::new();
         while !work.is_empty() {
             let mut next = Vec::new();
             let pending = work.len();
@@ -267,6 +271,7 @@ impl Terrain {
                 } else {
                     if miss > e {
                         unresolved += 1;
+                        flagged.push(leaf);
                     }
                     worst = worst.max(miss);
                     leaves.push(leaf);
@@ -284,6 +289,7 @@ impl Terrain {
             let mut kept = Vec::with_capacity(leaves.len());
             let mut next_worst = 0.0f64;
             let mut next_unresolved = 0usize;
+            let mut next_flagged = Vec::new();
             for (done, &leaf) in leaves.iter().enumerate() {
                 let profiles = edge_profiles(leaf, &by_row, &by_col, &row_heights, &col_heights);
                 let hanging = profiles.iter().any(|p| p.len() > 2);
@@ -300,6 +306,7 @@ impl Terrain {
                 } else {
                     if hanging && miss > e {
                         next_unresolved += 1;
+                        next_flagged.push(leaf);
                     }
                     next_worst = next_worst.max(miss);
                     kept.push(leaf);
@@ -308,6 +315,7 @@ impl Terrain {
             if !split_any {
                 worst = worst.max(next_worst);
                 unresolved += next_unresolved;
+                flagged.extend(next_flagged);
                 leaves = kept;
                 break;
             }
@@ -316,11 +324,68 @@ impl Terrain {
         leaves.sort_unstable_by_key(|l| (l.y, l.x));
 
         let (by_row, by_col) = corner_sets(&leaves);
-        let row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
-        let col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
+        let mut row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
+        let mut col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
         let mut centre_heights = Vec::with_capacity(leaves.len());
         for &leaf in &leaves {
             centre_heights.push(centre_height(&sample, leaf)?);
+        }
+        // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
+        // lowered to the lowest field value at their check points, so the surface stays
+        // below the field there too (lowering shared vertices only lowers neighbours).
+        flagged.sort_unstable_by_key(|l| (l.y, l.x, l.size));
+        flagged.dedup();
+        for f in &flagged {
+            let Ok(k) = leaves.binary_search_by_key(&(f.y, f.x), |l| (l.y, l.x)) else {
+                continue;
+            };
+            let leaf = leaves[k];
+            if leaf.size != f.size {
+                continue;
+            }
+            let s = leaf.size as f64;
+            let mut low = f64::INFINITY;
+            for j in 0..=4u32 {
+                for i in 0..=4u32 {
+                    let p = grid.point(
+                        leaf.x as f64 + s * f64::from(i) / 4.0,
+                        leaf.y as f64 + s * f64::from(j) / 4.0,
+                    );
+                    let v = field.sample(p);
+                    if v.is_finite() {
+                        low = low.min(v);
+                    }
+                }
+            }
+            if !low.is_finite() {
+                continue;
+            }
+            let sz = leaf.size;
+            for (line, from, rows) in [
+                (leaf.y, leaf.x, true),
+                (leaf.y + sz, leaf.x, true),
+                (leaf.x, leaf.y, false),
+                (leaf.x + sz, leaf.y, false),
+            ] {
+                let keys = if rows { &by_row } else { &by_col };
+                let lo = keys.partition_point(|&q| q < (line, from));
+                let hi = keys.partition_point(|&q| q <= (line, from + sz));
+                for i in lo..hi {
+                    let (a, b) = keys[i];
+                    let (row_key, col_key) = if rows {
+                        ((a, b), (b, a))
+                    } else {
+                        ((b, a), (a, b))
+                    };
+                    if let Ok(r) = by_row.binary_search(&row_key) {
+                        row_heights[r] = row_heights[r].min(low);
+                    }
+                    if let Ok(c) = by_col.binary_search(&col_key) {
+                        col_heights[c] = col_heights[c].min(low);
+                    }
+                }
+            }
+            centre_heights[k] = centre_heights[k].min(low);
         }
         let mut roots = vec![Vec::new(); (nx * ny) as usize];
         for (k, l) in leaves.iter().enumerate() {

@@ -40,26 +40,30 @@ fn check_sheet(t: &Terrain, bounds: Aabb2) {
     assert!((plan - size.x * size.y).abs() < 1e-3 * size.x * size.y);
 }
 
+/// Every leaf's 5 × 5 check points.
+fn check_points(t: &Terrain) -> impl Iterator<Item = DVec2> + '_ {
+    t.leaves.iter().flat_map(move |leaf| {
+        let s = leaf.size as f64;
+        (0..25u32).map(move |k| {
+            t.grid.point(
+                leaf.x as f64 + s * f64::from(k % 5) / 4.0,
+                leaf.y as f64 + s * f64::from(k / 5) / 4.0,
+            )
+        })
+    })
+}
+
 /// The one-sided bound at every check point of every leaf.
 fn check_bound(t: &Terrain, field: &dyn Field, e: f64) {
     assert_eq!(t.report.unresolved_leaves, 0, "{:?}", t.report);
     assert!(t.report.max_error_m <= e);
-    for leaf in &t.leaves {
-        let s = leaf.size as f64;
-        for j in 0..=4 {
-            for i in 0..=4 {
-                let p = t.grid.point(
-                    leaf.x as f64 + s * f64::from(i) / 4.0,
-                    leaf.y as f64 + s * f64::from(j) / 4.0,
-                );
-                let f = field.sample(p);
-                let h = t.height_at(p).unwrap();
-                assert!(
-                    h <= f + 1e-9 && h >= f - 2.0 * e - 1e-9,
-                    "{h} vs {f} at {p}"
-                );
-            }
-        }
+    for p in check_points(t) {
+        let f = field.sample(p);
+        let h = t.height_at(p).unwrap();
+        assert!(
+            h <= f + 1e-9 && h >= f - 2.0 * e - 1e-9,
+            "{h} vs {f} at {p}"
+        );
     }
 }
 
@@ -108,6 +112,13 @@ fn a_cliff_is_reported_not_a_panic() {
     assert!(t.report.unresolved_leaves > 0);
     assert!(t.report.max_error_m > 1.0);
     check_sheet(&t, bounds);
+    // Still below the field at every check point, even at the cliff.
+    for p in check_points(&t) {
+        assert!(
+            t.height_at(p).unwrap() <= field.sample(p) + 1e-9,
+            "above at {p}"
+        );
+    }
     // A leaf budget stops refinement without breaking the mesh.
     let small = TerrainOptions {
         max_leaves: 40,
