@@ -418,12 +418,22 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             Some(pal.road),
         )?))
     };
-    // Buildings reach below the ground as far as the terrain may lie below the map.
-    let foot = if inp.config.scene.terrain {
-        2.0 * inp.config.scene.terrain_mesh.max_error_m
+    // Buildings and plinths reach below the ground as far as the terrain may lie below
+    // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut and the
+    // lowering of smallest leaves that miss the bound at the foot of a bank (their
+    // diagonal's rise on the bank).
+    let sc = &inp.config.scene;
+    let foot = if sc.terrain {
+        let graded = if inp.cut_in.is_some() {
+            CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
+        } else {
+            0.0
+        };
+        2.0 * sc.terrain_mesh.max_error_m + graded
     } else {
         0.0
     };
+    let plinth_foot = PLINTH_FOOT_M.max(foot);
     // Each building's node (name, placement, metadata) and meshes.
     let buildings_job = || -> Vec<Leaf> {
         inp.buildings
@@ -478,13 +488,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                         let g = elevation.sample(p);
                         if g.is_finite() { g } else { base }
                     };
-                    m.add_draped_slab(
-                        &block.polygon,
-                        &PLINTH_REFINE,
-                        height,
-                        -PLINTH_FOOT_M,
-                        kerb,
-                    )?;
+                    m.add_draped_slab(&block.polygon, &PLINTH_REFINE, height, -plinth_foot, kerb)?;
                     m
                 } else {
                     polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
