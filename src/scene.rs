@@ -377,6 +377,9 @@ fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()
     Ok(())
 }
 
+/// Water bodies and the level of their surface, metres.
+type WaterLevels = Vec<(PolygonWithHoles, f64)>;
+
 /// Everything the scene is built from.
 pub(crate) struct SceneInputs<'a> {
     /// The ground everything stands on: the elevation map, with the roads graded into it.
@@ -504,7 +507,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     };
     // Water bodies (flat surfaces at their shore's lowest point) and the ground (terrain
     // textured by land use, which paints the water bed).
-    let water_and_ground = || -> Result<(Vec<(PolygonWithHoles, f64)>, Option<Ground>)> {
+    let water_and_ground = || -> Result<(WaterLevels, Option<Ground>)> {
         let scene = &inp.config.scene;
         let size = inp.config.size_m;
         let water = if inp.maps.has_water && (scene.water_surfaces || scene.terrain) {

@@ -170,6 +170,9 @@ impl Lattice {
     }
 }
 
+/// A leaf corner in lattice units, `(y, x)` or `(x, y)`.
+type Corner = (u64, u64);
+
 /// The heights along one edge of a leaf: `(parameter in [0, 1], field)`, sorted.
 type EdgeProfile = Vec<(f64, f64)>;
 
@@ -370,8 +373,7 @@ impl Terrain {
                 let keys = if rows { &by_row } else { &by_col };
                 let lo = keys.partition_point(|&q| q < (line, from));
                 let hi = keys.partition_point(|&q| q <= (line, from + sz));
-                for i in lo..hi {
-                    let (a, b) = keys[i];
+                for &(a, b) in keys.get(lo..hi).unwrap_or_default() {
                     let (row_key, col_key) = if rows {
                         ((a, b), (b, a))
                     } else {
@@ -540,7 +542,7 @@ fn centre_height(
 }
 
 /// Sorted, deduplicated leaf corners by `(y, x)` and by `(x, y)`.
-fn corner_sets(leaves: &[Leaf]) -> (Vec<(u64, u64)>, Vec<(u64, u64)>) {
+fn corner_sets(leaves: &[Leaf]) -> (Vec<Corner>, Vec<Corner>) {
     let mut by_row = Vec::with_capacity(4 * leaves.len());
     for l in leaves {
         let s = l.size;
