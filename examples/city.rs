@@ -96,6 +96,9 @@ struct Cli {
     /// Print the city statistics report and write `report.json` beside the outputs.
     #[arg(long)]
     report: bool,
+    /// Leave the ground (the terrain mesh textured by land use) out of the glb and OBJ.
+    #[arg(long)]
+    no_terrain: bool,
     /// Output formats to write, comma-separated: glb, obj, svg, geojson (or all).
     #[arg(long, value_name = "LIST", default_value = "all")]
     formats: Formats,
@@ -184,6 +187,9 @@ fn configure(cli: Cli) -> Result<Args, clap::Error> {
     }
     if let Some(n) = cli.threads {
         config.threads = Some(usize::from(n));
+    }
+    if cli.no_terrain {
+        config.scene.terrain = false;
     }
     let h = config.size_m * 0.5;
     let extent = Aabb2::new(

@@ -83,6 +83,10 @@ pub struct CityStats {
     /// including the sink's time).
     #[serde(default)]
     pub wall_time: Duration,
+    /// Cut and fill of the roads graded into the land (zero without an elevation map or
+    /// with [`SceneConfig::grade_roads`](crate::SceneConfig::grade_roads) off).
+    #[serde(default)]
+    pub earthworks: polis_roads::Earthworks,
 }
 
 impl CityStats {

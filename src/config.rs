@@ -8,8 +8,9 @@ use polis_cells::CellParams;
 #[cfg(feature = "gltf")]
 use polis_export::glb::Batching;
 use polis_facades::FacadeStyle;
+use polis_geom::mesh::TerrainOptions;
 use polis_lots::{BlockParams, LotParams};
-use polis_roads::RoadParams;
+use polis_roads::{GradeParams, RoadParams};
 use serde::{Deserialize, Serialize};
 
 use crate::citygen::{CitygenConfig, RoadMode};
@@ -308,6 +309,24 @@ pub struct SceneConfig {
     /// How each building kind is seated on sloping ground, in
     /// [`BuildingKind::ALL`] order. Default: [`Foundation::Highest`] for every kind.
     pub foundations: [Foundation; 6],
+    /// A ground mesh of the whole map (the elevation map as a terrain, textured by land
+    /// use) in a node `ground` of its own (false leaves it out). Default: true.
+    pub terrain: bool,
+    /// How finely the terrain follows the elevation map: its error bound (the surface
+    /// lies up to twice `max_error_m` below the map, never above) and leaf sizes.
+    /// Default: [`TerrainOptions::default`] (0.2 m, leaves of 2–64 m).
+    pub terrain_mesh: TerrainOptions,
+    /// Side of the land-use texture of the ground, pixels (a power of two, 16 to 4096).
+    /// Default: 1024 (about 4 m per pixel on a 4 km map).
+    pub land_use_pixels: u32,
+    /// Roads graded into the land on an elevation map: a height profile within a
+    /// maximum grade per class, cut and fill with embankments, the terrain, plinths and
+    /// buildings conformed to it (false: roads are draped on the raw map).
+    /// Default: true.
+    pub grade_roads: bool,
+    /// The grading's limits and embankments. Default: [`GradeParams::default`]
+    /// (highways 6 %, streets 15 %, 1:2 banks).
+    pub road_grading: GradeParams,
 }
 
 /// How a building is seated on the ground under its footprint (CityEngine's four
@@ -345,6 +364,11 @@ impl Default for SceneConfig {
             coarse_lod: false,
             water_surfaces: true,
             foundations: [Foundation::Highest; 6],
+            terrain: true,
+            terrain_mesh: TerrainOptions::default(),
+            land_use_pixels: 1024,
+            grade_roads: true,
+            road_grading: GradeParams::default(),
         }
     }
 }
@@ -525,6 +549,8 @@ impl CityConfig {
                 "give the glb's tile side as a finite length above 0 m",
             ));
         }
+        crate::ground::validate(&self.scene).map_err(|(field, why)| Error::config(field, why))?;
+        self.scene.road_grading.validate()?;
         self.effective_road_params().validate()?;
         self.citygen.validate()?;
         self.effective_building_params().validate()?;

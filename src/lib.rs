@@ -62,6 +62,7 @@ mod clock;
 mod config;
 pub mod editor;
 mod error;
+mod ground;
 mod maps;
 mod output;
 mod pipeline;
@@ -85,6 +86,7 @@ pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::{reference_city_name, road_statistics, street_graph};
+pub use scene::CORRIDOR_CUT_M;
 pub use stages::{Skip, Stage};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

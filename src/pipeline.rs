@@ -348,8 +348,28 @@ impl Pipeline {
         }
 
         self.report(Stage::Scene, 0.0);
+        // Roads graded into the land: the ground every later layer stands on.
+        let graded = if config.scene.grade_roads && config.maps.elevation.is_some() {
+            Some(polis_roads::grade_roads(
+                &network,
+                maps.inputs.elevation.as_ref(),
+                &config.scene.road_grading,
+            )?)
+        } else {
+            None
+        };
+        let earthworks = graded.as_ref().map(|g| g.earthworks).unwrap_or_default();
+        let ground: &dyn polis_geom::Field = match &graded {
+            Some(g) if g.moves_ground() => g,
+            _ => maps.inputs.elevation.as_ref(),
+        };
         let scene = if keep && self.scene {
             assemble(&SceneInputs {
+                ground,
+                cut_in: graded
+                    .as_ref()
+                    .filter(|g| g.moves_ground())
+                    .map(|g| g.cut_in(crate::scene::CORRIDOR_CUT_M, 1.0)),
                 config,
                 maps: &maps,
                 network: &network,
@@ -358,10 +378,12 @@ impl Pipeline {
                 building_cells: &kept.building_cells,
                 dresses: &kept.dresses,
                 tile_sets: &tile_sets,
+                green_spaces: &kept.green_spaces,
             })?
         } else {
             polis_geom::Scene::new()
         };
+        drop(graded);
         timings.push(lap(Stage::Scene, &mut clock));
         self.report(Stage::Scene, 1.0);
 
@@ -374,6 +396,7 @@ impl Pipeline {
             scene_triangles: scene.triangle_count(),
             timings: merge_timings(timings),
             wall_time: started.elapsed(),
+            earthworks,
             ..counts
         };
         report.warnings.extend(empty_city_warnings(&stats));

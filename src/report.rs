@@ -145,7 +145,14 @@ impl City {
             }),
             water: self.maps.has_water.then_some(water),
         };
-        let report = polis_stats::report(&input, options)?;
+        let mut report = polis_stats::report(&input, options)?;
+        let w = self.stats.earthworks;
+        report.earthworks = polis_stats::EarthworkMetrics {
+            cut_m3: w.cut_m3,
+            fill_m3: w.fill_m3,
+            moved_length_m: w.moved_length_m,
+            steepest_grade: w.steepest_grade,
+        };
         Ok(match reference_city_name(&self.config) {
             Some(name) => report.compare_with(name)?,
             None => report,

@@ -26,6 +26,7 @@ use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
 
 use crate::error::Result;
+use crate::ground::{Ground, add_ground, build_ground};
 use crate::stages::{Dress, SkinQuad};
 use crate::{CityConfig, CityMaps, Foundation};
 
@@ -133,11 +134,15 @@ struct Seat {
     base: f64,
     /// Depth of the plinth below the floor, metres (0: none).
     plinth: f64,
+    /// How far the bottom reaches below the ground under it besides, metres: the
+    /// terrain's allowance (it lies up to this below the elevation map), so no building
+    /// floats over the terrain mesh.
+    foot: f64,
 }
 
 /// The seat of a footprint on the ground under its corners, by foundation mode (see
 /// [`Foundation`]); non-finite ground samples are left out (0 m when none is finite).
-fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation) -> Seat {
+fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation, foot: f64) -> Seat {
     let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
     for &p in pts {
         let g = elevation.sample(p);
@@ -152,6 +157,7 @@ fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation) -> Seat {
         return Seat {
             base: 0.0,
             plinth: 0.0,
+            foot,
         };
     }
     let base = match mode {
@@ -162,6 +168,7 @@ fn seat(elevation: &dyn Field, pts: &[DVec2], mode: Foundation) -> Seat {
     Seat {
         base,
         plinth: base - lo,
+        foot,
     }
 }
 
@@ -176,7 +183,7 @@ fn lower_bottom(
     elevation: &dyn Field,
     origin: DVec2,
 ) {
-    if seat.plinth <= 0.0 {
+    if seat.plinth + seat.foot <= 0.0 {
         return;
     }
     let (positions, normals, uvs) = (
@@ -193,12 +200,12 @@ fn lower_bottom(
                 let (q, _) = polis_geom::to_layout(p.as_dvec3());
                 let g = elevation.sample(q + origin);
                 if g.is_finite() {
-                    (seat.base - g).clamp(0.0, seat.plinth)
+                    (seat.base - g).clamp(0.0, seat.plinth) + seat.foot
                 } else {
-                    seat.plinth
+                    seat.plinth + seat.foot
                 }
             }
-            _ => seat.plinth,
+            _ => seat.plinth + seat.foot,
         };
         p.y = -(depth as f32);
         if n.y.abs() < 0.5 {
@@ -260,6 +267,12 @@ impl Targets {
         self.meshes.get_mut(i)
     }
 }
+
+/// How deep the terrain is cut in under graded road corridors (and 1 m beyond, tapering
+/// over the next metre), metres: the terrain mesh's triangles span the sharp foot of a
+/// cut's banks without vertices on the corridor's edge, and this keeps them under the
+/// road surface.
+pub const CORRIDOR_CUT_M: f64 = 0.5;
 
 /// How far a block plinth draped on an elevation map reaches below the ground, metres: a
 /// foundation, so the ground between the plinth's vertices never shows under it.
@@ -379,8 +392,15 @@ fn push_skin_quad(mesh: &mut Mesh, q: &SkinQuad, face: &FacadeFace) -> Result<()
     Ok(())
 }
 
+/// Water bodies and the level of their surface, metres.
+type WaterLevels = Vec<(PolygonWithHoles, f64)>;
+
 /// Everything the scene is built from.
 pub(crate) struct SceneInputs<'a> {
+    /// The ground everything stands on: the elevation map, with the roads graded into it.
+    pub ground: &'a dyn Field,
+    /// The graded ground cut in under the road corridors, for the terrain mesh.
+    pub cut_in: Option<polis_roads::grading::CutIn<'a>>,
     pub config: &'a CityConfig,
     pub maps: &'a CityMaps,
     pub network: &'a RoadNetwork,
@@ -390,13 +410,15 @@ pub(crate) struct SceneInputs<'a> {
     pub building_cells: &'a [u64],
     pub dresses: &'a [Option<Dress>],
     pub tile_sets: &'a [TileSet],
+    /// Green spaces of the lot stage (parks on the ground).
+    pub green_spaces: &'a [PolygonWithHoles],
 }
 
 /// Builds the scene.
 pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     let mut scene = Scene::new();
     let pal = palette(&mut scene, inp.tile_sets)?;
-    let elevation = inp.maps.inputs.elevation.as_ref();
+    let elevation = inp.ground;
     let root = scene.add_root(inp.config.name.clone());
     scene.set_metadata(root, "seed", inp.config.seed as f64)?;
 
@@ -414,6 +436,22 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             Some(pal.road),
         )?))
     };
+    // Buildings and plinths reach below the ground as far as the terrain may lie below
+    // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut and the
+    // lowering of smallest leaves that miss the bound at the foot of a bank (their
+    // diagonal's rise on the bank).
+    let sc = &inp.config.scene;
+    let foot = if sc.terrain {
+        let graded = if inp.cut_in.is_some() {
+            CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
+        } else {
+            0.0
+        };
+        2.0 * sc.terrain_mesh.max_error_m + graded
+    } else {
+        0.0
+    };
+    let plinth_foot = PLINTH_FOOT_M.max(foot);
     // Each building's node (name, placement, metadata) and meshes.
     let buildings_job = || -> Vec<Leaf> {
         inp.buildings
@@ -421,7 +459,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .enumerate()
             .map(|(i, b)| {
                 let mode = foundation(inp.config, b.kind);
-                let seat = seat(elevation, b.footprint.points(), mode);
+                let seat = seat(elevation, b.footprint.points(), mode, foot);
                 let meshes = building_meshes(
                     b,
                     inp.dresses.get(i).and_then(Option::as_ref),
@@ -478,13 +516,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                         let g = elevation.sample(p);
                         if g.is_finite() { g } else { base }
                     };
-                    m.add_draped_slab(
-                        &block.polygon,
-                        &PLINTH_REFINE,
-                        height,
-                        -PLINTH_FOOT_M,
-                        kerb,
-                    )?;
+                    m.add_draped_slab(&block.polygon, &PLINTH_REFINE, height, -plinth_foot, kerb)?;
                     m
                 } else {
                     polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
@@ -502,31 +534,73 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect()
     };
-    // Water bodies: flat surfaces at their shore's lowest point.
-    let water_job = || -> Result<Vec<(PolygonWithHoles, f64)>> {
-        if !(inp.config.scene.water_surfaces && inp.maps.has_water) {
-            return Ok(Vec::new());
-        }
-        let water = inp.maps.inputs.water.as_ref();
-        Ok(crate::city::smooth_mask(water, inp.config.size_m)?
-            .into_iter()
-            .map(|p| {
-                let level = ground(elevation, p.outer.points());
-                (p, level)
-            })
-            .collect())
+    // Water bodies (flat surfaces at their shore's lowest point) and the ground (terrain
+    // textured by land use, which paints the water bed).
+    let water_and_ground = || -> Result<(WaterLevels, Option<Ground>)> {
+        let scene = &inp.config.scene;
+        let size = inp.config.size_m;
+        let water = if inp.maps.has_water && (scene.water_surfaces || scene.terrain) {
+            crate::city::smooth_mask(inp.maps.inputs.water.as_ref(), size)?
+        } else {
+            Vec::new()
+        };
+        let terrain = if scene.terrain {
+            let mut parks = if inp.maps.has_parks {
+                crate::city::smooth_mask(inp.maps.inputs.parks.as_ref(), size)?
+            } else {
+                Vec::new()
+            };
+            parks.extend(inp.green_spaces.iter().cloned());
+            let blocks = inp.blocks.iter().map(|b| &b.polygon);
+            let terrain_field: &dyn Field = match &inp.cut_in {
+                Some(c) => c,
+                None => elevation,
+            };
+            Some(build_ground(
+                inp.config,
+                terrain_field,
+                &water,
+                &parks,
+                blocks,
+            )?)
+        } else {
+            None
+        };
+        let water = if scene.water_surfaces {
+            water
+                .into_iter()
+                .map(|p| {
+                    let level = ground(elevation, p.outer.points());
+                    (p, level)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Ok((water, terrain))
     };
-    let ((road, water), (blocks, buildings)) = par::join(
-        || par::join(road_mesh, water_job),
+    let ((road, water_and_ground), (blocks, buildings)) = par::join(
+        || par::join(road_mesh, water_and_ground),
         || par::join(blocks_job, buildings_job),
     );
+    let (water, terrain) = water_and_ground?;
+    if let Some(terrain) = terrain {
+        add_ground(&mut scene, root, terrain)?;
+    }
     if let Some(mesh) = road? {
         let node = scene.add_node(root, "roads")?;
         scene.set_metadata(node, "layer", MetaValue::from_static("roads"))?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }
-    let water = water?;
+    // Bridges: closed decks on piers under the road surfaces.
+    if let Some(mut mesh) = crate::ground::bridge_mesh(inp.network, elevation)? {
+        let concrete = Material::new("bridge", [0.62, 0.60, 0.57, 1.0]);
+        mesh.material = Some(scene.add_material(concrete));
+        let node = scene.add_node(root, "bridges")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
     if !water.is_empty() {
         let material = scene.add_material(Material {
             roughness: 0.1,
@@ -594,6 +668,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     elevation,
                     b.footprint.points(),
                     foundation(inp.config, b.kind),
+                    foot,
                 );
                 let local = b.footprint.translated(-b.origin);
                 let wall = pal.walls[b.kind.index().min(5)];

@@ -521,6 +521,8 @@ pub(crate) fn tiler(cx: &StageContext<'_>) -> Result<Box<dyn DressBuilding + 'st
         let fc = &cx.config.facades;
         let opts = RasterOptions {
             pixels_per_metre: fc.pixels_per_metre,
+            // Power-of-two tiles suit the glb's repeating, mipmapped samplers.
+            power_of_two: true,
             ..RasterOptions::default()
         };
         let mut styles: Vec<PreparedStyle> = Vec::new();

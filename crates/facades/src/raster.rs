@@ -33,6 +33,12 @@ pub struct RasterOptions {
     pub pixels_per_metre: f64,
     /// Multiplies the height slopes in the normal map (1 = physical). Default: 1.
     pub normal_strength: f32,
+    /// Round each texture's width and height to the nearest power of two (the texels
+    /// then stretch to cover the same metres): images that suit repeating, mipmapped samplers
+    /// (the Khronos glTF validator warns on non-power-of-two images used so, as WebGL 1
+    /// cannot sample them). Default: false.
+    #[serde(default)]
+    pub power_of_two: bool,
 }
 
 impl Default for RasterOptions {
@@ -40,6 +46,7 @@ impl Default for RasterOptions {
         RasterOptions {
             pixels_per_metre: 64.0,
             normal_strength: 1.0,
+            power_of_two: false,
         }
     }
 }
@@ -648,7 +655,17 @@ impl Facade {
             "[0.001, 10000]",
         )?;
         let px = |m: f64| -> Result<u32> {
-            let v = (m * ppm).round().max(1.0);
+            let mut v = (m * ppm).round().max(1.0);
+            if opts.power_of_two && v <= f64::from(1u32 << 31) {
+                // The nearest power of two (texture memory stays about the same).
+                let up = (v as u32).next_power_of_two();
+                let down = (up / 2).max(1);
+                v = f64::from(if v - f64::from(down) < f64::from(up) - v {
+                    down
+                } else {
+                    up
+                });
+            }
             if v > f64::from(u32::MAX) {
                 return Err(FacadeError::TextureTooLarge {
                     width: v as u64,

@@ -54,6 +54,7 @@ pub mod lines;
 pub mod measure;
 pub mod mesh;
 pub mod metadata;
+pub mod paint;
 pub mod par;
 pub mod polygon;
 pub mod predicates;

@@ -82,6 +82,7 @@ pub mod constraints;
 pub mod error;
 pub mod generator;
 pub mod goals;
+pub mod grading;
 pub mod grid_builders;
 pub mod inputs;
 pub mod lattice;
@@ -101,6 +102,7 @@ pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };
 pub use goals::{DefaultGoals, GlobalGoals};
+pub use grading::{Earthworks, GradeParams, GradedGround, grade_roads};
 pub use grid_builders::{GridBuilderGrowth, GridParams, GridRoads, GridRules, grow_grid_roads};
 pub use inputs::{RoadInputs, procedural_lattice_m};
 pub use lattice::LazyLattice;

@@ -148,6 +148,23 @@ pub struct CityReport {
     /// The comparison with a reference city, once [`compare_with`](Self::compare_with)
     /// added it.
     pub realism: Option<Realism>,
+    /// Earthworks of the roads graded into the land, filled in by whoever graded them
+    /// (zero otherwise).
+    #[serde(default)]
+    pub earthworks: EarthworkMetrics,
+}
+
+/// Cut and fill of roads graded into the land (Kelly 2008 §4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct EarthworkMetrics {
+    /// Ground removed where roads run below it, m³.
+    pub cut_m3: f64,
+    /// Ground added where roads run above it, m³.
+    pub fill_m3: f64,
+    /// Road length whose profile leaves the ground by more than 5 cm, metres.
+    pub moved_length_m: f64,
+    /// Steepest graded road piece (rise per metre).
+    pub steepest_grade: f64,
 }
 
 impl CityReport {
@@ -197,5 +214,6 @@ pub fn report(city: &CityInput<'_>, options: &StatsOptions) -> Result<CityReport
         buildings: parcels::building_metrics(city.buildings, lot_area, land),
         defects: defects::plan_defects(city, &simple, options),
         realism: None,
+        earthworks: EarthworkMetrics::default(),
     })
 }

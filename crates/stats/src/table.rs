@@ -211,6 +211,24 @@ impl Display for CityReport {
                 d.buildings_in_road_corridor_share * 100.0
             ),
         )?;
+        let w = &self.earthworks;
+        if w.cut_m3 > 0.0 || w.fill_m3 > 0.0 {
+            writeln!(f, "earthworks (roads graded into the land)")?;
+            row(
+                f,
+                "cut / fill",
+                format!("{:.0} m³ / {:.0} m³", w.cut_m3, w.fill_m3),
+            )?;
+            row(
+                f,
+                "road off the ground / steepest",
+                format!(
+                    "{:.0} m / {:.1} %",
+                    w.moved_length_m,
+                    w.steepest_grade * 100.0
+                ),
+            )?;
+        }
         if let Some(r) = &self.realism {
             write!(f, "{r}")?;
         }

@@ -1,0 +1,663 @@
+//! Terrain: the ground of a whole map as one mesh, an adaptive quadtree over an elevation
+//! field with a stated, checked error bound.
+//!
+//! [`Terrain::build`] covers a rectangle with square-ish root cells of at most
+//! [`TerrainOptions::max_cell_m`] and splits a cell into four while its surface misses
+//! the field by more than [`TerrainOptions::max_error_m`] at its *check points* (the
+//! 5 × 5 lattice of quarter points of the cell), down to
+//! [`TerrainOptions::min_cell_m`]. Each leaf is a fan of triangles around its centre
+//! through every vertex on its border, its own corners and the corners of smaller
+//! neighbours (*hanging* vertices), so the mesh has no cracks and no T-junctions. Leaves
+//! whose border gained hanging vertices are checked again with their final fan, and split
+//! if they now miss the bound (repeated until nothing changes).
+//!
+//! The surface is **one-sided**: every vertex lies `max_error_m` *below* the field, so
+//! where the interpolation is within the bound the surface lies between `2·max_error_m`
+//! below the field and the field itself. Things that stand on the field (road surfaces a
+//! few centimetres above it, plinths reaching below it, buildings seated at their
+//! corners) are then never buried by the terrain, and float above it by at most
+//! `2·max_error_m` plus their own lift.
+//!
+//! # Guarantees
+//! * At every check point of every leaf, `field − 2·max_error_m ≤ surface ≤ field`,
+//!   except in [`TerrainReport::unresolved_leaves`] (leaves at the minimum size or
+//!   beyond the leaf budget that still miss the bound — cliffs, steps; their largest miss
+//!   is [`TerrainReport::max_error_m`]). Those leaves' vertices are lowered to the lowest
+//!   field value at their check points, so `surface ≤ field` holds at every check point
+//!   of every leaf (the one side that keeps things standing on the field unburied).
+//! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
+//!   directions), every triangle faces up, and it covers the rectangle exactly.
+//! * Deterministic: a pure function of the field, the rectangle and the options.
+//!
+//! # Limitations
+//! * Between check points (a quarter of a leaf apart) the miss can exceed the bound by
+//!   the field's curvature: at most `κ·(s/4)²/8` for a leaf of side `s` (0.03 m for a
+//!   64 m leaf on ground curving by 0.001 m⁻¹).
+//! * A field that is not finite somewhere inside the rectangle is an error.
+//!
+//! # References
+//! * Kelly 2008, §4.2 and §6.2 (roads and the city mapped onto the terrain);
+//!   Parish & Müller 2001, §3 (elevation as an input map). The quadtree with crack-free
+//!   fans is the usual restricted-quadtree terrain scheme (Lindstrom et al. 1996; Pajarola
+//!   1998), written here from its description.
+
+use glam::DVec2;
+
+use super::{Mesh, to_world};
+use crate::field::Field;
+use crate::scene::MaterialId;
+use crate::{Aabb2, GeomError, MAX_COORDINATE};
+
+/// Options of [`Terrain::build`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TerrainOptions {
+    /// Largest vertical miss between the interpolated field and the field at the check
+    /// points, metres (finite, > 0). The surface lies up to twice this below the field.
+    /// Default: 0.2.
+    pub max_error_m: f64,
+    /// Largest leaf side, metres (finite, ≥ `min_cell_m`). Default: 64.
+    pub max_cell_m: f64,
+    /// Smallest leaf side, metres (finite, > 0). Default: 2.
+    pub min_cell_m: f64,
+    /// Most leaves (≥ 1): refinement stops there and the rest is reported unresolved.
+    /// Default: 1,000,000.
+    pub max_leaves: usize,
+}
+
+impl Default for TerrainOptions {
+    fn default() -> Self {
+        TerrainOptions {
+            max_error_m: 0.2,
+            max_cell_m: 64.0,
+            min_cell_m: 2.0,
+            max_leaves: 1_000_000,
+        }
+    }
+}
+
+impl TerrainOptions {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<(), GeomError> {
+        let bad = |name: &'static str, reason: String| GeomError::InvalidParameter { name, reason };
+        if !(self.max_error_m.is_finite() && self.max_error_m > 0.0) {
+            return Err(bad(
+                "max_error_m",
+                format!("{} must be a finite number > 0", self.max_error_m),
+            ));
+        }
+        if !(self.min_cell_m.is_finite() && self.min_cell_m > 0.0) {
+            return Err(bad(
+                "min_cell_m",
+                format!("{} must be a finite number > 0", self.min_cell_m),
+            ));
+        }
+        if !(self.max_cell_m.is_finite() && self.max_cell_m >= self.min_cell_m) {
+            return Err(bad(
+                "max_cell_m",
+                format!(
+                    "{} must be finite and at least min_cell_m ({})",
+                    self.max_cell_m, self.min_cell_m
+                ),
+            ));
+        }
+        if self.max_leaves == 0 {
+            return Err(bad("max_leaves", "must be at least 1".into()));
+        }
+        Ok(())
+    }
+}
+
+/// What [`Terrain::build`] made.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
+pub struct TerrainReport {
+    /// Quadtree leaves.
+    pub leaves: usize,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Largest miss `|interpolated − field|` met at the check points, metres.
+    pub max_error_m: f64,
+    /// Leaves that still miss the bound (at the minimum size or beyond the leaf budget).
+    pub unresolved_leaves: usize,
+}
+
+/// One quadtree leaf, in lattice units (the lattice step is the smallest leaf side).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Leaf {
+    x: u64,
+    y: u64,
+    size: u64,
+}
+
+/// The terrain: its mesh and what it needs to answer heights at any point.
+#[derive(Debug, Clone)]
+pub struct Terrain {
+    /// The ground surface: one up-facing, smooth-shaded sheet; texture coordinates map
+    /// the rectangle onto the unit square (`u` east, `v` south: an image drawn north up).
+    pub mesh: Mesh,
+    /// Sizes and the error met.
+    pub report: TerrainReport,
+    grid: Lattice,
+    leaves: Vec<Leaf>,
+    /// Leaf corners sorted by `(y, x)` and by `(x, y)`, with the field there.
+    by_row: Vec<(u64, u64)>,
+    by_col: Vec<(u64, u64)>,
+    row_heights: Vec<f64>,
+    col_heights: Vec<f64>,
+    centre_heights: Vec<f64>,
+    /// Root cell → its leaves (indices into `leaves`).
+    roots: Vec<Vec<u32>>,
+    offset: f64,
+}
+
+/// The mapping between lattice units and metres.
+#[derive(Debug, Clone, Copy)]
+struct Lattice {
+    min: DVec2,
+    max: DVec2,
+    unit: DVec2,
+    /// Root cells along x and y.
+    nx: u64,
+    ny: u64,
+    /// Lattice units per root cell side.
+    root: u64,
+}
+
+impl Lattice {
+    fn point(&self, x: f64, y: f64) -> DVec2 {
+        DVec2::new(self.min.x + x * self.unit.x, self.min.y + y * self.unit.y)
+    }
+}
+
+/// A leaf corner in lattice units, `(y, x)` or `(x, y)`.
+type Corner = (u64, u64);
+
+/// The heights along one edge of a leaf: `(parameter in [0, 1], field)`, sorted.
+type EdgeProfile = Vec<(f64, f64)>;
+
+impl Terrain {
+    /// Builds the terrain of `field` over `bounds` (see the [module docs](self)).
+    ///
+    /// Fails on invalid options, an empty, non-finite or too large rectangle (beyond
+    /// [`MAX_COORDINATE`]), or a field that is not finite at a sample point.
+    pub fn build(
+        field: &dyn Field,
+        bounds: Aabb2,
+        options: &TerrainOptions,
+        material: Option<MaterialId>,
+    ) -> Result<Terrain, GeomError> {
+        options.validate()?;
+        let ok = |v: f64| v.is_finite() && v.abs() <= MAX_COORDINATE;
+        let size = bounds.max - bounds.min;
+        if !(ok(bounds.min.x) && ok(bounds.min.y) && ok(bounds.max.x) && ok(bounds.max.y))
+            || size.x <= 0.0
+            || size.y <= 0.0
+        {
+            return Err(GeomError::InvalidParameter {
+                name: "bounds",
+                reason: format!(
+                    "{:?}–{:?} must be a non-empty finite rectangle",
+                    bounds.min, bounds.max
+                ),
+            });
+        }
+        let nx = ((size.x / options.max_cell_m).ceil() as u64).clamp(1, 4096);
+        let ny = ((size.y / options.max_cell_m).ceil() as u64).clamp(1, 4096);
+        let cell = DVec2::new(size.x / nx as f64, size.y / ny as f64);
+        let mut levels = 0u32;
+        while cell.max_element() / f64::from(1u32 << levels) > options.min_cell_m && levels < 16 {
+            levels += 1;
+        }
+        // One lattice unit is half the smallest leaf, so every leaf's centre is a
+        // lattice point.
+        let root = 2u64 << levels;
+        let grid = Lattice {
+            min: bounds.min,
+            max: bounds.max,
+            unit: cell / root as f64,
+            nx,
+            ny,
+            root,
+        };
+        let sample = |x: u64, y: u64| -> Result<f64, GeomError> {
+            let p = grid.point(x as f64, y as f64);
+            let v = field.sample(p);
+            if v.is_finite() && v.abs() <= MAX_COORDINATE {
+                Ok(v)
+            } else {
+                Err(GeomError::InvalidParameter {
+                    name: "field",
+                    reason: format!("the ground is {v} at {p}; it must be finite"),
+                })
+            }
+        };
+        let e = options.max_error_m;
+
+        // Refinement on each leaf's own corners and centre.
+        let mut work: Vec<Leaf> = Vec::with_capacity((nx * ny) as usize);
+        for j in 0..ny {
+            for i in 0..nx {
+                work.push(Leaf {
+                    x: i * root,
+                    y: j * root,
+                    size: root,
+                });
+            }
+        }
+        let mut leaves = Vec::with_capacity(work.len());
+        let mut worst = 0.0f64;
+        let mut unresolved = 0usize;
+        // Leaves that miss the bound for good: lowered below the field at the end.
+        let mut flagged: Vec<Leaf> = Vec::new();
+        while !work.is_empty() {
+            let mut next = Vec::new();
+            let pending = work.len();
+            for (done, leaf) in work.into_iter().enumerate() {
+                let h = |dx: u64, dy: u64| sample(leaf.x + dx, leaf.y + dy);
+                let s = leaf.size;
+                let corners = [h(0, 0)?, h(s, 0)?, h(s, s)?, h(0, s)?];
+                let profiles = [
+                    vec![(0.0, corners[0]), (1.0, corners[1])],
+                    vec![(0.0, corners[1]), (1.0, corners[2])],
+                    vec![(0.0, corners[3]), (1.0, corners[2])],
+                    vec![(0.0, corners[0]), (1.0, corners[3])],
+                ];
+                let centre = centre_height(&sample, leaf)?;
+                let miss = leaf_miss(&grid, field, leaf, &profiles, centre)?;
+                // Leaves if this one splits: the settled, the next round's, the rest of
+                // this round's, and its four children.
+                let room =
+                    leaves.len() + next.len() + (pending - done - 1) + 4 <= options.max_leaves;
+                if miss > e && s > 2 && room {
+                    split(leaf, &mut next);
+                } else {
+                    if miss > e {
+                        unresolved += 1;
+                        flagged.push(leaf);
+                    }
+                    worst = worst.max(miss);
+                    leaves.push(leaf);
+                }
+            }
+            work = next;
+        }
+
+        // Check the final fans (with hanging vertices) until no leaf splits.
+        loop {
+            let (by_row, by_col) = corner_sets(&leaves);
+            let row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
+            let col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
+            let mut split_any = false;
+            let mut kept = Vec::with_capacity(leaves.len());
+            let mut next_worst = 0.0f64;
+            let mut next_unresolved = 0usize;
+            let mut next_flagged = Vec::new();
+            for (done, &leaf) in leaves.iter().enumerate() {
+                let profiles = edge_profiles(leaf, &by_row, &by_col, &row_heights, &col_heights);
+                let hanging = profiles.iter().any(|p| p.len() > 2);
+                let miss = if hanging {
+                    let centre = centre_height(&sample, leaf)?;
+                    leaf_miss(&grid, field, leaf, &profiles, centre)?
+                } else {
+                    0.0
+                };
+                let room = kept.len() + (leaves.len() - done - 1) + 4 <= options.max_leaves;
+                if hanging && miss > e && leaf.size > 2 && room {
+                    split(leaf, &mut kept);
+                    split_any = true;
+                } else {
+                    if hanging && miss > e {
+                        next_unresolved += 1;
+                        next_flagged.push(leaf);
+                    }
+                    next_worst = next_worst.max(miss);
+                    kept.push(leaf);
+                }
+            }
+            if !split_any {
+                worst = worst.max(next_worst);
+                unresolved += next_unresolved;
+                flagged.extend(next_flagged);
+                leaves = kept;
+                break;
+            }
+            leaves = kept;
+        }
+        leaves.sort_unstable_by_key(|l| (l.y, l.x));
+
+        let (by_row, by_col) = corner_sets(&leaves);
+        let mut row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
+        let mut col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
+        let mut centre_heights = Vec::with_capacity(leaves.len());
+        for &leaf in &leaves {
+            centre_heights.push(centre_height(&sample, leaf)?);
+        }
+        // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
+        // lowered to the lowest field value at their check points, so the surface stays
+        // below the field there too (lowering shared vertices only lowers neighbours).
+        flagged.sort_unstable_by_key(|l| (l.y, l.x, l.size));
+        flagged.dedup();
+        for f in &flagged {
+            let Ok(k) = leaves.binary_search_by_key(&(f.y, f.x), |l| (l.y, l.x)) else {
+                continue;
+            };
+            let leaf = leaves[k];
+            if leaf.size != f.size {
+                continue;
+            }
+            let s = leaf.size as f64;
+            let mut low = f64::INFINITY;
+            for j in 0..=4u32 {
+                for i in 0..=4u32 {
+                    let p = grid.point(
+                        leaf.x as f64 + s * f64::from(i) / 4.0,
+                        leaf.y as f64 + s * f64::from(j) / 4.0,
+                    );
+                    let v = field.sample(p);
+                    if v.is_finite() {
+                        low = low.min(v);
+                    }
+                }
+            }
+            if !low.is_finite() {
+                continue;
+            }
+            let sz = leaf.size;
+            for (line, from, rows) in [
+                (leaf.y, leaf.x, true),
+                (leaf.y + sz, leaf.x, true),
+                (leaf.x, leaf.y, false),
+                (leaf.x + sz, leaf.y, false),
+            ] {
+                let keys = if rows { &by_row } else { &by_col };
+                let lo = keys.partition_point(|&q| q < (line, from));
+                let hi = keys.partition_point(|&q| q <= (line, from + sz));
+                for &(a, b) in keys.get(lo..hi).unwrap_or_default() {
+                    let (row_key, col_key) = if rows {
+                        ((a, b), (b, a))
+                    } else {
+                        ((b, a), (a, b))
+                    };
+                    if let Ok(r) = by_row.binary_search(&row_key) {
+                        row_heights[r] = row_heights[r].min(low);
+                    }
+                    if let Ok(c) = by_col.binary_search(&col_key) {
+                        col_heights[c] = col_heights[c].min(low);
+                    }
+                }
+            }
+            centre_heights[k] = centre_heights[k].min(low);
+        }
+        let mut roots = vec![Vec::new(); (nx * ny) as usize];
+        for (k, l) in leaves.iter().enumerate() {
+            let r = (l.y / root) * nx + l.x / root;
+            if let Some(list) = roots.get_mut(r as usize) {
+                list.push(k as u32);
+            }
+        }
+        let mut terrain = Terrain {
+            mesh: Mesh::new(material),
+            report: TerrainReport {
+                leaves: leaves.len(),
+                triangles: 0,
+                max_error_m: worst,
+                unresolved_leaves: unresolved,
+            },
+            grid,
+            leaves,
+            by_row,
+            by_col,
+            row_heights,
+            col_heights,
+            centre_heights,
+            roots,
+            offset: e,
+        };
+        terrain.mesh = terrain.make_mesh(material)?;
+        terrain.report.triangles = terrain.mesh.triangle_count();
+        Ok(terrain)
+    }
+
+    /// The surface's height at `p` (metres, the mesh's own interpolation before rounding
+    /// to `f32`), or `None` outside the rectangle.
+    pub fn height_at(&self, p: DVec2) -> Option<f64> {
+        let g = &self.grid;
+        let lx = (p.x - g.min.x) / g.unit.x;
+        let ly = (p.y - g.min.y) / g.unit.y;
+        let (wx, wy) = ((g.nx * g.root) as f64, (g.ny * g.root) as f64);
+        if !(lx >= 0.0 && ly >= 0.0 && lx <= wx && ly <= wy) {
+            return None;
+        }
+        let rx = ((lx / g.root as f64) as u64).min(g.nx - 1);
+        let ry = ((ly / g.root as f64) as u64).min(g.ny - 1);
+        let list = self.roots.get((ry * g.nx + rx) as usize)?;
+        for &k in list {
+            let leaf = *self.leaves.get(k as usize)?;
+            let s = leaf.size as f64;
+            let (u, v) = ((lx - leaf.x as f64) / s, (ly - leaf.y as f64) / s);
+            if (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v) {
+                let profiles = edge_profiles(
+                    leaf,
+                    &self.by_row,
+                    &self.by_col,
+                    &self.row_heights,
+                    &self.col_heights,
+                );
+                let centre = *self.centre_heights.get(k as usize)?;
+                return Some(fan_height(&profiles, centre, u, v) - self.offset);
+            }
+        }
+        None
+    }
+
+    /// The fans of every leaf as one up-facing mesh.
+    fn make_mesh(&self, material: Option<MaterialId>) -> Result<Mesh, GeomError> {
+        let g = &self.grid;
+        let size = g.max - g.min;
+        let mut mesh = Mesh::with_capacity(
+            material,
+            self.by_row.len() + self.leaves.len(),
+            6 * self.leaves.len(),
+        );
+        let uv = |p: DVec2| DVec2::new((p.x - g.min.x) / size.x, (g.max.y - p.y) / size.y);
+        for (&(y, x), &h) in self.by_row.iter().zip(&self.row_heights) {
+            let p = g.point(x as f64, y as f64);
+            mesh.add_vertex(to_world(p, h - self.offset), glam::DVec3::Y, uv(p));
+        }
+        let corner = |x: u64, y: u64| -> Option<u32> {
+            self.by_row.binary_search(&(y, x)).ok().map(|i| i as u32)
+        };
+        let mut ring: Vec<u32> = Vec::new();
+        for (leaf, &hc) in self.leaves.iter().zip(&self.centre_heights) {
+            let s = leaf.size;
+            let c = g.point(
+                leaf.x as f64 + s as f64 / 2.0,
+                leaf.y as f64 + s as f64 / 2.0,
+            );
+            let centre = mesh.add_vertex(to_world(c, hc - self.offset), glam::DVec3::Y, uv(c));
+            // The border counter-clockwise: bottom (x up), right (y up), top (x down),
+            // left (y down); each corner once.
+            ring.clear();
+            let row = |y: u64, a: u64, b: u64| {
+                let lo = self.by_row.partition_point(|&k| k < (y, a));
+                let hi = self.by_row.partition_point(|&k| k <= (y, b));
+                self.by_row
+                    .get(lo..hi)
+                    .unwrap_or_default()
+                    .iter()
+                    .map(|&(_, x)| x)
+            };
+            let col = |x: u64, a: u64, b: u64| {
+                let lo = self.by_col.partition_point(|&k| k < (x, a));
+                let hi = self.by_col.partition_point(|&k| k <= (x, b));
+                self.by_col
+                    .get(lo..hi)
+                    .unwrap_or_default()
+                    .iter()
+                    .map(|&(_, y)| y)
+            };
+            for x in row(leaf.y, leaf.x, leaf.x + s - 1) {
+                ring.extend(corner(x, leaf.y));
+            }
+            for y in col(leaf.x + s, leaf.y, leaf.y + s - 1) {
+                ring.extend(corner(leaf.x + s, y));
+            }
+            let top: Vec<u64> = row(leaf.y + s, leaf.x + 1, leaf.x + s).collect();
+            for &x in top.iter().rev() {
+                ring.extend(corner(x, leaf.y + s));
+            }
+            let left: Vec<u64> = col(leaf.x, leaf.y + 1, leaf.y + s).collect();
+            for &y in left.iter().rev() {
+                ring.extend(corner(leaf.x, y));
+            }
+            for k in 0..ring.len() {
+                let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+                mesh.push_triangle(centre, a, b)?;
+            }
+        }
+        mesh.compute_smooth_normals()?;
+        Ok(mesh)
+    }
+}
+
+/// Appends the four children of `leaf`.
+fn split(leaf: Leaf, out: &mut Vec<Leaf>) {
+    let h = leaf.size / 2;
+    for (dx, dy) in [(0, 0), (h, 0), (0, h), (h, h)] {
+        out.push(Leaf {
+            x: leaf.x + dx,
+            y: leaf.y + dy,
+            size: h,
+        });
+    }
+}
+
+/// The field at the leaf's centre (a lattice point: leaves are at least 2 units).
+fn centre_height(
+    sample: &dyn Fn(u64, u64) -> Result<f64, GeomError>,
+    leaf: Leaf,
+) -> Result<f64, GeomError> {
+    sample(leaf.x + leaf.size / 2, leaf.y + leaf.size / 2)
+}
+
+/// Sorted, deduplicated leaf corners by `(y, x)` and by `(x, y)`.
+fn corner_sets(leaves: &[Leaf]) -> (Vec<Corner>, Vec<Corner>) {
+    let mut by_row = Vec::with_capacity(4 * leaves.len());
+    for l in leaves {
+        let s = l.size;
+        by_row.extend([
+            (l.y, l.x),
+            (l.y, l.x + s),
+            (l.y + s, l.x),
+            (l.y + s, l.x + s),
+        ]);
+    }
+    by_row.sort_unstable();
+    by_row.dedup();
+    let mut by_col: Vec<(u64, u64)> = by_row.iter().map(|&(y, x)| (x, y)).collect();
+    by_col.sort_unstable();
+    (by_row, by_col)
+}
+
+fn heights<T>(keys: &[T], f: impl Fn(&T) -> Result<f64, GeomError>) -> Result<Vec<f64>, GeomError> {
+    keys.iter().map(f).collect()
+}
+
+/// The height profiles of the leaf's four edges (bottom, right, top, left), each
+/// parametrised from its lower-left end, through every corner on it.
+fn edge_profiles(
+    leaf: Leaf,
+    by_row: &[(u64, u64)],
+    by_col: &[(u64, u64)],
+    row_h: &[f64],
+    col_h: &[f64],
+) -> [EdgeProfile; 4] {
+    let s = leaf.size;
+    let along = |keys: &[(u64, u64)], hs: &[f64], line: u64, from: u64| -> EdgeProfile {
+        let lo = keys.partition_point(|&k| k < (line, from));
+        let hi = keys.partition_point(|&k| k <= (line, from + s));
+        keys.get(lo..hi)
+            .unwrap_or_default()
+            .iter()
+            .zip(hs.get(lo..hi).unwrap_or_default())
+            .map(|(&(_, t), &h)| ((t - from) as f64 / s as f64, h))
+            .collect()
+    };
+    [
+        along(by_row, row_h, leaf.y, leaf.x),
+        along(by_col, col_h, leaf.x + s, leaf.y),
+        along(by_row, row_h, leaf.y + s, leaf.x),
+        along(by_col, col_h, leaf.x, leaf.y),
+    ]
+}
+
+/// The height of a sorted edge profile at parameter `t`.
+fn profile_at(p: &[(f64, f64)], t: f64) -> f64 {
+    let i = p
+        .partition_point(|&(q, _)| q <= t)
+        .clamp(1, p.len().max(2) - 1);
+    match (p.get(i - 1), p.get(i)) {
+        (Some(&(t0, h0)), Some(&(t1, h1))) if t1 > t0 => h0 + (h1 - h0) * (t - t0) / (t1 - t0),
+        (Some(&(_, h0)), _) => h0,
+        _ => 0.0,
+    }
+}
+
+/// The fan's height at local coordinates `(u, v)` in `[0, 1]²`: on the ray from the
+/// centre through the point, linear between the centre and the border profile.
+fn fan_height(profiles: &[EdgeProfile; 4], centre: f64, u: f64, v: f64) -> f64 {
+    let (du, dv) = (u - 0.5, v - 0.5);
+    let m = du.abs().max(dv.abs());
+    if m <= 0.0 {
+        return centre;
+    }
+    let lambda = m / 0.5;
+    // Where the ray meets the border, and along which edge.
+    let (eu, ev) = (0.5 + du / lambda, 0.5 + dv / lambda);
+    let border = if dv.abs() >= du.abs() {
+        if dv < 0.0 {
+            profile_at(&profiles[0], eu)
+        } else {
+            profile_at(&profiles[2], eu)
+        }
+    } else if du > 0.0 {
+        profile_at(&profiles[1], ev)
+    } else {
+        profile_at(&profiles[3], ev)
+    };
+    (1.0 - lambda) * centre + lambda * border
+}
+
+/// The largest miss of the leaf's fan against the field at its check points.
+fn leaf_miss(
+    grid: &Lattice,
+    field: &dyn Field,
+    leaf: Leaf,
+    profiles: &[EdgeProfile; 4],
+    centre: f64,
+) -> Result<f64, GeomError> {
+    let mut worst = 0.0f64;
+    let s = leaf.size as f64;
+    for j in 0..=4u32 {
+        for i in 0..=4u32 {
+            if (i % 4 == 0 && j % 4 == 0) || (i == 2 && j == 2) {
+                continue; // corners and centre are vertices
+            }
+            let (u, v) = (f64::from(i) / 4.0, f64::from(j) / 4.0);
+            let p = grid.point(leaf.x as f64 + u * s, leaf.y as f64 + v * s);
+            let f = field.sample(p);
+            if !f.is_finite() {
+                return Err(GeomError::InvalidParameter {
+                    name: "field",
+                    reason: format!("the ground is {f} at {p}; it must be finite"),
+                });
+            }
+            worst = worst.max((fan_height(profiles, centre, u, v) - f).abs());
+        }
+    }
+    Ok(worst)
+}
+
+#[cfg(test)]
+mod tests;

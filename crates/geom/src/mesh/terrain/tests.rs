@@ -1,0 +1,202 @@
+use super::*;
+use crate::field::{Fbm, FbmParams, FieldExt, FnField};
+use proptest::prelude::*;
+
+fn rect(w: f64, h: f64) -> Aabb2 {
+    Aabb2::new(
+        DVec2::new(-w / 2.0, -h / 3.0),
+        DVec2::new(w / 2.0, 2.0 * h / 3.0),
+    )
+}
+
+/// The sheet's edges: each interior edge twice in opposite directions, the border once,
+/// every triangle facing up.
+fn check_sheet(t: &Terrain, bounds: Aabb2) {
+    t.mesh.validate().unwrap();
+    let r = t.mesh.edge_use();
+    assert!(r.non_manifold.is_empty() && r.flipped.is_empty(), "{r:?}");
+    assert_eq!(r.components, 1);
+    let size = bounds.max - bounds.min;
+    let perimeter = 2.0 * (size.x + size.y);
+    // The border is the rectangle's perimeter (3-D length ≥ its plan length).
+    assert!(
+        r.open_length >= perimeter * (1.0 - 1e-6),
+        "{} < {perimeter}",
+        r.open_length
+    );
+    for tri in t.mesh.triangles() {
+        let [a, b, c] = tri.map(|i| t.mesh.positions[i as usize].as_dvec3());
+        assert!((b - a).cross(c - a).y > 0.0, "a triangle faces down");
+    }
+    // Plan area is the rectangle's.
+    let plan: f64 = t
+        .mesh
+        .triangles()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|i| t.mesh.positions[i as usize].as_dvec3());
+            0.5 * (b - a).cross(c - a).y
+        })
+        .sum();
+    assert!((plan - size.x * size.y).abs() < 1e-3 * size.x * size.y);
+}
+
+/// Every leaf's 5 × 5 check points.
+fn check_points(t: &Terrain) -> impl Iterator<Item = DVec2> + '_ {
+    t.leaves.iter().flat_map(move |leaf| {
+        let s = leaf.size as f64;
+        (0..25u32).map(move |k| {
+            t.grid.point(
+                leaf.x as f64 + s * f64::from(k % 5) / 4.0,
+                leaf.y as f64 + s * f64::from(k / 5) / 4.0,
+            )
+        })
+    })
+}
+
+/// The one-sided bound at every check point of every leaf.
+fn check_bound(t: &Terrain, field: &dyn Field, e: f64) {
+    assert_eq!(t.report.unresolved_leaves, 0, "{:?}", t.report);
+    assert!(t.report.max_error_m <= e);
+    for p in check_points(t) {
+        let f = field.sample(p);
+        let h = t.height_at(p).unwrap();
+        assert!(
+            h <= f + 1e-9 && h >= f - 2.0 * e - 1e-9,
+            "{h} vs {f} at {p}"
+        );
+    }
+}
+
+#[test]
+fn a_plane_needs_only_root_cells_and_lies_the_bound_below() {
+    let field = FnField(|p: DVec2| 3.0 + 0.1 * p.x - 0.05 * p.y);
+    let bounds = rect(300.0, 200.0);
+    let options = TerrainOptions::default();
+    let t = Terrain::build(&field, bounds, &options, None).unwrap();
+    assert_eq!(t.report.leaves, 5 * 4);
+    assert_eq!(t.report.triangles, 4 * 20);
+    check_sheet(&t, bounds);
+    for k in 0..50 {
+        let p = bounds.min + DVec2::new(k as f64 * 5.9, k as f64 * 3.7);
+        let h = t.height_at(p).unwrap();
+        assert!((h - (field.sample(p) - 0.2)).abs() < 1e-9);
+    }
+    assert_eq!(t.height_at(DVec2::new(1e4, 0.0)), None);
+    // Vertices: positions are the field less the bound (f32).
+    for p in &t.mesh.positions {
+        let (q, h) = crate::to_layout(p.as_dvec3());
+        assert!((h - (field.sample(q) - 0.2)).abs() < 1e-3);
+    }
+}
+
+#[test]
+fn a_hill_refines_and_keeps_the_bound() {
+    let field = FnField(|p: DVec2| 40.0 * (-(p.length_squared()) / (2.0 * 60.0f64.powi(2))).exp());
+    let bounds = rect(400.0, 300.0);
+    let options = TerrainOptions {
+        max_error_m: 0.1,
+        ..TerrainOptions::default()
+    };
+    let t = Terrain::build(&field, bounds, &options, None).unwrap();
+    assert!(t.report.leaves > 50, "{:?}", t.report);
+    check_sheet(&t, bounds);
+    check_bound(&t, &field, 0.1);
+}
+
+#[test]
+fn a_cliff_is_reported_not_a_panic() {
+    // A 30 m step: no leaf can resolve it, the unresolved leaves are counted.
+    let field = FnField(|p: DVec2| if p.x > 10.3 { 30.0 } else { 0.0 });
+    let bounds = rect(200.0, 200.0);
+    let t = Terrain::build(&field, bounds, &TerrainOptions::default(), None).unwrap();
+    assert!(t.report.unresolved_leaves > 0);
+    assert!(t.report.max_error_m > 1.0);
+    check_sheet(&t, bounds);
+    // Still below the field at every check point, even at the cliff.
+    for p in check_points(&t) {
+        assert!(
+            t.height_at(p).unwrap() <= field.sample(p) + 1e-9,
+            "above at {p}"
+        );
+    }
+    // A leaf budget stops refinement without breaking the mesh.
+    let small = TerrainOptions {
+        max_leaves: 40,
+        ..TerrainOptions::default()
+    };
+    let t = Terrain::build(&field, bounds, &small, None).unwrap();
+    assert!(t.report.leaves <= 40, "{:?}", t.report);
+    check_sheet(&t, bounds);
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let bounds = rect(100.0, 100.0);
+    let nan = FnField(|p: DVec2| if p.x > 20.0 { f64::NAN } else { 1.0 });
+    assert!(Terrain::build(&nan, bounds, &TerrainOptions::default(), None).is_err());
+    let flat = FnField(|_| 0.0);
+    for bad in [
+        TerrainOptions {
+            max_error_m: 0.0,
+            ..TerrainOptions::default()
+        },
+        TerrainOptions {
+            max_error_m: f64::NAN,
+            ..TerrainOptions::default()
+        },
+        TerrainOptions {
+            min_cell_m: 0.0,
+            ..TerrainOptions::default()
+        },
+        TerrainOptions {
+            max_cell_m: 1.0,
+            ..TerrainOptions::default()
+        },
+        TerrainOptions {
+            max_leaves: 0,
+            ..TerrainOptions::default()
+        },
+    ] {
+        assert!(
+            Terrain::build(&flat, bounds, &bad, None).is_err(),
+            "{bad:?}"
+        );
+    }
+    let empty = Aabb2::new(DVec2::ZERO, DVec2::new(0.0, 5.0));
+    assert!(Terrain::build(&flat, empty, &TerrainOptions::default(), None).is_err());
+    let huge = Aabb2::new(DVec2::ZERO, DVec2::splat(1e9));
+    assert!(Terrain::build(&flat, huge, &TerrainOptions::default(), None).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// On random fBm ground, the bound holds at every check point, the sheet is sound,
+    /// and between check points the miss stays within the curvature allowance.
+    #[test]
+    fn random_ground_keeps_the_bound(
+        seed in 0u64..1000,
+        wavelength in 40.0f64..400.0,
+        amplitude in 0.5f64..40.0,
+        e in 0.05f64..0.5,
+        w in 50.0f64..200.0,
+        h in 50.0f64..200.0,
+    ) {
+        let fbm = Fbm::new(FbmParams { seed, wavelength_m: wavelength, octaves: 3, ..FbmParams::default() }).unwrap();
+        let field = fbm.scaled(amplitude);
+        let bounds = rect(w, h);
+        let options = TerrainOptions { max_error_m: e, max_cell_m: 32.0, min_cell_m: 1.0, ..TerrainOptions::default() };
+        let t = Terrain::build(&field, bounds, &options, None).unwrap();
+        check_sheet(&t, bounds);
+        check_bound(&t, &field, e);
+        // Random points: within the bound plus a generous curvature allowance.
+        let slack = e;
+        for k in 0..200u32 {
+            let f = |n: u32| f64::from(n.wrapping_mul(2_654_435_761) % 10_007) / 10_007.0;
+            let p = bounds.min + (bounds.max - bounds.min) * DVec2::new(f(k), f(k + 5000));
+            let v = field.sample(p);
+            let s = t.height_at(p).unwrap();
+            prop_assert!(s <= v + slack && s >= v - 2.0 * e - slack, "{s} vs {v}");
+        }
+    }
+}
