@@ -526,10 +526,11 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         out: &mut Insertion,
     ) -> Result<NodeId, GeomError> {
         let (pc, pt) = (self.position(cur)?, self.position(target)?);
-        // The rounded crossing point landed on an end of the new segment: bend the
-        // crossed edge through that node instead of creating a coincident node.
+        // The rounded crossing point landed on (or within rounding of) an end of the
+        // current leg: bend the crossed edge through that node instead of creating a
+        // node a few ulps beside it, whose fan of edges would cross the node's own.
         for (n, pn) in [(cur, pc), (target, pt)] {
-            if c == pn {
+            if c.distance(pn) <= rounding_eps(pn) {
                 let piece = self.reroute_through(e, n)?;
                 if let Some(piece) = piece {
                     out.split.push((e, piece));

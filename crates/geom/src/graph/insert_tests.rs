@@ -486,12 +486,17 @@ fn planar_insert_case(data: &[u8]) -> Result<(), String> {
 /// that edge's end, which lay just beyond the snap distance of the caller's segment, so
 /// the edge was split there instead of routed through its end: a 1e-15 m edge that the
 /// crossed edge then met away from a node (`GraphCorrupt`). A crossing within rounding of
-/// an end now goes through the end.
+/// an end now goes through the end. The third (session 9): the new segment crossed two
+/// edges that passed within 1e-16 m of each other; the second crossing, rounded, lay one
+/// ulp beside the node of the first, and splitting there made two nodes one ulp apart
+/// whose fans crossed. A crossing within rounding of the current leg's ends now bends the
+/// crossed edge through that end node.
 #[test]
 fn planar_insert_fuzz_findings() {
-    let cases: [&str; 2] = [
+    let cases: [&str; 3] = [
         "7a428a2a8a8a0a8a8a9a003fe5255f5e5e0000ef00008a8a8abfe1",
         "2bc0fc070000f90206af000005b9277eefffffb2b37ab2b2b2ff",
+        "b7a4b4b427692c6f240000140bfdff0000ffff0000c2da692c6f240000140bfdff0001ffff0000545555ff55590000000bedff004bc2da692c6f001400fd0bb40000f902114c009061294b0090f2f69e4c0090610000000000000000000000000000000000000000000000c2da2200692c6f7500ff0b0000fd14fffffff72c",
     ];
     for hex in cases {
         let bytes: Vec<u8> = (0..hex.len() / 2)
