@@ -90,8 +90,7 @@ pub(crate) fn rgba(index: usize, image: &Image) -> Result<Rgba<'_>, ExportError>
 /// Halves `img` (2 × 2 box filter; an odd last row or column is averaged with itself)
 /// until both sides are at most `max_px`. `normal_map`: texels are unit vectors
 /// (`c / 255 · 2 − 1`), averaged and renormalised.
-pub(crate) fn cap<'a>(img: Rgba<'a>, max_px: u32, normal_map: bool) -> Rgba<'a> {
-    let mut img = img;
+pub(crate) fn cap(mut img: Rgba<'_>, max_px: u32, normal_map: bool) -> Rgba<'_> {
     while (img.width > max_px || img.height > max_px) && (img.width > 1 || img.height > 1) {
         let (w, h) = (img.width as usize, img.height as usize);
         let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
