@@ -12,7 +12,8 @@
 //! in milliseconds. The last lines check the targets of issue 26: tiled draw calls ≤ 4 ×
 //! materials × tiles; the web profile ≤ 25 % of the per-cell plain bytes; the tiled plain
 //! write no slower than the per-cell plain write. `--only tiled:plain` writes that one
-//! row once (for whole-process timings of one configuration).
+//! row once (for whole-process timings of one configuration). `--save DIR` also writes
+//! each row's file to `DIR/<preset>-<layout>-<profile>.glb`.
 
 use std::time::Instant;
 
@@ -32,10 +33,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut presets = Vec::new();
     let mut runs = 5usize;
     let mut only: Option<(String, String)> = None;
+    let mut save: Option<std::path::PathBuf> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--runs" => runs = args.next().ok_or("--runs N")?.parse()?,
+            "--save" => save = Some(args.next().ok_or("--save DIR")?.into()),
             "--only" => {
                 let v = args.next().ok_or("--only LAYOUT:PROFILE")?;
                 let (l, p) = v.split_once(':').ok_or("--only LAYOUT:PROFILE")?;
@@ -92,6 +95,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let r = write_glb(&city.scene, &options, &mut out)?;
                     times.push(t.elapsed().as_secs_f64() * 1e3);
                     report = Some(r);
+                }
+                if let Some(dir) = &save {
+                    let mut out = Vec::new();
+                    write_glb(&city.scene, &options, &mut out)?;
+                    std::fs::write(dir.join(format!("{name}-{lname}-{profile}.glb")), out)?;
                 }
                 times.sort_by(f64::total_cmp);
                 let ms = times[times.len() / 2];

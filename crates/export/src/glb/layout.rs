@@ -51,6 +51,10 @@ pub(crate) struct ArrayLayout {
     /// Web profile: `(offset, length)` of the meshopt stream in the binary chunk.
     #[cfg_attr(not(feature = "web"), allow(dead_code))]
     pub compressed: Option<(u64, u64)>,
+    /// Web profile: the `EXT_meshopt_compression` filter the stream was encoded with
+    /// (`OCTAHEDRAL` for normals and tangents), applied by the decoder.
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
+    pub filter: Option<&'static str>,
 }
 
 impl ArrayLayout {
@@ -186,6 +190,7 @@ pub(crate) fn plain(
                 offset: off,
                 length,
                 compressed: None,
+                filter: None,
             });
             off = pad4(off + length);
         };

@@ -56,8 +56,17 @@
 //!
 //! [`GlbProfile::Plain`] (the default) is core glTF 2.0 without extensions.
 //! [`GlbProfile::Web`] quantizes (`KHR_mesh_quantization`) and compresses
-//! (`EXT_meshopt_compression`) the vertex and index arrays; see `web` for the grids and
-//! why both extensions are then required.
+//! (`EXT_meshopt_compression`, normals and tangents through its octahedral filter) the
+//! vertex and index arrays, and re-encodes the textures as smaller PNG files (a
+//! resolution cap, [`GlbOptions::web_texture_max_px`], then the smallest lossless colour
+//! type: palette, RGB or RGBA); see `web` for the grids and why both extensions are then
+//! required, and `web_images` for the textures.
+//!
+//! ## Instancing
+//!
+//! [`GlbOptions::gpu_instancing`] (off by default) turns sibling leaves of the per-node
+//! layout that draw one mesh into one node with `EXT_mesh_gpu_instancing` (listed as used,
+//! not required); see `instancing`.
 //!
 //! ## Guarantees
 //!
@@ -81,6 +90,7 @@
 //!   Khronos validator reports as not decomposable. Scenes built with
 //!   [`Transform::Trs`] never hit this.
 
+mod instancing;
 mod layout;
 mod options;
 mod plan;
@@ -88,6 +98,8 @@ mod tangents;
 mod tiles;
 #[cfg(feature = "web")]
 mod web;
+#[cfg(feature = "web")]
+mod web_images;
 
 pub use options::{Batching, GlbOptions, GlbProfile};
 
@@ -137,6 +149,8 @@ pub struct GlbReport {
     pub tiles: usize,
     /// Stored geometries drawn by two or more nodes (shared, not copied).
     pub shared_geometries: usize,
+    /// Instances drawn through `EXT_mesh_gpu_instancing` ([`GlbOptions::gpu_instancing`]).
+    pub instances: usize,
 }
 
 /// Writes `scene` as a glTF 2.0 binary file to `out`.
@@ -165,30 +179,44 @@ pub fn write_glb<W: Write>(
 ) -> Result<GlbReport, ExportError> {
     options.validate()?;
     scene.validate()?;
-    let plan = match options.batching {
+    let mut plan = match options.batching {
         Batching::PerNode => plan::per_node(scene),
         Batching::PerParentAndMaterial => plan::batched(scene)?,
         Batching::Tiled => tiles::tiled(scene, options)?,
     };
+    if options.gpu_instancing && options.batching == Batching::PerNode {
+        instancing::instance(scene, &mut plan)?;
+    }
     let used = Used::new(scene, &plan);
-    let pngs = used
-        .images
-        .iter()
-        .map(|&i| png_bytes(i, &scene.images[i]))
-        .collect::<Result<Vec<_>, _>>()?;
-    let layout = match options.profile {
+    let pngs = match options.profile {
+        #[cfg(feature = "web")]
+        GlbProfile::Web => web::images(scene, &used, options.web_texture_max_px)?,
+        _ => used
+            .images
+            .iter()
+            .map(|&i| png_bytes(i, &scene.images[i]))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
+    let mut layout = match options.profile {
         GlbProfile::Plain => layout::plain(scene, &plan, &pngs)?,
         #[cfg(feature = "web")]
         GlbProfile::Web => web::layout(scene, &plan, &pngs)?,
         #[cfg(not(feature = "web"))]
         GlbProfile::Web => layout::plain(scene, &plan, &pngs)?,
     };
-    let root = document(scene, &plan, &layout, &used)?;
-    let json_bytes = if layout.fallback_len.is_some() {
-        #[cfg_attr(not(feature = "web"), allow(unused_mut))]
+    // Instance arrays (EXT_mesh_gpu_instancing) after the images.
+    let instances = instancing::arrays(scene, &plan, &layout.dequantize, layout.bin_len);
+    layout.bin_len += pad4(instances.bytes.len() as u64);
+    let (root, instance_accessors) = document(scene, &plan, &layout, &used, &instances)?;
+    let json_bytes = if layout.fallback_len.is_some() || !instances.nodes.is_empty() {
         let mut doc = serde_json::to_value(&root).map_err(ExportError::json("glTF JSON"))?;
         #[cfg(feature = "web")]
-        web::add_extensions(&mut doc, &layout);
+        {
+            if layout.fallback_len.is_some() {
+                web::add_extensions(&mut doc, &layout);
+            }
+        }
+        instancing::add_extension(&mut doc, &instances, &instance_accessors);
         serde_json::to_vec(&doc).map_err(ExportError::json("glTF JSON"))?
     } else {
         json::serialize::to_vec(&root).map_err(ExportError::json("glTF JSON"))?
@@ -235,6 +263,8 @@ pub fn write_glb<W: Write>(
                 w.put(png)?;
                 w.pad4()?;
             }
+            w.put(&instances.bytes)?;
+            w.pad4()?;
         }
         w.finish()?;
         debug_assert_eq!(w.written, total);
@@ -264,6 +294,7 @@ pub fn write_glb<W: Write>(
         features: plan.features,
         tiles: plan.tiles,
         shared_geometries: drawers.iter().filter(|&&d| d >= 2).count(),
+        instances: instances.nodes.iter().map(|&(_, count, _)| count).sum(),
         materials: used.materials.len(),
         textures: used.textures.len(),
         images: used.images.len(),
@@ -275,10 +306,10 @@ pub fn write_glb<W: Write>(
 
 /// The materials, textures and images the written primitives use (scene indices in
 /// scene order), and their new glTF indices.
-struct Used {
+pub(crate) struct Used {
     materials: Vec<usize>,
     textures: Vec<usize>,
-    images: Vec<usize>,
+    pub(crate) images: Vec<usize>,
     /// glTF index of each scene material / texture / image (`u32::MAX`: left out).
     material_index: Vec<u32>,
     texture_index: Vec<u32>,
@@ -354,15 +385,39 @@ impl Used {
             image_index,
         }
     }
+
+    /// Per written image (in `images` order): whether a written material uses it as its
+    /// normal texture.
+    #[cfg(feature = "web")]
+    pub(crate) fn normal_maps(&self, scene: &Scene) -> Vec<bool> {
+        let mut normal = vec![false; self.images.len()];
+        for mat in self
+            .materials
+            .iter()
+            .filter_map(|&k| scene.materials.get(k))
+        {
+            let image = mat
+                .normal_texture
+                .and_then(|t| scene.textures.get(t.0 as usize))
+                .and_then(|t| self.image_index.get(t.image.0 as usize))
+                .and_then(|&i| normal.get_mut(i as usize));
+            if let Some(n) = image {
+                *n = true;
+            }
+        }
+        normal
+    }
 }
 
-/// The glTF JSON document for a plan and its layout.
+/// The glTF JSON document for a plan and its layout, and per instanced node the
+/// accessors of its instance arrays (translation, rotation, scale, feature id).
 fn document(
     scene: &Scene,
     plan: &Plan<'_>,
     layout: &Layout,
     used: &Used,
-) -> Result<json::Root, ExportError> {
+    instances: &instancing::Instances,
+) -> Result<(json::Root, Vec<[u32; 4]>), ExportError> {
     let mut root = json::Root {
         asset: json::Asset {
             generator: Some(format!("polis-export {}", env!("CARGO_PKG_VERSION"))),
@@ -472,6 +527,42 @@ fn document(
             extensions: None,
             extras: None,
         });
+    }
+    let mut instance_accessors = Vec::with_capacity(instances.nodes.len());
+    for &(_, count, at) in &instances.nodes {
+        let mut ids = [0u32; 4];
+        let mut offset = at;
+        for (k, (ty, size)) in [
+            (json::accessor::Type::Vec3, 12u64),
+            (json::accessor::Type::Vec4, 16),
+            (json::accessor::Type::Vec3, 12),
+            (json::accessor::Type::Scalar, 4),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let length = size * count as u64;
+            let v = view(&mut root, json::Index::new(0), offset, length, None, None);
+            offset += length;
+            let id = root.push(json::Accessor {
+                buffer_view: Some(v),
+                byte_offset: None,
+                count: USize64(count as u64),
+                component_type: Checked::Valid(json::accessor::GenericComponentType(
+                    json::accessor::ComponentType::F32,
+                )),
+                extensions: None,
+                extras: None,
+                type_: Checked::Valid(ty),
+                min: None,
+                max: None,
+                name: None,
+                normalized: false,
+                sparse: None,
+            });
+            ids[k] = id.value() as u32;
+        }
+        instance_accessors.push(ids);
     }
     let mut samplers: BTreeMap<(u8, u8, u8), json::Index<json::texture::Sampler>> = BTreeMap::new();
     for tex in used.textures.iter().map(|&k| &scene.textures[k]) {
@@ -662,6 +753,8 @@ fn document(
             ..json::Node::default()
         };
         let transform = source.map_or(Transform::IDENTITY, |n| n.transform);
+        // Instanced nodes: the instances' transforms carry the dequantisation.
+        let dequantize = dequantize.filter(|_| pn.instances.is_empty());
         match dequantize {
             Some((offset, scale)) if children.is_empty() => {
                 set_transform(&mut out, &compose_dequantize(&transform, offset, scale));
@@ -699,7 +792,7 @@ fn document(
         });
         root.scene = Some(scene_index);
     }
-    Ok(root)
+    Ok((root, instance_accessors))
 }
 
 fn named(name: &str) -> Option<String> {
@@ -738,7 +831,7 @@ const TRS_TOLERANCE: f64 = 1e-9;
 
 /// `t` followed (inside) by the dequantisation `q ↦ offset + scale ⊙ q` of quantized
 /// positions: a TRS stays a TRS (the scale multiplies, the offset moves the translation).
-fn compose_dequantize(t: &Transform, offset: Vec3, scale: Vec3) -> Transform {
+pub(crate) fn compose_dequantize(t: &Transform, offset: Vec3, scale: Vec3) -> Transform {
     let (o, s) = (offset.as_dvec3(), scale.as_dvec3());
     match *t {
         Transform::Trs {

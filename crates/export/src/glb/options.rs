@@ -90,6 +90,18 @@ pub struct GlbOptions {
     /// LOD node's `extras.lod_range_m`; engines apply it themselves. Finite and > 0.
     /// Default: 300.
     pub lod_near_m: f64,
+    /// [`GlbProfile::Web`] only: the largest width or height of an embedded texture,
+    /// pixels, ≥ 1. Larger images are halved until they fit (normal maps averaged as
+    /// vectors); images within it are re-encoded losslessly. The plain profile embeds
+    /// every image at its size. Default: 256.
+    pub web_texture_max_px: u32,
+    /// [`Batching::PerNode`] only: sibling leaf nodes drawing the same mesh become one
+    /// node drawing it per instance (`EXT_mesh_gpu_instancing`; their names and metadata
+    /// in its `extras.instances`, numbered by the per-instance `_FEATURE_ID_0`). Read by
+    /// three.js, Babylon.js and Unity glTFast; loaders without it (Godot, Unreal)
+    /// draw one instance, so it is off by default. The other layouts merge shared
+    /// meshes into their batches and ignore it. Default: false.
+    pub gpu_instancing: bool,
 }
 
 impl Default for GlbOptions {
@@ -99,6 +111,8 @@ impl Default for GlbOptions {
             tile_size_m: 250.0,
             profile: GlbProfile::default(),
             lod_near_m: 300.0,
+            web_texture_max_px: 256,
+            gpu_instancing: false,
         }
     }
 }
@@ -124,6 +138,12 @@ impl GlbOptions {
                     reason: format!("{v} is not a finite length above 0 m"),
                 });
             }
+        }
+        if self.web_texture_max_px == 0 {
+            return Err(ExportError::InvalidOption {
+                name: "web_texture_max_px",
+                reason: "a texture needs at least 1 pixel".to_string(),
+            });
         }
         if self.profile == GlbProfile::Web && !cfg!(feature = "web") {
             return Err(ExportError::InvalidOption {

@@ -91,6 +91,9 @@ pub(crate) struct PlannedNode {
     pub extras: Option<serde_json::Map<String, serde_json::Value>>,
     pub mesh: Option<usize>,
     pub children: Vec<u32>,
+    /// `EXT_mesh_gpu_instancing`: the scene nodes whose transforms are the instances
+    /// (empty: a plain node).
+    pub instances: Vec<NodeId>,
 }
 
 impl PlannedNode {
@@ -101,6 +104,7 @@ impl PlannedNode {
             extras: None,
             mesh: None,
             children: Vec::new(),
+            instances: Vec::new(),
         }
     }
 
@@ -115,6 +119,7 @@ impl PlannedNode {
             },
             mesh: None,
             children: Vec::new(),
+            instances: Vec::new(),
         }
     }
 }

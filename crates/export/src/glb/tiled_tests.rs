@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::*;
-use polis_geom::glam::{DVec3, Vec2};
+use polis_geom::glam::{DMat4, DVec3, Vec2};
 use polis_geom::hash::splitmix64;
 use polis_geom::mesh::prism;
 use polis_geom::scene::{Material, MetaValue};
@@ -438,10 +438,10 @@ fn web_profile_decodes_to_the_plain_geometry() {
             e["byteLength"].as_u64().unwrap() as usize,
         );
         let mode = Mode::parse(e["mode"].as_str().unwrap()).unwrap();
+        let filter = Filter::parse(e["filter"].as_str().unwrap_or("NONE")).unwrap();
         let stride = e["byteStride"].as_u64().unwrap() as usize;
         let count = e["count"].as_u64().unwrap() as usize;
-        let raw =
-            decode_buffer_view(mode, Filter::None, count, stride, &wbin[o..o + l], ws).unwrap();
+        let raw = decode_buffer_view(mode, filter, count, stride, &wbin[o..o + l], ws).unwrap();
         (raw, stride)
     };
     let f32s = |v: &serde_json::Value, default: f32| {
@@ -517,8 +517,169 @@ fn web_profile_decodes_to_the_plain_geometry() {
             expect.sort();
             got.sort();
             assert_eq!(got, expect, "mesh {k}");
+            // Normals (octahedral filter, signed bytes): every decoded normal is within
+            // a few degrees of a plain normal of the same primitive; the faces of these
+            // boxes have six directions.
+            let filter = &wj["bufferViews"][wj["accessors"]
+                [wp["attributes"]["NORMAL"].as_u64().unwrap() as usize]["bufferView"]
+                .as_u64()
+                .unwrap() as usize]["extensions"]["EXT_meshopt_compression"]["filter"];
+            assert_eq!(filter, "OCTAHEDRAL");
+            let plain_normals = read(&pj, pbin, pp["attributes"]["NORMAL"].as_u64().unwrap());
+            let (qn, nstride) = decode(wp["attributes"]["NORMAL"].as_u64().unwrap(), &mut ws);
+            assert_eq!(nstride, 4);
+            for q in qn.chunks_exact(4) {
+                let d = [0, 1, 2].map(|a| f64::from(q[a] as i8) / 127.0);
+                let best = plain_normals
+                    .iter()
+                    .map(|p| p[0] * d[0] + p[1] * d[1] + p[2] * d[2])
+                    .fold(f64::MIN, f64::max);
+                assert!(best > 0.998, "normal {d:?} off by more than 3.6°");
+            }
         }
     }
+}
+
+/// The local matrix of a glTF node (or of one instance: the same TRS fields).
+fn local_matrix(n: &serde_json::Value) -> DMat4 {
+    if let Some(m) = n["matrix"].as_array() {
+        let c: Vec<f64> = m.iter().map(|x| x.as_f64().unwrap()).collect();
+        return DMat4::from_cols_slice(&c);
+    }
+    let v = |key: &str, d: [f64; 4]| -> [f64; 4] {
+        n[key].as_array().map_or(d, |a| {
+            let mut out = d;
+            for (o, x) in out.iter_mut().zip(a) {
+                *o = x.as_f64().unwrap();
+            }
+            out
+        })
+    };
+    let t = v("translation", [0.0; 4]);
+    let r = v("rotation", [0.0, 0.0, 0.0, 1.0]);
+    let s = v("scale", [1.0; 4]);
+    DMat4::from_scale_rotation_translation(
+        DVec3::new(s[0], s[1], s[2]),
+        polis_geom::glam::DQuat::from_xyzw(r[0], r[1], r[2], r[3]),
+        DVec3::new(t[0], t[1], t[2]),
+    )
+}
+
+/// Every triangle a plain-profile glb draws, in world space (instances expanded), as
+/// sorted corner triples rounded to 0.1 mm, sorted.
+fn world_triangles(bytes: &[u8]) -> Vec<[[i64; 3]; 3]> {
+    let (j, bin) = chunks(bytes);
+    let mut out = Vec::new();
+    let mut stack: Vec<(u64, DMat4)> = j["scenes"][0]["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| (n.as_u64().unwrap(), DMat4::IDENTITY))
+        .collect();
+    while let Some((i, parent)) = stack.pop() {
+        let n = &j["nodes"][i as usize];
+        let world = parent * local_matrix(n);
+        for c in n["children"].as_array().into_iter().flatten() {
+            stack.push((c.as_u64().unwrap(), world));
+        }
+        let Some(mesh) = n["mesh"].as_u64() else {
+            continue;
+        };
+        let placements: Vec<DMat4> =
+            match n["extensions"]["EXT_mesh_gpu_instancing"]["attributes"].as_object() {
+                None => vec![world],
+                Some(a) => {
+                    let t = read(&j, bin, a["TRANSLATION"].as_u64().unwrap());
+                    let r = read(&j, bin, a["ROTATION"].as_u64().unwrap());
+                    let s = read(&j, bin, a["SCALE"].as_u64().unwrap());
+                    (0..t.len())
+                        .map(|k| {
+                            world
+                                * DMat4::from_scale_rotation_translation(
+                                    DVec3::new(s[k][0], s[k][1], s[k][2]),
+                                    polis_geom::glam::DQuat::from_xyzw(
+                                        r[k][0], r[k][1], r[k][2], r[k][3],
+                                    ),
+                                    DVec3::new(t[k][0], t[k][1], t[k][2]),
+                                )
+                        })
+                        .collect()
+                }
+            };
+        for p in j["meshes"][mesh as usize]["primitives"].as_array().unwrap() {
+            let pos = read(&j, bin, p["attributes"]["POSITION"].as_u64().unwrap());
+            let idx = read(&j, bin, p["indices"].as_u64().unwrap());
+            for m in &placements {
+                for t in idx.chunks_exact(3) {
+                    let mut tri = [0, 1, 2].map(|k| {
+                        let q = &pos[t[k][0] as usize];
+                        let w = m.transform_point3(DVec3::new(q[0], q[1], q[2]));
+                        [w.x, w.y, w.z].map(|c| (c * 1e4).round() as i64)
+                    });
+                    tri.sort();
+                    out.push(tri);
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn gpu_instancing_expands_to_the_same_triangles_as_the_per_node_layout() {
+    let scene = town(60);
+    let plain = GlbOptions::with_batching(Batching::PerNode);
+    let (a, ra) = write(&scene, &plain);
+    let instanced = GlbOptions {
+        gpu_instancing: true,
+        ..plain.clone()
+    };
+    let (b, rb) = write(&scene, &instanced);
+    assert_eq!(ra.instances, 0);
+    assert!(rb.instances > 0 && rb.nodes < ra.nodes, "{rb:?}");
+    assert_eq!(world_triangles(&a), world_triangles(&b));
+    // Loads with the gltf crate; the extension is used, not required.
+    gltf::Gltf::from_slice(&b).unwrap();
+    let (j, bin) = chunks(&b);
+    assert_eq!(
+        j["extensionsUsed"],
+        serde_json::json!(["EXT_mesh_gpu_instancing"])
+    );
+    assert!(j.get("extensionsRequired").is_none());
+    // Each instanced node lists its instances, numbered by _FEATURE_ID_0, and every
+    // building of the scene is still named once (as a node or an instance).
+    let mut names = BTreeSet::new();
+    let mut instances = 0;
+    for n in j["nodes"].as_array().unwrap() {
+        let Some(a) = n["extensions"]["EXT_mesh_gpu_instancing"]["attributes"].as_object() else {
+            if let Some(name) = n["name"].as_str() {
+                names.insert(name.to_string());
+            }
+            continue;
+        };
+        let records = n["extras"]["instances"].as_array().unwrap();
+        let ids = read(&j, bin, a["_FEATURE_ID_0"].as_u64().unwrap());
+        assert_eq!(ids.len(), records.len());
+        for (k, (id, r)) in ids.iter().zip(records).enumerate() {
+            assert_eq!(id[0], k as f64);
+            assert!(names.insert(r["name"].as_str().unwrap().to_string()));
+        }
+        instances += records.len();
+    }
+    assert_eq!(instances, rb.instances);
+    for i in 0..60 {
+        assert!(names.contains(&format!("building {i}")), "building {i}");
+    }
+    // The web profile's instances carry the dequantisation: the same triangles on the
+    // grid, read back with the gltf crate's structure checks.
+    let web = GlbOptions {
+        profile: GlbProfile::Web,
+        ..instanced
+    };
+    let (w, rw) = write(&scene, &web);
+    assert_eq!(rw.instances, rb.instances);
+    gltf::Gltf::from_slice_without_validation(&w).unwrap();
 }
 
 #[test]

@@ -25,7 +25,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use polis_geom::Mesh;
-use polis_geom::glam::{DMat4, Vec3};
+use polis_geom::glam::{DMat4, DVec3, Vec3};
 use polis_geom::scene::{MaterialId, NodeId, Scene};
 use serde_json::{Map, Value, json};
 
@@ -100,6 +100,37 @@ fn append_triangles(
     for v in touched {
         remap[v] = u32::MAX;
     }
+}
+
+/// The translation of `frame` when it only moves (its linear part is the identity).
+fn translation_only(frame: &DMat4) -> Option<DVec3> {
+    let linear = polis_geom::glam::DMat3::from_mat4(*frame);
+    (linear == polis_geom::glam::DMat3::IDENTITY
+        && frame.row(3) == polis_geom::glam::DVec4::W
+        && frame.w_axis.is_finite())
+    .then(|| frame.w_axis.truncate())
+}
+
+/// Appends all of `m`, moved by `t` (as [`Mesh::transform`] moves it: in `f64`, normals
+/// renormalised), with feature `feature` per vertex.
+fn append_moved(target: &mut (Mesh, Vec<u32>), m: &Mesh, t: DVec3, feature: u32) {
+    let (out, features) = target;
+    let base = out.positions.len() as u32;
+    if t == DVec3::ZERO {
+        out.positions.extend_from_slice(&m.positions);
+        out.normals.extend_from_slice(&m.normals);
+    } else {
+        out.positions
+            .extend(m.positions.iter().map(|p| (p.as_dvec3() + t).as_vec3()));
+        out.normals.extend(
+            m.normals
+                .iter()
+                .map(|n| n.as_dvec3().normalize_or_zero().as_vec3()),
+        );
+    }
+    out.uvs.extend_from_slice(&m.uvs);
+    features.resize(features.len() + m.positions.len(), feature);
+    out.indices.extend(m.indices.iter().map(|&i| base + i));
 }
 
 /// The layout described in the [module docs](self).
@@ -230,6 +261,26 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     }
                 },
             };
+            // A frame that only moves (the usual building or block under its cell):
+            // vertices are moved while they are appended, without a transformed copy.
+            let shift = translation_only(&frame);
+            if let Some(t) = shift {
+                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for m in &drawn {
+                    let b = m.bbox();
+                    lo = lo.min(b.min.as_dvec3() + t);
+                    hi = hi.max(b.max.as_dvec3() + t);
+                }
+                if hi.x - lo.x <= size && hi.z - lo.z <= size {
+                    let c = ((lo + hi) * 0.5).as_vec3();
+                    let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
+                    let group = groups.entry(key).or_default();
+                    for m in drawn {
+                        append_moved(group.target(m.material), m, t, feature);
+                    }
+                    continue;
+                }
+            }
             let placed: Vec<Cow<'_, Mesh>> = if frame == DMat4::IDENTITY {
                 drawn.into_iter().map(Cow::Borrowed).collect()
             } else {
@@ -249,16 +300,15 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             }
             let whole = f64::from(hi.x - lo.x) <= size && f64::from(hi.z - lo.z) <= size;
             for m in &placed {
-                if remap.len() < m.vertex_count() {
-                    remap.resize(m.vertex_count(), u32::MAX);
-                }
                 if whole {
                     let c = (lo + hi) * 0.5;
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
                     let target = groups.entry(key).or_default().target(m.material);
-                    let all: Vec<u32> = (0..m.triangle_count() as u32).collect();
-                    append_triangles(target, m, &all, feature, &mut remap);
+                    append_moved(target, m, DVec3::ZERO, feature);
                     continue;
+                }
+                if remap.len() < m.vertex_count() {
+                    remap.resize(m.vertex_count(), u32::MAX);
                 }
                 // Cut: triangles sorted by the tile of their centroid.
                 let mut by_tile: Vec<(Tile, u32)> = m

@@ -19,7 +19,7 @@ use std::collections::BTreeMap;
 
 use gltf::json::accessor::{ComponentType as C, Type as T};
 use meshoptimizer_rs::codec::{
-    IndexEncoding, VertexEncoding, encode_index_buffer, encode_vertex_buffer,
+    IndexEncoding, VertexEncoding, encode_filter_oct, encode_index_buffer, encode_vertex_buffer,
 };
 use meshoptimizer_rs::{Limits, Workspace, optimize_vertex_cache};
 use polis_geom::glam::Vec3;
@@ -76,8 +76,18 @@ impl Grid {
     }
 }
 
-fn snorm8(x: f32) -> u8 {
-    ((x.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8
+/// The `EXT_meshopt_compression` filter of unit vectors.
+const OCTAHEDRAL: &str = "OCTAHEDRAL";
+
+/// Bits per octahedral component: 8, the signed bytes of the accessor (about 1° steps).
+const OCTAHEDRAL_BITS: u32 = 8;
+
+/// Unit vectors (four floats each: direction and `w`, the tangent handedness or 0) as
+/// meshopt's octahedral filter stores them: two octahedral coordinates, a constant
+/// and `w`, in signed bytes the decoder turns back into a normalized vector. The
+/// constant third byte and the smooth coordinates compress better than `x, y, z`.
+fn octahedral(unit: &[f32], n: usize, ws: &mut Workspace) -> Result<Vec<u8>, ExportError> {
+    encode_filter_oct(n, 4, OCTAHEDRAL_BITS, unit, ws).map_err(codec)
 }
 
 /// One array before offsets are known: its accessor, the raw byte length, the stream.
@@ -135,6 +145,7 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
         offset: 0,
         length: (n * stride) as u64,
         compressed: None,
+        filter: None,
     };
     let mut out = Vec::with_capacity(6);
 
@@ -155,14 +166,16 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
         stream: vertex(bytes, 8, &mut ws)?,
     });
 
-    let mut bytes = Vec::with_capacity(4 * n);
+    let mut unit = Vec::with_capacity(4 * n);
     for nrm in order.iter().map(|&v| &m.normals[v]) {
-        let v = nrm.normalize_or_zero();
-        bytes.extend_from_slice(&[snorm8(v.x), snorm8(v.y), snorm8(v.z), 0]);
+        unit.extend_from_slice(&nrm.normalize_or_zero().extend(0.0).to_array());
     }
     out.push(Encoded {
-        array: array(Slot::Normal, T::Vec3, C::I8, true, 4, None),
-        stream: vertex(bytes, 4, &mut ws)?,
+        array: ArrayLayout {
+            filter: Some(OCTAHEDRAL),
+            ..array(Slot::Normal, T::Vec3, C::I8, true, 4, None)
+        },
+        stream: vertex(octahedral(&unit, n, &mut ws)?, 4, &mut ws)?,
     });
 
     if writes_uvs(scene, m.material) {
@@ -191,20 +204,25 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
             offset: 0,
             length: (indices.len() * isize) as u64,
             compressed: None,
+            filter: None,
         },
         stream: encode_index_buffer(&indices, IndexEncoding::new(1).map_err(codec)?, &mut ws)
             .map_err(codec)?,
     });
 
     if writes_tangents(scene, m.material) {
-        let mut bytes = Vec::with_capacity(4 * n);
         let all = tangents::tangents(m);
+        let mut unit = Vec::with_capacity(4 * n);
         for t in order.iter().filter_map(|&v| all.get(v)) {
-            bytes.extend_from_slice(&t.to_array().map(snorm8));
+            let d = t.truncate().normalize_or_zero();
+            unit.extend_from_slice(&d.extend(if t.w < 0.0 { -1.0 } else { 1.0 }).to_array());
         }
         out.push(Encoded {
-            array: array(Slot::Tangent, T::Vec4, C::I8, true, 4, None),
-            stream: vertex(bytes, 4, &mut ws)?,
+            array: ArrayLayout {
+                filter: Some(OCTAHEDRAL),
+                ..array(Slot::Tangent, T::Vec4, C::I8, true, 4, None)
+            },
+            stream: vertex(octahedral(&unit, n, &mut ws)?, 4, &mut ws)?,
         });
     }
 
@@ -292,6 +310,21 @@ pub(crate) fn layout(
     })
 }
 
+/// The web profile's images (in the written order): re-encoded by `web_images`, in
+/// parallel.
+pub(crate) fn images(
+    scene: &Scene,
+    used: &super::Used,
+    max_px: u32,
+) -> Result<Vec<Cow<'static, [u8]>>, ExportError> {
+    let normal = used.normal_maps(scene);
+    used.images
+        .par_iter()
+        .zip(normal.par_iter())
+        .map(|(&i, &n)| super::web_images::web_png(i, &scene.images[i], max_px, n).map(Cow::Owned))
+        .collect()
+}
+
 /// Adds the extension objects the typed JSON cannot hold: `EXT_meshopt_compression` on
 /// the geometry views (created first, one per array in layout order) and on the
 /// fallback buffer (index 1), and both extensions as used and required.
@@ -311,6 +344,14 @@ pub(crate) fn add_extensions(doc: &mut Value, layout: &Layout) {
                         "mode": a.meshopt_mode(),
                     }}),
                 );
+                if let (Some(f), Some(e)) = (
+                    a.filter,
+                    v.get_mut("extensions")
+                        .and_then(|e| e.get_mut("EXT_meshopt_compression"))
+                        .and_then(Value::as_object_mut),
+                ) {
+                    e.insert("filter".into(), json!(f));
+                }
             }
         }
     }
