@@ -76,10 +76,11 @@ mod edit;
 mod file;
 pub(crate) mod key;
 mod memo;
+mod splice;
 mod state;
 
 pub use edit::{ChangeEvents, Delta, Edit, End, Preview, PreviewRoad, Regenerated};
 pub use file::EditingFile;
-pub use state::{CellInfo, CityEditor};
+pub use state::{CellInfo, CellParams, CityEditor};
 
 pub use crate::citygen::{CellParam, CellSettings, LotOverride, MapPaint, PaintLayer};
