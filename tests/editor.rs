@@ -544,12 +544,19 @@ fn a_pin_keeps_the_road_graph_and_splices_the_scene() {
     let mut ed = CityEditor::new(small()).unwrap();
     let roads = format!("{:?}", ed.city().roads);
     let cells = format!("{:?}", ed.city().cells);
-    let lot = ed.city().lots[ed.city().lots.len() / 4].id;
+    // A building that is not a skyscraper yet, pinned to one.
+    let lot = ed
+        .city()
+        .buildings
+        .iter()
+        .find(|b| b.kind != polis::buildings::BuildingKind::Skyscraper)
+        .unwrap()
+        .id;
     let before = building_leaves(ed.city(), lot);
     let ev = ed
-        .apply(Edit::PinHeight {
+        .apply(Edit::PinKind {
             lot,
-            height_m: 150.0,
+            kind: polis::buildings::BuildingKind::Skyscraper,
         })
         .unwrap();
     assert_eq!(ev.regenerated.cells, 0);
@@ -563,11 +570,17 @@ fn a_pin_keeps_the_road_graph_and_splices_the_scene() {
     assert_same_as_generate(&ed);
     // A cell edit after the pin regrows its cell (the growth memo survived the reused
     // road stage) and the splice keeps buildings outside it.
-    let cell = ed.cells()[0].id;
+    let first = &ed.cells()[0];
+    let cell = first.id;
+    let pattern = if first.pattern == Neighbourhood::Industrial.into() {
+        Neighbourhood::Suburbia
+    } else {
+        Neighbourhood::Industrial
+    };
     let ev = ed
         .apply(Edit::SetCellPattern {
             cell,
-            pattern: Neighbourhood::Industrial.into(),
+            pattern: pattern.into(),
         })
         .unwrap();
     assert_eq!(ev.dirty_cells, vec![cell]);
@@ -600,7 +613,10 @@ fn cell_params_show_pattern_parameters_and_seed() {
     .unwrap();
     let q = ed.cell_params(cell).unwrap();
     assert_eq!(q.params.lot_size_m, lot);
-    assert_eq!(q.pattern, Neighbourhood::Suburbia.into());
+    assert_eq!(
+        q.pattern,
+        polis::citygen::CellPatternChoice::from(Neighbourhood::Suburbia)
+    );
     assert_ne!(q.seed, p.seed);
     assert!(q.traits_apply);
     assert_eq!(q.settings.as_ref().map(|s| s.seed), Some(Some(77)));
