@@ -6,7 +6,13 @@
 //! ```text
 //! cargo bench --bench editor                       # citygen preset, 20 edits per kind
 //! cargo bench --bench editor -- --edits 1000 --size 1500
+//! cargo bench --bench editor -- --edits 5 --stages  # p50 per pipeline stage too
 //! ```
+//!
+//! With `--stages` each kind also prints the median of each pipeline stage's time
+//! (`City::stats.timings`; roads, buildings and facades preparation overlap) and the
+//! editor's own share (the edit's wall time minus the pipeline's: change events,
+//! orphans, dropping the old city).
 //!
 //! Per dirty cell = the edit's wall time divided by the number of city cells it regrew
 //! (at least 1; a pin regrows none). Refused edits (a move whose re-plotted roads would
@@ -39,6 +45,8 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 
 struct Stats {
     per_edit_ms: Vec<f64>,
+    /// Per stage (in `Stage::ALL` order, then the editor's own share): ms per edit.
+    stages_ms: Vec<Vec<f64>>,
     per_cell_ms: Vec<f64>,
     dirty_cells: usize,
     refused: usize,
@@ -49,12 +57,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut edits = 20usize;
     let mut size = None;
     let mut preset = "citygen".to_string();
+    let mut stages = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--edits" => edits = args.next().ok_or("--edits N")?.parse()?,
             "--size" => size = Some(args.next().ok_or("--size METRES")?.parse()?),
             "--preset" => preset = args.next().ok_or("--preset NAME")?,
+            "--stages" => stages = true,
             "--bench" => {}
             other => return Err(format!("unknown argument {other:?}").into()),
         }
@@ -94,6 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for kind in ["move node", "cell preset", "pin building"] {
         let mut s = Stats {
             per_edit_ms: Vec::new(),
+            stages_ms: vec![Vec::new(); polis::Stage::ALL.len() + 1],
             per_cell_ms: Vec::new(),
             dirty_cells: 0,
             refused: 0,
@@ -135,6 +146,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let ms = t.elapsed().as_secs_f64() * 1e3;
                     s.cpu_s += cpu_seconds().zip(cpu).map_or(0.0, |(b, a)| b - a);
                     s.per_edit_ms.push(ms);
+                    let st = &ed.city().stats;
+                    for (i, stage) in polis::Stage::ALL.iter().enumerate() {
+                        let t = st.timings.iter().find(|t| t.stage == *stage);
+                        s.stages_ms[i].push(t.map_or(0.0, |t| t.time.as_secs_f64() * 1e3));
+                    }
+                    s.stages_ms[polis::Stage::ALL.len()]
+                        .push(ms - st.wall_time.as_secs_f64() * 1e3);
                     s.per_cell_ms.push(ms / ev.dirty_cells.len().max(1) as f64);
                     s.dirty_cells += ev.dirty_cells.len();
                 }
@@ -156,6 +174,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.dirty_cells as f64 / s.per_edit_ms.len().max(1) as f64,
             s.cpu_s,
         );
+        if stages {
+            let mut line = String::from("  p50 by stage (ms):");
+            for (i, v) in s.stages_ms.iter_mut().enumerate() {
+                v.sort_by(f64::total_cmp);
+                let name = polis::Stage::ALL
+                    .get(i)
+                    .map_or("editor".to_string(), |st| format!("{st:?}").to_lowercase());
+                line.push_str(&format!(" {name} {:.1}", quantile(v, 0.5)));
+            }
+            println!("{line}");
+        }
     }
     Ok(())
 }

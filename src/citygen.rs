@@ -546,6 +546,8 @@ pub(crate) fn citygen_network_with(
                     building_hint: p.building_hint,
                 },
                 traits_apply: cg.cell_traits || explicit,
+                params: p.clone(),
+                seed,
             };
             let grow = || -> Result<std::result::Result<SecondaryRoads, Skip>> {
                 grow_cell(&input, &maps, pattern, &p, seed, &skip)
@@ -660,6 +662,11 @@ pub struct District {
     /// Whether the traits reach the lot and building stages
     /// ([`CitygenConfig::cell_traits`], or set on this cell by a cell edit).
     pub traits_apply: bool,
+    /// The growth parameters the cell was grown with (its pattern's preset in metres,
+    /// the road width factor, then its [`CellSettings`] parameters).
+    pub params: polis_roads::secondary::SecondaryParams,
+    /// The growth seed (the city's, or the cell's own from [`CellSettings::seed`]).
+    pub seed: u64,
 }
 
 /// The stable id of every cell of the primary decomposition: for a Kelly primary

@@ -49,6 +49,8 @@ pub struct Pipeline {
     facades: Box<dyn FacadeStage>,
     progress: Option<Arc<Progress>>,
     scene: bool,
+    /// Scene parts of an earlier city to reuse (the editor's).
+    reuse: Option<Arc<dyn crate::scene::SceneReuse + Send>>,
 }
 
 impl Default for Pipeline {
@@ -61,6 +63,7 @@ impl Default for Pipeline {
             facades: Box::new(TiledFacades),
             progress: None,
             scene: true,
+            reuse: None,
         }
     }
 }
@@ -135,6 +138,16 @@ impl Pipeline {
     /// Sets the progress callback.
     pub fn with_progress(mut self, progress: impl Fn(Stage, f64) + Send + Sync + 'static) -> Self {
         self.progress = Some(Arc::new(progress));
+        self
+    }
+
+    /// Reuses the leaves `reuse` hands back when assembling the scene (the editor's
+    /// splice of an earlier scene).
+    pub(crate) fn with_scene_reuse(
+        mut self,
+        reuse: Arc<dyn crate::scene::SceneReuse + Send>,
+    ) -> Self {
+        self.reuse = Some(reuse);
         self
     }
 
@@ -379,6 +392,10 @@ impl Pipeline {
                 dresses: &kept.dresses,
                 tile_sets: &tile_sets,
                 green_spaces: &kept.green_spaces,
+                reuse: self
+                    .reuse
+                    .as_deref()
+                    .map(|r| r as &dyn crate::scene::SceneReuse),
             })?
         } else {
             polis_geom::Scene::new()

@@ -412,7 +412,25 @@ pub(crate) struct SceneInputs<'a> {
     pub tile_sets: &'a [TileSet],
     /// Green spaces of the lot stage (parks on the ground).
     pub green_spaces: &'a [PolygonWithHoles],
+    /// Leaves of an earlier scene of the same city to reuse (the editor's splice).
+    pub reuse: Option<&'a dyn SceneReuse>,
 }
+
+/// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
+/// again. Each method returns what `assemble` would make for the item, or `None` to have
+/// it made; an implementation must only return parts whose inputs (the item, the
+/// ground, the palette, the configuration) are those of the earlier scene.
+pub(crate) trait SceneReuse: Sync {
+    /// The leaf of building `b` (with skin `dress`, in cell `cell`).
+    fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused>;
+    /// The coarse level-of-detail box of building `b` (`Some(None)`: it had none).
+    fn coarse(&self, b: &Building) -> Option<Option<Mesh>>;
+    /// The leaf of block `b`.
+    fn block(&self, b: &Block) -> Option<Reused>;
+}
+
+/// A reused leaf: its node's name, translation and metadata, and its meshes.
+pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
 /// Builds the scene.
 pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
@@ -458,6 +476,21 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .enumerate()
             .map(|(i, b)| {
+                let reused = inp.reuse.and_then(|r| {
+                    r.building(
+                        b,
+                        inp.dresses.get(i).and_then(Option::as_ref),
+                        inp.building_cells.get(i).copied(),
+                    )
+                });
+                if let Some((name, translation, metadata, meshes)) = reused {
+                    let node = LeafNode {
+                        name,
+                        translation,
+                        metadata,
+                    };
+                    return Ok((node, meshes));
+                }
                 let mode = foundation(inp.config, b.kind);
                 let seat = seat(elevation, b.footprint.points(), mode, foot);
                 let meshes = building_meshes(
@@ -507,6 +540,16 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         inp.blocks
             .par_iter()
             .map(|block| {
+                if let Some((name, translation, metadata, meshes)) =
+                    inp.reuse.and_then(|r| r.block(block))
+                {
+                    let node = LeafNode {
+                        name,
+                        translation,
+                        metadata,
+                    };
+                    return Ok((node, meshes));
+                }
                 let base = ground(elevation, block.polygon.outer.points());
                 let plinth = if inp.config.maps.elevation.is_some() {
                     // On an elevation map the plinth follows the ground: its top a kerb
@@ -664,6 +707,9 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .par_iter()
             .take(building_count)
             .map(|b| {
+                if let Some(made) = inp.reuse.and_then(|r| r.coarse(b)) {
+                    return made;
+                }
                 let seat = seat(
                     elevation,
                     b.footprint.points(),

@@ -414,7 +414,11 @@ impl Session {
             .into_iter()
             .find(|c| c.id == id)
             .ok_or_else(|| ApiError::not_found(format!("no city cell with id {id}")))?;
-        let params = self.cell_params(id, &cell.pattern)?;
+        let inspected = self
+            .editor
+            .cell_params(id)
+            .map_err(|e| ApiError::not_found(e.to_string()))?;
+        let params = &inspected.params;
         let d = |name: &str, label: &str, v: polis::roads::secondary::Deviated| json!({ "name": name, "label": label, "value": v.value, "deviance": v.deviance });
         let plain = |name: &str, label: &str, v: f64, integer: bool| json!({ "name": name, "label": label, "value": v, "deviance": null, "integer": integer });
         let list = vec![
@@ -460,39 +464,15 @@ impl Session {
             .count();
         to_json(&json!({
             "id": wire::id(id),
-            "pattern": pattern_name(&cell.pattern),
+            "pattern": pattern_name(&inspected.pattern),
             "params": list,
+            "seed": wire::id(inspected.seed),
+            "own_seed": inspected.settings.and_then(|s| s.seed).map(wire::id),
+            "traits_apply": inspected.traits_apply,
             "lots": lots,
             "buildings": buildings,
             "streets": streets.first().map_or(0, Vec::len),
         }))
-    }
-
-    /// The growth and trait parameters a cell grows with now: its pattern's preset in
-    /// metres (with the configuration's road width factor), then the cell's own settings.
-    fn cell_params(
-        &self,
-        id: u64,
-        pattern: &polis::citygen::CellPatternChoice,
-    ) -> Result<polis::roads::secondary::SecondaryParams, ApiError> {
-        use polis::citygen::CellPatternChoice;
-        let cg = &self.editor.config().citygen;
-        let preset = match pattern {
-            CellPatternChoice::Kelly(n) => *n,
-            CellPatternChoice::Grid(g) => g.traits_from(),
-            _ => Neighbourhood::default(),
-        };
-        let mut p = preset
-            .preset()
-            .map_err(|e| ApiError::internal(e.to_string()))?
-            .to_params(cg.unit_m);
-        p.road_width_m.value *= cg.road_width_factor;
-        if let Some(settings) = cg.cells.iter().find(|c| c.cell == id) {
-            for q in &settings.params {
-                q.apply(&mut p);
-            }
-        }
-        Ok(p)
     }
 
     /// The output log.

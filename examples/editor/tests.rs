@@ -260,6 +260,19 @@ fn chain_tool_closes_a_loop_into_a_new_cell_and_cells_take_presets() {
         (h["value"].as_f64(), h["deviance"].as_f64()),
         (Some(9.0), Some(0.2))
     );
+    // The seed in effect (text), then the cell's own after a seed edit.
+    assert!(
+        info["seed"]
+            .as_str()
+            .is_some_and(|s| s.parse::<u64>().is_ok())
+    );
+    assert!(info["own_seed"].is_null());
+    let e = json!({"op": "set_cell_seed", "cell": id, "seed": 42});
+    let r = call(&api, "POST", "/api/apply", &e.to_string());
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    let info = json_of(&call(&api, "GET", &format!("/api/cell/{id}"), ""));
+    assert_eq!(info["own_seed"], "42");
+    assert_eq!(info["traits_apply"], true);
 }
 
 #[test]

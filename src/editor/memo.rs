@@ -20,8 +20,8 @@ use super::key::Key;
 use crate::citygen::{ConfiguredRoads, GrowthMemo, RoadMode, citygen_network_with};
 use crate::error::Result;
 use crate::stages::{
-    BuildLot, BuildingStage, CellInput, CellLots, Dress, DressBuilding, FacadeStage, KellyLots,
-    LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
+    BuildLot, BuildingStage, CellInput, CellLots, CellStage, Dress, DressBuilding, EberlyCells,
+    FacadeStage, KellyLots, LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
 };
 
 /// Results of one kind: those the last run used, and those this run used so far.
@@ -54,9 +54,10 @@ impl<T: Clone> Store<T> {
         self.this.insert(key, v);
     }
 
-    /// Ends a run: keep what it used (or, after a failed run, everything).
+    /// Ends a run: keep what it used (or, after a failed run or one that skipped this
+    /// kind of work, such as growth when the road stage was reused whole, everything).
     fn finish(&mut self, ok: bool) {
-        if ok {
+        if ok && !self.this.is_empty() {
             self.last = std::mem::take(&mut self.this);
         } else {
             let this = std::mem::take(&mut self.this);
@@ -81,6 +82,10 @@ pub(crate) struct Redone {
 /// Fingerprints of the configuration parts each stage reads besides its item.
 #[derive(Debug, Clone, Copy)]
 struct Fingerprints {
+    /// Everything the road and cell stages read: the configuration but for the lot
+    /// overrides, the facade settings and the level of detail (the edits of lots,
+    /// buildings and styles), which only later stages read.
+    roads: Key,
     lots: Key,
     buildings: Key,
     facades: Key,
@@ -97,6 +102,35 @@ pub(crate) struct Memo {
     redone: Mutex<Redone>,
     districts: Mutex<Vec<crate::citygen::District>>,
     fingerprints: Mutex<Option<Fingerprints>>,
+    /// The last run's road stage output and cells, by [`Fingerprints::roads`]: an edit of
+    /// lots, buildings or styles reuses the union graph and its cells whole.
+    roads: Mutex<Option<(Key, RoadsOutput)>>,
+    cells: Mutex<Option<(Key, polis_cells::CellDecomposition)>>,
+}
+
+/// Writes serialised bytes into a [`Key`].
+struct KeyWriter(Key);
+
+impl std::io::Write for KeyWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0 = self.0.bytes(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The digest of what the road and cell stages read of `config` (see
+/// [`Fingerprints::roads`]); `None` if it cannot be serialised (the stages then run).
+fn roads_key(config: &crate::CityConfig) -> Option<Key> {
+    let mut c = config.clone();
+    c.citygen.lots.clear();
+    c.facades = Default::default();
+    c.lod = None;
+    let mut w = KeyWriter(Key::new(0x726F_6164));
+    serde_json::to_writer(&mut w, &c).ok()?;
+    Some(w.0)
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
@@ -137,6 +171,7 @@ impl Memo {
             .filter_map(|o| o.style.as_deref())
             .collect();
         *lock(&self.fingerprints) = Some(Fingerprints {
+            roads: roads_key(config).unwrap_or(Key::new(config.seed)),
             lots: text(
                 1,
                 format!("{:?}|{:?}|{}", config.blocks, config.lots, config.seed),
@@ -168,6 +203,7 @@ impl Memo {
 
     fn fingerprints(&self) -> Fingerprints {
         lock(&self.fingerprints).unwrap_or(Fingerprints {
+            roads: Key::new(0),
             lots: Key::new(1),
             buildings: Key::new(2),
             facades: Key::new(3),
@@ -178,6 +214,7 @@ impl Memo {
     pub(crate) fn pipeline(self: &Arc<Self>) -> crate::Pipeline {
         crate::Pipeline::default()
             .with_roads(MemoRoads(Arc::clone(self)))
+            .with_cells(MemoCells(Arc::clone(self)))
             .with_lots(MemoLots(Arc::clone(self)))
             .with_buildings(MemoBuildings(Arc::clone(self)))
             .with_facades(MemoFacades(Arc::clone(self)))
@@ -208,14 +245,45 @@ impl RoadStage for MemoRoads {
         if cx.config.road_mode != RoadMode::Citygen {
             return ConfiguredRoads::default().roads(cx);
         }
+        let key = self.0.fingerprints().roads;
+        if let Some((k, out)) = &*lock(&self.0.roads)
+            && *k == key
+        {
+            lock(&self.0.districts).clone_from(&out.districts);
+            return Ok(out.clone());
+        }
         let (net, growth) = citygen_network_with(cx, Some(&*self.0))?;
         lock(&self.0.districts).clone_from(&net.districts);
-        Ok(RoadsOutput {
+        let out = RoadsOutput {
             network: net.network,
             growth,
             skipped: net.skipped,
             districts: net.districts,
-        })
+        };
+        *lock(&self.0.roads) = Some((key, out.clone()));
+        Ok(out)
+    }
+}
+
+/// The cell stage, reused whole when the road stage's inputs are (the union graph is
+/// then the same graph).
+struct MemoCells(Arc<Memo>);
+
+impl CellStage for MemoCells {
+    fn cells(
+        &self,
+        network: &polis_roads::RoadNetwork,
+        cx: &StageContext<'_>,
+    ) -> Result<polis_cells::CellDecomposition> {
+        let key = self.0.fingerprints().roads;
+        if let Some((k, cells)) = &*lock(&self.0.cells)
+            && *k == key
+        {
+            return Ok(cells.clone());
+        }
+        let cells = EberlyCells.cells(network, cx)?;
+        *lock(&self.0.cells) = Some((key, cells.clone()));
+        Ok(cells)
     }
 }
 

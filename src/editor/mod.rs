@@ -34,6 +34,14 @@
 //! parameters, seed or maps changed, cells created, split or merged, and, downstream,
 //! road-graph cells whose ring or nearby roads changed.
 //!
+//! Two whole stages are reused as well. The road and cell stages read the configuration
+//! but for the lot overrides, the facade settings and the level of detail, so an edit of
+//! lots, buildings or styles keeps the union graph and its cells whole (keyed by a digest
+//! of what they read). And the 3-D scene is spliced (see `splice.rs`): it is assembled
+//! again, but every block and building equal to the one before the edit (same item,
+//! same skin and cell; same scene-wide settings and ground) takes its node and meshes
+//! from the scene before the edit instead of being meshed again.
+//!
 //! # Stable identity
 //!
 //! A city cell's id (and so its growth seed) is a hash of the ids of the primary roads
@@ -56,9 +64,13 @@
 //!
 //! # Limitations
 //!
-//! * The road graph's union, its cell decomposition and the 3-D scene are rebuilt whole
-//!   after each edit (their inputs are the whole city); the per-item work is reused.
-//!   BENCHMARKS.md gives the cost per edit.
+//! * An edit of the primary network or of a cell still builds the union graph and its
+//!   cell decomposition whole (their inputs are the whole city), and every edit walks
+//!   every item: memo look-ups copy each reused lot, building and skin, the scene copies
+//!   each reused leaf's meshes, and the change events compare the two cities. The cost
+//!   per edit is therefore proportional to the city's size, not to the dirty set;
+//!   BENCHMARKS.md gives it. With roads graded into an elevation map the scene is not
+//!   spliced (the ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it
 //!   changes where later road edits are legal.
 //! * Only Citygen-mode cities are editable ([`RoadMode::Citygen`](crate::RoadMode)).
@@ -76,10 +88,11 @@ mod edit;
 mod file;
 pub(crate) mod key;
 mod memo;
+mod splice;
 mod state;
 
 pub use edit::{ChangeEvents, Delta, Edit, End, Preview, PreviewRoad, Regenerated};
 pub use file::EditingFile;
-pub use state::{CellInfo, CityEditor};
+pub use state::{CellInfo, CellParams, CityEditor};
 
 pub use crate::citygen::{CellParam, CellSettings, LotOverride, MapPaint, PaintLayer};

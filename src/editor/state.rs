@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::diff::{changes, orphans};
 use super::edit::{ChangeEvents, Edit, Preview, PreviewRoad};
 use super::memo::Memo;
+use super::splice::{OldScene, scene_key};
 use crate::citygen::{
     CellPatternChoice, CellSettings, District, InlinePrimary, LotOverride, PrimarySource, RoadMode,
 };
@@ -25,6 +26,28 @@ pub struct CellInfo {
     pub outline: Vec<[f64; 2]>,
     /// Its pattern.
     pub pattern: CellPatternChoice,
+}
+
+/// Everything a cell inspector shows of a city cell (Kelly §5.5.1's property inspector):
+/// its pattern, the growth parameters it was grown with (each with its deviance, lot
+/// size and building height included) and its seed. From
+/// [`CityEditor::cell_params`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CellParams {
+    /// The stable id.
+    pub id: u64,
+    /// Its pattern (preset or grid pattern).
+    pub pattern: CellPatternChoice,
+    /// The growth parameters in metres: the pattern's preset, the road width factor and
+    /// the cell's own parameters applied (`{"value": …, "deviance": …}` for each
+    /// deviated one; `lot_size_m` and `building_height_m` among them).
+    pub params: polis_roads::secondary::SecondaryParams,
+    /// The growth seed in effect (the city's, or the cell's own).
+    pub seed: u64,
+    /// Whether the lot size, building height and hint reach the lot and building stages.
+    pub traits_apply: bool,
+    /// The cell's settings as edits wrote them (none when unedited).
+    pub settings: Option<CellSettings>,
 }
 
 /// The settings an edit other than a primary one changes (what undo restores).
@@ -70,7 +93,7 @@ pub struct CityEditor {
     base: CityConfig,
     config: CityConfig,
     primary: PrimaryEditor,
-    city: City,
+    city: Arc<City>,
     districts: Vec<District>,
     memo: Arc<Memo>,
     undo: Vec<Step>,
@@ -158,13 +181,13 @@ impl CityEditor {
         let primary = PrimaryEditor::with_network(network, terrain, EditOptions::default())
             .map_err(road_error)?;
         let memo = Arc::new(Memo::default());
-        let (city, districts, _) = build(&memo, &config)?;
+        let (city, districts, _) = build(&memo, &config, None)?;
         let orphans = orphans(&config, &city);
         Ok(CityEditor {
             base: config.clone(),
             config,
             primary,
-            city,
+            city: Arc::new(city),
             districts,
             memo,
             undo: Vec::new(),
@@ -206,6 +229,33 @@ impl CityEditor {
                 pattern: d.pattern,
             })
             .collect()
+    }
+
+    /// The inspector's view of cell `id`: pattern, parameters with deviances, lot size,
+    /// building height, seed.
+    ///
+    /// # Errors
+    /// [`Error::UnknownId`] if no grown cell has that id.
+    pub fn cell_params(&self, id: u64) -> Result<CellParams> {
+        let d = self
+            .districts
+            .iter()
+            .find(|d| d.id == id)
+            .ok_or(Error::UnknownId { kind: "cell", id })?;
+        Ok(CellParams {
+            id,
+            pattern: d.pattern,
+            params: d.params.clone(),
+            seed: d.seed,
+            traits_apply: d.traits_apply,
+            settings: self
+                .config
+                .citygen
+                .cells
+                .iter()
+                .find(|c| c.cell == id)
+                .cloned(),
+        })
     }
 
     /// The city cell containing `p`, if any.
@@ -449,7 +499,15 @@ impl CityEditor {
     /// editor's; returns what changed.
     fn rebuild(&mut self, config: CityConfig) -> Result<ChangeEvents> {
         let maps_changed = self.maps_changed(&config);
-        let (city, districts, redone) = build(&self.memo, &config)?;
+        // Leaves of the scene whose inputs the edit left alone are spliced in from the
+        // scene as it stands.
+        let reuse = match (scene_key(&self.config), scene_key(&config)) {
+            (Some(a), Some(b)) if a == b && !self.city.scene.nodes.is_empty() => {
+                Some(Arc::new(OldScene::new(Arc::clone(&self.city))))
+            }
+            _ => None,
+        };
+        let (city, districts, redone) = build(&self.memo, &config, reuse)?;
         let mut events = changes(&self.city, &city, &self.districts, &districts, &redone);
         let orphans = orphans(&config, &city);
         events.orphaned.clone_from(&orphans);
@@ -458,7 +516,7 @@ impl CityEditor {
             let maps = maps_of(&config)?;
             self.primary.set_terrain(terrain_of(&config, &maps)?);
         }
-        self.city = city;
+        self.city = Arc::new(city);
         self.districts = districts;
         self.config = config;
         self.orphans = orphans;
@@ -697,9 +755,14 @@ fn set_style(styles: &mut KindStyles, kind: polis_buildings::BuildingKind, style
 fn build(
     memo: &Arc<Memo>,
     config: &CityConfig,
+    reuse: Option<Arc<OldScene>>,
 ) -> Result<(City, Vec<District>, super::memo::Redone)> {
     memo.begin(config);
-    let result = memo.pipeline().generate(config);
+    let mut pipeline = memo.pipeline();
+    if let Some(r) = reuse {
+        pipeline = pipeline.with_scene_reuse(r);
+    }
+    let result = pipeline.generate(config);
     let (redone, districts) = memo.finish(result.is_ok());
     Ok((result?, districts, redone))
 }

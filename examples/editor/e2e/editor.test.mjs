@@ -151,7 +151,10 @@ try {
       const d = clearance(x, y);
       if (!c || d > c.d) c = { x, y, d };
     }
-    const r = Math.min(c.d * 0.6, 400);
+    // At most 200 m: the plotted primary roads follow the terrain and bend more over
+    // longer sides, and on the full preset a 400 m triangle's closing road met its first
+    // side at 5° (refused below the 15° minimum).
+    const r = Math.min(c.d * 0.6, 200);
     const pts = [0, 1, 2].map((k) => [c.x + r * Math.cos(Math.PI / 2 + (2 * Math.PI * k) / 3), c.y + r * Math.sin(Math.PI / 2 + (2 * Math.PI * k) / 3)]);
     return { cell: best.id, centre: [c.x, c.y], r, pts };
   });

@@ -438,6 +438,14 @@ async function updateInspector() {
       v.onchange = send;
       if (d) d.onchange = send;
     }
+    // The growth seed in effect (text: exact above 2^53); a new one is a safe integer.
+    const seed = textField(props, 'seed', info.own_seed ?? info.seed);
+    seed.id = 'cell-seed';
+    button(props, 'Set seed', () => {
+      const v = Number(seed.value);
+      if (!Number.isSafeInteger(v) || v < 0) log(`seed: give a whole number from 0 to ${Number.MAX_SAFE_INTEGER}`, true);
+      else commit({ op: 'set_cell_seed', cell: id, seed: v });
+    });
     const stats = document.createElement('div');
     stats.className = 'head';
     stats.textContent = `${info.lots} lots · ${info.buildings} buildings · ${info.streets} streets`;

@@ -1,0 +1,154 @@
+//! Splicing the scene: after an edit the 3-D scene is assembled again, but every block
+//! and building whose inputs are those of the city before the edit takes its node and
+//! meshes from the earlier scene instead of being meshed again (Kelly §6.7: each cell
+//! batches its own geometry, so an edit touches only its cells' batches).
+//!
+//! A leaf is reused when the scene-wide inputs are unchanged ([`scene_key`]: the
+//! configuration but for the Citygen edits, which reach the scene only through the
+//! layers; the pinned facade styles, which decide the palette) and its own inputs are
+//! equal: the same building (every part and facade), skin and cell; the same block.
+//! Roads graded into an elevation map move the ground every leaf stands on, so with
+//! grading on nothing is reused. The scene so made is the scene `assemble` would make:
+//! reuse only skips recomputing identical parts.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use polis_buildings::Building;
+use polis_geom::scene::NodeId;
+use polis_geom::{Mesh, Transform};
+use polis_lots::Block;
+
+use super::key::Key;
+use crate::City;
+use crate::CityConfig;
+use crate::scene::{Reused, SceneReuse};
+use crate::stages::Dress;
+
+/// The digest of what every leaf of the scene reads besides its own item, or `None`
+/// when the ground depends on the road graph (graded roads) and nothing may be reused.
+pub(super) fn scene_key(config: &CityConfig) -> Option<Key> {
+    if config.scene.grade_roads && config.maps.elevation.is_some() {
+        return None;
+    }
+    let mut c = config.clone();
+    let pinned: Vec<String> = c
+        .citygen
+        .lots
+        .iter()
+        .filter_map(|o| o.style.clone())
+        .collect();
+    c.citygen = Default::default();
+    let text = serde_json::to_string(&(&c, &pinned)).ok()?;
+    Some(Key::new(0x7363_656E).bytes(text.as_bytes()))
+}
+
+/// The scene of a city before an edit, indexed for reuse.
+pub(super) struct OldScene {
+    city: Arc<City>,
+    /// Building id → (index in the city's buildings, node).
+    buildings: BTreeMap<u64, (usize, NodeId)>,
+    /// Block id → (index in the city's blocks, node).
+    blocks: BTreeMap<u64, (usize, NodeId)>,
+}
+
+impl OldScene {
+    /// Indexes `city`'s scene leaves by the ids in their names.
+    pub(super) fn new(city: Arc<City>) -> Self {
+        let building_at: BTreeMap<u64, usize> = city
+            .buildings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.id, i))
+            .collect();
+        let block_at: BTreeMap<u64, usize> = city
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.id(), i))
+            .collect();
+        let mut buildings = BTreeMap::new();
+        let mut blocks = BTreeMap::new();
+        for (n, node) in city.scene.nodes.iter().enumerate() {
+            let id = |prefix: &str| node.name.strip_prefix(prefix)?.parse::<u64>().ok();
+            let node_id = NodeId(n as u32);
+            if let Some(id) = id("building ") {
+                if let Some(&i) = building_at.get(&id) {
+                    buildings.insert(id, (i, node_id));
+                }
+            } else if let Some(id) = id("block ")
+                && let Some(&i) = block_at.get(&id)
+            {
+                blocks.insert(id, (i, node_id));
+            }
+        }
+        OldScene {
+            city,
+            buildings,
+            blocks,
+        }
+    }
+
+    /// The node `n` as a reusable leaf (name, translation, metadata, meshes).
+    fn leaf(&self, n: NodeId) -> Option<Reused> {
+        let scene = &self.city.scene;
+        let node = scene.nodes.get(n.0 as usize)?;
+        let Transform::Trs { translation, .. } = node.transform else {
+            return None;
+        };
+        let meshes = node
+            .meshes
+            .iter()
+            .map(|m| scene.meshes.get(m.0 as usize).cloned())
+            .collect::<Option<Vec<Mesh>>>()?;
+        Some((
+            node.name.clone(),
+            translation,
+            node.metadata.clone(),
+            meshes,
+        ))
+    }
+
+    /// The old building with `b`'s id if it equals `b`: its index and node.
+    fn same_building(&self, b: &Building) -> Option<(usize, NodeId)> {
+        let &(i, n) = self.buildings.get(&b.id)?;
+        (self.city.buildings.get(i)? == b).then_some((i, n))
+    }
+}
+
+impl SceneReuse for OldScene {
+    fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused> {
+        let (i, n) = self.same_building(b)?;
+        let old_dress = self.city.dresses.get(i).and_then(Option::as_ref);
+        let old_cell = self.city.building_cells.get(i).copied();
+        if old_dress != dress || old_cell != cell {
+            return None;
+        }
+        self.leaf(n)
+    }
+
+    fn coarse(&self, b: &Building) -> Option<Option<Mesh>> {
+        let (_, n) = self.same_building(b)?;
+        let scene = &self.city.scene;
+        let node = scene.nodes.get(n.0 as usize)?;
+        let lod = node.children.iter().find_map(|c| {
+            let child = scene.nodes.get(c.0 as usize)?;
+            (child.name == "lod 0").then_some(child)
+        });
+        match lod {
+            None => Some(None),
+            Some(child) => {
+                let m = child.meshes.first()?;
+                Some(Some(scene.meshes.get(m.0 as usize)?.clone()))
+            }
+        }
+    }
+
+    fn block(&self, b: &Block) -> Option<Reused> {
+        let &(i, n) = self.blocks.get(&b.id())?;
+        if self.city.blocks.get(i)? != b {
+            return None;
+        }
+        self.leaf(n)
+    }
+}
