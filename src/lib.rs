@@ -60,6 +60,7 @@ mod city;
 pub mod citygen;
 mod clock;
 mod config;
+mod debug;
 pub mod editor;
 mod error;
 mod ground;
@@ -71,6 +72,7 @@ mod report;
 mod scene;
 pub mod seed;
 pub mod stages;
+mod streets;
 
 pub use city::{
     City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
