@@ -117,7 +117,7 @@ pub(crate) fn zone_map_kind(
 ) -> BuildingKind {
     let v = zoning.sample(p);
     if v.is_finite() && v.round() >= MIXED_ZONE {
-        let mut rng = Pcg64Mcg::seed_from_u64(lot_seed ^ 0x4D49_5845_44);
+        let mut rng = Pcg64Mcg::seed_from_u64(lot_seed ^ 0x004D_4958_4544);
         return if rng.random::<f64>() < mixed.commercial_share {
             mixed.commercial
         } else {

@@ -219,9 +219,8 @@ fn classify(surface: StreetSurface, s: f64, t: f64, seed: u64) -> Stuff {
             }
         }
         StreetSurface::Major => {
-            if band(gutter + 0.03, line) || band(1.0 - gutter - 0.03, line) {
-                Stuff::Paint(WHITE)
-            } else if band(0.5, line) && dash(4.0, MARKING_PERIOD_M) {
+            let edge = band(gutter + 0.03, line) || band(1.0 - gutter - 0.03, line);
+            if edge || (band(0.5, line) && dash(4.0, MARKING_PERIOD_M)) {
                 Stuff::Paint(WHITE)
             } else {
                 Stuff::Asphalt
