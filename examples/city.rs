@@ -6,6 +6,7 @@
 //!     [--population PNG] [--water PNG] [--parks PNG] [--elevation PNG METRES]
 //!     [--zoning PNG] [--max-height PNG METRES] [--report]
 //!     [--formats glb,obj,svg,geojson] [--anchor LON,LAT] [--glb-profile plain|web]
+//!     [--debug-layers plot,fans,blocks,lots,splits]
 //! cargo run --release --example city -- --help
 //! ```
 //!
@@ -110,6 +111,11 @@ struct Cli {
     /// meshopt-compressed, for three.js and glTFast).
     #[arg(long, value_name = "PROFILE", default_value = "plain")]
     glb_profile: polis::export::glb::GlbProfile,
+    /// Debug overlays in the SVG, comma-separated: plot, fans (the primary roads' plot
+    /// samples and fans, Citygen mode), blocks, lots (boundaries), splits (the lot
+    /// subdivision's split lines in order), or all.
+    #[arg(long, value_name = "LIST", default_value = "none")]
+    debug_layers: polis::export::svg::SvgDebug,
 }
 
 /// `LON,LAT` in degrees, inside WGS 84 bounds.
@@ -244,6 +250,7 @@ fn configure(cli: Cli) -> Result<Args, clap::Error> {
             formats: cli.formats,
             anchor_lon_lat: cli.anchor,
             glb_profile: cli.glb_profile,
+            svg_debug: cli.debug_layers,
         },
     })
 }

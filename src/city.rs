@@ -148,6 +148,9 @@ pub struct City {
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
+    /// The lot subdivision's split lines in the order they were cut, with the id of the
+    /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]).
+    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
     /// Buildings (one per built lot; `id` = the lot's id).
     pub buildings: Vec<Building>,
     /// Cell of each building (parallel to `buildings`).
@@ -310,12 +313,20 @@ impl City {
             if !(formats.svg || formats.geojson) {
                 return Ok(Vec::new());
             }
-            let map = self.map_layers()?;
+            #[allow(unused_mut)]
+            let mut map = self.map_layers()?;
             let mut files = Vec::new();
             #[cfg(feature = "svg")]
             if formats.svg {
+                if options.svg_debug.any() {
+                    map.debug = self.debug_map()?;
+                }
+                let svg_options = svg::SvgOptions {
+                    debug: options.svg_debug.clone(),
+                    ..svg::SvgOptions::default()
+                };
                 files.push(write_file(dir.join("city.svg"), |w| {
-                    svg::write_svg(&map, &svg::SvgOptions::default(), w)?;
+                    svg::write_svg(&map, &svg_options, w)?;
                     Ok(())
                 })?);
             }

@@ -154,6 +154,11 @@ pub struct ZoningConfig {
     pub fallback_kind: BuildingKind,
     /// Height limit where no band applies, metres. Default: 15.
     pub fallback_max_height_m: f64,
+    /// What mixed zones of the zoning map build (P&M §2). Default: [`MixedZone::default`](crate::MixedZone).
+    pub mixed: crate::MixedZone,
+    /// Height caps by lot ground area, applied after the bands and the maximum-height
+    /// map (P&M §4.1). Default: none.
+    pub area_caps: Vec<crate::AreaCap>,
 }
 
 impl Default for ZoningConfig {
@@ -173,6 +178,8 @@ impl Default for ZoningConfig {
             ],
             fallback_kind: BuildingKind::Industrial,
             fallback_max_height_m: 15.0,
+            mixed: crate::MixedZone::default(),
+            area_caps: Vec::new(),
         }
     }
 }
@@ -517,6 +524,11 @@ impl CityConfig {
                     ),
                 ));
             }
+        }
+        crate::zoning::validate(&self.zoning.mixed, &self.zoning.area_caps)?;
+        if let Some(z) = &self.maps.zoning {
+            let (lo, hi) = z.value_range();
+            crate::zoning::check_zone_map_range(lo, hi)?;
         }
         if !height_ok(self.zoning.fallback_max_height_m) {
             return Err(Error::config(

@@ -60,6 +60,7 @@ mod city;
 pub mod citygen;
 mod clock;
 mod config;
+mod debug;
 pub mod editor;
 mod error;
 mod ground;
@@ -71,6 +72,8 @@ mod report;
 mod scene;
 pub mod seed;
 pub mod stages;
+mod streets;
+mod zoning;
 
 pub use city::{
     City, CityLot, CityStats, SkipReport, StageTiming, Written, smooth_mask, trace_mask,
@@ -88,6 +91,7 @@ pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::{reference_city_name, road_statistics, street_graph};
 pub use scene::CORRIDOR_CUT_M;
 pub use stages::{Skip, Stage};
+pub use zoning::{AreaCap, MAX_ZONE_VALUE, MIXED_ZONE, MixedZone};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.
 #[doc = include_str!("../README.md")]

@@ -124,6 +124,10 @@ pub struct WriteOptions {
     /// meshopt-compressed). Default: [`GlbProfile::Plain`]. Only with the feature `gltf`.
     #[cfg(feature = "gltf")]
     pub glb_profile: GlbProfile,
+    /// The SVG's debug overlays (Kelly's debug views: plot samples and fans, block and lot
+    /// boundaries, lot split lines). Default: none. Only with the feature `svg`.
+    #[cfg(feature = "svg")]
+    pub svg_debug: polis_export::svg::SvgDebug,
 }
 
 impl From<Formats> for WriteOptions {
@@ -133,6 +137,8 @@ impl From<Formats> for WriteOptions {
             anchor_lon_lat: None,
             #[cfg(feature = "gltf")]
             glb_profile: GlbProfile::Plain,
+            #[cfg(feature = "svg")]
+            svg_debug: polis_export::svg::SvgDebug::default(),
         }
     }
 }

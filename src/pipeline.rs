@@ -426,6 +426,7 @@ impl Pipeline {
             blocks: kept.blocks,
             lots: kept.lots,
             green_spaces: kept.green_spaces,
+            lot_splits: kept.lot_splits,
             buildings: kept.buildings,
             building_cells: kept.building_cells,
             tile_sets,
@@ -543,6 +544,7 @@ impl Pipeline {
             report.skipped.extend(lots.skipped);
             out.blocks.extend(lots.blocks);
             out.green_spaces.extend(lots.green_spaces);
+            out.lot_splits.extend(lots.splits);
             for (i, lot) in lots.lots.into_iter().enumerate() {
                 if i >= 1 << 24 || cell >= 1 << 40 {
                     report.skipped.push(Skip {
@@ -725,6 +727,8 @@ pub struct CityChunk {
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
+    /// The lot subdivision's split lines with their block ids, cell by cell.
+    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
     /// Buildings (one per built lot; `id` = the lot's id).
     pub buildings: Vec<Building>,
     /// Cell of each building (parallel to `buildings`).
@@ -745,6 +749,7 @@ impl CityChunk {
         self.blocks.append(&mut other.blocks);
         self.lots.append(&mut other.lots);
         self.green_spaces.append(&mut other.green_spaces);
+        self.lot_splits.append(&mut other.lot_splits);
         self.buildings.append(&mut other.buildings);
         self.building_cells.append(&mut other.building_cells);
         self.dresses.append(&mut other.dresses);

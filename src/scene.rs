@@ -13,7 +13,7 @@
 
 use polis_buildings::{Building, BuildingKind, FacadeFace, PartRole};
 use polis_export::map::{MapRoad, RoadClass as MapClass};
-use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces};
+use polis_export::surfaces::{RoadSurfaceOptions, road_surface_parts};
 use polis_facades::TileSet;
 
 use polis_geom::par::{self, prelude::*};
@@ -33,7 +33,6 @@ use crate::{CityConfig, CityMaps, Foundation};
 /// Plain materials of the scene, by role.
 struct Palette {
     pavement: MaterialId,
-    road: MaterialId,
     walls: [MaterialId; 6],
     roof: MaterialId,
     detail: MaterialId,
@@ -45,8 +44,6 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
     let mut m = |name: &str, rgb: [f32; 3]| {
         scene.add_material(Material::new(name, [rgb[0], rgb[1], rgb[2], 1.0]))
     };
-    let pavement = m("pavement", [0.55, 0.55, 0.52]);
-    let road = m("asphalt", [0.18, 0.18, 0.19]);
     let walls = [
         m("wall skyscraper", [0.55, 0.62, 0.70]),
         m("wall office", [0.62, 0.66, 0.70]),
@@ -57,11 +54,9 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
     ];
     let roof = m("roof", [0.45, 0.25, 0.20]);
     let detail = m("detail", [0.30, 0.30, 0.32]);
-    // Road ribbons and junction plates keep their metre coordinates for a texture added
-    // later in an engine; the other plain materials drop theirs in exports.
-    if let Some(mat) = scene.materials.get_mut(road.index()) {
-        mat.keep_texture_coordinates = true;
-    }
+    // Pavements and footpaths (the block plinths): paving slabs in metre coordinates.
+    let pavement =
+        crate::streets::add_street_material(scene, polis_facades::street::StreetSurface::Paving)?;
     let mut tiles = Vec::with_capacity(sets.len());
     for set in sets {
         let mut ids = Vec::with_capacity(set.tiles.len());
@@ -100,7 +95,6 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
     }
     Ok(Palette {
         pavement,
-        road,
         walls,
         roof,
         detail,
@@ -442,16 +436,15 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
 
     // The road surfaces (one serial pass over the network) are built while the
     // buildings' meshes are made in parallel.
-    let road_mesh = || -> Result<Option<Mesh>> {
+    let road_mesh = || -> Result<Option<polis_export::surfaces::RoadSurfaceParts>> {
         if !(inp.config.scene.road_surfaces && inp.network.edge_count() > 0) {
             return Ok(None);
         }
         let roads = map_roads(inp.network)?;
-        Ok(Some(road_surfaces(
+        Ok(Some(road_surface_parts(
             &roads,
             elevation,
             &RoadSurfaceOptions::default(),
-            Some(pal.road),
         )?))
     };
     // Buildings and plinths reach below the ground as far as the terrain may lie below
@@ -630,11 +623,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     if let Some(terrain) = terrain {
         add_ground(&mut scene, root, terrain)?;
     }
-    if let Some(mesh) = road? {
+    if let Some(parts) = road? {
+        // Ribbons by class with their markings, junction plates apart (Kelly §5.4).
         let node = scene.add_node(root, "roads")?;
         scene.set_metadata(node, "layer", MetaValue::from_static("roads"))?;
-        let mesh = scene.add_mesh(mesh);
-        scene.attach_mesh(node, mesh)?;
+        for mesh in crate::streets::road_meshes(&mut scene, parts)? {
+            let mesh = scene.add_mesh(mesh);
+            scene.attach_mesh(node, mesh)?;
+        }
     }
     // Bridges: closed decks on piers under the road surfaces.
     if let Some(mut mesh) = crate::ground::bridge_mesh(inp.network, elevation)? {

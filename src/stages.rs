@@ -240,6 +240,9 @@ pub struct CellLots {
     pub green_spaces: Vec<PolygonWithHoles>,
     /// Degenerate pieces skipped (counted in the city's report).
     pub skipped: Vec<Skip>,
+    /// The lot subdivision's split lines, in order, with the id of the block each cut
+    /// (a debug record: [`City::debug_map`](crate::City::debug_map)). Default: empty.
+    pub splits: Vec<(u64, polis_lots::SplitLine)>,
 }
 
 /// Turns one cell into blocks and lots. Called for every cell, possibly in parallel.
@@ -273,9 +276,13 @@ impl LotStage for KellyLots {
         };
         let mut rng = Pcg64Mcg::seed_from_u64(input.seed);
         let params = input.lot_params.as_ref().unwrap_or(&cx.config.lots);
+        let mut subdivider = polis_lots::Subdivider::new();
+        subdivider.record_splits(true);
         for block in blocks {
-            match polis_lots::subdivide_block(&block, params, &mut rng) {
+            match subdivider.subdivide_block(&block, params, &mut rng) {
                 Ok(sub) => {
+                    let id = block.id();
+                    out.splits.extend(sub.splits.into_iter().map(|s| (id, s)));
                     out.lots.extend(
                         sub.lots
                             .into_iter()

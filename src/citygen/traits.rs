@@ -143,12 +143,15 @@ pub fn lot_plan(
     if let Some(z) = &maps.zoning
         && z.sample(c).is_finite()
     {
-        kind = polis_buildings::kind_from_zoning(z.as_ref(), c);
+        let seed = cx.seed(Stage::Buildings, l.id);
+        kind = crate::zoning::zone_map_kind(z.as_ref(), c, &config.zoning.mixed, seed);
     }
     if let Some(h) = &maps.max_height {
         // The map replaces the limit; 0 m (or less, or NaN) leaves the lot empty.
         max_height_m = h.sample(c);
     }
+    // Small lots build lower (P&M §4.1).
+    max_height_m = crate::zoning::area_capped(&config.zoning.area_caps, l.lot.area, max_height_m);
     let mut plan = LotPlan {
         kind,
         max_height_m,

@@ -180,6 +180,73 @@ impl MapFootprint {
     }
 }
 
+/// One fan of a primary road's plot (Kelly §4.2.2, the plot debug view of Fig. 72): the
+/// samples laid from a front's head, and the one taken.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapFan {
+    /// The head the fan was laid from, metres.
+    pub from: DVec2,
+    /// The samples, counter-clockwise, metres.
+    pub samples: Vec<DVec2>,
+    /// Index into `samples` of the sample the front moved to.
+    pub chosen: usize,
+}
+
+/// One lot subdivision step's split line (Kelly §5.5.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapSplit {
+    /// The block whose subdivision cut it.
+    pub block: u64,
+    /// The cut's parts inside the piece it split (one for a convex piece), metres.
+    pub chords: Vec<[DVec2; 2]>,
+}
+
+/// What Kelly's debug views draw over the map (§5.4.1, §5.5.1): the primary roads' plot
+/// points and sample fans, and the lot subdivision's split lines in the order they were
+/// cut. Block and lot boundaries come from [`MapLayers::blocks`] and [`MapLayers::lots`].
+/// The SVG writer draws them only when asked (`SvgOptions::debug`); other writers ignore
+/// them. Default: empty.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MapDebug {
+    /// Plot points of the primary roads (Kelly's plot samples), metres.
+    pub plot_points: Vec<DVec2>,
+    /// The sample fans of the primary roads' plots, in plotting order.
+    pub fans: Vec<MapFan>,
+    /// The lot subdivision's split lines, in order (block by block, step by step).
+    pub splits: Vec<MapSplit>,
+}
+
+impl MapDebug {
+    /// Checks every point as [`MapLayers::validate`] does, and every fan's chosen index.
+    pub fn validate(&self) -> Result<(), ExportError> {
+        for (k, &p) in self.plot_points.iter().enumerate() {
+            check_point(p, k, || "debug plot points".to_string())?;
+        }
+        for (i, f) in self.fans.iter().enumerate() {
+            let who = || format!("debug fan {i}");
+            check_point(f.from, 0, who)?;
+            for (k, &p) in f.samples.iter().enumerate() {
+                check_point(p, k, who)?;
+            }
+            if f.chosen >= f.samples.len() {
+                return Err(ExportError::map(
+                    who(),
+                    format!("chosen sample {} of {} samples", f.chosen, f.samples.len()),
+                ));
+            }
+        }
+        for (i, s) in self.splits.iter().enumerate() {
+            for (k, c) in s.chords.iter().enumerate() {
+                for &p in c {
+                    check_point(p, k, || format!("debug split line {i}"))?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Everything a map shows, by layer (drawn bottom to top in this order: water, parks,
 /// blocks, lots, roads, footprints).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -197,6 +264,8 @@ pub struct MapLayers {
     pub roads: Vec<MapRoad>,
     /// Building footprints.
     pub footprints: Vec<MapFootprint>,
+    /// Debug overlays (drawn only when a writer is asked to). Default: empty.
+    pub debug: MapDebug,
 }
 
 /// Which layers a writer includes.
@@ -298,7 +367,7 @@ impl MapLayers {
                 ));
             }
         }
-        Ok(())
+        self.debug.validate()
     }
 
     /// The bounding box of the selected layers as `(min, max)`, `None` if they are empty.

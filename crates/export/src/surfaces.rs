@@ -229,6 +229,81 @@ pub fn road_surfaces_with_report(
     Ok((mesh, report))
 }
 
+/// The ribbons of one road class and width (see [`RoadSurfaceParts`]).
+#[derive(Debug, Clone)]
+pub struct RibbonGroup {
+    /// The class of the roads.
+    pub class: crate::map::RoadClass,
+    /// Their width, metres.
+    pub width_m: f64,
+    /// The ribbons, texture coordinates in metres as in [`road_surfaces`] (`u` along the
+    /// road, `v` from `0` on the right edge to `−width_m` on the left), no material.
+    pub mesh: Mesh,
+}
+
+/// [`road_surfaces`] in separate surfaces (Kelly §5.4: roads as textured geometry,
+/// junction plates as their own surfaces): the ribbons grouped by class and width, so
+/// each group can take a texture laid out across its width, and the junction plates and
+/// dead-end caps apart.
+#[derive(Debug, Clone)]
+pub struct RoadSurfaceParts {
+    /// Ribbons by (class rank, class, width), in that order.
+    pub ribbons: Vec<RibbonGroup>,
+    /// Junction plates and dead-end caps, texture coordinates the layout position
+    /// `(x, −y)` in metres, no material.
+    pub junctions: Mesh,
+    /// The hard cases met, as [`road_surfaces_with_report`] counts them.
+    pub report: RoadSurfaceReport,
+}
+
+/// The surfaces of [`road_surfaces_with_report`], the same triangles split into ribbon
+/// groups and junction plates ([`RoadSurfaceParts`]).
+///
+/// # Errors
+/// As [`road_surfaces`].
+pub fn road_surface_parts(
+    roads: &[MapRoad],
+    elevation: &dyn Field,
+    options: &RoadSurfaceOptions,
+) -> Result<RoadSurfaceParts, ExportError> {
+    check_options(options)?;
+    check_roads(roads)?;
+    let plan = junctions::plan(roads, options);
+    let drape = Drape::new(roads, &plan, elevation, options)?;
+    let mut groups: std::collections::BTreeMap<(u8, String, u64), RibbonGroup> =
+        std::collections::BTreeMap::new();
+    for e in plan.edges.iter().filter(|e| !e.dropped && !e.internal) {
+        let road = &roads[e.road];
+        let key = (
+            road.class.rank(),
+            road.class.as_str().to_string(),
+            road.width_m.to_bits(),
+        );
+        let group = groups.entry(key).or_insert_with(|| RibbonGroup {
+            class: road.class.clone(),
+            width_m: road.width_m,
+            mesh: Mesh::new(None),
+        });
+        add_ribbon(&mut group.mesh, roads, e, &drape, options)?;
+    }
+    let mut junctions = Mesh::new(None);
+    let mut report = plan.report.clone();
+    for j in &plan.junctions {
+        if !add_junction(&mut junctions, j, &drape)? {
+            report.skipped_junctions += 1;
+            report.junctions -= 1;
+        }
+    }
+    Ok(RoadSurfaceParts {
+        ribbons: groups
+            .into_values()
+            .filter(|g| g.mesh.triangle_count() > 0)
+            .collect(),
+        junctions,
+        report,
+    })
+}
+
 fn check_options(o: &RoadSurfaceOptions) -> Result<(), ExportError> {
     if !(o.max_segment_m.is_finite() && o.max_segment_m > 0.0) {
         return Err(ExportError::InvalidOption {

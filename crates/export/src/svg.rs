@@ -17,7 +17,8 @@
 //!
 //! Each layer is a `<g id="water|parks|blocks|lots|roads|footprints">`; features carry
 //! `data-id` and a `class` (road class, building kind), so the file can be styled further
-//! with CSS.
+//! with CSS. Debug overlays ([`SvgDebug`], off by default) follow on top, each its own
+//! `<g id="debug-…">`.
 
 use std::io::Write;
 
@@ -26,6 +27,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 use crate::map::{BuildingKind, LayerSet, MapLayers, RoadClass};
+
+pub use debug::SvgDebug;
+
+mod debug;
 
 /// Colours (any SVG paint: `#rrggbb`, a name, …) and line widths of the map.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -140,6 +145,8 @@ pub struct SvgOptions {
     pub decimals: u8,
     /// Colours and line widths.
     pub style: SvgStyle,
+    /// Debug overlays drawn over everything (Kelly §5.4.1, §5.5.1). Default: none.
+    pub debug: SvgDebug,
 }
 
 impl Default for SvgOptions {
@@ -150,6 +157,7 @@ impl Default for SvgOptions {
             margin_m: 10.0,
             decimals: 2,
             style: SvgStyle::default(),
+            debug: SvgDebug::default(),
         }
     }
 }
@@ -202,6 +210,7 @@ pub fn write_svg<W: Write>(
             "style.footprint_stroke_width_m",
             o.style.footprint_stroke_width_m,
         ),
+        ("debug.line_width_m", o.debug.line_width_m),
     ] {
         if !(w.is_finite() && w >= 0.0) {
             return Err(ExportError::InvalidOption {
@@ -307,6 +316,7 @@ impl<W: Write> SvgWriter<W> {
             }
             writeln!(self.out, "</g>")?;
         }
+        self.debug(map, &o.debug)?;
         writeln!(self.out, "</svg>")
     }
 

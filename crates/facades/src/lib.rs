@@ -110,6 +110,7 @@ pub mod profile;
 pub mod raster;
 pub mod sample;
 pub mod stack;
+pub mod street;
 pub mod style;
 pub mod sweep;
 pub mod tile_plan;

@@ -115,6 +115,6 @@ pub use inset::{Inset, InsetRing, InsetShape, inset, inset_shapes, inset_weighte
 pub use polygon_split::{Region, TaggedRing, split_by_line};
 pub use skeleton::{EdgeRef, SkeletonArc, SkeletonNode, StraightSkeleton};
 pub use subdivision::{
-    DiscardReason, Discarded, Lot, LotParams, LotStrategy, Subdivider, Subdivision, subdivide,
-    subdivide_block,
+    DiscardReason, Discarded, Lot, LotParams, LotStrategy, SplitLine, Subdivider, Subdivision,
+    subdivide, subdivide_block,
 };

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 use crate::error::{Result, RoadError};
+use crate::feedback::PopulationFeedback;
 use crate::goals::{DefaultGoals, GlobalGoals};
 use crate::inputs::RoadInputs;
 use crate::modules::{QueryState, RoadModule, road_rules};
@@ -72,6 +73,7 @@ struct RoadEnv<'a> {
     graph: &'a mut RoadNetwork,
     constraints: &'a mut dyn LocalConstraints,
     params: &'a RoadParams,
+    feedback: Option<&'a PopulationFeedback>,
     step: u32,
     segments: usize,
     error: Option<RoadError>,
@@ -135,6 +137,11 @@ impl RoadEnv<'_> {
                 if let Some(p) = ins.nodes.last().and_then(|&n| self.graph.position(n).ok()) {
                     road.end = p;
                 }
+                if road.class == RoadClass::Street
+                    && let Some(f) = self.feedback
+                {
+                    f.use_up(road.end);
+                }
                 QueryState::Succeed
             }
             Err(
@@ -157,6 +164,7 @@ pub struct RoadGenerator {
     goals: Arc<dyn GlobalGoals>,
     constraints: Box<dyn LocalConstraints>,
     inputs: RoadInputs,
+    feedback: Option<Arc<PopulationFeedback>>,
 }
 
 impl std::fmt::Debug for RoadGenerator {
@@ -174,11 +182,19 @@ impl RoadGenerator {
     /// [`RoadError::InvalidParameter`] or [`RoadError::NoLegalStart`].
     pub fn new(params: &RoadParams, inputs: &RoadInputs) -> Result<Self> {
         params.validate()?;
+        // With population feedback (§3.2.1) the goals read the population the street
+        // ends lower; the map itself is never changed.
+        let feedback = PopulationFeedback::new(inputs.population.clone(), params).map(Arc::new);
+        let mut fed = inputs.clone();
+        if let Some(f) = &feedback {
+            fed.population = f.clone();
+        }
         Ok(RoadGenerator {
             params: params.clone(),
-            goals: Arc::new(DefaultGoals::new(params, inputs)?),
-            constraints: Box::new(DefaultConstraints::new(params, inputs)),
-            inputs: inputs.clone(),
+            goals: Arc::new(DefaultGoals::new(params, &fed)?),
+            constraints: Box::new(DefaultConstraints::new(params, &fed)),
+            inputs: fed,
+            feedback,
         })
     }
 
@@ -241,6 +257,7 @@ impl RoadGenerator {
             graph: &mut graph,
             constraints: self.constraints.as_mut(),
             params: &self.params,
+            feedback: self.feedback.as_deref(),
             step: 0,
             segments: 0,
             error: None,

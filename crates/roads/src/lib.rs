@@ -80,6 +80,7 @@ pub use polis_lsystem as lsystem;
 
 pub mod constraints;
 pub mod error;
+pub mod feedback;
 pub mod generator;
 pub mod goals;
 pub mod grading;
@@ -98,6 +99,7 @@ pub mod street_rules;
 
 pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 pub use error::{Result, RoadError, RoadsError};
+pub use feedback::PopulationFeedback;
 pub use generator::{
     Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };

@@ -128,6 +128,13 @@ pub struct RoadParams {
     pub smooth_highways: bool,
     /// Rounds of highway corner cutting. Default: 2.
     pub smoothing_rounds: u32,
+    /// Population feedback (§3.2.1, [`crate::feedback`]): the density each accepted
+    /// street end uses up at its own point, falling off to zero at
+    /// [`Self::feedback_radius_m`]; 0 turns the feedback off. Finite, ≥ 0. Default: 0.
+    pub population_feedback: f64,
+    /// Radius of the area a street end uses population from, metres (about a block).
+    /// Finite, > 0. Default: 120.
+    pub feedback_radius_m: f64,
 }
 
 impl Default for RoadParams {
@@ -175,6 +182,8 @@ impl Default for RoadParams {
             max_steps: 1000,
             smooth_highways: false,
             smoothing_rounds: 2,
+            population_feedback: 0.0,
+            feedback_radius_m: 120.0,
         }
     }
 }
@@ -298,6 +307,18 @@ impl RoadParams {
             self.highway_branch_probability,
         )?;
         unit("street_branch_probability", self.street_branch_probability)?;
+        check(
+            "population_feedback",
+            self.population_feedback.is_finite() && self.population_feedback >= 0.0,
+            self.population_feedback,
+            "a finite density ≥ 0",
+        )?;
+        check(
+            "feedback_radius_m",
+            self.feedback_radius_m.is_finite() && self.feedback_radius_m > 0.0,
+            self.feedback_radius_m,
+            "finite metres > 0",
+        )?;
         unit("max_prune_factor", self.max_prune_factor)?;
         check(
             "population_threshold",

@@ -688,3 +688,60 @@ proptest! {
         prop_assert!(m.positions.iter().all(|p| p.is_finite()));
     }
 }
+
+/// The parts are the same surface split apart: ribbons grouped by class and width (in
+/// rank order), junction plates on their own with layout-position coordinates; the
+/// triangles and the area add up to the one-mesh surface's.
+#[test]
+fn parts_split_the_same_surface_into_ribbon_groups_and_junction_plates() {
+    let roads = [
+        road(
+            &[(-60.0, 0.0), (0.0, 0.0), (60.0, 0.0)],
+            RoadClass::Highway,
+            16.0,
+        ),
+        road(&[(0.0, 0.0), (0.0, 70.0)], RoadClass::Street, 8.0),
+        road(&[(0.0, 0.0), (0.0, -50.0)], RoadClass::Street, 6.0),
+        road(&[(60.0, 0.0), (90.0, 40.0)], RoadClass::Street, 8.0),
+    ];
+    let o = RoadSurfaceOptions::default();
+    let whole = road_surfaces(&roads, &Constant(0.0), &o, None).unwrap();
+    let parts = road_surface_parts(&roads, &Constant(0.0), &o).unwrap();
+    let keys: Vec<(&str, f64)> = parts
+        .ribbons
+        .iter()
+        .map(|g| (g.class.as_str(), g.width_m))
+        .collect();
+    assert_eq!(keys, [("street", 6.0), ("street", 8.0), ("highway", 16.0)]);
+    let tris: usize = parts
+        .ribbons
+        .iter()
+        .map(|g| g.mesh.triangle_count())
+        .sum::<usize>()
+        + parts.junctions.triangle_count();
+    assert_eq!(tris, whole.triangle_count());
+    let area: f64 = parts
+        .ribbons
+        .iter()
+        .map(|g| g.mesh.surface_area())
+        .sum::<f64>()
+        + parts.junctions.surface_area();
+    assert!((area - whole.surface_area()).abs() < 1e-6 * area);
+    for g in &parts.ribbons {
+        g.mesh.validate().unwrap();
+        for uv in &g.mesh.uvs {
+            let v = f64::from(uv.y);
+            assert!(
+                v <= 1e-6 && v >= -g.width_m - 1e-4,
+                "v {v} across a {} m road",
+                g.width_m
+            );
+        }
+    }
+    parts.junctions.validate().unwrap();
+    assert!(parts.report.junctions >= 3);
+    for (p, uv) in parts.junctions.positions.iter().zip(&parts.junctions.uvs) {
+        // World (x, y, z) = layout (x, h, −y): uv = (x, −y) = (world x, world z).
+        assert!((uv.x - p.x).abs() < 1e-3 && (uv.y - p.z).abs() < 1e-3);
+    }
+}

@@ -186,3 +186,90 @@ fn escaping_and_control_characters() {
     ));
     check_xml(&svg(&map, &SvgOptions::default()));
 }
+
+/// The debug overlays are off by default; on, each is its own group over the map, and the
+/// split layer lists one path per split line in the order given (`data-order`), with
+/// every chord of a line in that line's path.
+#[test]
+fn debug_layers_list_one_split_line_per_step_in_order() {
+    use crate::map::{MapDebug, MapFan, MapSplit};
+    let mut map = sample_map();
+    let d = |x: f64, y: f64| DVec2::new(x, y);
+    map.debug = MapDebug {
+        plot_points: vec![d(0.0, 0.0), d(10.0, 0.0), d(20.0, 5.0)],
+        fans: vec![MapFan {
+            from: d(0.0, 0.0),
+            samples: vec![d(9.0, -3.0), d(10.0, 0.0), d(9.0, 3.0)],
+            chosen: 1,
+        }],
+        splits: (0..5)
+            .map(|i| MapSplit {
+                block: 7 + (i / 3) as u64,
+                chords: (0..=(i % 2))
+                    .map(|k| {
+                        [
+                            d(i as f64, k as f64 * 10.0),
+                            d(i as f64, k as f64 * 10.0 + 5.0),
+                        ]
+                    })
+                    .collect(),
+            })
+            .collect(),
+    };
+    let plain = svg(&map, &SvgOptions::default());
+    assert!(!plain.contains("debug-"));
+    let o = SvgOptions {
+        debug: SvgDebug::all(),
+        ..SvgOptions::default()
+    };
+    let text = svg(&map, &o);
+    let els = check_xml(&text);
+    let groups: Vec<&str> = els
+        .iter()
+        .filter(|e| e.0 == "g")
+        .filter_map(|e| attr(e, "id"))
+        .collect();
+    assert_eq!(
+        groups[6..],
+        [
+            "debug-plot",
+            "debug-fans",
+            "debug-blocks",
+            "debug-lots",
+            "debug-splits"
+        ]
+    );
+    let splits: Vec<_> = els
+        .iter()
+        .filter(|e| e.0 == "path" && attr(e, "class") == Some("split"))
+        .collect();
+    assert_eq!(splits.len(), map.debug.splits.len());
+    for (i, (e, s)) in splits.iter().zip(&map.debug.splits).enumerate() {
+        assert_eq!(attr(e, "data-order"), Some(i.to_string().as_str()));
+        assert_eq!(attr(e, "data-block"), Some(s.block.to_string().as_str()));
+        let moves = attr(e, "d").unwrap().matches('M').count();
+        assert_eq!(moves, s.chords.len());
+    }
+    let dots = els.iter().filter(|e| e.0 == "circle").count();
+    assert_eq!(dots, 3);
+    let chosen = els
+        .iter()
+        .filter(|e| attr(e, "class") == Some("chosen"))
+        .count();
+    assert_eq!(chosen, 1);
+    // Outlines of every block and lot.
+    let outlines = |id: &str| {
+        let start = text.find(&format!("<g id=\"{id}\"")).unwrap();
+        let end = start + text[start..].find("</g>").unwrap();
+        text[start..end].matches("<path").count()
+    };
+    assert_eq!(outlines("debug-blocks"), map.blocks.len());
+    assert_eq!(outlines("debug-lots"), map.lots.len());
+    // A chosen index beyond the samples is refused.
+    map.debug.fans[0].chosen = 3;
+    let mut out = Vec::new();
+    assert!(matches!(
+        write_svg(&map, &o, &mut out),
+        Err(ExportError::InvalidMap { .. })
+    ));
+}

@@ -113,8 +113,16 @@ impl Arena {
     /// Splits piece `p` by the line perpendicular to `a → b` through the point at fraction
     /// `t` from `a`. If a vertex lies (almost) on that line the point is moved a little
     /// along the edge, so a split never runs along an edge or through a vertex. The pieces
-    /// go to `out` (just `p` again if the line misses).
-    pub fn split_across(&mut self, p: Piece, a: DVec2, b: DVec2, t: f64, out: &mut Vec<Piece>) {
+    /// go to `out` (just `p` again if the line misses). Returns the cut line as two points
+    /// on it (`q`, `q + (b − a)⊥`).
+    pub fn split_across(
+        &mut self,
+        p: Piece,
+        a: DVec2,
+        b: DVec2,
+        t: f64,
+        out: &mut Vec<Piece>,
+    ) -> (DVec2, DVec2) {
         out.clear();
         let d = b - a;
         let len2 = d.length_squared();
@@ -130,18 +138,45 @@ impl Arena {
         }
         let r = q + d.perp();
         if p.convex && self.split_convex(p, q, r, out) {
-            return;
+            return (q, r);
         }
         out.clear();
         let pieces = split_by_line(&self.region(p), q, r);
         if pieces.len() < 2 {
             out.push(p);
-            return;
+            return (q, r);
         }
         for piece in pieces {
             let np = self.push(&piece.outer, None);
             out.push(np);
         }
+        (q, r)
+    }
+
+    /// The parts of the line through `q` and `r` that lie inside piece `p`: its crossings
+    /// with the ring, sorted along the line and paired (even–odd rule). The split line a
+    /// subdivision step cut, for the debug record ([`super::SplitLine`]).
+    pub fn chords(&self, p: Piece, q: DVec2, r: DVec2) -> Vec<[DVec2; 2]> {
+        let pts = self.points(p);
+        let n = pts.len();
+        let dir = r - q;
+        let len2 = dir.length_squared();
+        if len2 == 0.0 {
+            return Vec::new();
+        }
+        let mut hits: Vec<(f64, DVec2)> = Vec::new();
+        for i in 0..n {
+            let (u, v) = (pts[i], pts[if i + 1 == n { 0 } else { i + 1 }]);
+            let (su, sv) = (orient2d_value(q, r, u), orient2d_value(q, r, v));
+            // Half-open rule: a vertex on the line counts for the edge leaving it upward.
+            if (su > 0.0) == (sv > 0.0) {
+                continue;
+            }
+            let x = lerp_stable(u, v, su / (su - sv));
+            hits.push(((x - q).dot(dir) / len2, x));
+        }
+        hits.sort_by(|x, y| x.0.total_cmp(&y.0));
+        hits.chunks_exact(2).map(|c| [c[0].1, c[1].1]).collect()
     }
 
     /// The fast split of a convex ring: one exit and one entry crossing.

@@ -93,10 +93,11 @@ pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R
         splits += 1;
         let (a, b) = ctx.arena.edge(r, edge);
         let mut out = std::mem::take(ctx.scratch);
-        ctx.arena.split_across(r, a, b, t, &mut out);
+        let line = ctx.arena.split_across(r, a, b, t, &mut out);
         if out.len() < 2 {
             ctx.finish(r);
         } else {
+            ctx.record_split(r, line);
             for &p in &out {
                 if ctx.arena.has_street(p) {
                     ctx.pieces.push(p);

@@ -163,6 +163,15 @@ pub struct Discarded {
     pub area: f64,
 }
 
+/// One subdivision step's cut, recorded when [`Subdivider::record_splits`] is on (Kelly
+/// §5.5.1: the lot subdivision debug view draws the split lines in order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SplitLine {
+    /// The cut line's parts inside the piece it split, metres: one chord for a convex
+    /// piece, several where the line crosses a concave piece more than once.
+    pub chords: Vec<[polis_geom::DVec2; 2]>,
+}
+
 /// The result of subdividing one region.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Subdivision {
@@ -172,6 +181,10 @@ pub struct Subdivision {
     pub green_spaces: Vec<PolygonWithHoles>,
     /// Everything else that is not a lot.
     pub discarded: Vec<Discarded>,
+    /// The split lines, one per subdivision step, in the order they were cut; empty unless
+    /// [`Subdivider::record_splits`] is on. Default: empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub splits: Vec<SplitLine>,
 }
 
 impl Subdivision {
@@ -179,6 +192,7 @@ impl Subdivision {
         self.lots.extend(other.lots);
         self.green_spaces.extend(other.green_spaces);
         self.discarded.extend(other.discarded);
+        self.splits.extend(other.splits);
     }
 }
 
@@ -216,12 +230,38 @@ pub struct Subdivider {
     arena: Arena,
     pieces: Vec<Piece>,
     scratch: Vec<Piece>,
+    record_splits: bool,
 }
 
 impl Subdivider {
     /// A worker with empty buffers.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Whether [`Subdivision::splits`] records every step's split line (a debug record; it
+    /// never changes the lots). Default: off.
+    pub fn record_splits(&mut self, on: bool) -> &mut Self {
+        self.record_splits = on;
+        self
+    }
+
+    /// Same as [`subdivide_block`], reusing this worker's buffers (and its
+    /// [`record_splits`](Self::record_splits) choice).
+    ///
+    /// # Errors
+    /// As [`subdivide`].
+    pub fn subdivide_block<R: Rng + ?Sized>(
+        &mut self,
+        block: &Block,
+        params: &LotParams,
+        rng: &mut R,
+    ) -> Result<Subdivision, LotsError> {
+        let mut out = Subdivision::default();
+        for parcel in &block.parcels {
+            out.append(self.subdivide(parcel, block.id(), params, rng)?);
+        }
+        Ok(out)
     }
 
     /// Same as [`subdivide`], reusing this worker's buffers.
@@ -275,6 +315,7 @@ impl Subdivider {
             block_id,
             params,
             out,
+            record_splits: self.record_splits,
         };
         match params.strategy {
             LotStrategy::Kelly => kelly::run(&mut ctx, piece, rng),
@@ -291,9 +332,18 @@ pub(crate) struct Ctx<'a> {
     pub block_id: u64,
     pub params: &'a LotParams,
     pub out: &'a mut Subdivision,
+    pub record_splits: bool,
 }
 
 impl Ctx<'_> {
+    /// Records the line `(q, r)` that split piece `p` (when recording is on).
+    pub fn record_split(&mut self, p: Piece, (q, r): (polis_geom::DVec2, polis_geom::DVec2)) {
+        if self.record_splits {
+            let chords = self.arena.chords(p, q, r);
+            self.out.splits.push(SplitLine { chords });
+        }
+    }
+
     /// Sorts a finished piece into lots, green space or discarded.
     pub fn finish(&mut self, p: Piece) {
         let params = self.params;

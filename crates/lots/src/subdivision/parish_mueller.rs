@@ -51,10 +51,11 @@ pub(super) fn run<R: Rng + ?Sized>(ctx: &mut Ctx<'_>, region: Piece, rng: &mut R
         let t = 0.5 + params.deviance * (rng.random::<f64>() - 0.5) * 0.5;
         splits += 1;
         let mut out = std::mem::take(ctx.scratch);
-        ctx.arena.split_across(r, a, b, t, &mut out);
+        let line = ctx.arena.split_across(r, a, b, t, &mut out);
         if out.len() < 2 {
             ctx.finish(r);
         } else {
+            ctx.record_split(r, line);
             ctx.pieces.extend(out.iter().rev());
         }
         *ctx.scratch = out;
