@@ -4,8 +4,12 @@
 //!
 //! ```text
 //! cargo run --release --example citygen -- [PRESET] [--city | --city-only] [--lod N]
-//!     [--threads N] [--out DIR]
+//!     [--threads N] [--out DIR] [--bench-growth RUNS [--index-search]]
 //! ```
+//!
+//! `--bench-growth RUNS` grows every Kelly cell serially on one thread `RUNS` times and
+//! prints CPU time and a digest of the grown graphs; `--index-search` makes the snap
+//! search use each cell graph's hashed index instead of the flat grid (same digest).
 //!
 //! `--city` also generates the whole city (without the 3-D scene) after the road part;
 //! `--city-only` only generates the whole city, scene included (for timing any preset).
@@ -31,6 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut city_only = false;
     let mut lod = None;
     let mut bench_growth = 0usize;
+    let mut index_search = false;
     let mut threads = None;
     let mut out = std::path::PathBuf::from("out");
     let mut args = std::env::args().skip(1);
@@ -41,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--bench-growth" => {
                 bench_growth = args.next().and_then(|t| t.parse().ok()).unwrap_or(5)
             }
+            "--index-search" => index_search = true,
             "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
             "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
             "--out" => out = args.next().unwrap_or_default().into(),
@@ -82,7 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (net, _) = pool.install(|| citygen_network(&cx))?;
     let total = t.elapsed();
     if bench_growth > 0 {
-        return growth_bench(&cx, &net.primary, bench_growth);
+        return growth_bench(&cx, &net.primary, bench_growth, !index_search);
     }
     let mut stats = StreetStats::default();
     let mut per_cell = Vec::new();
@@ -171,23 +177,27 @@ fn growth_bench(
     cx: &StageContext<'_>,
     primary: &polis::roads::RoadNetwork,
     runs: usize,
+    flat_grid: bool,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth};
     let cg = &cx.config.citygen;
     let cells = polis::cells::extract_with(primary, &cx.config.cells)?;
+    let zoning = polis::citygen::zoning_of(cx)?;
     let mut inputs = Vec::new();
     for cell in &cells.cells {
         let Ok(region) = cell.polygon_with_holes() else {
             continue;
         };
         // Kelly's growth only: cells given a grid pattern are not in this benchmark.
-        let polis::citygen::CellPatternChoice::Kelly(n) =
-            polis::citygen::neighbourhood_of(cx, &region)
-        else {
+        let chosen = polis::citygen::choose_pattern(cx, zoning.as_ref(), &region);
+        let polis::citygen::CellPatternChoice::Kelly(n) = chosen.pattern else {
             continue;
         };
         let mut p = n.preset()?.to_params(cg.unit_m);
         p.road_width_m.value *= cg.road_width_factor;
+        for q in &chosen.params {
+            q.apply(&mut p);
+        }
         let filaments = cell
             .filaments
             .iter()
@@ -208,9 +218,12 @@ fn growth_bench(
     for run in 0..runs {
         let (t, c) = (Instant::now(), thread_cpu_ns());
         let mut roads = 0;
+        let mut digest = 0u64;
         for (cell, p) in &inputs {
-            if let Ok(r) = SecondaryGrowth::new(p.clone())?.grow(cell, &maps, seed) {
+            let mut growth = SecondaryGrowth::new(p.clone())?.with_flat_grid(flat_grid);
+            if let Ok(r) = growth.grow(cell, &maps, seed) {
                 roads += r.segments().count();
+                digest = polis::geom::hash::splitmix64(digest ^ graph_digest(&r.network));
             }
         }
         let (wall, cpu) = (
@@ -218,10 +231,33 @@ fn growth_bench(
             (thread_cpu_ns() - c) as f64 / 1e6,
         );
         println!(
-            "run {run}: {} cells, {roads} secondary roads, serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
+            "run {run}: {} cells, {roads} secondary roads (digest {digest:016x}), serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
             inputs.len(),
             cpu / inputs.len().max(1) as f64
         );
     }
     Ok(())
+}
+
+/// FNV-1a over a graph's nodes and edges in id order (positions to the bit).
+fn graph_digest(net: &polis::roads::RoadNetwork) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |v: u64| {
+        for b in v.to_le_bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for (n, p, _) in net.nodes() {
+        eat(n.index() as u64);
+        eat(p.x.to_bits());
+        eat(p.y.to_bits());
+    }
+    for (e, u, v, r) in net.edges() {
+        eat(e.index() as u64);
+        eat(u.index() as u64);
+        eat(v.index() as u64);
+        eat(r.width.to_bits());
+    }
+    h
 }

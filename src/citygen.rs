@@ -40,12 +40,14 @@ use crate::error::{Error, Result};
 mod edits;
 mod kelly;
 mod traits;
+mod zones;
 use crate::stages::{ParishMullerRoads, RoadStage, RoadsOutput, Skip, Stage, StageContext};
 pub use edits::{
     CellParam, CellSettings, LotOverride, MapPaint, PaintLayer, lot_override, paint_maps,
 };
 pub use kelly::{InlinePrimary, PATH_TOLERANCE_M};
 pub use traits::{LotPlan, block_ids, district_at, hint_kind, lot_params_of, lot_plan};
+pub use zones::{MIN_ZONE_SAMPLES, ZoneLevel, ZoneMap, ZoneRule, Zoning};
 
 /// How the city's roads are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -219,6 +221,12 @@ pub struct CitygenConfig {
     /// Explicit neighbourhoods; the first override whose point lies in a cell applies.
     /// Default: none.
     pub overrides: Vec<CellOverride>,
+    /// A zoning map whose levels choose each cell's neighbourhood (and optionally some
+    /// of its parameters) by the cell's area majority or centroid ([`ZoneMap`]); it
+    /// comes after per-cell settings and overrides, before the population bands.
+    /// Default: none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub zones: Option<ZoneMap>,
     /// Carriageway widths of secondary roads are multiplied by this (Kelly's widths in
     /// Citygen units come out narrow in metres). Must be in (0, 10]. Default: 1.
     pub road_width_factor: f64,
@@ -244,6 +252,7 @@ impl Default for CitygenConfig {
             neighbourhood: CellPatternChoice::Kelly(Neighbourhood::Manhattan),
             by_population: Vec::new(),
             overrides: Vec::new(),
+            zones: None,
             road_width_factor: 1.0,
             cell_traits: false,
             cells: Vec::new(),
@@ -306,6 +315,9 @@ impl CitygenConfig {
         for (i, p) in self.paint.iter().enumerate() {
             p.validate(f64::INFINITY)
                 .map_err(|e| Error::config(format!("citygen.paint[{i}]"), e.to_string()))?;
+        }
+        if let Some(z) = &self.zones {
+            z.validate()?;
         }
         for (i, o) in self.overrides.iter().enumerate() {
             if !(o.at[0].is_finite() && o.at[1].is_finite()) {
@@ -492,6 +504,7 @@ pub(crate) fn citygen_network_with(
         crate::editor::key::Key::new(0x6772_6F77).bytes(text.as_bytes())
     });
     let ids = cell_ids(&decomposition, &primary, kelly_roads.as_deref());
+    let zoning = zoning_of(cx)?;
     let started = crate::clock::Instant::now();
     let grown: Vec<Result<std::result::Result<(SecondaryRoads, District), Skip>>> = decomposition
         .cells
@@ -508,24 +521,29 @@ pub(crate) fn citygen_network_with(
                 Err(e) => return Ok(Err(skip(format!("cell {id}: {e}")))),
             };
             let settings = cg.cells.iter().find(|s| s.cell == id);
-            let pattern = settings
-                .and_then(|s| s.pattern)
-                .unwrap_or_else(|| neighbourhood_of(cx, &region));
+            let chosen = choose_pattern(cx, zoning.as_ref(), &region);
+            let pattern = settings.and_then(|s| s.pattern).unwrap_or(chosen.pattern);
+            // A zone level's parameters apply to its pattern only, not to a pattern the
+            // cell's settings chose instead.
+            let zone_params = if pattern == chosen.pattern {
+                chosen.params.as_slice()
+            } else {
+                &[]
+            };
             let mut p = match pattern {
                 CellPatternChoice::Kelly(n) => preset(n),
                 CellPatternChoice::Grid(g) => preset(g.traits_from()),
             };
-            let explicit = settings.is_some_and(|s| {
-                s.params.iter().any(|q| {
-                    matches!(
-                        q,
-                        CellParam::LotSize(_)
-                            | CellParam::BuildingHeight(_)
-                            | CellParam::BuildingHint(_)
-                    )
-                })
+            let cell_params = settings.map(|s| s.params.as_slice()).unwrap_or_default();
+            let explicit = zone_params.iter().chain(cell_params).any(|q| {
+                matches!(
+                    q,
+                    CellParam::LotSize(_)
+                        | CellParam::BuildingHeight(_)
+                        | CellParam::BuildingHint(_)
+                )
             });
-            for q in settings.map(|s| s.params.as_slice()).unwrap_or_default() {
+            for q in zone_params.iter().chain(cell_params) {
                 q.apply(&mut p);
             }
             let seed = settings
@@ -760,27 +778,86 @@ fn filament_segments(cell: &Cell) -> Vec<[DVec2; 2]> {
         .collect()
 }
 
-/// The neighbourhood the configuration gives the cell with region `region`: the first
-/// override inside it, else the highest population band reached at the mean of its outer
-/// ring's vertices, else [`CitygenConfig::neighbourhood`].
-pub fn neighbourhood_of(
+/// A cell's pattern as the configuration chooses it (before per-cell settings).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChosenPattern {
+    /// The pattern.
+    pub pattern: CellPatternChoice,
+    /// Parameter overrides of the zoning level that chose it (empty otherwise), applied
+    /// on top of the pattern's preset.
+    pub params: Vec<CellParam>,
+    /// The zoning level (index into `citygen.zones.levels`) that chose it, if any.
+    pub zone: Option<usize>,
+}
+
+/// Builds the configuration's zoning map, if any, checking that an image covers the
+/// city.
+///
+/// # Errors
+/// [`Error::Config`] for a map not covering the city; errors building the map.
+pub fn zoning_of(cx: &StageContext<'_>) -> Result<Option<Zoning>> {
+    let Some(z) = &cx.config.citygen.zones else {
+        return Ok(None);
+    };
+    z.validate()?;
+    z.check_extent(cx.config.size_m)?;
+    let salt = cx.seed(Stage::Maps, 0x2045_0E5);
+    Ok(Some(z.build(salt, cx.config.maps.max_image_pixels)?))
+}
+
+/// The pattern the configuration gives the cell with region `region`: the first
+/// override inside it, else the level of the zoning map `zoning` (built by
+/// [`zoning_of`]) by the map's rule, else the highest population band reached at the
+/// mean of its outer ring's vertices, else [`CitygenConfig::neighbourhood`].
+pub fn choose_pattern(
     cx: &StageContext<'_>,
+    zoning: Option<&Zoning>,
     region: &polis_geom::PolygonWithHoles,
-) -> CellPatternChoice {
+) -> ChosenPattern {
     let cg = &cx.config.citygen;
+    let plain = |pattern| ChosenPattern {
+        pattern,
+        params: Vec::new(),
+        zone: None,
+    };
     for o in &cg.overrides {
         if region.contains(DVec2::new(o.at[0], o.at[1])) {
-            return o.neighbourhood;
+            return plain(o.neighbourhood);
         }
+    }
+    if let (Some(zones), Some(zoning)) = (&cg.zones, zoning)
+        && let Some(i) = zoning.level_of(zones, region)
+        && let Some(level) = zones.levels.get(i)
+    {
+        return ChosenPattern {
+            pattern: level.neighbourhood,
+            params: level.params.clone(),
+            zone: Some(i),
+        };
     }
     let pts = region.outer.points();
     let centre = pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64;
     let density = cx.maps.inputs.population.sample(centre);
-    cg.by_population
-        .iter()
-        .filter(|b| density >= b.min_density)
-        .max_by(|a, b| a.min_density.total_cmp(&b.min_density))
-        .map_or(cg.neighbourhood, |b| b.neighbourhood)
+    plain(
+        cg.by_population
+            .iter()
+            .filter(|b| density >= b.min_density)
+            .max_by(|a, b| a.min_density.total_cmp(&b.min_density))
+            .map_or(cg.neighbourhood, |b| b.neighbourhood),
+    )
+}
+
+/// The pattern the configuration gives the cell with region `region` ([`choose_pattern`]
+/// with the configuration's zoning map, built for this one call).
+///
+/// # Errors
+/// As [`zoning_of`].
+pub fn neighbourhood_of(
+    cx: &StageContext<'_>,
+    region: &polis_geom::PolygonWithHoles,
+) -> Result<CellPatternChoice> {
+    let zoning = zoning_of(cx)?;
+    Ok(choose_pattern(cx, zoning.as_ref(), region).pattern)
 }
 
 /// Primary and secondary roads in one planar graph, cells joined in order.
@@ -1117,11 +1194,11 @@ mod tests {
             ]))
         };
         assert_eq!(
-            neighbourhood_of(&cx, &square(0.0, 50.0)),
+            neighbourhood_of(&cx, &square(0.0, 50.0)).unwrap(),
             Neighbourhood::Manhattan.into()
         );
         assert_eq!(
-            neighbourhood_of(&cx, &square(500.0, 50.0)),
+            neighbourhood_of(&cx, &square(500.0, 50.0)).unwrap(),
             Neighbourhood::Industrial.into()
         );
         config.citygen.by_population = vec![PopulationBand {
@@ -1133,7 +1210,7 @@ mod tests {
             maps: &maps,
         };
         assert_eq!(
-            neighbourhood_of(&cx, &square(500.0, 50.0)),
+            neighbourhood_of(&cx, &square(500.0, 50.0)).unwrap(),
             Neighbourhood::Organic.into()
         );
     }

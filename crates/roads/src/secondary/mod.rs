@@ -32,6 +32,7 @@
 
 pub mod cell;
 pub mod error;
+mod grid;
 pub mod growth;
 pub mod params;
 pub mod pattern;

@@ -34,6 +34,7 @@ use polis_geom::predicates::{Orientation, closest_point_on_segment, orient2d};
 use polis_geom::spatial::{Shape, SpatialIndex};
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
 
+use super::grid::SnapGrid;
 use crate::network::RoadNetwork;
 
 /// The outcome of one snap query.
@@ -75,9 +76,26 @@ pub struct Snapper {
     pub box_hits: u64,
     /// Queries answered by test 0 (the proposal folds onto a road at its root).
     pub folded: u64,
+    /// The cell's flat grid, when [`begin_cell`](Self::begin_cell) set one up.
+    grid: SnapGrid,
+    use_grid: bool,
 }
 
 impl Snapper {
+    /// Searches the roads of one growing cell graph through a flat grid laid over
+    /// `bounds` in squares of about `square_m` metres (instead of the graph's hashed
+    /// index) until [`end_cell`](Self::end_cell). Every query until then must be on the
+    /// same graph, which may only gain roads and split or remove them (as growth does).
+    pub fn begin_cell(&mut self, bounds: Aabb2, square_m: f64) {
+        self.grid.reset(bounds, square_m);
+        self.use_grid = true;
+    }
+
+    /// Ends [`begin_cell`](Self::begin_cell): queries use the graph's own index again.
+    pub fn end_cell(&mut self) {
+        self.use_grid = false;
+    }
+
     fn begin(&mut self, nodes: usize) {
         if self.stamp.len() < nodes {
             self.stamp.resize(nodes, 0);
@@ -142,13 +160,24 @@ impl Snapper {
         // road whose box meets it, so the ends of these roads are test 1's candidates too.
         let mut roads = std::mem::take(&mut self.roads);
         roads.clear();
-        g.edge_index().for_each_candidate(&ext, |e, shape| {
-            if let Shape::Segment(u, v) = *shape
-                && Aabb2::new(u, v).intersects(&ext)
-            {
-                roads.push(e);
-            }
-        });
+        if self.use_grid {
+            self.grid.sync(g);
+            self.grid.for_each_in(&ext, |e| {
+                if let Ok((u, v)) = g.segment(e)
+                    && Aabb2::new(u, v).intersects(&ext)
+                {
+                    roads.push(e);
+                }
+            });
+        } else {
+            g.edge_index().for_each_candidate(&ext, |e, shape| {
+                if let Shape::Segment(u, v) = *shape
+                    && Aabb2::new(u, v).intersects(&ext)
+                {
+                    roads.push(e);
+                }
+            });
+        }
         // The index reports each road once, in an order fixed by the graph's state; every
         // choice below breaks ties by id, so the order does not matter.
         self.box_hits += roads.len() as u64;

@@ -344,3 +344,50 @@ proptest! {
         }
     }
 }
+
+/// FNV-1a over everything a cell graph holds, in id order (node and edge ids, positions
+/// to the bit, class, width, step).
+fn digest(net: &crate::network::RoadNetwork) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |v: u64| {
+        for b in v.to_le_bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for (n, p, j) in net.nodes() {
+        eat(n.index() as u64);
+        eat(p.x.to_bits());
+        eat(p.y.to_bits());
+        eat(u64::from(j.step));
+    }
+    for (e, u, v, r) in net.edges() {
+        eat(e.index() as u64);
+        eat(u.index() as u64);
+        eat(v.index() as u64);
+        eat(matches!(r.class, RoadClass::Highway) as u64);
+        eat(r.width.to_bits());
+        eat(u64::from(r.step));
+    }
+    h
+}
+
+/// The flat grid is a performance knob: the snap search through the cell graph's own
+/// index grows the same roads to the bit.
+#[test]
+fn the_flat_grid_and_the_graph_index_grow_the_same_roads() {
+    for n in Neighbourhood::ALL {
+        let params = n.params().unwrap();
+        for cell in fixed_cells() {
+            for seed in 0..2 {
+                let grow = |flat: bool| {
+                    let mut g = SecondaryGrowth::new(params.clone())
+                        .unwrap()
+                        .with_flat_grid(flat);
+                    digest(&g.grow(&cell, &CellMaps::none(), seed).unwrap().network)
+                };
+                assert_eq!(grow(true), grow(false), "{} cell {}", n.name(), cell.id);
+            }
+        }
+    }
+}
