@@ -599,7 +599,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
 /// Raster entries met by one query walk (with repeats), kept by reference on the stack
 /// for the usual few dozen: no allocation and no copies of the 64-byte entries.
 struct RasterBuf<'a, K> {
-    inline: [Option<&'a Entry<K>>; 48],
+    inline: [Option<&'a Entry<K>>; 32],
     len: usize,
     more: Vec<&'a Entry<K>>,
 }
@@ -607,7 +607,7 @@ struct RasterBuf<'a, K> {
 impl<'a, K> RasterBuf<'a, K> {
     fn new() -> Self {
         RasterBuf {
-            inline: [None; 48],
+            inline: [None; 32],
             len: 0,
             more: Vec::new(),
         }
@@ -654,6 +654,28 @@ impl<'a, K> RasterBuf<'a, K> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// More raster entries than the inline buffer holds, each met in many cells: every
+    /// one is reported once, in key order, by both walks.
+    #[test]
+    fn many_long_segments_spill_and_are_reported_once() {
+        let mut g = GridIndex::<u32>::new(GridOptions { cell_size: 1.0 }).unwrap_or_default();
+        for k in 0..100u32 {
+            let x = f64::from(k) * 0.25;
+            let _ = g.insert(
+                k,
+                Shape::Segment(DVec2::new(x, -20.0), DVec2::new(x + 3.0, 20.0)),
+            );
+        }
+        let (a, b) = (DVec2::new(-5.0, 0.5), DVec2::new(40.0, 1.5));
+        let mut along = Vec::new();
+        g.for_each_candidate_along(a, b, |k, _| along.push(k));
+        let mut boxed = Vec::new();
+        g.for_each_candidate(&Aabb2::new(a, b), |k, _| boxed.push(k));
+        let all: Vec<u32> = (0..100).collect();
+        assert_eq!(along, all);
+        assert_eq!(boxed, all);
+    }
 
     #[test]
     fn an_entry_fits_a_cache_line() {
