@@ -238,12 +238,12 @@ pub fn segment_intersection(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> Segme
     }
     let o1 = orient2d_value(a0, a1, b0);
     let o2 = orient2d_value(a0, a1, b1);
-    let o3 = orient2d_value(b0, b1, a0);
-    let o4 = orient2d_value(b0, b1, a1);
-
+    // `b` strictly on one side of `a`'s line: no need for the other two orientations.
     if (o1 > 0.0 && o2 > 0.0) || (o1 < 0.0 && o2 < 0.0) {
         return Disjoint;
     }
+    let o3 = orient2d_value(b0, b1, a0);
+    let o4 = orient2d_value(b0, b1, a1);
     if (o3 > 0.0 && o4 > 0.0) || (o3 < 0.0 && o4 < 0.0) {
         return Disjoint;
     }

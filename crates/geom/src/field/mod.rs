@@ -139,6 +139,12 @@ pub trait Field: Send + Sync {
     fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
         (self.sample(p), self.gradient(p))
     }
+
+    /// `Some(v)` when the field is known to be `v` everywhere (so callers may skip
+    /// sampling it), `None` when unknown. Default: `None`; [`Constant`] says its value.
+    fn constant_value(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The gradient of `field` at `p` by central differences with step `h` metres:
@@ -165,6 +171,9 @@ impl<F: Field + ?Sized> Field for &F {
     fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
         (**self).sample_with_gradient(p)
     }
+    fn constant_value(&self) -> Option<f64> {
+        (**self).constant_value()
+    }
 }
 
 impl<F: Field + ?Sized> Field for Box<F> {
@@ -177,6 +186,9 @@ impl<F: Field + ?Sized> Field for Box<F> {
     fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
         (**self).sample_with_gradient(p)
     }
+    fn constant_value(&self) -> Option<f64> {
+        (**self).constant_value()
+    }
 }
 
 impl<F: Field + ?Sized> Field for Arc<F> {
@@ -188,6 +200,9 @@ impl<F: Field + ?Sized> Field for Arc<F> {
     }
     fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
         (**self).sample_with_gradient(p)
+    }
+    fn constant_value(&self) -> Option<f64> {
+        (**self).constant_value()
     }
 }
 
@@ -205,6 +220,9 @@ impl Field for Constant {
     }
     fn sample_with_gradient(&self, _p: DVec2) -> (f64, DVec2) {
         (self.0, DVec2::ZERO)
+    }
+    fn constant_value(&self) -> Option<f64> {
+        Some(self.0)
     }
 }
 

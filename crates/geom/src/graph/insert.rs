@@ -53,7 +53,7 @@ use serde::{Deserialize, Serialize};
 use super::{EdgeId, NodeId, PlanarGraph};
 use crate::error::{GeomError, validate_point};
 use crate::predicates::{SegmentIntersection, closest_point_on_segment, point_on_segment};
-use crate::spatial::SpatialIndex;
+use crate::spatial::{SegmentHit, Shape, SpatialIndex, classify_hit};
 
 /// Relative size of floating-point rounding in computed points (crossings, projections):
 /// at a point `p`, distances up to `ROUNDING_TOLERANCE · max(1, |p.x|, |p.y|)` metres are
@@ -289,8 +289,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         // Exactly on an edge (exact test, independent of the distance rounding).
         let on: Option<EdgeId> = self
             .edge_index
-            .segments_crossing(p, p)
-            .first()
+            .first_crossing(p, p, |_| true)
             .map(|h| h.key);
         if let Some(e) = on {
             return self.anchor_on_edge(e, p);
@@ -456,12 +455,14 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             }
         };
         // Nodes within the snap distance of the open segment.
+        // Candidates come in no particular order: `offer` keeps the least event by
+        // (t, rank, id), so the answer does not depend on it.
         let bx = crate::Aabb2::new(pc, pt).expanded(snap);
-        for n in self.node_index.query_box(&bx) {
-            if !fresh(n) {
-                continue;
+        self.node_index.for_each_candidate(&bx, |n, shape| {
+            let Shape::Point(pn) = *shape else { return };
+            if !bx.contains(pn) || !fresh(n) {
+                return;
             }
-            let pn = self.position(n)?;
             let (closest, t) = closest_point_on_segment(pn, pc, pt);
             let on = point_on_segment(pn, pc, pt);
             // Within rounding of the leg, a node is on it whatever the snap bound says.
@@ -472,9 +473,11 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             {
                 offer(t, Event::Node(n));
             }
-        }
-        // Edges meeting the segment.
-        for hit in self.edge_index.segments_crossing(pc, pt) {
+        });
+        // Edges meeting the segment (in no particular order either; a corrupt graph is
+        // reported whichever offending edge comes first).
+        let mut failure: Option<GeomError> = None;
+        let mut visit = |hit: SegmentHit<EdgeId>| -> Result<(), GeomError> {
             match hit.kind {
                 SegmentIntersection::Crossing { point, .. } => {
                     let (a, b) = self.endpoints(hit.key)?;
@@ -490,7 +493,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                         let coincident = da.min(db) <= rounding_eps(pn);
                         if fresh(n) && (coincident || near_line(pn)) {
                             offer(hit.t, Event::Node(n));
-                            continue;
+                            return Ok(());
                         }
                     }
                     offer(hit.t, Event::Cross(hit.key, point));
@@ -510,6 +513,19 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 // are node events.
                 _ => {}
             }
+            Ok(())
+        };
+        self.edge_index.for_each_candidate_along(pc, pt, |key, s| {
+            if failure.is_none()
+                && let Shape::Segment(s0, s1) = *s
+                && let Some(hit) = classify_hit(key, pc, pt, s0, s1)
+                && let Err(e) = visit(hit)
+            {
+                failure = Some(e);
+            }
+        });
+        if let Some(e) = failure {
+            return Err(e);
         }
         Ok(best.map(|(_, ev)| ev))
     }
@@ -586,23 +602,34 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         for &e in edges {
             let (a, b) = self.endpoints(e)?;
             let (pa, pb) = (self.position(a)?, self.position(b)?);
-            for hit in self.edge_index.segments_crossing(pa, pb) {
-                if hit.key == e {
-                    continue;
+            // The first offending edge in candidate order (no allocation, no sorting).
+            let mut bad: Option<SegmentHit<EdgeId>> = None;
+            self.edge_index.for_each_candidate_along(pa, pb, |key, s| {
+                if bad.is_some() || key == e {
+                    return;
                 }
-                let (c, d) = self.endpoints(hit.key)?;
+                let Shape::Segment(s0, s1) = *s else { return };
+                let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
+                    return;
+                };
                 let ok = match hit.kind {
                     SegmentIntersection::Touching { point, .. } => {
-                        (point == pa && (c == a || d == a)) || (point == pb && (c == b || d == b))
+                        self.endpoints(key).is_ok_and(|(c, d)| {
+                            (point == pa && (c == a || d == a))
+                                || (point == pb && (c == b || d == b))
+                        })
                     }
                     _ => false,
                 };
                 if !ok {
-                    return Err(GeomError::GraphCorrupt(format!(
-                        "after insertion, edge {e} meets edge {} away from a common node ({:?}); please report this input",
-                        hit.key, hit.kind
-                    )));
+                    bad = Some(hit);
                 }
+            });
+            if let Some(hit) = bad {
+                return Err(GeomError::GraphCorrupt(format!(
+                    "after insertion, edge {e} meets edge {} away from a common node ({:?}); please report this input",
+                    hit.key, hit.kind
+                )));
             }
         }
         Ok(())

@@ -351,7 +351,12 @@ impl<K: IndexKey> GridIndex<K> {
     }
 
     /// Calls `visit` with every occupied cell of the inclusive range, chunk by chunk.
-    fn walk_range(&self, (i0, j0): Cell, (i1, j1): Cell, mut visit: impl FnMut(Cell, &[Entry<K>])) {
+    fn walk_range<'s>(
+        &'s self,
+        (i0, j0): Cell,
+        (i1, j1): Cell,
+        mut visit: impl FnMut(Cell, &'s [Entry<K>]),
+    ) {
         for ci in (i0 >> CHUNK_BITS)..=(i1 >> CHUNK_BITS) {
             for cj in (j0 >> CHUNK_BITS)..=(j1 >> CHUNK_BITS) {
                 let Some(ch) = self.chunks.get(&(ci, cj)) else {
@@ -373,12 +378,8 @@ impl<K: IndexKey> GridIndex<K> {
     }
 
     /// Reports the raster entries gathered by a walk, each once, in key order.
-    fn report_raster<F: FnMut(K, &Shape)>(mut found: Vec<Entry<K>>, f: &mut F) {
-        found.sort_unstable_by_key(|e| e.key);
-        found.dedup_by_key(|e| e.key);
-        for e in found {
-            f(e.key, &e.shape);
-        }
+    fn report_raster<F: FnMut(K, &Shape)>(found: &mut RasterBuf<'_, K>, f: &mut F) {
+        found.report(f);
     }
 
     /// The cell range of `b` clipped to the occupied extent, or `None` if they miss.
@@ -516,20 +517,20 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         };
         // A box-stored entry is reported at its lowest cell clipped to the range; raster
         // entries are gathered and de-duplicated.
-        let mut raster: Vec<Entry<K>> = Vec::new();
+        let mut raster = RasterBuf::new();
         self.walk_range((i0, j0), (i1, j1), |c, list| {
             for e in list {
                 if !e.bbox().intersects(b) {
                     continue;
                 }
                 if e.raster {
-                    raster.push(*e);
+                    raster.push(e);
                 } else if (e.first.0.max(i0), e.first.1.max(j0)) == c {
                     f(e.key, &e.shape);
                 }
             }
         });
-        Self::report_raster(raster, &mut f);
+        Self::report_raster(&mut raster, &mut f);
     }
 
     fn for_each_candidate_along<F: FnMut(K, &Shape)>(&self, a: DVec2, b: DVec2, mut f: F) {
@@ -558,7 +559,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
         // A box-stored entry is in every cell of its box: report it at the first cell of
         // the walk (columns in increasing order, rows increasing within a column) inside
         // its box. Raster entries are gathered and de-duplicated.
-        let mut raster: Vec<Entry<K>> = Vec::new();
+        let mut raster = RasterBuf::new();
         for (r, &(i, j0, j1)) in runs.iter().enumerate() {
             for j in j0..=j1 {
                 let Some(list) = self.cell((i, j)) else {
@@ -570,7 +571,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
                         continue;
                     }
                     if e.raster {
-                        raster.push(*e);
+                        raster.push(e);
                         continue;
                     }
                     let (ei0, ej0) = e.first;
@@ -591,13 +592,90 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
                 }
             }
         }
-        Self::report_raster(raster, &mut f);
+        Self::report_raster(&mut raster, &mut f);
+    }
+}
+
+/// Raster entries met by one query walk (with repeats), kept by reference on the stack
+/// for the usual few dozen: no allocation and no copies of the 64-byte entries.
+struct RasterBuf<'a, K> {
+    inline: [Option<&'a Entry<K>>; 32],
+    len: usize,
+    more: Vec<&'a Entry<K>>,
+}
+
+impl<'a, K> RasterBuf<'a, K> {
+    fn new() -> Self {
+        RasterBuf {
+            inline: [None; 32],
+            len: 0,
+            more: Vec::new(),
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, e: &'a Entry<K>) {
+        if self.more.is_empty()
+            && let Some(slot) = self.inline.get_mut(self.len)
+        {
+            *slot = Some(e);
+            self.len += 1;
+        } else {
+            if self.more.is_empty() {
+                self.more.extend(self.inline.iter().flatten().copied());
+            }
+            self.more.push(e);
+        }
+    }
+
+    /// Reports every gathered entry once, in key order.
+    fn report<F: FnMut(K, &Shape)>(&mut self, f: &mut F)
+    where
+        K: IndexKey,
+    {
+        let mut last: Option<K> = None;
+        let mut emit = |e: &Entry<K>| {
+            if last != Some(e.key) {
+                last = Some(e.key);
+                f(e.key, &e.shape);
+            }
+        };
+        if self.more.is_empty() {
+            let list = self.inline.get_mut(..self.len).unwrap_or(&mut []);
+            list.sort_unstable_by_key(|e| e.map(|e| e.key));
+            list.iter().flatten().for_each(|e| emit(e));
+        } else {
+            self.more.sort_unstable_by_key(|e| e.key);
+            self.more.iter().for_each(|e| emit(e));
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// More raster entries than the inline buffer holds, each met in many cells: every
+    /// one is reported once, in key order, by both walks.
+    #[test]
+    fn many_long_segments_spill_and_are_reported_once() {
+        let mut g = GridIndex::<u32>::new(GridOptions { cell_size: 1.0 }).unwrap_or_default();
+        for k in 0..100u32 {
+            let x = f64::from(k) * 0.25;
+            let _ = g.insert(
+                k,
+                Shape::Segment(DVec2::new(x, -20.0), DVec2::new(x + 3.0, 20.0)),
+            );
+        }
+        let (a, b) = (DVec2::new(-5.0, 0.5), DVec2::new(40.0, 1.5));
+        let mut along = Vec::new();
+        g.for_each_candidate_along(a, b, |k, _| along.push(k));
+        let mut boxed = Vec::new();
+        g.for_each_candidate(&Aabb2::new(a, b), |k, _| boxed.push(k));
+        let all: Vec<u32> = (0..100).collect();
+        assert_eq!(along, all);
+        assert_eq!(boxed, all);
+    }
 
     #[test]
     fn an_entry_fits_a_cache_line() {
