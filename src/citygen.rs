@@ -801,7 +801,7 @@ pub fn zoning_of(cx: &StageContext<'_>) -> Result<Option<Zoning>> {
     };
     z.validate()?;
     z.check_extent(cx.config.size_m)?;
-    let salt = cx.seed(Stage::Maps, 0x2045_0E5);
+    let salt = cx.seed(Stage::Maps, 0x0204_50E5);
     Ok(Some(z.build(salt, cx.config.maps.max_image_pixels)?))
 }
 
