@@ -336,7 +336,11 @@ fn cone_rise(beyond: f64, slope: f64, max_bank: f64) -> Option<f64> {
         return Some(slope * beyond);
     }
     let x = (beyond - max_bank) / RETAINING_WALL_M;
-    (x < 1.0).then(|| slope * beyond + slope * RETAINING_WALL_M * x / (1.0 - x))
+    if x < 1.0 {
+        Some(slope * beyond + slope * RETAINING_WALL_M * x / (1.0 - x))
+    } else {
+        None
+    }
 }
 
 /// Grid cell of the index of pieces that move the ground (queried `half width +
