@@ -20,9 +20,12 @@
 //!    the centre line), and beyond it heights within
 //!    [`GradeParams::embankment_slope`] (rise per metre) times the distance: where the
 //!    road runs above the ground (fill) the ground rises to it, where below (cut) it falls
-//!    to it, until the banks meet the natural ground. Where two roads' cones leave no
-//!    common height, their meeting height. Bridges leave the ground alone (decks on
-//!    piers).
+//!    to it, until the banks meet the natural ground. A bank that would be wider than
+//!    [`GradeParams::max_embankment_m`] steepens into a retaining wall's face over the
+//!    next [`RETAINING_WALL_M`] (the cone lets go of the ground continuously, so the
+//!    conformed ground has no step a terrain mesh or a road surface could not follow).
+//!    Where two roads' cones leave no common height, their meeting height. Bridges leave
+//!    the ground alone (decks on piers).
 //! 4. **Volumes**: per profile edge the cross-section `2·w/2·Δ + Δ²/s` (corridor plus two
 //!    embankment wedges, `Δ` the road's height above the ground on the centre line, `s` the
 //!    embankment slope) integrated along the road (trapezoids); positive parts are fill,
@@ -39,7 +42,8 @@
 //! * Where corridors of roads at different heights overlap (junction corners) the ground
 //!   takes the cones' meeting height, a little off both roads; the volumes count each
 //!   road's cross-section on its own, so overlaps at junctions are counted twice. A bank
-//!   wider than [`GradeParams::max_embankment_m`] ends in a step (a retaining wall).
+//!   wider than [`GradeParams::max_embankment_m`] ends in a steep wall face (up to
+//!   [`RETAINING_WALL_M`] wide) whose volume the cross-sections do not count.
 //! * The ground is sampled at the profile points; bumps shorter than `sample_m` between
 //!   them are neither smoothed nor cut.
 //!
@@ -76,7 +80,8 @@ pub struct GradeParams {
     /// Default: 0.5.
     pub embankment_slope: f64,
     /// Widest embankment on either side of a corridor, metres (finite, ≥ 0): beyond it
-    /// the ground is left alone (a retaining wall). Default: 30.
+    /// the bank steepens into a retaining wall's face over [`RETAINING_WALL_M`] and the
+    /// ground beyond is left alone. Default: 30.
     pub max_embankment_m: f64,
 }
 
@@ -317,6 +322,33 @@ fn profile(network: &RoadNetwork, ground: &dyn Field, params: &GradeParams) -> R
     })
 }
 
+/// Width of the band beyond the widest bank over which a cone lets go of the ground
+/// (the face of a retaining wall), metres.
+pub const RETAINING_WALL_M: f64 = 10.0;
+
+/// How far a road's cone lets the ground rise or fall at `beyond` metres past its
+/// corridor: `slope · beyond` on the bank (up to `max_bank`), then, over the next
+/// [`RETAINING_WALL_M`], growing without bound (`slope · beyond + slope · W · x / (1 − x)`
+/// with `x` the share of the wall band `W` crossed), so the cone lets go of the ground
+/// continuously instead of in a step; `None` past the band (the cone binds nowhere).
+fn cone_rise(beyond: f64, slope: f64, max_bank: f64) -> Option<f64> {
+    if beyond <= max_bank {
+        return Some(slope * beyond);
+    }
+    let x = (beyond - max_bank) / RETAINING_WALL_M;
+    if x < 1.0 {
+        Some(slope * beyond + slope * RETAINING_WALL_M * x / (1.0 - x))
+    } else {
+        None
+    }
+}
+
+/// Grid cell of the index of pieces that move the ground (queried `half width +
+/// max_embankment_m` around every ground sample), metres.
+const CONE_CELL_M: f64 = 16.0;
+/// Grid cell of the index of corridors (queried a few metres around a sample), metres.
+const CORRIDOR_CELL_M: f64 = 8.0;
+
 /// Multi-source Dijkstra: `min over sources m of (value(m) + sign·dist)`, with `sign = 1`
 /// for the upper envelope; for the lower one the values are negated.
 fn envelope(p: &Profile, values: &[f64]) -> Vec<f64> {
@@ -389,8 +421,14 @@ pub fn grade_roads<'a>(
         .collect();
     // 3. Pieces, the index of those that move the ground, and 4. the volumes.
     let mut pieces = Vec::with_capacity(p.edges.len());
-    let mut index = SegmentIndex::new(GridOptions::default())?;
-    let mut corridors = SegmentIndex::new(GridOptions::default())?;
+    // Cells near the pieces' length (at most `sample_m`, 10 m by default) and a fraction
+    // of the cones' reach: every ground sample visits only the pieces near it.
+    let mut index = SegmentIndex::new(GridOptions {
+        cell_size: CONE_CELL_M,
+    })?;
+    let mut corridors = SegmentIndex::new(GridOptions {
+        cell_size: CORRIDOR_CELL_M,
+    })?;
     let mut works = Earthworks::default();
     let mut reach = 0.0f64;
     let s = params.embankment_slope;
@@ -433,7 +471,7 @@ pub fn grade_roads<'a>(
             }
             if da.abs().max(db.abs()) > 1e-9 && len > 0.0 {
                 // A cone binds wherever the ground leaves it, up to the widest bank.
-                reach = reach.max(half_width + params.max_embankment_m);
+                reach = reach.max(half_width + params.max_embankment_m + RETAINING_WALL_M);
                 index.insert(pieces.len() as u32, Shape::Segment(piece.a, piece.b))?;
             }
         }
@@ -513,10 +551,10 @@ impl Field for CutIn<'_> {
 impl Field for GradedGround<'_> {
     /// The ground clamped into every nearby road's *cone*: a road piece at height `r`
     /// allows heights within `r ± slope · b` at `b` metres beyond its corridor (so `r`
-    /// itself inside it), up to [`GradeParams::max_embankment_m`] beyond. Where two cones
-    /// leave no common height (roads at different heights side by side), their meeting
-    /// height is taken. Continuous except where a bank would run past its widest
-    /// (a retaining wall).
+    /// itself inside it), up to [`GradeParams::max_embankment_m`] beyond, then ever wider
+    /// over the [`RETAINING_WALL_M`] after it. Where two cones leave no common height
+    /// (roads at different heights side by side), their meeting height is taken.
+    /// Continuous wherever the ground is.
     fn sample(&self, p: DVec2) -> f64 {
         let g = self.ground.sample(p);
         if self.index.is_empty() || !g.is_finite() {
@@ -530,9 +568,8 @@ impl Field for GradedGround<'_> {
             };
             let (t, d) = piece.project(p);
             let beyond = (d - piece.half_width).max(0.0);
-            if beyond <= self.max_bank {
+            if let Some(rise) = cone_rise(beyond, self.slope, self.max_bank) {
                 let r = piece.height_at(t);
-                let rise = self.slope * beyond;
                 lo = lo.max(r - rise);
                 hi = hi.min(r + rise);
             }

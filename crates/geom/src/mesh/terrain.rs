@@ -22,9 +22,11 @@
 //! * At every check point of every leaf, `field − 2·max_error_m ≤ surface ≤ field`,
 //!   except in [`TerrainReport::unresolved_leaves`] (leaves at the minimum size or
 //!   beyond the leaf budget that still miss the bound — cliffs, steps; their largest miss
-//!   is [`TerrainReport::max_error_m`]). Those leaves' vertices are lowered to the lowest
-//!   field value at their check points, so `surface ≤ field` holds at every check point
-//!   of every leaf (the one side that keeps things standing on the field unburied).
+//!   is [`TerrainReport::max_error_m`]). Those leaves' vertices are lowered by their fan's
+//!   largest rise above the field at their check points (at most that miss), so
+//!   `surface ≤ field` holds at every check point of every leaf (the one side that keeps
+//!   things standing on the field unburied), while a fan that misses only on one side is
+//!   lowered only as far as it rises, not to the bottom of the step.
 //! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
 //!   directions), every triangle faces up, and it covers the rectangle exactly.
 //! * Deterministic: a pure function of the field, the rectangle and the options.
@@ -334,10 +336,13 @@ impl Terrain {
             centre_heights.push(centre_height(&sample, leaf)?);
         }
         // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
-        // lowered to the lowest field value at their check points, so the surface stays
-        // below the field there too (lowering shared vertices only lowers neighbours).
+        // lowered by the fan's largest rise above the field at their check points (the
+        // fan is linear in its vertex heights, so it then lies below the field there);
+        // lowering shared vertices only lowers neighbours. The rises are measured on the
+        // unlowered fans, then applied together (order-independent).
         flagged.sort_unstable_by_key(|l| (l.y, l.x, l.size));
         flagged.dedup();
+        let mut drops: Vec<(usize, f64)> = Vec::with_capacity(flagged.len());
         for f in &flagged {
             let Ok(k) = leaves.binary_search_by_key(&(f.y, f.x), |l| (l.y, l.x)) else {
                 continue;
@@ -346,23 +351,19 @@ impl Terrain {
             if leaf.size != f.size {
                 continue;
             }
-            let s = leaf.size as f64;
-            let mut low = f64::INFINITY;
-            for j in 0..=4u32 {
-                for i in 0..=4u32 {
-                    let p = grid.point(
-                        leaf.x as f64 + s * f64::from(i) / 4.0,
-                        leaf.y as f64 + s * f64::from(j) / 4.0,
-                    );
-                    let v = field.sample(p);
-                    if v.is_finite() {
-                        low = low.min(v);
-                    }
-                }
+            let profiles = edge_profiles(leaf, &by_row, &by_col, &row_heights, &col_heights);
+            let rise = leaf_rise(&grid, field, leaf, &profiles, centre_heights[k]);
+            if rise > 0.0 {
+                drops.push((k, rise));
             }
-            if !low.is_finite() {
-                continue;
-            }
+        }
+        let (row_orig, col_orig, centre_orig) = (
+            row_heights.clone(),
+            col_heights.clone(),
+            centre_heights.clone(),
+        );
+        for &(k, drop) in &drops {
+            let leaf = leaves[k];
             let sz = leaf.size;
             for (line, from, rows) in [
                 (leaf.y, leaf.x, true),
@@ -380,14 +381,14 @@ impl Terrain {
                         ((b, a), (a, b))
                     };
                     if let Ok(r) = by_row.binary_search(&row_key) {
-                        row_heights[r] = row_heights[r].min(low);
+                        row_heights[r] = row_heights[r].min(row_orig[r] - drop);
                     }
                     if let Ok(c) = by_col.binary_search(&col_key) {
-                        col_heights[c] = col_heights[c].min(low);
+                        col_heights[c] = col_heights[c].min(col_orig[c] - drop);
                     }
                 }
             }
-            centre_heights[k] = centre_heights[k].min(low);
+            centre_heights[k] = centre_heights[k].min(centre_orig[k] - drop);
         }
         let mut roots = vec![Vec::new(); (nx * ny) as usize];
         for (k, l) in leaves.iter().enumerate() {
@@ -627,6 +628,31 @@ fn fan_height(profiles: &[EdgeProfile; 4], centre: f64, u: f64, v: f64) -> f64 {
         profile_at(&profiles[3], ev)
     };
     (1.0 - lambda) * centre + lambda * border
+}
+
+/// The fan's largest rise above the field at the leaf's check points (0 when it lies
+/// below the field at all of them); check points where the field is not finite are
+/// skipped.
+fn leaf_rise(
+    grid: &Lattice,
+    field: &dyn Field,
+    leaf: Leaf,
+    profiles: &[EdgeProfile; 4],
+    centre: f64,
+) -> f64 {
+    let mut worst = 0.0f64;
+    let s = leaf.size as f64;
+    for j in 0..=4u32 {
+        for i in 0..=4u32 {
+            let (u, v) = (f64::from(i) / 4.0, f64::from(j) / 4.0);
+            let p = grid.point(leaf.x as f64 + u * s, leaf.y as f64 + v * s);
+            let f = field.sample(p);
+            if f.is_finite() {
+                worst = worst.max(fan_height(profiles, centre, u, v) - f);
+            }
+        }
+    }
+    worst
 }
 
 /// The largest miss of the leaf's fan against the field at its check points.

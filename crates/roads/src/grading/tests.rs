@@ -165,6 +165,63 @@ fn a_steep_valley_is_filled_within_the_grade_and_banked() {
     );
 }
 
+/// Where a cut's bank would run past its widest, the ground steepens into a wall face
+/// and lets go of the road continuously: no step for a terrain or a road surface.
+#[test]
+fn a_bank_past_its_widest_ends_in_a_continuous_wall_face() {
+    // The ground climbs along the road faster than a highway may, and three times as
+    // fast across it as a bank: the cut's banks never meet it.
+    let ground = FnField(|p: DVec2| 0.3 * p.x + 1.5 * p.y.abs());
+    let mut net = RoadNetwork::new();
+    let pts: Vec<DVec2> = (0..=8)
+        .map(|i| DVec2::new(-200.0 + 50.0 * f64::from(i), 0.0))
+        .collect();
+    chain(&mut net, &pts, road(RoadClass::Highway, 8.0, false));
+    let params = GradeParams::default();
+    let g = grade_roads(&net, &ground, &params).unwrap();
+    check_grades(&g, &params);
+    let x = 150.0;
+    let piece = g
+        .pieces()
+        .iter()
+        .find(|p| p.a.x <= x && x <= p.b.x)
+        .unwrap();
+    let r = piece.height_at((x - piece.a.x) / (piece.b.x - piece.a.x));
+    assert!(
+        ground.sample(DVec2::new(x, 0.0)) - r > 5.0,
+        "a cut at x = {x}"
+    );
+    let (hw, m, s) = (4.0, params.max_embankment_m, params.embankment_slope);
+    // On the bank: the road's height plus the bank's rise.
+    let on_bank = g.sample(DVec2::new(x, hw + 0.5 * m));
+    assert!((on_bank - (r + s * 0.5 * m)).abs() < 1e-6, "{on_bank}");
+    // Across the bank's edge and the wall band, in 1 cm steps: no jump.
+    let mut prev = g.sample(DVec2::new(x, hw + m - 1.0));
+    let steps = ((RETAINING_WALL_M + 2.0) / 0.01) as usize;
+    let mut steepest = 0.0f64;
+    for k in 1..=steps {
+        let y = hw + m - 1.0 + 0.01 * k as f64;
+        let h = g.sample(DVec2::new(x, y));
+        let ground_h = ground.sample(DVec2::new(x, y));
+        assert!(h <= ground_h + 1e-9, "a cut never rises above the ground");
+        steepest = steepest.max((h - prev).abs() / 0.01);
+        prev = h;
+    }
+    // The gap the wall closes (tens of metres here) would be one step without the face;
+    // with it, no centimetre climbs more than a fortieth of it (the face is steepest
+    // where it meets the ground: about gap² / (slope · RETAINING_WALL_M²)).
+    let edge = DVec2::new(x, hw + m);
+    let gap = ground.sample(edge) - (r + s * m);
+    assert!(gap > 20.0, "gap {gap}");
+    assert!(
+        steepest * 0.01 < gap / 40.0,
+        "steepest {steepest} m/m for a gap of {gap} m"
+    );
+    // Past the band the ground is left alone.
+    let past = DVec2::new(x, hw + m + RETAINING_WALL_M + 1.0);
+    assert_eq!(g.sample(past), ground.sample(past));
+}
+
 #[test]
 fn a_grade_limit_of_zero_levels_each_network() {
     let ground = FnField(|p: DVec2| 0.1 * p.x);

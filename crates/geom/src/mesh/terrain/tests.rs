@@ -129,6 +129,42 @@ fn a_cliff_is_reported_not_a_panic() {
     check_sheet(&t, bounds);
 }
 
+/// Every vertex lies at most `max_error_m` plus the worst miss below the field: a leaf
+/// that cannot meet the bound is lowered by its fan's rise above the field, not to the
+/// bottom of the step or the valley in it.
+fn check_vertices_not_sunk(t: &Terrain, field: &dyn Field, e: f64) {
+    let allowance = e + t.report.max_error_m;
+    for p in &t.mesh.positions {
+        let (q, h) = crate::mesh::to_layout(p.as_dvec3());
+        let f = field.sample(q);
+        // f32 positions: a millimetre per hundred metres of height and extent.
+        let tol = 1e-3 * (1.0 + f.abs() / 100.0 + q.abs().max_element() / 100.0);
+        assert!(
+            h >= f - allowance - tol,
+            "sunk at {q}: {h} < {f} − {allowance}"
+        );
+        assert!(h <= f + tol, "above at {q}: {h} > {f}");
+    }
+}
+
+#[test]
+fn unresolved_leaves_sink_by_their_rise_only() {
+    let bounds = rect(200.0, 200.0);
+    let o = TerrainOptions::default();
+    // A cliff, and a valley too sharp for the smallest leaves, off the lattice lines.
+    let cliff = FnField(|p: DVec2| if p.x > 10.3 { 30.0 } else { 0.0 });
+    let valley = FnField(|p: DVec2| 8.0 * (p.x - 10.8).abs() + 0.3 * p.y);
+    for field in [&cliff as &dyn Field, &valley] {
+        let t = Terrain::build(field, bounds, &o, None).unwrap();
+        assert!(t.report.unresolved_leaves > 0, "{:?}", t.report);
+        check_sheet(&t, bounds);
+        check_vertices_not_sunk(&t, field, o.max_error_m);
+        for p in check_points(&t) {
+            assert!(t.height_at(p).unwrap() <= field.sample(p) + 1e-9);
+        }
+    }
+}
+
 #[test]
 fn bad_input_is_an_error() {
     let bounds = rect(100.0, 100.0);
