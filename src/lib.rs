@@ -67,6 +67,7 @@ mod maps;
 mod output;
 mod pipeline;
 pub mod prelude;
+mod prune;
 mod report;
 mod scene;
 pub mod seed;

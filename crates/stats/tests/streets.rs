@@ -17,6 +17,7 @@ fn street(a: usize, b: usize) -> StreetEdge {
         b,
         width_m: 10.0,
         class: StreetClass::Street,
+        bridge: false,
     }
 }
 
