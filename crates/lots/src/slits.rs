@@ -140,13 +140,13 @@ pub fn with_filaments(cell: &Cell, filaments: &[FilamentRoad]) -> Result<Cell, L
     let mut k = 0;
     for (_, ring) in cell.polygon.rings() {
         let ids: Vec<usize> = ring.points().iter().map(|&p| g.vertex(p)).collect();
-        for i in 0..ids.len() {
+        for (i, &a) in ids.iter().enumerate() {
             let w = *cell
                 .road_widths
                 .get(k)
                 .ok_or_else(|| bad("fewer road widths than ring edges"))?;
             k += 1;
-            g.add(ids[i], ids[(i + 1) % ids.len()], w, false);
+            g.add(a, ids[(i + 1) % ids.len()], w, false);
         }
     }
     for f in filaments {
@@ -196,14 +196,17 @@ pub fn with_filaments(cell: &Cell, filaments: &[FilamentRoad]) -> Result<Cell, L
     })
 }
 
-/// Every closed walk with the land on its left, as (from, to, width) steps.
-fn walk_faces(g: &WalkGraph) -> Result<Vec<Vec<(usize, usize, f64)>>, LotsError> {
+/// A closed walk: (from, to, road width) steps.
+type Walk = Vec<(usize, usize, f64)>;
+
+/// Every closed walk with the land on its left.
+fn walk_faces(g: &WalkGraph) -> Result<Vec<Walk>, LotsError> {
     let mut used: Vec<Vec<bool>> = g.out.iter().map(|o| vec![false; o.len()]).collect();
     let total: usize = g.out.iter().map(Vec::len).sum();
     let mut walks = Vec::new();
-    for v0 in 0..g.out.len() {
-        for j0 in 0..g.out[v0].len() {
-            if used[v0][j0] || !g.out[v0][j0].land_left {
+    for (v0, halves) in g.out.iter().enumerate() {
+        for (j0, half) in halves.iter().enumerate() {
+            if used[v0][j0] || !half.land_left {
                 continue;
             }
             let mut walk = Vec::new();
