@@ -68,6 +68,7 @@ mod maps;
 mod output;
 mod pipeline;
 pub mod prelude;
+mod prune;
 mod report;
 mod scene;
 pub mod seed;

@@ -288,7 +288,7 @@ impl Pipeline {
         );
         let (roads, roads_time) = roads?;
         let ((builder, buildings_time), (dresser, facades_time)) = prepared?;
-        let network = roads.network;
+        let mut network = roads.network;
         report.skipped.extend(roads.skipped);
         timings.push(StageTiming {
             stage: Stage::Roads,
@@ -307,6 +307,8 @@ impl Pipeline {
         self.report(Stage::Cells, 0.0);
         clock = Instant::now();
         let cells = self.cells.cells(&network, &cx)?;
+        let water = maps.has_water.then(|| maps.inputs.water.as_ref());
+        crate::prune::prune_outer_stubs(&mut network, &cells, config.size_m, water)?;
         timings.push(lap(Stage::Cells, &mut clock));
         self.report(Stage::Cells, 1.0);
         self.report(Stage::Lots, 0.0);

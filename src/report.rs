@@ -36,16 +36,21 @@ fn land_area(water: &dyn Field, size_m: f64) -> f64 {
     size_m * size_m * (1.0 - wet as f64 / (cells * cells) as f64)
 }
 
-/// The road network as polis-stats' [`StreetGraph`] (class and carriageway width per
-/// edge), without elevation.
+/// The road network as polis-stats' [`StreetGraph`] (class, carriageway width and bridge
+/// flag per edge), without elevation.
 pub fn street_graph(roads: &polis_roads::RoadNetwork) -> StreetGraph {
-    StreetGraph::from_planar(roads, |r| {
+    let mut g = StreetGraph::from_planar(roads, |r| {
         let class = match r.class {
             RoadClass::Highway => StreetClass::Highway,
             RoadClass::Street => StreetClass::Street,
         };
         (class, r.width)
-    })
+    });
+    // `from_planar` lists the edges in the graph's order: carry the bridge flags over.
+    for (edge, (_, _, _, road)) in g.edges.iter_mut().zip(roads.edges()) {
+        edge.bridge = road.bridge;
+    }
+    g
 }
 
 /// The street-network part of the report, fast: only the maps and the road stage of
@@ -61,7 +66,7 @@ pub fn street_graph(roads: &polis_roads::RoadNetwork) -> StreetGraph {
 /// the road stage's error; [`Error::Stats`](crate::Error::Stats) for an unknown
 /// reference city.
 pub fn road_statistics(config: &CityConfig) -> Result<CityReport> {
-    use crate::stages::{ParishMullerRoads, RoadStage, StageContext};
+    use crate::stages::{CellStage, ParishMullerRoads, RoadStage, StageContext};
     config.validate()?;
     if config.road_mode != crate::RoadMode::ParishMuller {
         return Err(crate::Error::Config {
@@ -78,8 +83,12 @@ pub fn road_statistics(config: &CityConfig) -> Result<CityReport> {
         config,
         maps: &maps,
     };
-    let roads = ParishMullerRoads::default().roads(&cx)?;
-    let streets = street_graph(&roads.network);
+    let mut network = ParishMullerRoads::default().roads(&cx)?.network;
+    // The fringe stubs the pipeline prunes after its cell stage (`crate::prune`).
+    let cells = crate::stages::EberlyCells.cells(&network, &cx)?;
+    let water = maps.has_water.then(|| maps.inputs.water.as_ref());
+    crate::prune::prune_outer_stubs(&mut network, &cells, config.size_m, water)?;
+    let streets = street_graph(&network);
     let h = config.size_m * 0.5;
     let mut input = CityInput::streets_only(&streets);
     input.bounds = Some(Aabb2::new(DVec2::splat(-h), DVec2::splat(h)));

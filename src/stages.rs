@@ -263,17 +263,24 @@ impl LotStage for KellyLots {
     fn lots(&self, input: &CellInput<'_>, cx: &StageContext<'_>) -> Result<CellLots> {
         let mut out = CellLots::default();
         let id = input.region.id;
-        let blocks = match polis_lots::blocks(&input.region, &cx.config.blocks) {
-            Ok(b) => b,
-            Err(e) => {
-                out.skipped.push(Skip {
-                    stage: Stage::Lots,
-                    id,
-                    reason: format!("cell {id}: no blocks: {e}"),
-                });
-                return Ok(out);
-            }
-        };
+        // Filaments (culs-de-sac, connectors) are cut into the cell as slits so the
+        // blocks leave their corridors and lots face them; a cell the cut cannot make
+        // valid keeps its plain region (the lots then stay clear of the filament).
+        let slit = polis_lots::with_filaments(&input.region, &filament_roads(input))
+            .ok()
+            .and_then(|c| polis_lots::blocks(&c, &cx.config.blocks).ok());
+        let blocks =
+            match slit.map_or_else(|| polis_lots::blocks(&input.region, &cx.config.blocks), Ok) {
+                Ok(b) => b,
+                Err(e) => {
+                    out.skipped.push(Skip {
+                        stage: Stage::Lots,
+                        id,
+                        reason: format!("cell {id}: no blocks: {e}"),
+                    });
+                    return Ok(out);
+                }
+            };
         let mut rng = Pcg64Mcg::seed_from_u64(input.seed);
         let params = input.lot_params.as_ref().unwrap_or(&cx.config.lots);
         let mut subdivider = polis_lots::Subdivider::new();
@@ -300,6 +307,38 @@ impl LotStage for KellyLots {
         }
         Ok(out)
     }
+}
+
+/// The cell's filaments with the width of each segment (read from the roads near the
+/// cell, which hold every road of the cell; a segment not found there gets the narrowest
+/// ring road's width).
+fn filament_roads(input: &CellInput<'_>) -> Vec<polis_lots::FilamentRoad> {
+    let fallback = input
+        .region
+        .road_widths
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let fallback = if fallback.is_finite() { fallback } else { 1.0 };
+    input
+        .cell
+        .filaments
+        .iter()
+        .map(|f| polis_lots::FilamentRoad {
+            points: f.points.clone(),
+            widths: f
+                .points
+                .windows(2)
+                .map(|w| {
+                    input
+                        .nearby_roads
+                        .iter()
+                        .find(|&&(a, b, _)| (a == w[0] && b == w[1]) || (a == w[1] && b == w[0]))
+                        .map_or(fallback, |r| r.2)
+                })
+                .collect(),
+        })
+        .collect()
 }
 
 /// Whether `lot` stays out of every road corridor of `roads` (`(a, b, width)`): its

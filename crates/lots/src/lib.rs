@@ -20,6 +20,7 @@
 //! | [`block`] | [`Cell`] → [`Block`]s with [`Footpath`]s and parcels ([`blocks`]) |
 //! | [`subdivision`] | [`subdivide`], [`subdivide_block`], [`Subdivider`]: [`Lot`]s ([`LotParams`]) |
 //! | [`polygon_split`] | [`split_by_line`]: a region cut by a line into all its pieces |
+//! | [`slits`] | [`with_filaments`]: roads inside a cell on no cycle cut into its boundary, so lots face them |
 //!
 //! ## Example
 //!
@@ -107,6 +108,7 @@ mod error;
 pub mod inset;
 pub mod polygon_split;
 pub mod skeleton;
+pub mod slits;
 pub mod subdivision;
 
 pub use block::{Block, BlockParams, Cell, Footpath, TexturedRing, blocks};
@@ -114,6 +116,7 @@ pub use error::LotsError;
 pub use inset::{Inset, InsetRing, InsetShape, inset, inset_shapes, inset_weighted};
 pub use polygon_split::{Region, TaggedRing, split_by_line};
 pub use skeleton::{EdgeRef, SkeletonArc, SkeletonNode, StraightSkeleton};
+pub use slits::{FilamentRoad, SLIT_HALF_M, with_filaments};
 pub use subdivision::{
     DiscardReason, Discarded, Lot, LotParams, LotStrategy, SplitLine, Subdivider, Subdivision,
     subdivide, subdivide_block,

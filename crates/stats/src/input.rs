@@ -27,6 +27,9 @@ pub struct StreetEdge {
     pub width_m: f64,
     /// Highway or street.
     pub class: StreetClass,
+    /// Whether the segment is a bridge (it crosses water). Default: `false`.
+    #[serde(default)]
+    pub bridge: bool,
 }
 
 /// A street network: straight segments between nodes. Curved streets are chains of
@@ -66,6 +69,7 @@ impl StreetGraph {
                     b: index[b.index()],
                     width_m,
                     class,
+                    bridge: false,
                 }
             })
             .collect();

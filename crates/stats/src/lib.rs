@@ -39,7 +39,7 @@
 //! let mut g = StreetGraph::default();
 //! g.nodes = vec![DVec2::ZERO, DVec2::X * 100.0, DVec2::Y * 100.0, -DVec2::X * 100.0, -DVec2::Y * 100.0];
 //! for k in 1..5 {
-//!     g.edges.push(StreetEdge { a: 0, b: k, width_m: 10.0, class: StreetClass::Street });
+//!     g.edges.push(StreetEdge { a: 0, b: k, width_m: 10.0, class: StreetClass::Street, bridge: false });
 //! }
 //! let report = polis_stats::report(&CityInput::streets_only(&g), &StatsOptions::default())?
 //!     .compare_with("Manhattan")?;

@@ -113,6 +113,12 @@ pub struct StreetMetrics {
     pub land_area_km2: f64,
     /// Grades, when elevations were given.
     pub grade: Option<GradeMetrics>,
+    /// Input segments flagged as bridges ([`StreetEdge::bridge`](crate::StreetEdge)).
+    #[serde(default)]
+    pub bridges: usize,
+    /// Their total length, metres.
+    #[serde(default)]
+    pub bridge_length_m: f64,
 }
 
 /// Bin of a bearing in degrees (any value; taken mod 360).
@@ -198,6 +204,14 @@ pub fn street_metrics(g: &StreetGraph, s: &SimpleGraph, land_area_m2: f64) -> St
         intersection_density_per_km2: ratio(intersections as f64, land_km2),
         land_area_km2: land_km2,
         grade: g.elevations.as_ref().map(|z| grades(s, z)),
+        bridges: g.edges.iter().filter(|e| e.bridge).count(),
+        bridge_length_m: g
+            .edges
+            .iter()
+            .filter(|e| e.bridge)
+            .map(|e| g.nodes[e.a].distance(g.nodes[e.b]))
+            .filter(|l| l.is_finite())
+            .sum(),
     }
 }
 

@@ -109,6 +109,11 @@ impl Display for CityReport {
         row(f, "circuity", format!("{:.4}", s.circuity))?;
         row(
             f,
+            "bridges",
+            format!("{} ({:.0} m)", s.bridges, s.bridge_length_m),
+        )?;
+        row(
+            f,
             "length / highway share",
             format!("{:.1} km / {:.3}", s.total_length_km, s.highway_share),
         )?;

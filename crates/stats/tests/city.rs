@@ -20,6 +20,7 @@ fn street(a: usize, b: usize, width_m: f64) -> StreetEdge {
         b,
         width_m,
         class: StreetClass::Street,
+        bridge: false,
     }
 }
 

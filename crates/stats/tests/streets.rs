@@ -17,6 +17,7 @@ fn street(a: usize, b: usize) -> StreetEdge {
         b,
         width_m: 10.0,
         class: StreetClass::Street,
+        bridge: false,
     }
 }
 
@@ -367,4 +368,23 @@ proptest! {
         let cmp = report.clone().compare_with("Manhattan").unwrap();
         assert_all_finite(&cmp);
     }
+}
+
+/// Bridges are counted with their length, and the table names them; a graph without
+/// bridge flags has none.
+#[test]
+fn bridges_are_counted() {
+    let nodes = vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(100.0, 0.0),
+        DVec2::new(400.0, 0.0),
+        DVec2::new(400.0, 30.0),
+    ];
+    let mut g = graph(nodes, &[(0, 1), (1, 2), (2, 3)]);
+    assert_eq!(run(&g).streets.bridges, 0);
+    g.edges[1].bridge = true;
+    let r = run(&g);
+    assert_eq!(r.streets.bridges, 1);
+    assert!((r.streets.bridge_length_m - 300.0).abs() < 1e-9);
+    assert!(r.to_string().contains("bridges"));
 }
