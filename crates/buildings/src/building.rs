@@ -6,7 +6,6 @@ use polis_geom::{
     DVec2, DVec3, Mesh, PointLocation, Polygon, SegmentIntersection, segment_intersection,
 };
 use polis_lsystem::ParamString;
-use serde::{Deserialize, Serialize};
 
 use crate::BuildingsError;
 use crate::grammar::{BuildingGrammar, Op};
@@ -16,7 +15,8 @@ use crate::solid::prism;
 use crate::template::Template;
 
 /// What a part of a building is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum PartRole {
     /// A mass (`Box`, or a non-terminal drawn as its volume).
     Mass,
@@ -38,7 +38,8 @@ pub struct Part {
 }
 
 /// The role of a facade face, for the facades stage.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum FacadeRole {
     /// An upper-storey wall.
     Wall,
@@ -54,7 +55,8 @@ pub enum FacadeRole {
 /// Stored as its bottom-left corner and two unit axes (104 bytes): [`corners`](Self::corners),
 /// [`normal`](Self::normal) and [`at`](Self::at) give the geometry. A city keeps eight
 /// faces per building, so the derived values are not stored.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FacadeFace {
     /// The bottom-left corner seen from outside, metres relative to [`Building::origin`]
     /// (glTF axes).

@@ -443,7 +443,8 @@ fn extents(ring: &[DVec2]) -> (f64, f64, DVec2) {
 }
 
 /// How zones choose building types.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ZoneRule {
     /// The zoning map's value, rounded, indexes [`BuildingKind::ALL`] (0 skyscraper … 5
     /// industrial; out of range clamps).

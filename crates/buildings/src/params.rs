@@ -1,10 +1,9 @@
 //! The stage's options: building types, footprint strategies, height distributions.
 
-use serde::{Deserialize, Serialize};
-
 /// The building types of Parish & Müller §4.2 (commercial, residential, industrial), with
 /// skyscrapers and the commercial and residential sub-types of the issue.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum BuildingKind {
     /// Downtown tower with setbacks, crown and antenna or spire.
     Skyscraper,
@@ -64,7 +63,8 @@ impl BuildingKind {
 }
 
 /// How a footprint is cut from its lot (Kelly 2008 §4.4.3.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum FootprintStrategy {
     /// Zero inset: the whole lot (down-town).
     Downtown,
@@ -80,8 +80,9 @@ pub enum FootprintStrategy {
 }
 
 /// Footprint options (metres).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct FootprintParams {
     /// Setback from street edges for suburban kinds, m. Default: 5.
     pub street_setback: f64,
@@ -105,7 +106,8 @@ impl Default for FootprintParams {
 }
 
 /// The distribution building heights are drawn from (Kelly §4.4.3.2 and §7.4).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum HeightDistribution {
     /// Kelly's building height ± deviance: uniform in `[m·(1 − d), m·(1 + d)]` with `m`
     /// the kind's median height.
@@ -143,8 +145,9 @@ impl Default for HeightDistribution {
 /// The building stage's options: one struct, serde, with units.
 ///
 /// *What* (style) only: there is no performance knob that could change the city.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct BuildingParams {
     /// City seed; each building draws from a generator seeded by (seed, lot id).
     /// Default: 0.

@@ -1,10 +1,10 @@
 //! The error type of `polis-cells`.
 
 use polis_geom::{DVec2, EdgeId, GeomError, NodeId};
-use serde::{Deserialize, Serialize};
 
 /// One way in which the input graph fails to be planar.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Conflict {
     /// Two edges cross at a point interior to both.
     Crossing {

@@ -2,11 +2,11 @@
 //! and the [`ExtractionReport`].
 
 use polis_geom::{DVec2, EdgeId, NodeId, Polygon, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 /// The index of a [`Cell`] in [`CellDecomposition::cells`] (and of its minimal cycle).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(transparent)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(transparent))]
 pub struct CellId(pub u32);
 
 impl CellId {
@@ -29,7 +29,8 @@ impl std::fmt::Display for CellId {
 /// `edges[i]` joins `nodes[i]` and `nodes[(i + 1) % len]`; `polygon` holds the nodes'
 /// positions in the same order (no repeated closing vertex). The ids name the input
 /// graph's nodes and edges, so their payloads (road class, width …) stay reachable.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Ring {
     /// The nodes in ring order.
     pub nodes: Vec<NodeId>,
@@ -57,7 +58,8 @@ impl Ring {
 }
 
 /// How a filament is attached.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum FilamentKind {
     /// Starts at a branch point (degree ≥ 3) and ends at a dead end (degree 1): a cul-de-sac.
     DeadEnd,
@@ -72,7 +74,8 @@ pub enum FilamentKind {
 ///
 /// `edges[i]` joins `nodes[i]` and `nodes[i + 1]`; `points` are the nodes' positions.
 /// Dead-end filaments run from the branch point to the dead end.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Filament {
     /// The nodes along the chain.
     pub nodes: Vec<NodeId>,
@@ -87,7 +90,8 @@ pub struct Filament {
 }
 
 /// A node without edges.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct IsolatedNode {
     /// The node.
     pub node: NodeId,
@@ -101,7 +105,8 @@ pub struct IsolatedNode {
 ///
 /// Self-contained (owns all its geometry and ids; `Clone + Send + Sync`), so cells can be
 /// handed to parallel workers together with a shared `&PlanarGraph` for the payloads.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Cell {
     /// This cell's id (its index in [`CellDecomposition::cells`]).
     pub id: CellId,
@@ -148,7 +153,8 @@ impl Cell {
 }
 
 /// Why an edge of the input was left out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum DropReason {
     /// After merging coincident nodes it joins the same pair of nodes as `kept`.
     Duplicate {
@@ -163,7 +169,8 @@ pub enum DropReason {
 }
 
 /// An edge left out of the extraction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct DroppedEdge {
     /// The edge.
     pub edge: EdgeId,
@@ -172,7 +179,8 @@ pub struct DroppedEdge {
 }
 
 /// A node merged into another at the same position.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NodeMerge {
     /// The merged node: it appears in no output.
     pub node: NodeId,
@@ -183,7 +191,8 @@ pub struct NodeMerge {
 }
 
 /// What the extraction repaired or counted.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ExtractionReport {
     /// Coincident nodes merged (see [`CoincidentNodes`](crate::CoincidentNodes)).
     pub merged_nodes: Vec<NodeMerge>,
@@ -200,7 +209,8 @@ pub struct ExtractionReport {
 }
 
 /// The cells of a planar road graph: Eberly's minimal cycle basis grouped by containment.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CellDecomposition {
     /// One cell per minimal cycle (bounded face), in extraction order: left to right by
     /// the leftmost node of each cycle. A parent always precedes its children.

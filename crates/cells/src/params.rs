@@ -1,9 +1,8 @@
 //! [`CellParams`]: the options of cell extraction.
 
-use serde::{Deserialize, Serialize};
-
 /// What to do with two or more nodes at exactly the same position.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum CoincidentNodes {
     /// Merge them into the one with the smallest id, drop edges that become duplicates,
     /// and list both in the [`ExtractionReport`](crate::ExtractionReport).
@@ -18,8 +17,9 @@ pub enum CoincidentNodes {
 ///
 /// Neither option changes the cells of a valid planar graph: they decide how invalid
 /// input is treated and what is checked.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct CellParams {
     /// Nodes at exactly the same position (no tolerance: snapping nearby points is the job
     /// of the graph's planar insertion). Default: [`CoincidentNodes::Merge`].

@@ -58,7 +58,9 @@ pub enum ExportError {
         /// The encoder's message.
         reason: String,
     },
-    /// Serialising JSON failed (only possible through an I/O error of the writer).
+    /// Serialising JSON failed (only possible through an I/O error of the writer). Only
+    /// with the `serde` feature (which the JSON writers, glb and GeoJSON, turn on).
+    #[cfg(feature = "serde")]
     #[error("writing JSON for {what} failed: {source}")]
     Json {
         /// What was being serialised.
@@ -87,6 +89,7 @@ impl ExportError {
 
     /// A [`Json`](Self::Json) error about `what`; I/O failures inside serde_json are
     /// reported as [`Io`](Self::Io).
+    #[cfg(feature = "serde")]
     pub(crate) fn json(what: impl Into<String>) -> impl FnOnce(serde_json::Error) -> ExportError {
         let what = what.into();
         move |source| {

@@ -27,13 +27,13 @@ use polis_geom::glam::DVec3;
 use polis_geom::mesh::{to_world, triangulate};
 use polis_geom::scene::MaterialId;
 use polis_geom::{DVec2, MAX_COORDINATE, Mesh, Polygon, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 
 /// Options of [`footpath_mesh`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct FootpathOptions {
     /// Height of the kerb above the road surface, metres (finite, > 0). Default: 0.15.
     pub kerb_height_m: f64,

@@ -44,8 +44,10 @@
 use std::io::Write;
 
 use polis_geom::{DVec2, PolygonWithHoles, Ring};
+#[cfg(feature = "serde")]
 use serde::ser::{SerializeMap, SerializeSeq};
-use serde::{Deserialize, Serialize, Serializer};
+#[cfg(feature = "serde")]
+use serde::{Serialize, Serializer};
 
 use crate::ExportError;
 use crate::map::{LayerSet, MapLayers};
@@ -58,8 +60,9 @@ use projection::TangentPlane;
 pub const CRS_MEMBER: &str = "polis:coordinates";
 
 /// Options of [`write_geojson`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct GeoJsonOptions {
     /// Which layers to write. Default: all.
     pub layers: LayerSet,
@@ -74,8 +77,9 @@ pub struct GeoJsonOptions {
 }
 
 /// The coordinate system of the positions [`write_geojson`] writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum Coordinates {
     /// `[x, y]` metres in the layout plane (`x` east, `y` north), as polis computes them.
@@ -292,6 +296,7 @@ struct Feature<'a, P> {
     properties: P,
 }
 
+#[cfg(feature = "serde")]
 impl<P: Serialize> Serialize for Feature<'_, P> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(Some(4))?;
@@ -309,25 +314,25 @@ impl<P: Serialize> Serialize for Feature<'_, P> {
     }
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct Layer {
     layer: &'static str,
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct BlockProps {
     layer: &'static str,
     id: u64,
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct LotProps {
     layer: &'static str,
     id: u64,
     block: Option<u64>,
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct RoadProps<'a> {
     layer: &'static str,
     id: u64,
@@ -336,7 +341,7 @@ struct RoadProps<'a> {
     bridge: bool,
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct BuildingProps<'a> {
     layer: &'static str,
     id: u64,
@@ -357,6 +362,7 @@ struct Projected<'a> {
     proj: Option<TangentPlane>,
 }
 
+#[cfg(feature = "serde")]
 impl Serialize for Projected<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(Some(2))?;
@@ -386,6 +392,7 @@ impl Serialize for Projected<'_> {
 /// A polygon's rings: outer counter-clockwise, holes clockwise, each closed.
 struct Rings<'a>(&'a PolygonWithHoles, Option<TangentPlane>);
 
+#[cfg(feature = "serde")]
 impl Serialize for Rings<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut seq = s.serialize_seq(Some(1 + self.0.holes.len()))?;
@@ -410,6 +417,7 @@ struct Positions<'a> {
     proj: Option<TangentPlane>,
 }
 
+#[cfg(feature = "serde")]
 impl Serialize for Positions<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let n = self.points.len() + usize::from(self.close && !self.points.is_empty());

@@ -48,8 +48,9 @@
 //! All on by default: `gltf` ([`glb`]), `obj` ([`obj`]), `svg` ([`svg`]), `geojson`
 //! ([`geojson`]) — one per writer —, `png` (PNG encoding of raw scene images, needed by
 //! the glb and OBJ writers) and `parallel` (the OBJ text formatted on rayon through
-//! [`geom::par`]; the same bytes without). [`map`], [`surfaces`], [`footpaths`] and
-//! [`sink`] are always there.
+//! [`geom::par`]; the same bytes without), and `serde` (`Serialize`/`Deserialize` for
+//! the option and surface types; `gltf` and `geojson` turn it on). [`map`],
+//! [`surfaces`], [`footpaths`] and [`sink`] are always there.
 //!
 //! ## Guarantees
 //!

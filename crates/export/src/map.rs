@@ -27,12 +27,12 @@
 //! ```
 
 use polis_geom::{DVec2, MAX_COORDINATE, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 
 /// The class of a road, for styling and attributes.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum RoadClass {
     /// A highway: the fast network between population centres (Parish & Müller §3).
@@ -73,7 +73,8 @@ impl RoadClass {
 }
 
 /// The kind of a building, for styling and attributes.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum BuildingKind {
     /// Houses and apartment blocks.
@@ -102,7 +103,8 @@ impl BuildingKind {
 }
 
 /// A road as a centre line.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapRoad {
     /// A stable id chosen by the producer (e.g. the road-graph edge id). Default: 0.
     pub id: u64,
@@ -130,7 +132,8 @@ impl MapRoad {
 }
 
 /// A city block: the area enclosed by roads, inset by half their width.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapBlock {
     /// A stable id chosen by the producer.
     pub id: u64,
@@ -139,7 +142,8 @@ pub struct MapBlock {
 }
 
 /// A lot: a parcel of a block.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapLot {
     /// A stable id chosen by the producer.
     pub id: u64,
@@ -150,7 +154,8 @@ pub struct MapLot {
 }
 
 /// A building footprint.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapFootprint {
     /// A stable id chosen by the producer. Default: 0.
     pub id: u64,
@@ -249,8 +254,9 @@ impl MapDebug {
 
 /// Everything a map shows, by layer (drawn bottom to top in this order: water, parks,
 /// blocks, lots, roads, footprints).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct MapLayers {
     /// Lakes, rivers, sea.
     pub water: Vec<PolygonWithHoles>,
@@ -269,8 +275,9 @@ pub struct MapLayers {
 }
 
 /// Which layers a writer includes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct LayerSet {
     /// Water areas. Default: true.
     pub water: bool,

@@ -41,7 +41,6 @@ use polis_geom::Mesh;
 use polis_geom::glam::{DMat3, DMat4};
 use polis_geom::par::{self, prelude::*};
 use polis_geom::scene::{Material, Scene};
-use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 use crate::images::{png_bytes, sanitize};
@@ -49,8 +48,9 @@ use crate::sink::FileSink;
 use crate::text::{push_f32, push_u64};
 
 /// Options of [`write_obj`].
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct ObjOptions {
     /// The stem of the side files: the MTL library is `<stem>.mtl` (named in the OBJ's
     /// `mtllib`), textures `<stem>_<image>_<name>.png`. ASCII letters, digits, `-`, `_`

@@ -76,7 +76,6 @@ use polis_geom::glam::DVec3;
 use polis_geom::mesh::to_world;
 use polis_geom::scene::MaterialId;
 use polis_geom::{DVec2, Mesh};
-use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 use crate::map::{MapRoad, check_roads};
@@ -89,7 +88,8 @@ pub use junctions::MIN_TRIM_HALF_WIDTHS;
 pub const MITER_LIMIT: f64 = 2.0;
 
 /// How a road ends at a dead end (a node with one road).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum EndCap {
     /// The ribbon stops square at the node.
@@ -111,8 +111,9 @@ impl Default for EndCap {
 }
 
 /// Options of [`road_surfaces`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct RoadSurfaceOptions {
     /// Longest piece of ribbon between two terrain samples, metres (finite, > 0).
     /// Default: 10.0.
@@ -137,7 +138,8 @@ impl Default for RoadSurfaceOptions {
 }
 
 /// What [`road_surfaces_with_report`] built and which hard cases it met.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct RoadSurfaceReport {
     /// Junction polygons and dead-end caps in the mesh.

@@ -23,7 +23,6 @@
 use std::io::Write;
 
 use polis_geom::{DVec2, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::ExportError;
 use crate::map::{BuildingKind, LayerSet, MapLayers, RoadClass};
@@ -33,8 +32,9 @@ pub use debug::SvgDebug;
 mod debug;
 
 /// Colours (any SVG paint: `#rrggbb`, a name, …) and line widths of the map.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct SvgStyle {
     /// Background. Default: `#f2efe9`.
     pub background: String,
@@ -131,8 +131,9 @@ impl SvgStyle {
 }
 
 /// Options of [`write_svg`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct SvgOptions {
     /// Which layers to draw (they also decide the extent). Default: all.
     pub layers: LayerSet,

@@ -18,39 +18,39 @@
 
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::{FacadeError, Result, check_range};
 use crate::interval::{Interval, IntervalGroup, Part};
 use crate::profile::Profile;
 use crate::{MAX_INTERVALS, MAX_LENGTH_M, MIN_SEGMENT_M};
 
 /// One segment of an [`AxisStyle`]: becomes one interval.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Segment {
     /// The row/column kind (`"window"`, `"pier"`, `"ground"`, `"cornice"` …), used by
     /// layer selections. Default: `"wall"`.
-    #[serde(default = "default_name")]
+    #[cfg_attr(feature = "serde", serde(default = "default_name"))]
     pub name: String,
     /// Nominal length, metres (> 0).
     pub length_m: f64,
     /// Weight with which this segment absorbs extra or missing length; 0 = rigid.
     /// Default: 0.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub flex: f64,
     /// Smallest length a flexible segment may shrink to, metres. Default: half of
     /// `length_m` for flexible segments; rigid segments never shrink.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub min_m: Option<f64>,
     /// The interval's profile for layers that use it. Default: [`Profile::Off`].
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub profile: Profile,
     /// Whether this segment is a storey (rows only). Default: false.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub floor: bool,
 }
 
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 fn default_name() -> String {
     "wall".into()
 }
@@ -125,24 +125,25 @@ impl Segment {
 
 /// One axis of a facade style (columns or rows): start segments, a repeated module, end
 /// segments. See the [module docs](self) for the fitting rule.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct AxisStyle {
     /// Fixed segments at the start (left margin; plinth and ground floor for rows).
     /// Default: none.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub start: Vec<Segment>,
     /// The module repeated `n` times (a bay; a storey). Default: none.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub module: Vec<Segment>,
     /// Fixed segments at the end (right margin; cornice, attic). Default: none.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub end: Vec<Segment>,
     /// Fewest repetitions of the module. Default: 0.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub min_repeats: u32,
     /// Most repetitions of the module (`None`: unlimited). Default: `None`.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub max_repeats: Option<u32>,
 }
 

@@ -4,8 +4,6 @@
 use std::fmt;
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::{FacadeError, Result};
 use crate::sample::{FacadeSample, hash2, unit};
 use crate::sweep::RowSink;
@@ -56,8 +54,9 @@ impl PartialEq for ColFn {
 
 /// A brick or ashlar pattern in facade metres (continuous across cells) or in cell-box
 /// metres.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Bricks {
     /// The brick (or stone block) surface.
     pub brick: FacadeSample,
@@ -71,13 +70,13 @@ pub struct Bricks {
     /// bond, 0 = stack bond).
     pub bond: f64,
     /// Per-brick brightness variation (0 = none, 0.2 = ±20 %).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub variation: f32,
     /// Lay the pattern in the cell box instead of the facade. Default: false.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub in_cell: bool,
     /// Seed salt for the per-brick variation. Default: 0.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub salt: u64,
 }
 
@@ -237,8 +236,9 @@ fn corrugated_at(
 }
 
 /// The colour function of a layer.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum Col {
     /// One surface everywhere.
     Solid(FacadeSample),
@@ -278,7 +278,7 @@ pub enum Col {
         fallback: FacadeSample,
     },
     /// A user closure (not serialisable).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     Custom(ColFn),
 }
 

@@ -5,7 +5,6 @@ use std::sync::{Arc, OnceLock};
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use serde::{Deserialize, Serialize};
 
 use crate::axis::{AxisStyle, AxisSums};
 use crate::error::{FacadeError, Result, check_range};
@@ -20,8 +19,9 @@ use crate::tiles::TileOptions;
 use crate::{MAX_FLOORS, MAX_LENGTH_M};
 
 /// What a face is for; decides which layers and rows it gets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum FaceRole {
     /// A street front: every layer, including entrances.
     #[default]
@@ -37,8 +37,9 @@ pub enum FaceRole {
 }
 
 /// One face to texture, as the buildings stage (or a user) describes it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct FacadeSpec {
     /// Width along the wall, metres (`s` runs left to right seen from outside).
     pub width_m: f64,
@@ -46,13 +47,13 @@ pub struct FacadeSpec {
     pub height_m: f64,
     /// Storey count, if the building knows it; the style's rows are fitted to it when
     /// that fits the height. Default: `None` (best fit).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub floors: Option<u32>,
     /// What the face is for. Default: street.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub role: FaceRole,
     /// Seed of this facade (e.g. derived from the building id and face index).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub seed: u64,
 }
 
@@ -101,8 +102,9 @@ impl FacadeSpec {
 }
 
 /// A facade style: the primary grid and the layer stack (serialisable).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct FacadeStyle {
     /// Name (also salts the facade seed).
     pub name: String,
@@ -113,10 +115,10 @@ pub struct FacadeStyle {
     /// The layers over the grid.
     pub stack: StackStyle,
     /// How the shared tile set is cut. Default: see [`TileOptions`].
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub tiles: TileOptions,
     /// Per-facade brightness variation (0.1 = ±10 %). Default: 0.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub tint_jitter: f32,
 }
 
@@ -139,11 +141,13 @@ impl FacadeStyle {
         Ok(())
     }
 
-    /// The style as pretty-printed JSON (a starting point for a style file).
+    /// The style as pretty-printed JSON (a starting point for a style file). Feature
+    /// `serde`.
     ///
     /// # Errors
     /// [`FacadeError::InvalidStyle`] if the style holds closures (which cannot be
     /// serialised).
+    #[cfg(feature = "serde")]
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(self).map_err(|e| FacadeError::InvalidStyle {
             style: self.name.clone(),
@@ -151,11 +155,12 @@ impl FacadeStyle {
         })
     }
 
-    /// Reads and validates a style from JSON.
+    /// Reads and validates a style from JSON. Feature `serde`.
     ///
     /// # Errors
     /// [`FacadeError::InvalidStyle`] with the parser's message (line and column) for
     /// malformed JSON, or the validation error.
+    #[cfg(feature = "serde")]
     pub fn from_json(text: &str) -> Result<Self> {
         let style: FacadeStyle =
             serde_json::from_str(text).map_err(|e| FacadeError::InvalidStyle {

@@ -10,6 +10,7 @@ use std::ops::Deref;
 use std::sync::Arc;
 
 use polis_geom::{Aabb2, DVec2};
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::facade::Facade;
@@ -17,7 +18,8 @@ use crate::layer::{CellRole, Eval, Layer};
 use crate::stack::LayerStack;
 
 /// One active cell rectangle.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FacadeCell {
     /// The rectangle in facade metres (`s` right, `t` up).
     pub rect: Aabb2,
@@ -111,12 +113,14 @@ impl PartialEq<String> for LayerName {
     }
 }
 
+#[cfg(feature = "serde")]
 impl Serialize for LayerName {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(&self.0)
     }
 }
 
+#[cfg(feature = "serde")]
 impl<'de> Deserialize<'de> for LayerName {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         String::deserialize(d).map(LayerName::from)

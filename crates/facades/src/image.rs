@@ -9,8 +9,6 @@
 
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::{FacadeError, Result};
 use crate::sample::{FacadeSample, mix64, unit};
 
@@ -187,8 +185,9 @@ impl ImageSet {
 }
 
 /// A serialisable description of one image.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum ImageStyle {
     /// A sash window drawn procedurally: frame, glazing bars, glass reflecting the sky and,
     /// when open, the dark room behind the raised lower sash.
@@ -206,7 +205,7 @@ pub enum ImageStyle {
         /// The room seen through the opening.
         interior: FacadeSample,
         /// Curtain colour drawn at both sides, if any.
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         curtain: Option<[f32; 3]>,
     },
     /// Office glazing with a blind lowered over the top part.

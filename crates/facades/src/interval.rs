@@ -7,15 +7,14 @@
 
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::{FacadeError, Result, check_range};
 use crate::profile::Profile;
 use crate::{MAX_INTERVALS, MAX_LENGTH_M};
 
 /// Which part of an [`AxisStyle`](crate::AxisStyle) produced an interval.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Part {
     /// The fixed, irregular segments at the start (margins, plinth, ground floor).
     Start,

@@ -11,7 +11,6 @@ use std::fmt;
 use std::sync::Arc;
 
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
 
 use crate::color::{Col, PointCtx};
 use crate::error::{FacadeError, Result};
@@ -21,10 +20,9 @@ use crate::sample::{FacadeSample, hash2};
 use crate::stack::LayerStack;
 
 /// What an active cell is, for geometry mode and for consumers' materials.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, Default,
-)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum CellRole {
     /// Plain wall (base layers).
     #[default]

@@ -6,14 +6,13 @@
 //! AND (minimum) or OR (maximum) gives the active area. Profiles with soft edges give
 //! non-rectangular active areas.
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::{FacadeError, Result};
 
 /// A function over one interval of length `len`, evaluated at a local position `x ∈ [0, len]`
 /// (metres from the interval's start). Values ≥ 0.5 count as active.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum Profile {
     /// 0 everywhere: the interval is never active (walls, piers, margins).
     #[default]

@@ -13,7 +13,6 @@
 //! layers and closures are probed texel by texel.
 
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
 
 use crate::MAX_TEXTURE_TEXELS;
 use crate::error::{FacadeError, Result, check_range};
@@ -26,8 +25,9 @@ use crate::sweep::{RowRuns, RowSweep, RunKind};
 pub const HEIGHT_RANGE_M: f32 = 0.5;
 
 /// How to rasterise.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct RasterOptions {
     /// Texels per metre. Default: 64 (a 1.1 m window is 70 texels wide).
     pub pixels_per_metre: f64,
@@ -37,7 +37,7 @@ pub struct RasterOptions {
     /// then stretch to cover the same metres): images that suit repeating, mipmapped samplers
     /// (the Khronos glTF validator warns on non-power-of-two images used so, as WebGL 1
     /// cannot sample them). Default: false.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub power_of_two: bool,
 }
 

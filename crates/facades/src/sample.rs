@@ -1,26 +1,26 @@
 //! What a facade evaluates to at one point, and the stateless hashes used for per-cell
 //! randomness.
 
-use serde::{Deserialize, Serialize};
-
 /// The surface at one facade point: everything a PBR material (glTF metallic-roughness)
 /// needs, plus a height for bump, normal and relief mapping.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct FacadeSample {
     /// Base colour, sRGB-encoded, each channel in `[0, 1]`; alpha last.
     pub albedo: [f32; 4],
     /// Height relative to the wall plane, metres (negative: recessed, e.g. a window).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub height: f32,
     /// Perceptual roughness in `[0, 1]` (glTF `roughnessFactor`).
-    #[serde(default = "default_roughness")]
+    #[cfg_attr(feature = "serde", serde(default = "default_roughness"))]
     pub roughness: f32,
     /// Metalness in `[0, 1]` (glTF `metallicFactor`).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub metallic: f32,
 }
 
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 fn default_roughness() -> f32 {
     0.8
 }

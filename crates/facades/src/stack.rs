@@ -7,7 +7,6 @@
 //! fig. 14 right: differently sized and coloured bricks around windows and doors).
 
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
 
 use crate::color::Col;
 use crate::error::{FacadeError, Result};
@@ -17,8 +16,9 @@ use crate::sample::FacadeSample;
 
 /// How a target cell must lie relative to a source layer's active cells for a
 /// [`Influence::ScaleCells`] to apply.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum Relation {
     /// The target's active box overlaps a source box (positive area).
     Overlap,

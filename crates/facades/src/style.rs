@@ -10,7 +10,6 @@
 use std::collections::BTreeMap;
 
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
 use crate::axis::AxisStyle;
 use crate::color::Col;
@@ -27,20 +26,22 @@ pub const MAX_NESTING: u32 = 4;
 
 /// Which intervals of an axis a layer uses: those named in `names` (all when empty), then
 /// a pick among them.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Select {
     /// Interval names to keep (empty: every interval). Default: empty.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub names: Vec<String>,
     /// Which of those. Default: all.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub pick: Pick,
 }
 
 /// A pick among the intervals a [`Select`] kept.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum Pick {
     /// All of them.
     #[default]
@@ -124,8 +125,9 @@ impl Select {
 }
 
 /// The interval group a layer uses along one axis.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum AxisRef {
     /// The facade's primary grid (inside a nested stack: one interval over the whole box).
     #[default]
@@ -138,8 +140,9 @@ pub enum AxisRef {
 
 /// The serialisable evaluation function of a layer (closures are available on
 /// [`Layer`]s built in code).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum EvalStyle {
     /// Every selected cell is active.
     Always,
@@ -153,7 +156,7 @@ pub enum EvalStyle {
         /// The images.
         images: Vec<ImageStyle>,
         /// Their weights (empty: equal).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         weights: Vec<f32>,
     },
     /// A nested layer stack evaluated over each active box.
@@ -161,43 +164,44 @@ pub enum EvalStyle {
 }
 
 /// One layer of a style.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct LayerStyle {
     /// Name, referenced by influences.
     pub name: String,
     /// Role of its active cells. Default: wall.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub role: CellRole,
     /// Column axis. Default: the grid.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub u: AxisRef,
     /// Row axis. Default: the grid.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub v: AxisRef,
     /// Replaces the column profiles (e.g. a sill as wide as its window column). Default:
     /// keep the axis' profiles.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub u_profile: Option<Profile>,
     /// Replaces the row profiles. Default: keep.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub v_profile: Option<Profile>,
     /// Which columns. Default: all.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub cols: Select,
     /// Which rows. Default: all.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub rows: Select,
     /// Evaluation function. Default: AND.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub eval: EvalStyle,
     /// Colour function.
     pub col: Col,
     /// Offset from the wall plane, metres (negative: recessed). Default: 0.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub depth_m: f32,
     /// Only on street-facing facades (entrances). Default: false.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub street_only: bool,
 }
 
@@ -234,8 +238,9 @@ impl LayerStyle {
 }
 
 /// A serialisable influence between two layers, by name.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 pub enum InfluenceStyle {
     /// See [`Influence::ScaleCells`].
     ScaleCells {
@@ -262,16 +267,17 @@ pub enum InfluenceStyle {
 }
 
 /// Layers (bottom first), influences and a background.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct StackStyle {
     /// The layers, bottom first.
     pub layers: Vec<LayerStyle>,
     /// Influences between them.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub influences: Vec<InfluenceStyle>,
     /// Surface where no layer is active (`None`: fall through to the enclosing layer).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub background: Option<FacadeSample>,
 }
 

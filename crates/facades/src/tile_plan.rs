@@ -29,7 +29,6 @@
 use std::sync::Arc;
 
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
 
 use crate::color::Col;
 use crate::facade::{FacadeLayout, FacadeSpec, FaceRole, PreparedStyle};
@@ -39,8 +38,9 @@ use crate::style::{AxisRef, EvalStyle, InfluenceStyle, LayerStyle, Pick, StackSt
 use crate::tiles::{TileQuad, TileSet, tile_quads};
 
 /// Why part of a facade is not reproduced exactly by its tile set.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum TileIssueKind {
     /// The fit stretched modules or margins away from the prototype's sizes; the tiles
@@ -63,7 +63,8 @@ pub enum TileIssueKind {
 }
 
 /// A region of a facade that a tile rendering does not reproduce exactly.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TileIssue {
     /// The region, facade metres.
     pub rect: Aabb2,

@@ -23,7 +23,6 @@
 //! ([`crate::tile_plan`]), so callers know where to fall back to a facade's own texture.
 
 use polis_geom::{Aabb2, DVec2};
-use serde::{Deserialize, Serialize};
 
 use crate::error::{FacadeError, Result};
 use crate::facade::{Facade, FacadeLayout, FacadeReport, FacadeSpec, FaceRole, PreparedStyle};
@@ -32,8 +31,9 @@ use crate::raster::{FacadeTextures, RasterOptions};
 use crate::tile_plan::PROTOTYPE_SEED;
 
 /// How a style's tile set is cut.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct TileOptions {
     /// Bays (column modules) per repeated tile. Default: 3.
     pub bays: u32,
@@ -91,7 +91,8 @@ pub struct TileSet {
 }
 
 /// A quad of a facade textured with one tile.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TileQuad {
     /// The rectangle on the facade, metres.
     pub rect: Aabb2,

@@ -1,12 +1,12 @@
 //! Axis-aligned bounding boxes.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 /// An axis-aligned box in the XY plane, in metres.
 ///
 /// The empty box has `min = +∞`, `max = −∞`; extending it with a point gives that point.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Aabb2 {
     /// Lower-left corner.
     pub min: DVec2,

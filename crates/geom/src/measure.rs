@@ -7,14 +7,14 @@
 //! point–segment distances ([`distance_to_segment`]).
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use crate::hash::splitmix64;
 use crate::polygon::{PointLocation, Polygon};
 use crate::predicates::{SegmentIntersection, distance_to_segment, segment_intersection};
 
 /// A circle: centre and radius in metres.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Circle {
     /// Centre.
     pub center: DVec2,

@@ -7,7 +7,6 @@
 //! [`PolygonWithHoles::normalize`] fix the orientation.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use crate::Aabb2;
 use crate::error::{GeomError, Ring, validate_point};
@@ -30,8 +29,9 @@ pub enum PointLocation {
 /// A simple polygon: one closed ring of points in metres, without a repeated closing vertex.
 ///
 /// Edge `i` runs from vertex `i` to vertex `(i + 1) % len`.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(transparent)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(transparent))]
 pub struct Polygon {
     points: Vec<DVec2>,
 }
@@ -248,7 +248,8 @@ impl Polygon {
 }
 
 /// A polygon with holes: a counter-clockwise outer ring and clockwise holes inside it.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PolygonWithHoles {
     /// The outer boundary (counter-clockwise once normalised).
     pub outer: Polygon,

@@ -34,7 +34,6 @@
 use std::borrow::Cow;
 
 use glam::{DMat4, DQuat, DVec3};
-use serde::{Deserialize, Serialize};
 
 use crate::GeomError;
 use crate::mesh::Mesh;
@@ -43,10 +42,9 @@ pub use crate::metadata::{MetaValue, Metadata};
 macro_rules! typed_id {
     ($(#[$doc:meta])* $name:ident) => {
         $(#[$doc])*
-        #[derive(
-            Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize,
-        )]
-        #[serde(transparent)]
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+        #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+        #[cfg_attr(feature = "serde", serde(transparent))]
         pub struct $name(pub u32);
 
         impl $name {
@@ -84,7 +82,8 @@ typed_id!(
 pub const ROTATION_TOLERANCE: f64 = 1e-6;
 
 /// A node's placement relative to its parent (world axes, metres).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Transform {
     /// Translation, rotation (unit quaternion) and scale, applied as `T · R · S`.
     Trs {
@@ -170,7 +169,8 @@ impl Transform {
 }
 
 /// One node of the scene tree.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Node {
     /// A name for people and tools (need not be unique).
     pub name: String,
@@ -195,7 +195,8 @@ impl Node {
 }
 
 /// A metallic-roughness PBR material (glTF 2.0 core).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Material {
     /// A name for people and tools.
     pub name: String,
@@ -219,7 +220,7 @@ pub struct Material {
     /// later: road ribbons, junction plates, footpaths). A textured material always keeps
     /// them; an untextured one without this flag drops them (glTF validators list unused
     /// `TEXCOORD_0` attributes). Default: false.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub keep_texture_coordinates: bool,
 }
 
@@ -273,7 +274,8 @@ impl Material {
 }
 
 /// How texture coordinates outside `[0, 1]` are treated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Wrap {
     /// Tile the image (the default: UVs are in metres).
     #[default]
@@ -285,7 +287,8 @@ pub enum Wrap {
 }
 
 /// How texels are filtered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Filter {
     /// Nearest texel (pixel-art look).
     Nearest,
@@ -295,7 +298,8 @@ pub enum Filter {
 }
 
 /// A texture: an image and how to sample it.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Texture {
     /// A name for people and tools.
     pub name: String,
@@ -310,7 +314,8 @@ pub struct Texture {
 }
 
 /// The pixels of an image.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ImageData {
     /// A complete PNG file, embedded by the glTF writer as it is.
     Png(Vec<u8>),
@@ -327,7 +332,8 @@ pub enum ImageData {
 }
 
 /// An image for textures.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Image {
     /// A name (and the file stem used by writers that store images beside the model).
     pub name: String,
@@ -365,7 +371,8 @@ impl Image {
 }
 
 /// A scene: a forest of nodes with meshes, materials, textures and images.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Scene {
     /// Every node; the tree structure is in [`Node::children`] and [`roots`](Self::roots).
     pub nodes: Vec<Node>,

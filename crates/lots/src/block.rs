@@ -3,7 +3,6 @@
 
 use polis_geom::polygon::locate_in_ring;
 use polis_geom::{DVec2, PointLocation, Polygon, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
 use crate::error::check_positive;
@@ -12,7 +11,8 @@ use crate::polygon_split::{Region, TaggedRing};
 
 /// A cell as this stage sees it: a region of the road network and the width of the road
 /// along each of its edges. A plain struct: build it by hand or from `polis-cells`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Cell {
     /// A stable id (used to name the blocks and seed their lots).
     pub id: u64,
@@ -23,8 +23,9 @@ pub struct Cell {
 }
 
 /// Parameters of the block stage.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct BlockParams {
     /// Width of the footpath strip along the block boundary, metres (0 = no footpath).
     /// Default: 2.5.
@@ -58,7 +59,8 @@ impl BlockParams {
 }
 
 /// A ring with the accumulated boundary length at each vertex, for texture coordinates.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TexturedRing {
     /// The vertices, with the first repeated at the end so the last length is the perimeter.
     pub points: Vec<DVec2>,
@@ -85,7 +87,8 @@ impl TexturedRing {
 }
 
 /// The footpath: the strip between a block's boundary and its inset by the footpath width.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Footpath {
     /// The strip as polygons with holes.
     pub strips: Vec<PolygonWithHoles>,
@@ -95,7 +98,8 @@ pub struct Footpath {
 }
 
 /// One block: a connected piece of a cell after insetting by half the road widths.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Block {
     /// The cell it came from.
     pub cell_id: u64,

@@ -23,7 +23,6 @@
 
 use polis_geom::lines::innermost_ring_containing;
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
 use polis_geom::predicates::{Orientation, orient2d};
@@ -33,7 +32,8 @@ use crate::skeleton::wavefront::{EdgeLine, Motion, motion};
 use crate::skeleton::{check_input, reset_checked};
 
 /// One ring of an inset shape, with the input edge each of its edges comes from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct InsetRing {
     /// The vertices (counter-clockwise for outer rings, clockwise for holes).
     pub points: Vec<DVec2>,
@@ -44,7 +44,8 @@ pub struct InsetRing {
 }
 
 /// One connected piece of an inset, with edge sources.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct InsetShape {
     /// The outer ring.
     pub outer: InsetRing,

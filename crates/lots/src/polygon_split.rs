@@ -11,10 +11,10 @@
 use polis_geom::DVec2;
 use polis_geom::lines::{TaggedRegion, TaggedRing as GeomRing};
 use polis_geom::polygon::ring_signed_area;
-use serde::{Deserialize, Serialize};
 
 /// A ring with a tag per edge: `street[i]` belongs to edge `points[i] → points[i + 1]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TaggedRing {
     /// The vertices.
     pub points: Vec<DVec2>,
@@ -39,7 +39,8 @@ impl TaggedRing {
 }
 
 /// A region to split: a counter-clockwise outer ring and clockwise holes, with edge tags.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Region {
     /// The outer ring (counter-clockwise).
     pub outer: TaggedRing,

@@ -1,9 +1,8 @@
 //! The turtle command vocabulary shared by typed and text modules.
 
-use serde::{Deserialize, Serialize};
-
 /// Which turtle vector a query module asks for (ABOP's `?P ?H ?U ?L`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum QueryKind {
     /// `?P`: the position.
     Position,
@@ -19,7 +18,8 @@ pub enum QueryKind {
 ///
 /// `Option<f64>` arguments are the module's first parameter; `None` means "use the turtle's
 /// configured default" ([`TurtleOptions`](crate::TurtleOptions)).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum Command {
     /// No turtle meaning (an ordinary symbol such as `A`).

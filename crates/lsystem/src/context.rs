@@ -16,7 +16,8 @@
 use crate::command::ModuleKind;
 
 /// One element of a context pattern.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ContextItem<T> {
     /// A module, described by `T` (a symbol id for typed modules).
     Module(T),

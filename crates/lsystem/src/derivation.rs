@@ -26,7 +26,6 @@
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use serde::{Deserialize, Serialize};
 
 use crate::command::{Command, ModuleKind, QueryKind};
 use crate::context::{BranchIndex, ContextView, end_of_branch};
@@ -38,8 +37,9 @@ use crate::turtle::{Turtle, TurtleOptions, TurtleSink, TurtleState};
 const MAX_DEPTH_CAP: usize = 4096;
 
 /// Options of a derivation: seed, growth guards and the turtle used between steps.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct DeriveOptions {
     /// Seed of the `Pcg64Mcg` generator behind stochastic productions and random
     /// expressions. Default: 0.
@@ -164,7 +164,8 @@ pub trait Environment<S> {
 }
 
 /// What a derivation step did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepReport {
     /// Number of steps done, including this one.
     pub step: usize,

@@ -25,13 +25,13 @@
 //! [`Turtle::unbalanced`].
 
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
 
 use crate::command::Command;
 
 /// Turtle configuration. Lengths are in the caller's units (metres in polis).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct TurtleOptions {
     /// Length of `F`/`f` without a parameter. Default: 1.0.
     pub step: f64,
@@ -64,7 +64,8 @@ impl Default for TurtleOptions {
 }
 
 /// The turtle's state: what query and communication modules receive.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TurtleState {
     /// Position `P`.
     pub position: DVec3,
@@ -108,7 +109,8 @@ impl TurtleState {
 }
 
 /// A drawn line segment.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Segment {
     /// Start point.
     pub from: DVec3,
@@ -121,7 +123,8 @@ pub struct Segment {
 }
 
 /// A chain of segments sharing width and colour (see [`Geometry::polylines`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Polyline {
     /// The points, at least two.
     pub points: Vec<DVec3>,
@@ -132,7 +135,8 @@ pub struct Polyline {
 }
 
 /// A polygon recorded with `{ . }`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TurtlePolygon {
     /// The recorded vertices, in order.
     pub vertices: Vec<DVec3>,
@@ -141,7 +145,8 @@ pub struct TurtlePolygon {
 }
 
 /// A dot drawn with `@o`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Dot {
     /// Centre.
     pub centre: DVec3,
@@ -165,7 +170,8 @@ pub trait TurtleSink {
 impl TurtleSink for () {}
 
 /// A ready sink that keeps everything.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Geometry {
     /// Segments in drawing order.
     pub segments: Vec<Segment>,

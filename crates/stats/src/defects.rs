@@ -20,7 +20,6 @@
 use polis_geom::measure::polygon_segment_distance;
 use polis_geom::predicates::distance_to_segment;
 use polis_geom::{Aabb2, DVec2, PointLocation};
-use serde::{Deserialize, Serialize};
 
 use crate::boxgrid::BoxGrid;
 use crate::input::CityInput;
@@ -29,7 +28,8 @@ use crate::{StatsOptions, summary::ratio};
 use polis_geom::par::{self, prelude::*};
 
 /// The plan-defect counters.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PlanDefects {
     /// Road segments inside a block.
     pub segments_inside_blocks: usize,

@@ -3,12 +3,12 @@
 //! [`CityInput`].
 
 use polis_geom::{Aabb2, DVec2, Field, PlanarGraph, Polygon, PolygonWithHoles};
-use serde::{Deserialize, Serialize};
 
 use crate::error::StatsError;
 
 /// The class of a street edge.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum StreetClass {
     /// A highway or arterial.
     Highway,
@@ -17,7 +17,8 @@ pub enum StreetClass {
 }
 
 /// One straight street segment between two nodes of a [`StreetGraph`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StreetEdge {
     /// First node (index into [`StreetGraph::nodes`]).
     pub a: usize,
@@ -37,7 +38,8 @@ pub struct StreetEdge {
 ///
 /// Parallel edges, zero-length edges and isolated nodes are allowed: zero-length edges
 /// are contracted and isolated nodes counted, never measured.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StreetGraph {
     /// Node positions, metres (layout: x east, y north).
     pub nodes: Vec<DVec2>,

@@ -78,12 +78,11 @@ pub use realism::{Band, Realism, RealismRow, compare};
 pub use reference::{ReferenceCity, reference_cities, reference_city};
 pub use streets::StreetMetrics;
 
-use serde::{Deserialize, Serialize};
-
 /// What the plan-defect counters call "along", "at the edge" and "in the corridor".
 /// Definitions, not performance knobs: changing them changes the counts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct StatsOptions {
     /// A lot is along a road when it comes within half the road's width plus this,
     /// metres (footpath and front garden). Default: 8.
@@ -133,7 +132,8 @@ impl StatsOptions {
 }
 
 /// The whole report.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CityReport {
     /// Street-network metrics.
     pub streets: StreetMetrics,
@@ -150,12 +150,13 @@ pub struct CityReport {
     pub realism: Option<Realism>,
     /// Earthworks of the roads graded into the land, filled in by whoever graded them
     /// (zero otherwise).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub earthworks: EarthworkMetrics,
 }
 
 /// Cut and fill of roads graded into the land (Kelly 2008 §4.2).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct EarthworkMetrics {
     /// Ground removed where roads run below it, m³.
     pub cut_m3: f64,

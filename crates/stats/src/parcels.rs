@@ -19,7 +19,6 @@
 use std::collections::BTreeMap;
 
 use polis_geom::measure::min_enclosing_circle;
-use serde::{Deserialize, Serialize};
 
 use crate::input::{BuildingInput, LotInput};
 use crate::summary::{Distribution, Histogram, ratio};
@@ -31,7 +30,8 @@ pub const SHAPE_FACTOR_BINS: [f64; 11] = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7
 pub const HEIGHT_BINS_M: [f64; 6] = [0.0, 10.0, 20.0, 40.0, 80.0, 160.0];
 
 /// Block metrics.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BlockMetrics {
     /// Blocks.
     pub count: usize,
@@ -46,7 +46,8 @@ pub struct BlockMetrics {
 }
 
 /// Lot metrics.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct LotMetrics {
     /// Lots.
     pub count: usize,
@@ -63,7 +64,8 @@ pub struct LotMetrics {
 }
 
 /// Building metrics.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BuildingMetrics {
     /// Buildings.
     pub count: usize,

@@ -6,13 +6,12 @@
 //! without a band (φ carries the same information). A metric the reference lacks has
 //! no verdict.
 
-use serde::{Deserialize, Serialize};
-
 use crate::reference::ReferenceCity;
 use crate::streets::StreetMetrics;
 
 /// How far from the reference value a metric may be.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Band {
     /// Within ± this much of the reference value.
     Absolute(f64),
@@ -42,7 +41,8 @@ impl std::fmt::Display for Band {
 }
 
 /// One compared metric.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RealismRow {
     /// Metric name (`phi`, `k_avg` …, as in the reference table).
     pub metric: String,
@@ -57,7 +57,8 @@ pub struct RealismRow {
 }
 
 /// A city's street metrics against a reference city.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Realism {
     /// The reference city.
     pub city: String,

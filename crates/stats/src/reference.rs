@@ -9,15 +9,14 @@
 //! cities of a region value by value; they agree with the paper's Table 2 (US/Canada
 //! φ ≈ 0.427, P₄ ≈ 0.334).
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::StatsError;
 
 /// The reference table as CSV text (header line first).
 pub const REFERENCE_CSV: &str = include_str!("../data/street-network-reference.csv");
 
 /// One real city's street-network values (`None` where the table has none).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ReferenceCity {
     /// World region (`US/Canada`, `Europe`, `Asia/Oceania`, `Latin America`,
     /// `Middle East/Africa`).

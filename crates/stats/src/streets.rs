@@ -26,8 +26,6 @@
 //! G. Boeing, *Urban spatial order: street network orientation, configuration, and
 //! entropy*, Applied Network Science 4:67 (2019), §"Methods".
 
-use serde::{Deserialize, Serialize};
-
 use crate::input::{StreetClass, StreetGraph};
 use crate::simplify::SimpleGraph;
 use crate::summary::{Distribution, ratio};
@@ -52,7 +50,8 @@ pub fn orientation_order(h: f64) -> f64 {
 }
 
 /// Grade statistics of the streets.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct GradeMetrics {
     /// Median absolute grade (rise / run).
     pub median: f64,
@@ -65,7 +64,8 @@ pub struct GradeMetrics {
 }
 
 /// The street-network metrics.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StreetMetrics {
     /// Nodes of the simplified graph (isolated nodes excluded).
     pub nodes: usize,

@@ -1,11 +1,10 @@
 //! [`Distribution`] (count, mean, percentiles) and [`Histogram`]: how the report
 //! summarises a list of values. Empty lists give zeros, never NaN.
 
-use serde::{Deserialize, Serialize};
-
 /// Summary of a list of values: count, mean, extremes and percentiles (linear
 /// interpolation between order statistics, as NumPy's default). All zero for no values.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Distribution {
     /// Number of values.
     pub count: usize,
@@ -72,7 +71,8 @@ pub fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
 /// Counts of values in consecutive bins `[edges[i], edges[i+1])`; the last bin also
 /// holds values equal to its upper edge. With `open_top`, one more bin holds everything
 /// at or above the last edge.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Histogram {
     /// Bin edges, ascending (finite).
     pub edges: Vec<f64>,

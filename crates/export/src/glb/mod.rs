@@ -110,6 +110,7 @@ use gltf::json;
 use gltf::json::validation::{Checked, USize64};
 use polis_geom::glam::{DMat4, Vec3};
 use polis_geom::scene::{Filter, Scene, Transform, Wrap};
+#[cfg(feature = "serde")]
 use serde::Serialize;
 
 use crate::ExportError;

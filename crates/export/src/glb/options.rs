@@ -1,7 +1,5 @@
 //! The options of the glb writer: node layout, tile size, profile, LOD switch distances.
 
-use serde::{Deserialize, Serialize};
-
 use crate::ExportError;
 
 /// How scene nodes become glTF nodes and meshes. Which to use:
@@ -11,7 +9,8 @@ use crate::ExportError;
 /// | [`Tiled`](Self::Tiled) (default) | ≈ materials × tiles | games and viewers: few draw calls, each layer (`roads`, `blocks`, `buildings`, `water`, `ground`, …) a node that can be hidden, streamed or given colliders tile by tile; buildings picked by their `_FEATURE_ID_0` |
 /// | [`PerParentAndMaterial`](Self::PerParentAndMaterial) | materials × cells | tools that work cell by cell (the Citygen editor's regeneration unit) |
 /// | [`PerNode`](Self::PerNode) | one per object and material | picking, editing, moving single buildings in a DCC tool (Blender); identical meshes stored once |
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Batching {
     /// One glTF node per scene node, each with its own metadata (picking, editing).
     /// Meshes with identical bytes are stored once and shared by every node drawing them.
@@ -30,7 +29,8 @@ pub enum Batching {
 }
 
 /// Which glTF extensions the writer may use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum GlbProfile {
     /// Core glTF 2.0, no extension: every loader reads it (Godot, Unity, Unreal, Bevy,
     /// Blender, three.js). The default.
@@ -73,8 +73,9 @@ impl std::fmt::Display for GlbProfile {
 }
 
 /// Options of [`write_glb`](super::write_glb).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct GlbOptions {
     /// Node structure. Default: [`Batching::Tiled`].
     pub batching: Batching,

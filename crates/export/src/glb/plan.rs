@@ -7,7 +7,6 @@ use std::hash::{Hash, Hasher};
 
 use polis_geom::Mesh;
 use polis_geom::scene::{MaterialId, MeshId, Metadata, NodeId, Scene};
-use serde::Serialize;
 
 use crate::ExportError;
 
@@ -126,7 +125,8 @@ impl PlannedNode {
 
 /// A leaf node whose geometry was merged into its parent's mesh (batched mode), recorded in
 /// the mesh's `extras.objects` so that tools can still pick it.
-#[derive(Debug, Serialize)]
+#[derive(Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub(crate) struct BatchedObject<'a> {
     /// The leaf node's name.
     pub name: &'a str,

@@ -10,12 +10,12 @@
 //! Combinators never panic, whatever their parameters.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::Field;
 
 /// `factor · field`. Built by [`FieldExt::scaled`](super::FieldExt::scaled).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Scaled<F> {
     /// The field scaled.
     pub field: F,
@@ -44,7 +44,8 @@ impl<F: Field> Field for Scaled<F> {
 }
 
 /// `field + offset`. Built by [`FieldExt::offset`](super::FieldExt::offset).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Offset<F> {
     /// The field shifted.
     pub field: F,
@@ -73,7 +74,8 @@ impl<F: Field> Field for Offset<F> {
 }
 
 /// `a + b`. Built by [`FieldExt::plus`](super::FieldExt::plus).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Sum<A, B> {
     /// First term.
     pub a: A,
@@ -103,7 +105,8 @@ impl<A: Field, B: Field> Field for Sum<A, B> {
 }
 
 /// `a · b`. Built by [`FieldExt::times`](super::FieldExt::times).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Product<A, B> {
     /// First factor.
     pub a: A,
@@ -139,7 +142,8 @@ impl<A: Field, B: Field> Field for Product<A, B> {
 ///
 /// Typical use: a water map `water.threshold(0.5)` as the legality test of Parish & Müller's
 /// local constraints (§3.3).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Threshold<F> {
     /// The field tested.
     pub field: F,
@@ -188,7 +192,8 @@ fn pick(va: f64, vb: f64, take_a: bool) -> Option<bool> {
 
 /// The smaller of `a` and `b` (`a` on ties, NaN if either is NaN); the gradient is the
 /// chosen one's. Built by [`FieldExt::min`](super::FieldExt::min).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Min<A, B> {
     /// First field.
     pub a: A,
@@ -227,7 +232,8 @@ impl<A: Field, B: Field> Field for Min<A, B> {
 
 /// The larger of `a` and `b` (`a` on ties, NaN if either is NaN); the gradient is the
 /// chosen one's. Built by [`FieldExt::max`](super::FieldExt::max).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Max<A, B> {
     /// First field.
     pub a: A,
@@ -270,7 +276,8 @@ impl<A: Field, B: Field> Field for Max<A, B> {
 ///
 /// Bounds given in the wrong order are swapped; a NaN bound is ignored (no limit on that
 /// side). A NaN value stays NaN.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Clamp<F> {
     /// The field limited.
     pub field: F,
@@ -320,7 +327,8 @@ impl<F: Field> Field for Clamp<F> {
 /// [`FieldExt::select`](super::FieldExt::select) (threshold 0.5).
 ///
 /// Typical use: a zoning map choosing between two height maps.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Mask<M, T, E> {
     /// The selecting field.
     pub mask: M,
@@ -388,7 +396,8 @@ impl<M: Field, T: Field, E: Field> Field for Mask<M, T, E> {
 ///
 /// Typical use: Parish & Müller §3.2.2 blend street-pattern rules by grey-scale control
 /// maps; the same idea blends any two maps.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Blend<W, A, B> {
     /// The weight (0 → `zero`, 1 → `one`).
     pub weight: W,
@@ -441,7 +450,8 @@ impl<W: Field, A: Field, B: Field> Field for Blend<W, A, B> {
 /// [`FieldExt::translated`](super::FieldExt::translated),
 /// [`FieldExt::magnified`](super::FieldExt::magnified) and
 /// [`FieldExt::transformed`](super::FieldExt::transformed).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct DomainTransform<F> {
     /// The field read.
     pub field: F,

@@ -35,7 +35,6 @@
 //! to represent a digitized line*, 1973.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::Field;
 use crate::lines::innermost_ring_containing;
@@ -46,8 +45,9 @@ use crate::{Aabb2, GeomError, Polygon, PolygonWithHoles};
 pub const MAX_CONTOUR_CELLS: usize = 4096;
 
 /// Options of [`contour_regions`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct ContourOptions {
     /// Side of the sampling cells, metres. Default: 10.
     pub cell_m: f64,

@@ -207,8 +207,9 @@ impl<F: Field + ?Sized> Field for Arc<F> {
 }
 
 /// The same value everywhere; the gradient is zero. The point is ignored, even when NaN.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(transparent)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(transparent))]
 pub struct Constant(pub f64);
 
 impl Field for Constant {

@@ -22,7 +22,6 @@ use std::f64::consts::FRAC_1_SQRT_2;
 use glam::DVec2;
 use rand_pcg::Pcg64Mcg;
 use rand_pcg::rand_core::{Rng, SeedableRng};
-use serde::{Deserialize, Serialize};
 
 use super::Field;
 use crate::GeomError;
@@ -74,15 +73,17 @@ const GRADIENTS: [[f64; 2]; 16] = [
 /// assert!((-1.0..=1.0).contains(&v));
 /// assert_eq!(v, SimplexNoise::new(42).sample(DVec2::new(0.3, 1.7)));
 /// ```
-#[derive(Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(from = "SimplexSeed", into = "SimplexSeed")]
+#[derive(Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(from = "SimplexSeed", into = "SimplexSeed"))]
 pub struct SimplexNoise {
     seed: u64,
     perm: [u8; 256],
 }
 
 /// The serialised form of [`SimplexNoise`].
-#[derive(Clone, Serialize, Deserialize)]
+#[derive(Clone)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct SimplexSeed {
     seed: u64,
 }
@@ -272,8 +273,9 @@ impl Field for SimplexNoise {
 pub const MAX_OCTAVES: u32 = 24;
 
 /// Parameters of fractal Brownian motion noise ([`Fbm`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct FbmParams {
     /// Seed of the octaves' permutation tables and offsets. Default: 0.
     pub seed: u64,
@@ -316,8 +318,9 @@ struct Octave {
 /// Octave `k` has its own permutation table and a random offset `oₖ ∈ [0, 256)²` noise
 /// units, both drawn from `Pcg64Mcg::seed_from_u64(seed)`. NaN or infinite points give
 /// NaN. Serialises as its [`FbmParams`].
-#[derive(Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "FbmParams", into = "FbmParams")]
+#[derive(Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "FbmParams", into = "FbmParams"))]
 pub struct Fbm {
     params: FbmParams,
     octaves: Vec<Octave>,

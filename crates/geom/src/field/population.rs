@@ -1,14 +1,14 @@
 //! The population-density map of the priority-queue slides: three layers of simplex noise.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::{Field, SimplexNoise};
 use crate::GeomError;
 
 /// Parameters of [`Population`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct PopulationParams {
     /// Seed of the simplex noise shared by the three layers. Default: 0.
     pub seed: u64,
@@ -58,8 +58,12 @@ impl Default for PopulationParams {
 /// assert!((0.0..=1.0).contains(&d));
 /// # Ok::<(), polis_geom::GeomError>(())
 /// ```
-#[derive(Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "PopulationParams", into = "PopulationParams")]
+#[derive(Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(try_from = "PopulationParams", into = "PopulationParams")
+)]
 pub struct Population {
     params: PopulationParams,
     noise: SimplexNoise,

@@ -1,7 +1,6 @@
 //! Grid fields: an `f32` image laid over a world-space box, sampled bilinearly.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::Field;
 use crate::{Aabb2, GeomError};
@@ -38,8 +37,9 @@ use crate::{Aabb2, GeomError};
 /// assert_eq!(r.gradient(DVec2::new(10.0, 5.0)), DVec2::new(0.1, 0.0)); // 1 per 10 m
 /// # Ok::<(), polis_geom::GeomError>(())
 /// ```
-#[derive(Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "RasterData", into = "RasterData")]
+#[derive(Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "RasterData", into = "RasterData"))]
 pub struct Raster {
     width: usize,
     height: usize,
@@ -50,7 +50,8 @@ pub struct Raster {
 }
 
 /// The serialised form of [`Raster`].
-#[derive(Clone, Serialize, Deserialize)]
+#[derive(Clone)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct RasterData {
     width: usize,
     height: usize,

@@ -5,7 +5,6 @@
 //! combinators over them, nested as deeply as needed.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::{
     Blend, Clamp, Constant, DomainTransform, Fbm, FbmParams, Field, Mask, Max, Min, Offset,
@@ -38,8 +37,9 @@ use crate::GeomError;
 /// assert!(v == 0.0 || v == 1.0);
 /// # Ok::<(), polis_geom::GeomError>(())
 /// ```
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum FieldSpec {
     /// [`Constant`]: the same value everywhere.
@@ -137,7 +137,7 @@ pub enum FieldSpec {
         /// Used elsewhere.
         if_false: Box<FieldSpec>,
         /// Selection level. Default: 0.5.
-        #[serde(default = "half")]
+        #[cfg_attr(feature = "serde", serde(default = "half"))]
         threshold: f64,
     },
     /// [`Blend`]: `(1 − w)·zero + w·one`, `w = weight` clamped to `[0, 1]`.
@@ -154,18 +154,20 @@ pub enum FieldSpec {
         /// Inner map.
         field: Box<FieldSpec>,
         /// Component-wise factor on the point. Default: (1, 1).
-        #[serde(default = "one")]
+        #[cfg_attr(feature = "serde", serde(default = "one"))]
         scale: DVec2,
         /// Added after scaling. Default: (0, 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         offset: DVec2,
     },
 }
 
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 fn half() -> f64 {
     0.5
 }
 
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 fn one() -> DVec2 {
     DVec2::ONE
 }

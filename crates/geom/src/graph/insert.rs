@@ -48,7 +48,6 @@
 //!   snap distance of a long segment are found through its bounding box.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::{EdgeId, NodeId, PlanarGraph};
 use crate::error::{GeomError, validate_point};
@@ -78,8 +77,9 @@ fn rounding_eps(p: DVec2) -> f64 {
 }
 
 /// Tolerances of planar insertion ([`PlanarGraph::insert_segment`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct SnapOptions {
     /// Distance, in metres, within which a segment end snaps to an existing node (first)
     /// or onto an existing edge (splitting it); existing nodes within this distance of a

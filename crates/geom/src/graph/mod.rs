@@ -77,10 +77,10 @@ pub mod insert;
 #[cfg(test)]
 mod insert_tests;
 mod invariants;
+#[cfg(feature = "serde")]
 mod serde_impl;
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use crate::bbox::Aabb2;
 use crate::error::{GeomError, validate_point};
@@ -90,13 +90,15 @@ use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, Spatial
 pub use insert::{Insertion, ROUNDING_TOLERANCE, SnapOptions};
 
 /// The id of a node of a [`PlanarGraph`]. Stable: never reused after removal.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(transparent)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(transparent))]
 pub struct NodeId(u32);
 
 /// The id of an edge of a [`PlanarGraph`]. Stable: never reused after removal.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(transparent)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(transparent))]
 pub struct EdgeId(u32);
 
 macro_rules! id_methods {

@@ -2,49 +2,51 @@
 //! system and spatial indexes rebuilt on load.
 
 use glam::DVec2;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::{NodeId, PlanarGraph};
 use crate::error::GeomError;
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct NodeOut<'a, N> {
     position: DVec2,
     payload: &'a N,
 }
 
-#[derive(Serialize)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 struct EdgeOut<'a, E> {
     ends: [NodeId; 2],
     payload: &'a E,
 }
 
-#[derive(Serialize)]
-#[serde(rename = "PlanarGraph")]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename = "PlanarGraph"))]
 struct GraphOut<'a, N, E> {
     nodes: Vec<Option<NodeOut<'a, N>>>,
     edges: Vec<Option<EdgeOut<'a, E>>>,
 }
 
-#[derive(Deserialize)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 struct NodeIn<N> {
     position: DVec2,
     payload: N,
 }
 
-#[derive(Deserialize)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 struct EdgeIn<E> {
     ends: [NodeId; 2],
     payload: E,
 }
 
-#[derive(Deserialize)]
-#[serde(rename = "PlanarGraph")]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename = "PlanarGraph"))]
 struct GraphIn<N, E> {
     nodes: Vec<Option<NodeIn<N>>>,
     edges: Vec<Option<EdgeIn<E>>>,
 }
 
+#[cfg(feature = "serde")]
 /// Serialised as `{ "nodes": [{ "position": [x, y], "payload": … } or null, …],
 /// "edges": [{ "ends": [a, b], "payload": … } or null, …] }`, where the index in each list
 /// is the id and `null` marks a removed id.
@@ -76,6 +78,7 @@ impl<N: Serialize, E: Serialize> Serialize for PlanarGraph<N, E> {
     }
 }
 
+#[cfg(feature = "serde")]
 /// Loads what [`Serialize`] wrote, keeping every id, and rebuilds the counter-clockwise
 /// adjacency and the spatial indexes. Checks what [`PlanarGraph::add_node`] and
 /// [`PlanarGraph::add_edge`] check (coordinates, live distinct ends, no duplicate edge);

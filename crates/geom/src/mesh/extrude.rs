@@ -1,7 +1,6 @@
 //! Mesh builders from layout polygons: flat and lifted faces, extruded prisms.
 
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
 
 use super::{
     HORIZONTAL_FACE_TOLERANCE, Mesh, RefineOptions, to_world, triangulate, triangulate_refined,
@@ -10,7 +9,8 @@ use crate::scene::MaterialId;
 use crate::{GeomError, MAX_COORDINATE, PolygonWithHoles};
 
 /// Which side of a horizontal face is its front.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Facing {
     /// Seen from above: roofs, road surfaces, top caps.
     #[default]

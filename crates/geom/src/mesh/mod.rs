@@ -55,7 +55,6 @@
 //! [`PolygonWithHoles`]: crate::PolygonWithHoles
 
 use glam::{DMat3, DMat4, DVec2, DVec3, Vec2, Vec3};
-use serde::{Deserialize, Serialize};
 
 use crate::GeomError;
 use crate::scene::MaterialId;
@@ -108,7 +107,8 @@ pub const NORMAL_LENGTH_TOLERANCE: f32 = 1e-3;
 /// An axis-aligned box in 3-D world space (`f32`, metres).
 ///
 /// The empty box has `min = +∞`, `max = −∞`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Aabb3 {
     /// The corner with the smallest coordinates.
     pub min: Vec3,
@@ -174,7 +174,8 @@ impl Aabb3 {
 /// `normals` and `uvs` have one entry per position; `indices` lists whole triangles of
 /// existing vertices, counter-clockwise seen from the front; every value is finite; normals
 /// have unit length; no triangle has zero area.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Mesh {
     /// Vertex positions in metres (world axes, see [`to_world`]).
     pub positions: Vec<Vec3>,

@@ -1,7 +1,6 @@
 //! Planar faces in any orientation: a 2-D polygon drawn in a plane of the world.
 
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
 
 use super::{Mesh, to_world, triangulate};
 use crate::{GeomError, MAX_COORDINATE, PolygonWithHoles};
@@ -13,7 +12,8 @@ pub const FRAME_TOLERANCE: f64 = 1e-9;
 /// An orthonormal frame of a plane in world space: 2-D coordinates `(x, y)` in the plane
 /// are the world point `origin + x·u + y·v`. The front of the plane is on the side of
 /// `u × v`, so counter-clockwise polygons in `(x, y)` face the front.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PlaneFrame {
     /// The world point at `(0, 0)`, metres.
     pub origin: DVec3,

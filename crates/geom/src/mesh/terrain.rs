@@ -51,8 +51,9 @@ use crate::scene::MaterialId;
 use crate::{Aabb2, GeomError, MAX_COORDINATE};
 
 /// Options of [`Terrain::build`].
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct TerrainOptions {
     /// Largest vertical miss between the interpolated field and the field at the check
     /// points, metres (finite, > 0). The surface lies up to twice this below the field.
@@ -111,7 +112,8 @@ impl TerrainOptions {
 }
 
 /// What [`Terrain::build`] made.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct TerrainReport {
     /// Quadtree leaves.

@@ -3,7 +3,6 @@
 use std::collections::VecDeque;
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 use spade::handles::{FixedFaceHandle, InnerTag};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
@@ -96,8 +95,9 @@ pub(super) fn spade_triangles(polygon: &PolygonWithHoles) -> Result<Vec<[u32; 3]
 ///
 /// These are *how* knobs of a mesh, not of the city's layout: they change the number of
 /// vertices of a surface, never its outline.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct RefineOptions {
     /// The largest triangle area, in m². Default: 25 (about 7 m sides), fine enough to
     /// follow a terrain sampled every 10 m.
@@ -121,7 +121,8 @@ impl Default for RefineOptions {
 }
 
 /// A triangulation with added (Steiner) vertices, from [`triangulate_refined`].
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RefinedTriangulation {
     /// The vertices: the polygon's, ring by ring as in [`triangulate`], then the added ones.
     pub points: Vec<DVec2>,

@@ -54,7 +54,6 @@ use std::fmt::Debug;
 use std::hash::Hash;
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use crate::bbox::Aabb2;
 use crate::error::GeomError;
@@ -73,8 +72,9 @@ pub trait IndexKey: Copy + Ord + Hash + Debug {}
 impl<T: Copy + Ord + Hash + Debug> IndexKey for T {}
 
 /// Tuning of a [`GridIndex`]. A performance knob only: answers never depend on it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct GridOptions {
     /// Side of a grid cell, in metres. Best near the typical segment length and query
     /// radius. Must be finite and at least [`GridOptions::MIN_CELL_SIZE`].

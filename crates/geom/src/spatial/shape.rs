@@ -1,7 +1,6 @@
 //! [`Shape`]: what a spatial index stores under a key.
 
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
 
 use super::SegmentNear;
 use crate::bbox::Aabb2;
@@ -9,7 +8,8 @@ use crate::error::{GeomError, validate_point};
 use crate::predicates::{closest_point_on_segment, orient2d_value};
 
 /// A point or a closed segment, in metres.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Shape {
     /// A point.
     Point(DVec2),

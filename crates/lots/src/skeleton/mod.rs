@@ -52,14 +52,14 @@ pub(crate) mod events;
 pub(crate) mod wavefront;
 
 use polis_geom::{DVec2, Polygon, PolygonWithHoles, Ring};
-use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
 use crate::error::check_positive;
 use events::Engine;
 
 /// A skeleton node: where wavefront vertices meet (or an input vertex, at time 0).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SkeletonNode {
     /// Position in metres.
     pub position: DVec2,
@@ -69,7 +69,8 @@ pub struct SkeletonNode {
 
 /// A skeleton arc: the straight path of one wavefront vertex, or a ridge where two
 /// wavefront edges met face to face.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SkeletonArc {
     /// Index of the start node (the earlier one).
     pub from: usize,
@@ -85,7 +86,7 @@ pub struct SkeletonArc {
     /// lies on the offset line of one of them, not necessarily both. An arc between two
     /// steps stands still (`from` and `to` are at the same place): `left_edge` is then an
     /// input edge through `from` and `right_edge` one through `to`.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub step: bool,
 }
 
@@ -103,7 +104,8 @@ pub struct EdgeRef {
 /// Input edges are numbered ring by ring: the outer ring's edges first, then each hole's.
 /// Nodes `0..n` are the input vertices in the same order (node `i` is the start of edge
 /// `i`); later nodes are events.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StraightSkeleton {
     nodes: Vec<SkeletonNode>,
     arcs: Vec<SkeletonArc>,

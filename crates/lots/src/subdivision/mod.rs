@@ -25,7 +25,6 @@ mod parish_mueller;
 
 use polis_geom::{Polygon, PolygonWithHoles};
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
 use crate::LotsError;
 use crate::block::Block;
@@ -33,7 +32,8 @@ use crate::polygon_split::{Region, TaggedRing};
 use arena::{Arena, Piece};
 
 /// Which subdivision algorithm to run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum LotStrategy {
     /// Kelly 2008: street-facing edges first, width/depth targets, concave splits.
     #[default]
@@ -43,8 +43,9 @@ pub enum LotStrategy {
 }
 
 /// Parameters of lot subdivision.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct LotParams {
     /// The algorithm. Default: [`LotStrategy::Kelly`].
     pub strategy: LotStrategy,
@@ -127,7 +128,8 @@ impl LotParams {
 }
 
 /// A building lot.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Lot {
     /// The lot, counter-clockwise.
     pub polygon: Polygon,
@@ -140,7 +142,8 @@ pub struct Lot {
 }
 
 /// Why a piece was not kept as a lot.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum DiscardReason {
     /// No edge faces a street.
     NoStreetAccess,
@@ -153,7 +156,8 @@ pub enum DiscardReason {
 }
 
 /// A piece of the block that is not a lot.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Discarded {
     /// The piece.
     pub polygon: PolygonWithHoles,
@@ -173,7 +177,8 @@ pub struct SplitLine {
 }
 
 /// The result of subdividing one region.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Subdivision {
     /// The lots.
     pub lots: Vec<Lot>,
