@@ -187,7 +187,8 @@ impl MapFootprint {
 
 /// One fan of a primary road's plot (Kelly §4.2.2, the plot debug view of Fig. 72): the
 /// samples laid from a front's head, and the one taken.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapFan {
     /// The head the fan was laid from, metres.
     pub from: DVec2,
@@ -198,7 +199,8 @@ pub struct MapFan {
 }
 
 /// One lot subdivision step's split line (Kelly §5.5.1).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MapSplit {
     /// The block whose subdivision cut it.
     pub block: u64,
@@ -211,8 +213,9 @@ pub struct MapSplit {
 /// cut. Block and lot boundaries come from [`MapLayers::blocks`] and [`MapLayers::lots`].
 /// The SVG writer draws them only when asked (`SvgOptions::debug`); other writers ignore
 /// them. Default: empty.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct MapDebug {
     /// Plot points of the primary roads (Kelly's plot samples), metres.
     pub plot_points: Vec<DVec2>,

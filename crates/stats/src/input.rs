@@ -29,7 +29,7 @@ pub struct StreetEdge {
     /// Highway or street.
     pub class: StreetClass,
     /// Whether the segment is a bridge (it crosses water). Default: `false`.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub bridge: bool,
 }
 

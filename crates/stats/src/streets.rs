@@ -114,10 +114,10 @@ pub struct StreetMetrics {
     /// Grades, when elevations were given.
     pub grade: Option<GradeMetrics>,
     /// Input segments flagged as bridges ([`StreetEdge::bridge`](crate::StreetEdge)).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub bridges: usize,
     /// Their total length, metres.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub bridge_length_m: f64,
 }
 

@@ -4,16 +4,15 @@
 
 use std::io::Write;
 
-use serde::{Deserialize, Serialize};
-
 use super::{SvgWriter, esc};
 use crate::map::MapLayers;
 
 /// Which debug overlays the SVG writer draws over the map, and in what colours. Each
 /// overlay is a group of its own (`<g id="debug-plot">`, `debug-fans`, `debug-blocks`,
 /// `debug-lots`, `debug-splits`), drawn in that order over every map layer.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 pub struct SvgDebug {
     /// The primary roads' plot points, as dots. Default: false.
     pub plot_points: bool,

@@ -169,7 +169,8 @@ pub struct Discarded {
 
 /// One subdivision step's cut, recorded when [`Subdivider::record_splits`] is on (Kelly
 /// §5.5.1: the lot subdivision debug view draws the split lines in order).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SplitLine {
     /// The cut line's parts inside the piece it split, metres: one chord for a convex
     /// piece, several where the line crosses a concave piece more than once.
@@ -188,7 +189,10 @@ pub struct Subdivision {
     pub discarded: Vec<Discarded>,
     /// The split lines, one per subdivision step, in the order they were cut; empty unless
     /// [`Subdivider::record_splits`] is on. Default: empty.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Vec::is_empty")
+    )]
     pub splits: Vec<SplitLine>,
 }
 
