@@ -246,8 +246,8 @@ fn solid_meshes<'a>(city: &'a City, node: &polis::geom::scene::Node) -> Vec<&'a 
 
 /// 100 % of building masses and block plinths are one closed, 2-manifold, outward solid
 /// each, by the edge-use check: the merged solids the buildings stage offers and what the
-/// scene exports (a building or block node's untextured meshes; the textured ones are
-/// the facade skins, surfaces of their own).
+/// scene exports (a building node's untextured meshes, the textured ones being its
+/// facade skins, surfaces of their own; a block node's paved plinth).
 fn check_solids(name: &str, city: &City) {
     use polis::geom::mesh::edge_use;
     let mut failed = Vec::new();
@@ -278,7 +278,18 @@ fn check_solids(name: &str, city: &City) {
         if !(is_building || node.name.starts_with("block ")) {
             continue;
         }
-        let report = edge_use(solid_meshes(city, node));
+        // A block's plinth is paved (a textured material since the street textures of
+        // issue 27) and is the block's whole solid; a building's textured meshes are its
+        // facade skins, surfaces of their own.
+        let meshes = if is_building {
+            solid_meshes(city, node)
+        } else {
+            node.meshes
+                .iter()
+                .map(|id| &city.scene.meshes[id.0 as usize])
+                .collect()
+        };
+        let report = edge_use(meshes);
         assert!(report.is_solid(), "{name}: {}: {report:?}", node.name);
         if is_building {
             buildings += 1;
