@@ -338,6 +338,12 @@ impl<N, E: Clone> PlanarGraph<N, E> {
 
     /// Splits `e` at `c`; if `c` cannot split it (it rounds onto or beyond an end), the
     /// end of `e` nearer to `c`.
+    ///
+    /// No node is ever created within rounding ([`ROUNDING_TOLERANCE`]) of an existing
+    /// one: two nodes a few ulps apart have fans of edges that cross each other. If a
+    /// node lies within rounding of `c` (an end of `e`, an end of the current leg, or any
+    /// other node the computed point landed beside), `e` is bent through that node
+    /// instead and the node is returned.
     fn split_or_end(
         &mut self,
         e: EdgeId,
@@ -347,6 +353,14 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     ) -> Result<NodeId, GeomError> {
         let (a, b) = self.endpoints(e)?;
         let (pa, pb) = (self.position(a)?, self.position(b)?);
+        if let Some((n, _)) = self.nearest_node(c, rounding_eps(c)) {
+            if n != a && n != b {
+                if let Some(piece) = self.reroute_through(e, n)? {
+                    out.split.push((e, piece));
+                }
+            }
+            return Ok(n);
+        }
         let d = pb - pa;
         let t = (c - pa).dot(d) / d.length_squared();
         if c != pa && c != pb && t > 0.0 && t < 1.0 {
@@ -413,7 +427,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 }
                 Some(Event::Node(x)) => targets.push(x),
                 Some(Event::Cross(e, c)) => {
-                    let x = self.split_at_crossing(e, c, cur, target, make_node, out)?;
+                    let x = self.split_or_end(e, c, make_node, out)?;
                     targets.push(x);
                 }
             }
@@ -528,33 +542,6 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             return Err(e);
         }
         Ok(best.map(|(_, ev)| ev))
-    }
-
-    /// Splits edge `e` where it crosses the line `cur → target` at `c`, returning the
-    /// node at the crossing.
-    fn split_at_crossing(
-        &mut self,
-        e: EdgeId,
-        c: DVec2,
-        cur: NodeId,
-        target: NodeId,
-        make_node: &mut impl FnMut(DVec2) -> N,
-        out: &mut Insertion,
-    ) -> Result<NodeId, GeomError> {
-        let (pc, pt) = (self.position(cur)?, self.position(target)?);
-        // The rounded crossing point landed on (or within rounding of) an end of the
-        // current leg: bend the crossed edge through that node instead of creating a
-        // node a few ulps beside it, whose fan of edges would cross the node's own.
-        for (n, pn) in [(cur, pc), (target, pt)] {
-            if c.distance(pn) <= rounding_eps(pn) {
-                let piece = self.reroute_through(e, n)?;
-                if let Some(piece) = piece {
-                    out.split.push((e, piece));
-                }
-                return Ok(n);
-            }
-        }
-        self.split_or_end(e, c, make_node, out)
     }
 
     /// Bends every edge passing within rounding distance of the new node `m` (but not
