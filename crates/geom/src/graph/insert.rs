@@ -354,10 +354,11 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let (a, b) = self.endpoints(e)?;
         let (pa, pb) = (self.position(a)?, self.position(b)?);
         if let Some((n, _)) = self.nearest_node(c, rounding_eps(c)) {
-            if n != a && n != b {
-                if let Some(piece) = self.reroute_through(e, n)? {
-                    out.split.push((e, piece));
-                }
+            if n != a
+                && n != b
+                && let Some(piece) = self.reroute_through(e, n)?
+            {
+                out.split.push((e, piece));
             }
             return Ok(n);
         }
