@@ -22,8 +22,10 @@
 //! points are computed in floating point afterwards, so a split edge may bend by a few
 //! units in the last place. Edges passing within that rounding distance
 //! ([`ROUNDING_TOLERANCE`]) of a new crossing node are bent through it, so several
-//! segments through one point share one node. Every created or split edge is checked
-//! against the edge index before the call returns.
+//! segments through one point share one node; no node is created within that distance of
+//! another (the edge is bent through the existing node), and every piece a split or a bend
+//! creates is bent through any node it passes within that distance of. Every created or
+//! split edge is checked against the edge index before the call returns.
 //!
 //! # Guarantees
 //! * After every successful call the graph is planar in the sense of
@@ -123,9 +125,9 @@ pub struct Insertion {
     pub created: Vec<EdgeId>,
     /// Existing edges split by this call, as `(edge, new piece)`: see
     /// [`PlanarGraph::split_edge`]. The pieces carry clones of the edge's payload. (In the
-    /// rare case that a rounded crossing point lands exactly on an end of the new segment,
-    /// the crossed edge is replaced by two new edges through that node and listed as
-    /// `(removed edge, first new edge)`.)
+    /// rare case that a rounded crossing point lands within rounding of an existing node,
+    /// or a split piece passes within rounding of one, the edge is replaced by new edges
+    /// through that node, each listed as `(removed edge, new edge)`.)
     pub split: Vec<(EdgeId, EdgeId)>,
 }
 
@@ -354,11 +356,8 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let (a, b) = self.endpoints(e)?;
         let (pa, pb) = (self.position(a)?, self.position(b)?);
         if let Some((n, _)) = self.nearest_node(c, rounding_eps(c)) {
-            if n != a
-                && n != b
-                && let Some(piece) = self.reroute_through(e, n)?
-            {
-                out.split.push((e, piece));
+            if n != a && n != b {
+                self.bend_through(e, n, out)?;
             }
             return Ok(n);
         }
@@ -368,6 +367,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             let (m, piece) = self.split_edge(e, c, make_node(c))?;
             out.split.push((e, piece));
             self.absorb_edges_near(m, out)?;
+            self.settle(vec![e, piece], out)?;
             Ok(m)
         } else if c.distance_squared(pa) <= c.distance_squared(pb) {
             Ok(a)
@@ -561,28 +561,76 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 // Passes near m only at its end: two nodes within rounding; leave them.
                 continue;
             }
-            if let Some(piece) = self.reroute_through(near.key, m)? {
-                out.split.push((near.key, piece));
+            self.bend_through(near.key, m, out)?;
+        }
+        Ok(())
+    }
+
+    /// Bends edge `e` through node `n` (see [`reroute_through`](Self::reroute_through)),
+    /// records the new pieces in `out.split`, and settles them.
+    fn bend_through(&mut self, e: EdgeId, n: NodeId, out: &mut Insertion) -> Result<(), GeomError> {
+        let pieces = self.reroute_through(e, n)?;
+        out.split.extend(pieces.iter().map(|&piece| (e, piece)));
+        self.settle(pieces, out)
+    }
+
+    /// Edges made by a split or a bend leave the line of the edge they replace by a few
+    /// units in the last place, and so may pass within rounding of a node they do not end
+    /// at — on its wrong side, where a later edge from that node crosses them. Bends each
+    /// such edge through the node nearest its first end, and its pieces likewise, until no
+    /// edge of the work list passes within rounding of a node it does not end at.
+    fn settle(&mut self, mut work: Vec<EdgeId>, out: &mut Insertion) -> Result<(), GeomError> {
+        let limit = 64 + self.node_count();
+        let mut steps = 0usize;
+        while let Some(e) = work.pop() {
+            if !self.contains_edge(e) {
+                continue;
+            }
+            steps += 1;
+            if steps > limit {
+                return Err(GeomError::GraphCorrupt(format!(
+                    "settling edge {e} through nearby nodes did not converge; check_invariants() may tell why"
+                )));
+            }
+            let (a, b) = self.endpoints(e)?;
+            let (pa, pb) = (self.position(a)?, self.position(b)?);
+            let eps = rounding_eps(pa.abs().max(pb.abs()));
+            let bx = crate::Aabb2::new(pa, pb).expanded(eps);
+            // The least (t, id): independent of the index's candidate order.
+            let mut best: Option<(f64, NodeId)> = None;
+            self.node_index.for_each_candidate(&bx, |n, shape| {
+                let Shape::Point(pn) = *shape else { return };
+                if n == a || n == b || !bx.contains(pn) {
+                    return;
+                }
+                let (closest, t) = closest_point_on_segment(pn, pa, pb);
+                let better = best.is_none_or(|(bt, bn)| (t, n.raw()) < (bt, bn.raw()));
+                if t > 0.0 && t < 1.0 && closest.distance(pn) <= eps && better {
+                    best = Some((t, n));
+                }
+            });
+            if let Some((_, n)) = best {
+                let pieces = self.reroute_through(e, n)?;
+                out.split.extend(pieces.iter().map(|&piece| (e, piece)));
+                work.extend(pieces);
             }
         }
         Ok(())
     }
 
-    /// Replaces edge `e = a–b` by new edges `a–n` and `n–b` (returning the first one
-    /// created), skipping a piece that already exists.
-    fn reroute_through(&mut self, e: EdgeId, n: NodeId) -> Result<Option<EdgeId>, GeomError> {
+    /// Replaces edge `e = a–b` by new edges `a–n` and `n–b`, skipping a piece that already
+    /// exists; returns the edges created.
+    fn reroute_through(&mut self, e: EdgeId, n: NodeId) -> Result<Vec<EdgeId>, GeomError> {
         let (a, b) = self.endpoints(e)?;
         let payload = self.remove_edge(e)?;
-        let mut piece = None;
+        let mut pieces = Vec::with_capacity(2);
         if self.find_edge(a, n).is_none() {
-            let id = self.add_edge(a, n, payload.clone())?;
-            piece = Some(id);
+            pieces.push(self.add_edge(a, n, payload.clone())?);
         }
         if self.find_edge(n, b).is_none() {
-            let id = self.add_edge(n, b, payload)?;
-            piece = piece.or(Some(id));
+            pieces.push(self.add_edge(n, b, payload)?);
         }
-        Ok(piece)
+        Ok(pieces)
     }
 
     /// Checks that the given edges meet other edges only at common end nodes.
