@@ -136,8 +136,13 @@ impl DefaultConstraints {
             self.stats.pruned += 1;
             return Some((a + (b - a) * lo, angle, Span::Ground));
         }
-        // Highways bridge water up to the maximum length.
-        if class == RoadClass::Highway && v.what == Illegal::Water && p.max_bridge_length_m > 0.0 {
+        let under_water = p.tunnel_under_water;
+        // Highways bridge water up to the maximum length (unless they tunnel under it).
+        if class == RoadClass::Highway
+            && v.what == Illegal::Water
+            && p.max_bridge_length_m > 0.0
+            && !under_water
+        {
             let step = self.legality.step();
             let d = dir(angle);
             let mut s = v.t * len;
@@ -173,15 +178,18 @@ impl DefaultConstraints {
             }
             k += 1.0;
         }
-        // Highways pass under land no rotation avoids (a park, a slope) in a tunnel.
+        // Highways pass under land no rotation avoids (a park, a slope) in a tunnel, and
+        // under water where the parameters say so.
         if class == RoadClass::Highway
-            && matches!(v.what, Illegal::Park | Illegal::Slope)
+            && (matches!(v.what, Illegal::Park | Illegal::Slope)
+                || (v.what == Illegal::Water && under_water))
             && let Some(far) = tunnel_landing(
                 &self.legality,
                 a,
                 dir(angle),
                 v.t * len,
                 p.max_tunnel_length_m,
+                under_water,
             )
         {
             self.stats.tunnels += 1;
@@ -395,7 +403,8 @@ impl LocalConstraints for DefaultConstraints {
                         || self.legality.point(end) == Some(Illegal::Water))
             } else if tunnel {
                 // A tunnel ends at its far portal, on legal ground: never inside the hill.
-                len <= self.params.max_tunnel_length_m + 1e-9 && tunnelable(&self.legality, a, end)
+                len <= self.params.max_tunnel_length_m + 1e-9
+                    && tunnelable(&self.legality, a, end, self.params.tunnel_under_water)
             } else {
                 self.legality.segment_ok(a, end)
             };
@@ -408,7 +417,8 @@ impl LocalConstraints for DefaultConstraints {
         // ends at the first road it would cross (a junction on legal ground there, its
         // far portal), or is refused.
         if tunnel && let Some(c) = self.first_crossing(net, start_node, a, end) {
-            if !(a.distance(c) >= min_len && tunnelable(&self.legality, a, c)) {
+            let under_water = self.params.tunnel_under_water;
+            if !(a.distance(c) >= min_len && tunnelable(&self.legality, a, c, under_water)) {
                 self.stats.failed_tunnel += 1;
                 return QueryState::Failed;
             }

@@ -48,7 +48,7 @@
 //! * No road other than a bridge or a tunnel has a legality sample (every
 //!   `legality_step_m`) in water, a park, outside the map or above the slope limit;
 //!   bridges are at most `max_bridge_length_m`, tunnels ([`tunnels`]) at most
-//!   `max_tunnel_length_m` and never under water.
+//!   `max_tunnel_length_m` and under water only with `tunnel_under_water`.
 //! * Deterministic: same parameters, maps and seed give the same graph, ids included.
 //! * Never panics on parameters: [`RoadParams::validate`] rejects bad values with a
 //!   typed [`RoadError`].

@@ -114,6 +114,10 @@ pub struct RoadParams {
     /// legal ground (§3.3: "two tunnel entrances"); longer crossings are refused. 0 turns
     /// tunnels off. Default: 300 m.
     pub max_tunnel_length_m: f64,
+    /// Highways cross water in tunnels (within [`max_tunnel_length_m`](Self::max_tunnel_length_m))
+    /// instead of bridges: for a preset whose city tunnels under its river (§3.3 leaves
+    /// the choice to the geometry stage). Default: false (bridges).
+    pub tunnel_under_water: bool,
     /// Snap radius of the self-sensitive constraints (Kelly's snap size): a segment end
     /// this close to a junction or road is extended to it. Default: 30 m.
     pub snap_radius_m: f64,
@@ -179,6 +183,7 @@ impl Default for RoadParams {
             rotate_step_deg: 5.0,
             max_bridge_length_m: 400.0,
             max_tunnel_length_m: 300.0,
+            tunnel_under_water: false,
             snap_radius_m: 30.0,
             min_angle_deg: 30.0,
             min_segment_length_m: 12.0,

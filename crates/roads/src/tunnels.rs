@@ -15,13 +15,14 @@
 //! which [`tunnelable`]`(a, b)` holds:
 //!
 //! 1. `b` is legal ground (inside the map, no water, no park);
-//! 2. every sample between lies on land — legal or park, never water (water is a
-//!    bridge's) nor outside the map;
+//! 2. every sample between lies on land — legal or park, not outside the map, and not
+//!    water (a bridge's) unless [`RoadParams::tunnel_under_water`](crate::RoadParams::tunnel_under_water)
+//!    lets highways cross water in tunnels instead of on bridges;
 //! 3. the tunnel's own grade, a straight bore between the portals at the ground's height
 //!    there, is within the slope limit;
 //! 4. the ground above the bore is nowhere more than [`COVER_TOLERANCE_M`] below it: a
 //!    tunnel runs *under* its hill or park. A valley (ground falling away under the
-//!    chord) is no tunnel; the highway is refused there.
+//!    chord) is no tunnel; the highway is refused there. (Not tested under water.)
 //!
 //! The walk stops at [`RoadParams::max_tunnel_length_m`](crate::RoadParams::max_tunnel_length_m)
 //! (the whole segment, portal to portal) or at water or the map edge: such a highway is
@@ -38,7 +39,8 @@
 //! ## Guarantees
 //!
 //! * A tunnel is at most `max_tunnel_length_m` long, both its ends are legal ground, no
-//!   sample along it is water or outside the map, its grade is within `max_slope`.
+//!   sample along it is outside the map (nor water, unless `tunnel_under_water`), its
+//!   grade is within `max_slope`.
 //! * A tunnel is never a bridge (`bridge` and `tunnel` are never both set).
 //! * With `max_tunnel_length_m = 0`, or on maps without parks and slopes over the
 //!   limit, the network is the same as without tunnels (tunnels are tried only where
@@ -48,8 +50,8 @@
 //!
 //! * The bore is a straight chord between the portals at ground height; its depth under
 //!   a flat park is not modelled (cut and cover), nor is the inside of the tunnel drawn.
-//! * Only highways tunnel (as only highways bridge). Water is always bridged, never
-//!   tunnelled.
+//! * Only highways tunnel (as only highways bridge). Water is bridged unless
+//!   `tunnel_under_water` is set, and then always tunnelled (no choice per crossing).
 //! * The cells and lots stages see a tunnel as any other road edge (a block boundary);
 //!   Kelly's secondary growth in a cell (`secondary`) may still meet a tunnel edge.
 //!
@@ -79,10 +81,11 @@ pub const PORTAL_WALL_M: f64 = 1.0;
 const PORTAL_FOOT_M: f64 = 1.0;
 
 /// Whether the straight piece `a–b` may be a tunnel: `b` on legal ground, every sample
-/// (every `legality_step_m`) on land (legal or park, not water, not outside), the grade
-/// between the ends within the slope limit and the ground nowhere more than
-/// [`COVER_TOLERANCE_M`] below the straight bore.
-pub fn tunnelable(legality: &Legality, a: DVec2, b: DVec2) -> bool {
+/// (every `legality_step_m`) on land (legal or park, not outside the map; water only
+/// when `under_water`), the grade between the ends within the slope limit and the ground
+/// nowhere more than [`COVER_TOLERANCE_M`] below the straight bore (not tested under
+/// water, whose bed the elevation map need not hold).
+pub fn tunnelable(legality: &Legality, a: DVec2, b: DVec2, under_water: bool) -> bool {
     let len = a.distance(b);
     if !(len.is_finite() && len > 0.0) || legality.point(b).is_some() {
         return false;
@@ -95,9 +98,14 @@ pub fn tunnelable(legality: &Legality, a: DVec2, b: DVec2) -> bool {
     (1..n).all(|i| {
         let t = i as f64 / n as f64;
         let p = a + (b - a) * t;
-        let land = matches!(legality.point(p), None | Some(Illegal::Park));
-        let ground = legality.elevation(p);
-        land && ground.is_finite() && ground >= ha + (hb - ha) * t - COVER_TOLERANCE_M
+        match legality.point(p) {
+            None | Some(Illegal::Park) => {
+                let ground = legality.elevation(p);
+                ground.is_finite() && ground >= ha + (hb - ha) * t - COVER_TOLERANCE_M
+            }
+            Some(Illegal::Water) => under_water,
+            Some(Illegal::Outside | Illegal::Slope) => false,
+        }
     })
 }
 
@@ -106,13 +114,14 @@ pub fn tunnelable(legality: &Legality, a: DVec2, b: DVec2) -> bool {
 /// legality step past a legal sample with [`tunnelable`]`(a, b)` and climbable ground
 /// for [`RoadParams::slope_step_m`](crate::RoadParams::slope_step_m) beyond, at most `max_len`
 /// metres from `a`. `None` when there is none (the crossing is too long, reaches water
-/// or the map edge, or is a valley).
+/// or the map edge, or is a valley). Water ends the search unless `under_water`.
 pub fn tunnel_landing(
     legality: &Legality,
     a: DVec2,
     d: DVec2,
     s0: f64,
     max_len: f64,
+    under_water: bool,
 ) -> Option<DVec2> {
     let step = legality.step();
     if !(max_len > 0.0 && step > 0.0 && s0.is_finite()) {
@@ -122,14 +131,15 @@ pub fn tunnel_landing(
     while s + step <= max_len {
         s += step;
         match legality.point(a + d * s) {
-            Some(Illegal::Water | Illegal::Outside) => return None,
-            Some(Illegal::Park | Illegal::Slope) => {}
+            Some(Illegal::Outside) => return None,
+            Some(Illegal::Water) if !under_water => return None,
+            Some(Illegal::Water | Illegal::Park | Illegal::Slope) => {}
             None => {
                 let b = a + d * (s + step).min(max_len);
                 // The portal opens onto ground a road can climb, not onto the hill's flank.
                 let ahead = legality.segment(b, b + d * legality.slope_step());
                 let flank = ahead.is_some_and(|v| v.what == Illegal::Slope);
-                if !flank && tunnelable(legality, a, b) {
+                if !flank && tunnelable(legality, a, b, under_water) {
                     return Some(b);
                 }
             }

@@ -63,7 +63,7 @@ fn a_highway_meeting_a_park_becomes_a_tunnel() {
         None,
         "the far portal is on legal ground"
     );
-    assert!(tunnelable(&legality, r.start, r.end));
+    assert!(tunnelable(&legality, r.start, r.end, false));
     // Streets never tunnel.
     let mut c = DefaultConstraints::new(&p, &inputs);
     let mut st = RoadAttr::new(DVec2::new(95.0, 0.0), 0.0, 90.0, RoadClass::Street);
@@ -189,6 +189,38 @@ fn water_stays_bridged() {
     assert_eq!(s, QueryState::Failed, "{r:?}");
 }
 
+#[test]
+fn water_is_tunnelled_where_the_parameters_say_so() {
+    let mut inputs = RoadInputs::flat(Arc::new(Constant(0.5)));
+    inputs.water = Arc::new(FnField::new(|p: DVec2| {
+        if (100.0..=200.0).contains(&p.x) {
+            1.0
+        } else {
+            0.0
+        }
+    }));
+    let p = RoadParams {
+        tunnel_under_water: true,
+        ..RoadParams::default()
+    };
+    let (s, r, stats) = propose(&p, &inputs, (95.0, 0.0), 90.0);
+    assert_eq!(s, QueryState::Succeed);
+    assert!(r.tunnel && !r.bridge, "{r:?}");
+    assert!(r.end.x > 200.0 && r.length <= p.max_tunnel_length_m);
+    assert_eq!((stats.bridges, stats.tunnels), (0, 1));
+    let legality = Legality::new(&inputs, &p);
+    assert!(tunnelable(&legality, r.start, r.end, true));
+    assert!(!tunnelable(&legality, r.start, r.end, false));
+    // Over the tunnel limit: refused, not bridged.
+    let p = RoadParams {
+        max_tunnel_length_m: 80.0,
+        ..p
+    };
+    let (s, _, stats) = propose(&p, &inputs, (95.0, 0.0), 90.0);
+    assert_eq!(s, QueryState::Failed);
+    assert_eq!((stats.bridges, stats.tunnels), (0, 0));
+}
+
 /// A whole network across a park strip from x = 300 to 450 (highways start at the
 /// origin, heading east and west).
 fn city(inputs: &RoadInputs, max_tunnel_length_m: f64) -> Generated {
@@ -226,7 +258,7 @@ fn a_city_tunnels_under_its_park_and_nothing_meets_the_tunnel() {
         assert!(!r.bridge && r.class == RoadClass::Highway);
         assert!(net.edge_length(e).unwrap() <= 300.0 + 1e-9);
         let (a, b) = net.segment(e).unwrap();
-        assert!(tunnelable(&legality, a, b) || tunnelable(&legality, b, a));
+        assert!(tunnelable(&legality, a, b, false) || tunnelable(&legality, b, a, false));
         // Both ends on legal ground: no road joins the tunnel inside the park.
         for n in [u, v] {
             assert_eq!(legality.point(net.position(n).unwrap()), None);
@@ -278,7 +310,7 @@ fn a_city_tunnels_through_its_ridge() {
     assert!(!t.is_empty());
     for (a, b) in t {
         assert!(
-            tunnelable(&legality, a, b) || tunnelable(&legality, b, a),
+            tunnelable(&legality, a, b, false) || tunnelable(&legality, b, a, false),
             "{a} {b}: {} {}",
             legality.elevation(a),
             legality.elevation(b)
@@ -332,7 +364,7 @@ proptest! {
         if s == QueryState::Succeed && r.tunnel {
             prop_assert!(!r.bridge);
             prop_assert!(r.length <= limit + 1e-9);
-            prop_assert!(tunnelable(&legality, r.start, r.end));
+            prop_assert!(tunnelable(&legality, r.start, r.end, false));
         }
         if s == QueryState::Succeed && !r.tunnel {
             prop_assert!(legality.segment_ok(r.start, r.end));
