@@ -115,6 +115,7 @@ impl RoadStage for GridRoads {
                             class,
                             width,
                             bridge: false,
+                            tunnel: false,
                             step: 0,
                         },
                     )?;

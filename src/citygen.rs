@@ -979,6 +979,7 @@ fn close_with_map_edge(net: &mut RoadNetwork, size_m: f64) -> Result<()> {
         class: RoadClass::Highway,
         width: 16.0,
         bridge: false,
+        tunnel: false,
         step: 0,
     };
     for i in 0..4 {
@@ -1034,6 +1035,7 @@ fn rings_network(
         class: RoadClass::Highway,
         width,
         bridge: false,
+        tunnel: false,
         step: 0,
     };
     let add = |net: &mut RoadNetwork, a: DVec2, b: DVec2, w: f64| -> Result<()> {

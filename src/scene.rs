@@ -116,6 +116,7 @@ pub(crate) fn map_roads(network: &RoadNetwork) -> Result<Vec<MapRoad>> {
             },
             width_m: road.width,
             bridge: road.bridge,
+            tunnel: road.tunnel,
         });
     }
     Ok(roads)
@@ -440,7 +441,12 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         if !(inp.config.scene.road_surfaces && inp.network.edge_count() > 0) {
             return Ok(None);
         }
-        let roads = map_roads(inp.network)?;
+        // No surface between a tunnel's portals (polis_roads::tunnels).
+        let mut roads = map_roads(inp.network)?;
+        roads.retain(|r| !r.tunnel);
+        if roads.is_empty() {
+            return Ok(None);
+        }
         Ok(Some(road_surface_parts(
             &roads,
             elevation,
@@ -637,6 +643,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         let concrete = Material::new("bridge", [0.62, 0.60, 0.57, 1.0]);
         mesh.material = Some(scene.add_material(concrete));
         let node = scene.add_node(root, "bridges")?;
+        let mesh = scene.add_mesh(mesh);
+        scene.attach_mesh(node, mesh)?;
+    }
+    // Tunnels: a concrete frame at each portal (the road surface stops there).
+    if let Some(mut mesh) = polis_roads::portal_mesh(inp.network, elevation)? {
+        let concrete = Material::new("tunnel portal", [0.55, 0.54, 0.52, 1.0]);
+        mesh.material = Some(scene.add_material(concrete));
+        let node = scene.add_node(root, "tunnel portals")?;
         let mesh = scene.add_mesh(mesh);
         scene.attach_mesh(node, mesh)?;
     }

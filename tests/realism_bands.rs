@@ -13,8 +13,10 @@
 //! BENCHMARKS.md then). After the plan-defect work of issue 19 (fringe stubs pruned,
 //! park maps in `default`, `old_town` and `san_francisco`): `default` seed 3 is in band
 //! now, seed 2 still misses k̄ and both shares; pruning lowers the dead-end share
-//! (`old_town` 1 and 4) and the parks bend the streets (circuity of `old_town` 2–4, the
-//! median segment of `san_francisco` 2). Retuning the presets for both remains.
+//! (`old_town` 1 and 4) and the parks bend the streets (circuity of `old_town` 2–4).
+//! Retuning the presets for both remains. `san_francisco` seed 2's median segment
+//! (69.6 m against 94.4 ± 25 %) is in band since tunnels (issue 27): highways pass under
+//! the hills they used to stop at (72.5 m).
 //!
 //! `default` is not deterministic on this branch: runs of the same build give one of
 //! two sets of misses (seed 2 k̄ and both shares; or seed 2 circuity and seeds 3 and 5
@@ -64,7 +66,6 @@ const KNOWN_MISSES: &[(&str, u64, &str)] = &[
     ("old_town", 3, "circuity"),
     ("old_town", 4, "P_deadend"),
     ("old_town", 4, "circuity"),
-    ("san_francisco", 2, "median_seg_len_m"),
 ];
 
 /// Presets whose misses vary between runs (see the module documentation): a listed

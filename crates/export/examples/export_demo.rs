@@ -156,6 +156,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             class,
             width_m,
             bridge,
+            tunnel: false,
         });
     }
     // The roads meet where they share a point (the crossing at (50, 0), the T at

@@ -8,7 +8,7 @@
 //! | parks | `Polygon` | `layer: "park"` |
 //! | blocks | `Polygon` | `layer: "block"`, `id` |
 //! | lots | `Polygon` | `layer: "lot"`, `id`, `block` (or `null`) |
-//! | roads | `LineString` | `layer: "road"`, `id`, `class`, `width_m`, `bridge` |
+//! | roads | `LineString` | `layer: "road"`, `id`, `class`, `width_m`, `bridge`, `tunnel` |
 //! | footprints | `Polygon` | `layer: "building"`, `id`, `kind`, `height_m`, `floors`, `lot` |
 //!
 //! Every feature also has a top-level `id` `"<layer>-<id>"` (`"<layer>-<index>"` for water
@@ -241,6 +241,7 @@ pub fn write_geojson<W: Write>(
                     class: r.class.as_str(),
                     width_m: r.width_m,
                     bridge: r.bridge,
+                    tunnel: r.tunnel,
                 },
             })?;
         }
@@ -339,6 +340,7 @@ struct RoadProps<'a> {
     class: &'a str,
     width_m: f64,
     bridge: bool,
+    tunnel: bool,
 }
 
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]

@@ -116,10 +116,14 @@ pub struct MapRoad {
     pub width_m: f64,
     /// Whether the road is a bridge (over water).
     pub bridge: bool,
+    /// Whether the road is a tunnel (under a park or a hill, between two portals): no
+    /// road surface is drawn for it; maps draw it dashed. Default: `false`.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub tunnel: bool,
 }
 
 impl MapRoad {
-    /// A road that is not a bridge, with id 0.
+    /// A road that is neither a bridge nor a tunnel, with id 0.
     pub fn new(points: Vec<DVec2>, class: RoadClass, width_m: f64) -> Self {
         MapRoad {
             id: 0,
@@ -127,6 +131,7 @@ impl MapRoad {
             class,
             width_m,
             bridge: false,
+            tunnel: false,
         }
     }
 }

@@ -194,6 +194,7 @@ fn map() -> impl Strategy<Value = MapLayers> {
                     class,
                     width_m,
                     bridge,
+                    tunnel: false,
                 })
                 .collect(),
             footprints: footprints

@@ -1,7 +1,8 @@
 //! SVG map writer.
 //!
 //! [`write_svg`] draws a [`MapLayers`] as a plan: water, parks, blocks, lots, roads (by
-//! class, at their true width, bridges with a casing, larger classes over smaller ones) and
+//! class, at their true width, bridges with a casing, tunnels dashed under everything
+//! else, larger classes over smaller ones) and
 //! building footprints coloured by kind. One SVG user unit is one metre; the `y` axis is
 //! flipped so that north (layout `+y`) is up; the drawing is translated so that the
 //! selected layers' bounding box plus a margin starts at `(0, 0)`.
@@ -165,6 +166,11 @@ impl Default for SvgOptions {
 
 /// The largest [`SvgOptions::decimals`].
 pub const MAX_DECIMALS: u8 = 6;
+
+/// Length of a tunnel's dashes in the plan, metres.
+pub const TUNNEL_DASH_M: f64 = 8.0;
+/// Gap between a tunnel's dashes in the plan, metres.
+pub const TUNNEL_GAP_M: f64 = 6.0;
 
 /// Writes `map` as an SVG image to `out`.
 ///
@@ -348,9 +354,13 @@ impl<W: Write> SvgWriter<W> {
             self.out,
             r#"<g id="roads" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
         )?;
-        // Bridges over everything, larger classes over smaller; input order otherwise.
+        // Tunnels under everything, bridges over everything, larger classes over smaller;
+        // input order otherwise.
         let mut order: Vec<usize> = (0..map.roads.len()).collect();
-        order.sort_by_key(|&i| (map.roads[i].bridge, map.roads[i].class.rank()));
+        order.sort_by_key(|&i| {
+            let r = &map.roads[i];
+            (r.bridge, !r.tunnel, r.class.rank())
+        });
         for i in order {
             let r = &map.roads[i];
             if r.bridge {
@@ -366,9 +376,20 @@ impl<W: Write> SvgWriter<W> {
             }
             let width = self.fmt(r.width_m);
             let bridge = if r.bridge { " bridge" } else { "" };
+            // A tunnel: dashes of TUNNEL_DASH_M every TUNNEL_DASH_M + TUNNEL_GAP_M.
+            let tunnel = if r.tunnel {
+                format!(
+                    r#" stroke-dasharray="{} {}" stroke-linecap="butt""#,
+                    self.fmt(TUNNEL_DASH_M),
+                    self.fmt(TUNNEL_GAP_M)
+                )
+            } else {
+                String::new()
+            };
+            let class = if r.tunnel { " tunnel" } else { "" };
             write!(
                 self.out,
-                r#"<path data-id="{}" class="{}{bridge}" stroke="{}" stroke-width="{width}" d=""#,
+                r#"<path data-id="{}" class="{}{bridge}{class}" stroke="{}" stroke-width="{width}"{tunnel} d=""#,
                 r.id,
                 esc(r.class.as_str()),
                 esc(s.road(&r.class))

@@ -460,6 +460,7 @@ pub fn sample_map() -> crate::map::MapLayers {
         class,
         width_m: w,
         bridge,
+        tunnel: false,
     };
     m.roads.push(road(
         1,

@@ -1,4 +1,4 @@
-//! Local constraints (§3.3, §3.3.1): legality (prune, bridge, rotate) and
+//! Local constraints (§3.3, §3.3.1): legality (prune, bridge, rotate, tunnel) and
 //! self-sensitivity (crossings, snapping to junctions and roads, minimum angles).
 
 use polis_geom::{DVec2, NodeId};
@@ -10,14 +10,34 @@ use crate::modules::{QueryState, RoadAttr};
 use crate::network::{RoadClass, RoadNetwork, angle_diff, angle_of, dir};
 use crate::params::RoadParams;
 use crate::snap::{SnapEvent, SnapQuery, snap};
+use crate::tunnels::{tunnel_landing, tunnelable};
+
+/// Why a snap event was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Refusal {
+    /// Below the minimum angle.
+    Angle,
+    /// On a tunnel between its portals.
+    Tunnel,
+}
+
+/// What a legal segment crosses: its own ground, water (a bridge) or land under a
+/// tunnel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Span {
+    Ground,
+    Bridge,
+    Tunnel,
+}
 
 /// The `localConstraints` function of p8: adjust a proposed segment to the environment
 /// and the existing network, or reject it.
 ///
 /// On [`QueryState::Succeed`] the generator inserts `road.start → road.end` into the
-/// network (planar insertion: crossings become junctions), flagged with `road.bridge`.
+/// network (planar insertion: crossings become junctions), flagged with `road.bridge` or
+/// `road.tunnel`.
 pub trait LocalConstraints: Send {
-    /// Adjusts `road` (its `end`, `angle`, `length`, `bridge`, `snapped`) and returns
+    /// Adjusts `road` (its `end`, `angle`, `length`, `bridge`, `tunnel`, `snapped`) and returns
     /// `Succeed` or `Failed`.
     fn adjust(&mut self, road: &mut RoadAttr, network: &RoadNetwork) -> QueryState;
 
@@ -38,6 +58,9 @@ pub struct ConstraintStats {
     pub rotated: usize,
     /// Highway segments turned into bridges.
     pub bridges: usize,
+    /// Highway segments turned into tunnels ([`crate::tunnels`]).
+    #[serde(default)]
+    pub tunnels: usize,
     /// Segments ended at a crossing with an existing road.
     pub crossings: usize,
     /// Segments extended or shortened to an existing junction.
@@ -50,6 +73,9 @@ pub struct ConstraintStats {
     pub failed_angle: usize,
     /// Rejected: too short after adjustment.
     pub failed_short: usize,
+    /// Rejected: would join or cross a tunnel between its portals.
+    #[serde(default)]
+    pub failed_tunnel: usize,
 }
 
 /// The default local constraints of Parish & Müller with Kelly's snap algorithm.
@@ -78,18 +104,18 @@ impl DefaultConstraints {
         &self.legality
     }
 
-    /// Step 1 of §3.3: make the segment legal (prune, bridge, rotate). Returns the new
-    /// end and whether it is a bridge, or `None`.
+    /// Step 1 of §3.3: make the segment legal (prune, bridge, rotate, tunnel). Returns
+    /// the new end and angle and what the segment crosses, or `None`.
     fn make_legal(
         &mut self,
         a: DVec2,
         angle: f64,
         len: f64,
         class: RoadClass,
-    ) -> Option<(DVec2, f64, bool)> {
+    ) -> Option<(DVec2, f64, Span)> {
         let b = a + dir(angle) * len;
         let Some(v) = self.legality.segment(a, b) else {
-            return Some((b, angle, false));
+            return Some((b, angle, Span::Ground));
         };
         let p = &self.params;
         // Prune to the last legal sample, refined by bisection toward the violation.
@@ -108,10 +134,15 @@ impl DefaultConstraints {
         if pruned >= (1.0 - p.max_prune_factor) * len && pruned >= p.min_segment_length_m.max(1e-3)
         {
             self.stats.pruned += 1;
-            return Some((a + (b - a) * lo, angle, false));
+            return Some((a + (b - a) * lo, angle, Span::Ground));
         }
-        // Highways bridge water up to the maximum length.
-        if class == RoadClass::Highway && v.what == Illegal::Water && p.max_bridge_length_m > 0.0 {
+        let under_water = p.tunnel_under_water;
+        // Highways bridge water up to the maximum length (unless they tunnel under it).
+        if class == RoadClass::Highway
+            && v.what == Illegal::Water
+            && p.max_bridge_length_m > 0.0
+            && !under_water
+        {
             let step = self.legality.step();
             let d = dir(angle);
             let mut s = v.t * len;
@@ -121,7 +152,7 @@ impl DefaultConstraints {
                     let landing = a + d * (s + step).min(p.max_bridge_length_m);
                     if self.legality.bridgeable(a, landing) {
                         self.stats.bridges += 1;
-                        return Some((landing, angle, true));
+                        return Some((landing, angle, Span::Bridge));
                     }
                     break;
                 }
@@ -142,10 +173,27 @@ impl DefaultConstraints {
                 let e = a + dir(ang) * len;
                 if self.legality.segment_ok(a, e) {
                     self.stats.rotated += 1;
-                    return Some((e, ang, false));
+                    return Some((e, ang, Span::Ground));
                 }
             }
             k += 1.0;
+        }
+        // Highways pass under land no rotation avoids (a park, a slope) in a tunnel, and
+        // under water where the parameters say so.
+        if class == RoadClass::Highway
+            && (matches!(v.what, Illegal::Park | Illegal::Slope)
+                || (v.what == Illegal::Water && under_water))
+            && let Some(far) = tunnel_landing(
+                &self.legality,
+                a,
+                dir(angle),
+                v.t * len,
+                p.max_tunnel_length_m,
+                under_water,
+            )
+        {
+            self.stats.tunnels += 1;
+            return Some((far, angle, Span::Tunnel));
         }
         self.stats.failed_illegal += 1;
         None
@@ -183,7 +231,7 @@ impl DefaultConstraints {
 impl DefaultConstraints {
     /// Kelly's snap of `a → end` for a road of `class` leaving `start_node`: `Ok(None)`
     /// when nothing is near, `Ok(Some(event))` for an event meeting the minimum angle,
-    /// `Err(())` for one below it.
+    /// `Err` for one below it or one on a tunnel edge.
     fn snap_event(
         &self,
         net: &RoadNetwork,
@@ -191,7 +239,7 @@ impl DefaultConstraints {
         a: DVec2,
         end: DVec2,
         class: RoadClass,
-    ) -> Result<Option<SnapEvent>, ()> {
+    ) -> Result<Option<SnapEvent>, Refusal> {
         let q = SnapQuery {
             a,
             b: end,
@@ -205,13 +253,49 @@ impl DefaultConstraints {
         let Some(ev) = snap(net, &q) else {
             return Ok(None);
         };
+        // Nothing joins or crosses a tunnel between its portals.
+        if let SnapEvent::Cross { edge, .. } | SnapEvent::Road { edge, .. } = ev
+            && net.edge_payload(edge).is_ok_and(|r| r.tunnel)
+        {
+            return Err(Refusal::Tunnel);
+        }
         let ok = match ev {
             SnapEvent::Junction { node, .. } => self.angle_ok_at(net, node, a),
             SnapEvent::Cross { edge, .. } | SnapEvent::Road { edge, .. } => {
                 self.angle_ok_edge(net, edge, a, ev.point())
             }
         };
-        if ok { Ok(Some(ev)) } else { Err(()) }
+        if ok {
+            Ok(Some(ev))
+        } else {
+            Err(Refusal::Angle)
+        }
+    }
+
+    /// The first crossing of `a → b` with any road of `net`, or junction on it, before
+    /// `b` (the start junction excluded), or `None`.
+    fn first_crossing(
+        &self,
+        net: &RoadNetwork,
+        start_node: Option<NodeId>,
+        a: DVec2,
+        b: DVec2,
+    ) -> Option<DVec2> {
+        let q = SnapQuery {
+            a,
+            b,
+            radius: 0.0,
+            start_node,
+            only: None,
+        };
+        match snap(net, &q) {
+            Some(SnapEvent::Cross { point, .. } | SnapEvent::Junction { point, .. })
+                if point.distance(b) > SAME_POINT_M =>
+            {
+                Some(point)
+            }
+            _ => None,
+        }
     }
 
     fn count_snap(&mut self, ev: &SnapEvent) {
@@ -259,17 +343,18 @@ impl LocalConstraints for DefaultConstraints {
                 road.angle = angle_of(end - a);
                 road.length = len;
                 road.bridge = false;
+                road.tunnel = false;
                 road.snapped = true;
                 road.crossed = matches!(ev, SnapEvent::Cross { .. });
                 return QueryState::Succeed;
             }
         }
         // Step 1: legality.
-        let Some((mut end, angle, bridge)) =
-            self.make_legal(a, road.angle, road.length, road.class)
+        let Some((mut end, angle, span)) = self.make_legal(a, road.angle, road.length, road.class)
         else {
             return QueryState::Failed;
         };
+        let (bridge, tunnel) = (span == Span::Bridge, span == Span::Tunnel);
         if let Some(s) = start_node
             && !self.angle_ok_at(net, s, end)
         {
@@ -285,8 +370,12 @@ impl LocalConstraints for DefaultConstraints {
         let mut snapped = false;
         let mut crossed = false;
         match event {
-            Err(()) => {
+            Err(Refusal::Angle) => {
                 self.stats.failed_angle += 1;
+                return QueryState::Failed;
+            }
+            Err(Refusal::Tunnel) => {
+                self.stats.failed_tunnel += 1;
                 return QueryState::Failed;
             }
             Ok(Some(ev)) => {
@@ -303,13 +392,19 @@ impl LocalConstraints for DefaultConstraints {
             return QueryState::Failed;
         }
         let max_bridge = self.params.max_bridge_length_m;
-        // A bridge cut short before the water is an ordinary road.
-        let bridge = bridge && !(snapped && self.legality.segment_ok(a, end));
+        // A bridge cut short before the water, or a tunnel before the park or hill, is an
+        // ordinary road.
+        let on_ground = snapped && (bridge || tunnel) && self.legality.segment_ok(a, end);
+        let (bridge, tunnel) = (bridge && !on_ground, tunnel && !on_ground);
         if snapped {
             let legal = if bridge {
                 len <= max_bridge + 1e-9
                     && (self.legality.bridgeable(a, end)
                         || self.legality.point(end) == Some(Illegal::Water))
+            } else if tunnel {
+                // A tunnel ends at its far portal, on legal ground: never inside the hill.
+                len <= self.params.max_tunnel_length_m + 1e-9
+                    && tunnelable(&self.legality, a, end, self.params.tunnel_under_water)
             } else {
                 self.legality.segment_ok(a, end)
             };
@@ -318,10 +413,23 @@ impl LocalConstraints for DefaultConstraints {
                 return QueryState::Failed;
             }
         }
+        // Highways snap to highways only, but a tunnel passes under no road at all: it
+        // ends at the first road it would cross (a junction on legal ground there, its
+        // far portal), or is refused.
+        if tunnel && let Some(c) = self.first_crossing(net, start_node, a, end) {
+            let under_water = self.params.tunnel_under_water;
+            if !(a.distance(c) >= min_len && tunnelable(&self.legality, a, c, under_water)) {
+                self.stats.failed_tunnel += 1;
+                return QueryState::Failed;
+            }
+            (end, snapped, crossed) = (c, true, true);
+        }
+        let len = a.distance(end);
         road.end = end;
         road.angle = if snapped { angle_of(end - a) } else { angle };
         road.length = len;
         road.bridge = bridge;
+        road.tunnel = tunnel;
         road.snapped = snapped;
         road.crossed = crossed;
         QueryState::Succeed
@@ -441,6 +549,7 @@ mod tests {
             class: RoadClass::Street,
             width: 8.0,
             bridge: false,
+            tunnel: false,
             step: 0,
         };
         n.insert_segment(

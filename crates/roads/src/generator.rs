@@ -122,6 +122,7 @@ impl RoadEnv<'_> {
                 RoadClass::Street => self.params.street_width_m,
             },
             bridge: road.bridge,
+            tunnel: road.tunnel,
             step: self.step,
         };
         let step = self.step;

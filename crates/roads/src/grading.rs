@@ -168,7 +168,7 @@ pub struct GradedPiece {
     pub hb: f64,
     /// Half the road's width, metres.
     pub half_width: f64,
-    /// A bridge piece (leaves the ground alone).
+    /// A bridge or tunnel piece (leaves the ground alone).
     pub bridge: bool,
     /// The road's class.
     pub class: RoadClass,
@@ -259,11 +259,11 @@ fn profile(network: &RoadNetwork, ground: &dyn Field, params: &GradeParams) -> R
             *slot = points.len() as u32;
         }
         points.push(p);
-        // A junction is a source unless every road at it is a bridge.
+        // A junction is a source unless every road at it is a bridge (or a tunnel).
         let all_bridges = network
             .edges_at(n)?
             .iter()
-            .all(|&e| network.edge_payload(e).map(|r| r.bridge).unwrap_or(false));
+            .all(|&e| network.edge_payload(e).is_ok_and(|r| r.bridge || r.tunnel));
         source.push(!all_bridges || network.degree(n)? == 0);
     }
     let mut edges = Vec::new();
@@ -281,7 +281,9 @@ fn profile(network: &RoadNetwork, ground: &dyn Field, params: &GradeParams) -> R
         let pieces = ((len / params.sample_m).ceil() as usize).clamp(1, 1 << 20);
         let grade = params.max_grade(road.class);
         let r = roads.len();
-        roads.push((road.class, 0.5 * road.width.max(0.0), road.bridge));
+        // A tunnel leaves the ground above it alone, as a bridge the ground below.
+        let off_ground = road.bridge || road.tunnel;
+        roads.push((road.class, 0.5 * road.width.max(0.0), off_ground));
         let mut prev = ia;
         for k in 1..=pieces {
             let next = if k == pieces {
@@ -289,7 +291,7 @@ fn profile(network: &RoadNetwork, ground: &dyn Field, params: &GradeParams) -> R
             } else {
                 let p = pa.lerp(pb, k as f64 / pieces as f64);
                 points.push(p);
-                source.push(!road.bridge);
+                source.push(!off_ground);
                 (points.len() - 1) as u32
             };
             edges.push((prev, next, grade * len / pieces as f64, r));

@@ -193,6 +193,21 @@ impl Legality {
     pub fn step(&self) -> f64 {
         self.step
     }
+
+    /// Ground elevation at `p`, metres (NaN where the map has none).
+    pub fn elevation(&self, p: DVec2) -> f64 {
+        self.inputs.elevation.sample(p)
+    }
+
+    /// The baseline over which slope is measured, metres.
+    pub fn slope_step(&self) -> f64 {
+        self.slope_step
+    }
+
+    /// The slope limit (rise over run).
+    pub fn max_slope(&self) -> f64 {
+        self.max_slope
+    }
 }
 
 /// The inner box of [`Legality::flat_inner`], or `None` unless water and parks are

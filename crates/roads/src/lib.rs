@@ -22,6 +22,7 @@
 //! | [`LocalConstraints`], [`DefaultConstraints`] | `localConstraints` of p8 |
 //! | [`RoadGenerator`], [`generate`], [`generate_default`] | run the L-system |
 //! | [`RoadNetwork`], [`Junction`], [`Road`], [`RoadClass`] | the output |
+//! | [`tunnels`]: [`Portal`], [`portals`], [`portal_mesh`] | highways under parks and hills (P&M §3.3's "two tunnel entrances") |
 //! | [`StreetRules`] | per pattern: branching, crossroads or T, culs-de-sac, curved links of several segments, spread of street lengths |
 //! | [`modules`] | the modules `R`, `B`, `?I` and productions p1–p9 |
 //! | [`primary`]: [`PrimaryNetwork`], [`PrimaryEditor`] | Kelly's primary network: adaptive roads over terrain, validity-checked edits, undo (Citygen §4.2, §5.3) |
@@ -44,8 +45,10 @@
 //!
 //! * The network is always a valid planar straight-line graph (insertion through
 //!   `PlanarGraph::insert_segment`, which splits at every crossing with exact predicates).
-//! * No non-bridge road has a legality sample (every `legality_step_m`) in water, a park,
-//!   outside the map or above the slope limit; bridges are at most `max_bridge_length_m`.
+//! * No road other than a bridge or a tunnel has a legality sample (every
+//!   `legality_step_m`) in water, a park, outside the map or above the slope limit;
+//!   bridges are at most `max_bridge_length_m`, tunnels ([`tunnels`]) at most
+//!   `max_tunnel_length_m` and under water only with `tunnel_under_water`.
 //! * Deterministic: same parameters, maps and seed give the same graph, ids included.
 //! * Never panics on parameters: [`RoadParams::validate`] rejects bad values with a
 //!   typed [`RoadError`].
@@ -54,8 +57,9 @@
 //!
 //! * Legality is sampled (every `legality_step_m`, default 5 m; slope over `slope_step_m`): a sliver of water
 //!   thinner than that can be missed.
-//! * Streets do not lower the population around them (the open-L-system feedback the
-//!   paper mentions); the population threshold alone stops them.
+//! * Streets lower the population around them (the open-L-system feedback the paper
+//!   mentions, [`PopulationFeedback`]) only with `population_feedback` above 0 (off by
+//!   default); otherwise the population threshold alone stops them.
 //! * The turtle modules `+F` and the brackets of p5 are not kept in the string (see
 //!   [`modules`]).
 //! * Roads stop where a proposal fails (illegal with no prune/rotate/bridge variant, or
@@ -96,6 +100,7 @@ pub mod secondary;
 pub mod smooth;
 pub mod snap;
 pub mod street_rules;
+pub mod tunnels;
 
 pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 pub use error::{Result, RoadError, RoadsError};
@@ -113,3 +118,4 @@ pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_
 pub use params::{Pattern, RoadParams};
 pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};
 pub use street_rules::{BranchChoice, StreetRules};
+pub use tunnels::{Portal, portal_mesh, portals};

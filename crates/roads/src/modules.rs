@@ -100,6 +100,9 @@ pub struct RoadAttr {
     pub end: DVec2,
     /// Set by the local constraints: the segment crosses water (a bridge).
     pub bridge: bool,
+    /// Set by the local constraints: the segment passes under illegal land (a park, a
+    /// slope over the limit) between two portals (a tunnel, [`crate::tunnels`]).
+    pub tunnel: bool,
     /// Set by the local constraints: the segment was connected to an existing road or
     /// junction (a crossing); the road stops growing (§3.3.1).
     pub snapped: bool,
@@ -119,6 +122,7 @@ impl RoadAttr {
             class,
             end: start + crate::network::dir(angle) * length,
             bridge: false,
+            tunnel: false,
             snapped: false,
             crossed: false,
         }

@@ -31,6 +31,13 @@ pub struct Road {
     /// geometry stage. Such a road is never longer than
     /// [`RoadParams::max_bridge_length_m`](crate::RoadParams::max_bridge_length_m).
     pub bridge: bool,
+    /// `true` when the road passes under illegal land (a park, a slope over the limit)
+    /// between two portals: a tunnel ([`crate::tunnels`]), never longer than
+    /// [`RoadParams::max_tunnel_length_m`](crate::RoadParams::max_tunnel_length_m); no
+    /// other road meets it between its ends. Never set together with `bridge`.
+    /// Default (serde): `false`.
+    #[serde(default)]
+    pub tunnel: bool,
     /// Derivation step of the L-system at which the segment was created.
     pub step: u32,
 }
@@ -52,6 +59,8 @@ pub struct NetworkStats {
     pub street_length_m: f64,
     /// Total bridge length, metres.
     pub bridge_length_m: f64,
+    /// Total tunnel length, metres.
+    pub tunnel_length_m: f64,
     /// Junctions of degree 1 (dead ends).
     pub dead_ends: usize,
 }
@@ -71,6 +80,9 @@ pub fn network_stats(network: &RoadNetwork) -> NetworkStats {
         }
         if road.bridge {
             s.bridge_length_m += len;
+        }
+        if road.tunnel {
+            s.tunnel_length_m += len;
         }
     }
     s.dead_ends = network

@@ -109,6 +109,15 @@ pub struct RoadParams {
     pub rotate_step_deg: f64,
     /// Highways may cross water with segments (flagged `bridge`) up to this long. Default: 400 m.
     pub max_bridge_length_m: f64,
+    /// Highways may pass under illegal land (a park, a slope over [`max_slope`](Self::max_slope))
+    /// with segments (flagged `tunnel`) up to this long, where no rotation keeps them on
+    /// legal ground (§3.3: "two tunnel entrances"); longer crossings are refused. 0 turns
+    /// tunnels off. Default: 300 m.
+    pub max_tunnel_length_m: f64,
+    /// Highways cross water in tunnels (within [`max_tunnel_length_m`](Self::max_tunnel_length_m))
+    /// instead of bridges: for a preset whose city tunnels under its river (§3.3 leaves
+    /// the choice to the geometry stage). Default: false (bridges).
+    pub tunnel_under_water: bool,
     /// Snap radius of the self-sensitive constraints (Kelly's snap size): a segment end
     /// this close to a junction or road is extended to it. Default: 30 m.
     pub snap_radius_m: f64,
@@ -173,6 +182,8 @@ impl Default for RoadParams {
             max_rotate_deg: 30.0,
             rotate_step_deg: 5.0,
             max_bridge_length_m: 400.0,
+            max_tunnel_length_m: 300.0,
+            tunnel_under_water: false,
             snap_radius_m: 30.0,
             min_angle_deg: 30.0,
             min_segment_length_m: 12.0,
@@ -273,6 +284,7 @@ impl RoadParams {
         nonneg("street_width_m", self.street_width_m)?;
         nonneg("max_slope", self.max_slope)?;
         nonneg("max_bridge_length_m", self.max_bridge_length_m)?;
+        nonneg("max_tunnel_length_m", self.max_tunnel_length_m)?;
         nonneg("snap_radius_m", self.snap_radius_m)?;
         nonneg("min_segment_length_m", self.min_segment_length_m)?;
         nonneg("street_deviation_deg", self.street_deviation_deg)?;
@@ -380,6 +392,7 @@ impl RoadParams {
             .max(self.street_length_m)
             .max(self.block_length_m)
             .max(self.max_bridge_length_m)
+            .max(self.max_tunnel_length_m)
             + self.snap_radius_m;
         check(
             "legality_step_m",

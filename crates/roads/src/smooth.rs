@@ -111,6 +111,7 @@ mod tests {
             class: RoadClass::Highway,
             width: 16.0,
             bridge: false,
+            tunnel: false,
             step: 0,
         }
     }

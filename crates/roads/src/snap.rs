@@ -199,6 +199,7 @@ mod tests {
             class: RoadClass::Street,
             width: 8.0,
             bridge: false,
+            tunnel: false,
             step: 0,
         }
     }

@@ -163,3 +163,20 @@ fn layers_selectable_and_errors() {
     ));
     assert!(out.is_empty());
 }
+
+#[test]
+fn tunnels_keep_their_flag() {
+    let mut map = sample_map();
+    map.roads[2].tunnel = true;
+    let id = format!("road-{}", map.roads[2].id);
+    let (_, v) = geojson(&map, &GeoJsonOptions::default());
+    let features = v["features"].as_array().unwrap();
+    let roads: Vec<&Value> = features
+        .iter()
+        .filter(|f| f["properties"]["layer"] == "road")
+        .collect();
+    assert_eq!(roads.len(), map.roads.len());
+    for f in roads {
+        assert_eq!(f["properties"]["tunnel"], f["id"] == id.as_str(), "{f}");
+    }
+}

@@ -273,3 +273,29 @@ fn debug_layers_list_one_split_line_per_step_in_order() {
         Err(ExportError::InvalidMap { .. })
     ));
 }
+
+#[test]
+fn tunnels_are_dashed_under_every_other_road() {
+    let mut map = MapLayers::default();
+    map.roads.push(MapRoad::new(
+        vec![DVec2::new(-20.0, 10.0), DVec2::new(20.0, 10.0)],
+        RoadClass::Footpath,
+        2.0,
+    ));
+    map.roads.push(MapRoad {
+        tunnel: true,
+        ..MapRoad::new(
+            vec![DVec2::new(0.0, 0.0), DVec2::new(0.0, 50.0)],
+            RoadClass::Highway,
+            10.0,
+        )
+    });
+    let text = svg(&map, &SvgOptions::default());
+    let els = check_xml(&text);
+    let paths: Vec<_> = els.iter().filter(|e| e.0 == "path").collect();
+    let classes: Vec<&str> = paths.iter().map(|e| attr(e, "class").unwrap()).collect();
+    // The tunnel first (under the footpath that crosses over it), then the footpath.
+    assert_eq!(classes, ["highway tunnel", "footpath"]);
+    assert_eq!(attr(paths[0], "stroke-dasharray"), Some("8 6"));
+    assert_eq!(attr(paths[1], "stroke-dasharray"), None);
+}

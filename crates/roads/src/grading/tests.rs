@@ -8,6 +8,7 @@ fn road(class: RoadClass, width: f64, bridge: bool) -> Road {
         class,
         width,
         bridge,
+        tunnel: false,
         step: 0,
     }
 }

@@ -24,6 +24,7 @@ pub const BOUNDARY_ROAD: Road = Road {
     class: RoadClass::Highway,
     width: 0.0,
     bridge: false,
+    tunnel: false,
     step: 0,
 };
 
@@ -72,6 +73,7 @@ fn street(width: f64, step: u32) -> Road {
         class: RoadClass::Street,
         width,
         bridge: false,
+        tunnel: false,
         step,
     }
 }

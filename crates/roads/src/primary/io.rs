@@ -378,6 +378,7 @@ impl PrimaryNetwork {
                     class: RoadClass::Highway,
                     width: r.spec.width_m,
                     bridge: r.path.bridge.get(i - 1).copied().unwrap_or(false),
+                    tunnel: false,
                     step: 0,
                 };
                 let e = g.add_edge(prev, v, road)?;

@@ -211,6 +211,7 @@ impl SecondaryGrowth {
             class: RoadClass::Highway,
             width: 0.0,
             bridge: false,
+            tunnel: false,
             step: 0,
         };
         // The boundary rings, and their sides with inward normals.
@@ -509,6 +510,7 @@ impl Run<'_> {
             class: RoadClass::Street,
             width,
             bridge: false,
+            tunnel: false,
             step: self.report.steps,
         };
         let step = self.report.steps;

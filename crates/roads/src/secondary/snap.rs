@@ -398,6 +398,7 @@ mod tests {
             class: RoadClass::Street,
             width: 8.0,
             bridge: false,
+            tunnel: false,
             step: 0,
         };
         for &((ax, ay), (bx, by)) in segs {
