@@ -16,11 +16,11 @@
 //! (`old_town` 1 and 4) and the parks bend the streets (circuity of `old_town` 2–4, the
 //! median segment of `san_francisco` 2). Retuning the presets for both remains.
 //!
-//! `default` is not deterministic on this branch: runs of the same build give one of
-//! two sets of misses (seed 2 k̄ and both shares; or seed 2 circuity and seeds 3 and 5
-//! dead ends), first seen after its park map (noise 0.15, read through the road stage's
-//! lazy map cache) was added. The cause is not found; until it is, `default`'s misses
-//! must lie within [`KNOWN_MISSES`] (see [`UNSTABLE`]) instead of matching it exactly.
+//! Determinism: the misses are the same in every fresh process and with one or two
+//! threads (checked with `street_bands --preset default` three times each with
+//! `RAYON_NUM_THREADS=1` and with the default pool: identical output). An earlier note
+//! that `default` gave one of two miss lists compared two different builds; the two
+//! lists it saw are together the list below, so every preset is held to its exact list.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -67,10 +67,6 @@ const KNOWN_MISSES: &[(&str, u64, &str)] = &[
     ("san_francisco", 2, "median_seg_len_m"),
 ];
 
-/// Presets whose misses vary between runs (see the module documentation): a listed
-/// miss that does not occur is not an error for them.
-const UNSTABLE: &[&str] = &["default"];
-
 fn check(preset: &str) {
     let mut unexpected = Vec::new();
     let mut gone = Vec::new();
@@ -97,10 +93,7 @@ fn check(preset: &str) {
         unexpected.is_empty(),
         "{preset} out of band: {unexpected:#?}"
     );
-    assert!(
-        gone.is_empty() || UNSTABLE.contains(&preset),
-        "{preset}: update KNOWN_MISSES: {gone:#?}"
-    );
+    assert!(gone.is_empty(), "{preset}: update KNOWN_MISSES: {gone:#?}");
 }
 
 #[test]
