@@ -1,4 +1,5 @@
-//! Every Parish & Müller preset lands in its real city's bands (issue 19): φ ± 0.10,
+//! Every Parish & Müller preset, and `suburbia` (Citygen mode: Kelly's Suburbia
+//! growing inside P&M highway cells), lands in its real city's bands (issue 19): φ ± 0.10,
 //! `k̄` ± 0.20, dead-end share ± 0.05, four-way share ± 0.08, median segment ± 25 %,
 //! circuity ± 0.02, wherever Boeing 2019's table has the value.
 //!
@@ -109,6 +110,14 @@ fn san_francisco_is_in_san_franciscos_band() {
 #[test]
 fn old_town_is_in_romes_band() {
     check("old_town");
+}
+
+/// Kelly's Suburbia against Charlotte (dead-end share 0.288 ± 0.05, issue 18): the
+/// preset tunes its connectivity (0.035, Kelly's 0.05) and branches more highways, so
+/// the primary network encloses enough cells for the statistics to settle.
+#[test]
+fn suburbia_is_in_charlottes_band() {
+    check("suburbia");
 }
 
 /// `road_statistics` measures the same streets as the whole city's statistics: every
