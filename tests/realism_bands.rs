@@ -146,3 +146,43 @@ fn road_statistics_agree_with_the_whole_city() {
         );
     }
 }
+
+/// Manhattan's blocks are long across the island, its lots 25 ft wide on the street, its
+/// median building mid-rise (issue 19's table: it was 259 m with 71 % skyscrapers and a
+/// coverage of 0.96). On a 2 km `manhattan` (the island is at 75°, so across it is 165°).
+#[test]
+fn manhattan_blocks_lots_and_heights() {
+    let mut c = CityConfig::preset("manhattan").unwrap();
+    c.size_m = 2000.0;
+    c.facades.enabled = false;
+    let city = polis::Pipeline::default()
+        .with_scene(false)
+        .generate(&c)
+        .unwrap();
+    let r = city.statistics().unwrap();
+    let across = (r.blocks.long_axis_deg - 165.0).abs();
+    assert!(across < 15.0, "block long axis {}°", r.blocks.long_axis_deg);
+    assert!(
+        r.blocks.long_axis_order > 0.6,
+        "{}",
+        r.blocks.long_axis_order
+    );
+    // 25 ft = 7.62 m of frontage.
+    assert!(
+        (r.lots.frontage_m.median - 7.62).abs() < 1.0,
+        "{}",
+        r.lots.frontage_m.median
+    );
+    assert!(
+        (15.0..40.0).contains(&r.buildings.height_m.median),
+        "median height {}",
+        r.buildings.height_m.median
+    );
+    let towers = r.buildings.kinds.get("skyscraper").copied().unwrap_or(0);
+    assert!(
+        (towers as f64) < 0.12 * r.buildings.count as f64,
+        "{towers} of {}",
+        r.buildings.count
+    );
+    assert!(r.buildings.coverage < 0.96, "{}", r.buildings.coverage);
+}
