@@ -8,10 +8,12 @@
 //!     [--size METRES] [--config FILE]...
 //! ```
 //!
-//! `--config` reads a configuration file instead of a preset. Without either: every preset whose road mode is Parish & Müller and which names a
-//! reference city. `--seeds` defaults to 1-5, `--size` to each preset's own size.
+//! `--config` reads a configuration file instead of a preset. Without either: every preset
+//! that names a reference city, in either road mode (Parish & Müller, or Citygen's
+//! secondary growth per cell). `--seeds` defaults to 1-5, `--size` to each preset's own
+//! size.
 
-use polis::{CityConfig, RoadMode};
+use polis::CityConfig;
 
 struct Args {
     presets: Vec<String>,
@@ -68,9 +70,6 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     for (name, mut config) in configs {
-        if config.road_mode != RoadMode::ParishMuller && !explicit {
-            continue;
-        }
         let Some(city) = config.imitates.clone() else {
             continue;
         };

@@ -43,7 +43,8 @@ mod traits;
 mod zones;
 use crate::stages::{ParishMullerRoads, RoadStage, RoadsOutput, Skip, Stage, StageContext};
 pub use edits::{
-    CellParam, CellSettings, LotOverride, MapPaint, PaintLayer, lot_override, paint_maps,
+    CellParam, CellSettings, LotOverride, MapPaint, PaintLayer, PresetParams, lot_override,
+    paint_maps,
 };
 pub use kelly::{InlinePrimary, PATH_TOLERANCE_M};
 pub use traits::{LotPlan, block_ids, district_at, hint_kind, lot_params_of, lot_plan};
@@ -230,6 +231,10 @@ pub struct CitygenConfig {
     /// Carriageway widths of secondary roads are multiplied by this (Kelly's widths in
     /// Citygen units come out narrow in metres). Must be in (0, 10]. Default: 1.
     pub road_width_factor: f64,
+    /// City-wide parameter overrides of neighbourhood presets ([`PresetParams`]), after
+    /// the unit and width factor. Default: none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub preset_params: Vec<PresetParams>,
     /// Whether every cell's lot size, building height (with deviances) and building hint
     /// reach the lot and building stages (Kelly §5.5.1); when false only cells whose
     /// settings set one of them do, and the `lots` options and zoning bands decide
@@ -254,6 +259,7 @@ impl Default for CitygenConfig {
             overrides: Vec::new(),
             zones: None,
             road_width_factor: 1.0,
+            preset_params: Vec::new(),
             cell_traits: false,
             cells: Vec::new(),
             lots: Vec::new(),
@@ -292,6 +298,13 @@ impl CitygenConfig {
                     format!("citygen.by_population[{i}].min_density"),
                     "must be finite",
                 ));
+            }
+        }
+        for (i, t) in self.preset_params.iter().enumerate() {
+            for q in &t.params {
+                q.validate().map_err(|e| {
+                    Error::config(format!("citygen.preset_params[{i}].params"), e.to_string())
+                })?;
             }
         }
         for (i, c) in self.cells.iter().enumerate() {
@@ -480,6 +493,11 @@ pub(crate) fn citygen_network_with(
             .map_err(polis_roads::RoadError::from)?
             .to_params(cg.unit_m);
         p.road_width_m.value *= cg.road_width_factor;
+        for t in cg.preset_params.iter().filter(|t| t.neighbourhood == n) {
+            for q in &t.params {
+                q.apply(&mut p);
+            }
+        }
         presets.push((n, p));
     }
     let preset = |n: Neighbourhood| {

@@ -58,22 +58,16 @@ pub fn street_graph(roads: &polis_roads::RoadNetwork) -> StreetGraph {
 /// alone), measured over the city square and compared with the city the configuration
 /// imitates. Its street metrics and realism rows are those of
 /// [`City::statistics`] for the same configuration, except the intersection density,
-/// which is per km² of the whole square here (not of land). Only the Parish & Müller road
-/// mode is run; a Citygen configuration is an error.
+/// which is per km² of the whole square here (not of land). The road stage is the one
+/// the configuration's [`road_mode`](CityConfig::road_mode) names (Parish & Müller, or
+/// Citygen's primary network and secondary growth per cell), as the pipeline runs it.
 ///
 /// # Errors
-/// [`Error::Config`](crate::Error::Config) for a bad configuration or the Citygen mode;
-/// the road stage's error; [`Error::Stats`](crate::Error::Stats) for an unknown
-/// reference city.
+/// [`Error::Config`](crate::Error::Config) for a bad configuration; the road stage's
+/// error; [`Error::Stats`](crate::Error::Stats) for an unknown reference city.
 pub fn road_statistics(config: &CityConfig) -> Result<CityReport> {
-    use crate::stages::{CellStage, ParishMullerRoads, RoadStage, StageContext};
+    use crate::stages::{CellStage, RoadStage, StageContext};
     config.validate()?;
-    if config.road_mode != crate::RoadMode::ParishMuller {
-        return Err(crate::Error::Config {
-            field: "road_mode".into(),
-            reason: "road_statistics runs the Parish & Müller road stage only".into(),
-        });
-    }
     // The maps exactly as the pipeline builds them (salted with the maps stage's seed).
     let maps = crate::CityMaps::build(
         &config.maps,
@@ -83,7 +77,9 @@ pub fn road_statistics(config: &CityConfig) -> Result<CityReport> {
         config,
         maps: &maps,
     };
-    let mut network = ParishMullerRoads::default().roads(&cx)?.network;
+    let mut network = crate::citygen::ConfiguredRoads::default()
+        .roads(&cx)?
+        .network;
     // The fringe stubs the pipeline prunes after its cell stage (`crate::prune`).
     let cells = crate::stages::EberlyCells.cells(&network, &cx)?;
     let water = maps.has_water.then(|| maps.inputs.water.as_ref());

@@ -251,3 +251,63 @@ fn zones_read_from_json() {
     let back = CityConfig::from_json(&c.to_json(), "zones").unwrap();
     assert_eq!(back, c);
 }
+
+/// The `citygen` preset zones its cells with a painted map (Kelly §5.5, a 16 × 16
+/// raster of 250 m texels): Manhattan in the core (within 800 m of the centre), Raster
+/// around it (to 1,450 m), Industrial along the waterfront to the east (x > 875 m) and
+/// Suburbia at the edge. A cell takes the zone holding most of its area, so a large cell
+/// straddling a border may go either way: the checks allow one cell radius of slack, and
+/// the zones' order outwards is checked on the mean distances.
+#[test]
+fn the_citygen_preset_is_zoned_core_ring_waterfront_edge() {
+    let c = CityConfig::preset("citygen").unwrap();
+    assert!(c.citygen.zones.is_some());
+    let net = network(&c).unwrap();
+    let mut at: Vec<(Neighbourhood, DVec2, f64)> = Vec::new();
+    for d in &net.districts {
+        let CellPatternChoice::Kelly(n) = d.pattern else {
+            panic!("a grid pattern in the citygen preset: {:?}", d.pattern);
+        };
+        let centre = d.region.outer.centroid();
+        let radius = d
+            .region
+            .outer
+            .points()
+            .iter()
+            .map(|p| p.distance(centre))
+            .fold(0.0, f64::max);
+        at.push((n, centre, radius));
+    }
+    let of = |n: Neighbourhood| -> Vec<(DVec2, f64)> {
+        at.iter().filter(|a| a.0 == n).map(|a| (a.1, a.2)).collect()
+    };
+    let mean_distance =
+        |v: &[(DVec2, f64)]| v.iter().map(|(p, _)| p.length()).sum::<f64>() / v.len().max(1) as f64;
+    let core = of(Neighbourhood::Manhattan);
+    let ring = of(Neighbourhood::Raster);
+    let water = of(Neighbourhood::Industrial);
+    let edge = of(Neighbourhood::Suburbia);
+    for (name, v) in [
+        ("core", &core),
+        ("ring", &ring),
+        ("water", &water),
+        ("edge", &edge),
+    ] {
+        assert!(v.len() >= 2, "{name}: {v:?}");
+    }
+    assert!(core.iter().all(|(p, r)| p.length() < 800.0 + r), "{core:?}");
+    assert!(water.iter().all(|(p, r)| p.x > 875.0 - r), "{water:?}");
+    assert!(edge.iter().all(|(p, r)| p.length() > 800.0 - r), "{edge:?}");
+    assert!(
+        mean_distance(&core) < mean_distance(&ring) && mean_distance(&ring) < mean_distance(&edge),
+        "{} {} {}",
+        mean_distance(&core),
+        mean_distance(&ring),
+        mean_distance(&edge)
+    );
+    let mean_x = water.iter().map(|(p, _)| p.x).sum::<f64>() / water.len() as f64;
+    assert!(
+        mean_x > 875.0,
+        "the industrial cells lie by the water: {mean_x}"
+    );
+}

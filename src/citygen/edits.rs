@@ -89,6 +89,21 @@ impl CellParam {
     }
 }
 
+/// Parameter overrides of one neighbourhood preset, city-wide: wherever the preset
+/// grows a cell (chosen by default, a population band, an override, a zone or a cell's
+/// settings; grid patterns take their traits from it too), its parameters are these over
+/// Kelly's, before a zone level's and the cell's own parameters apply. A city preset
+/// tunes a neighbourhood to the real city it imitates this way, leaving Kelly's shipped
+/// values (Fig. 76) as they are.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PresetParams {
+    /// The neighbourhood preset tuned.
+    pub neighbourhood: polis_roads::secondary::Neighbourhood,
+    /// Parameters over the preset's (metres), applied in order.
+    pub params: Vec<CellParam>,
+}
+
 /// The settings of one city cell, keyed by its stable id
 /// ([`stable_cell_id`](super::stable_cell_id) / the bounding primary roads).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

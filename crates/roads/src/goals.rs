@@ -242,11 +242,20 @@ impl DefaultGoals {
         let k = ((a - g) / FRAC_PI_2).round();
         let angle = g + k * FRAC_PI_2;
         let along = (k as i64).rem_euclid(2) == 0;
-        let length = match class {
+        let mut length = match class {
             RoadClass::Highway => self.params.highway_length_m,
             RoadClass::Street if along => self.params.block_length_m,
             RoadClass::Street => self.params.block_width_m,
         };
+        if class == RoadClass::Street && self.params.street_rules(Pattern::NewYork).lattice {
+            // To the next lattice line (through the start) at least half a block ahead.
+            let t = (p - self.start).dot(dir(angle));
+            let mut next = ((t / length).floor() + 1.0) * length;
+            if next - t < 0.5 * length {
+                next += length;
+            }
+            length = next - t;
+        }
         Aim { angle, length }
     }
 
@@ -694,6 +703,53 @@ mod tests {
         assert!((b2.road.angle + 80f64.to_radians()).abs() < 1e-9);
         // Branches start where the segment ended.
         assert_eq!(b1.road.start, road.end);
+    }
+
+    /// With the lattice on, a New York street segment from anywhere ends on a lattice
+    /// line through the start, 0.5 to 1.5 blocks ahead; off, it is one block long.
+    #[test]
+    fn new_york_lattice_puts_segment_ends_on_lattice_lines() {
+        let mut params = RoadParams {
+            pattern: Pattern::NewYork,
+            grid_angle_deg: 30.0,
+            block_length_m: 80.0,
+            block_width_m: 240.0,
+            ..RoadParams::default()
+        };
+        params.streets.insert(
+            Pattern::NewYork,
+            crate::StreetRules {
+                lattice: true,
+                ..crate::StreetRules::default()
+            },
+        );
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let origin = g.start();
+        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        for _ in 0..200 {
+            let p = origin
+                + DVec2::new(
+                    unit_f64(&mut rng) * 1800.0 - 900.0,
+                    unit_f64(&mut rng) * 1800.0 - 900.0,
+                );
+            let a = unit_f64(&mut rng) * std::f64::consts::TAU;
+            let aim = g.new_york(p, a, RoadClass::Street);
+            let u = dir(aim.angle);
+            // Along the grid angle (or against it): block length; across: width.
+            let along = (u.dot(dir(30f64.to_radians()))).abs() > 0.5;
+            let s = if along { 80.0 } else { 240.0 };
+            assert!(
+                (0.5 * s - 1e-9..1.5 * s + 1e-9).contains(&aim.length),
+                "{}",
+                aim.length
+            );
+            let t = (p + u * aim.length - origin).dot(u) / s;
+            assert!((t - t.round()).abs() < 1e-9, "{t}");
+        }
+        params.streets.clear();
+        let g = DefaultGoals::new(&params, &flat()).unwrap();
+        let aim = g.new_york(origin + DVec2::new(13.0, 7.0), 0.5, RoadClass::Street);
+        assert_eq!(aim.length, 80.0);
     }
 
     #[test]

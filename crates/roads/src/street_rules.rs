@@ -68,6 +68,14 @@ pub struct StreetRules {
     /// `exp(σ · z)`, z standard normal (the median stays the street length); ≥ 0, at most
     /// 2. Default: 0.
     pub length_sigma: f64,
+    /// New York only: street segments end on a city-wide lattice of the pattern's block
+    /// length and width (lines through the axiom's start, along and across the grid
+    /// angle), so the grids that growth fronts from different highway points lay down
+    /// line up into whole blocks instead of cutting each other's blocks short. Each
+    /// segment runs to the next lattice line at least half a block ahead (its length is
+    /// 0.5–1.5 blocks). Needs one segment per link and no length spread to stay on the
+    /// lattice; a local grid-angle map bends the lattice with it. Default: false.
+    pub lattice: bool,
 }
 
 impl Default for StreetRules {
@@ -80,6 +88,7 @@ impl Default for StreetRules {
             segments_per_link: 1,
             curve_deg: 0.0,
             length_sigma: 0.0,
+            lattice: false,
         }
     }
 }

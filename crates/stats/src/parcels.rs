@@ -8,6 +8,12 @@
 //! * **Lot frontage**: the total length of the lot's street-facing edges. **Depth**: the
 //!   largest distance of a lot vertex from the line of its longest street edge. Both
 //!   only for lots with street access.
+//! * **Block long axis**: the major principal axis of the outer ring's second moment of
+//!   area (the direction the block is longest in). The blocks' common direction is the
+//!   axial mean of these axes (angles doubled, so 10° and 190° agree), each weighted by
+//!   the block's area times its elongation `(λ₁ − λ₂) / (λ₁ + λ₂)` of the moment's
+//!   eigenvalues, so square blocks do not vote; its strength is the length of that mean,
+//!   0 (no common direction) to 1 (every block long the same way).
 //! * **Coverage**: building footprint area over lot area; **floor-area ratio**:
 //!   Σ footprint × storeys over lot area.
 //!
@@ -43,6 +49,58 @@ pub struct BlockMetrics {
     pub shape_factor_histogram: Histogram,
     /// Blocks with zero area or no enclosing circle.
     pub degenerate: usize,
+    /// The blocks' common long-axis direction (see the module definitions), degrees in
+    /// [0, 180) counter-clockwise from +x; 0 without elongated blocks.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub long_axis_deg: f64,
+    /// How strongly the blocks share that direction, 0 to 1.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub long_axis_order: f64,
+}
+
+/// The major principal axis of `ring`'s second moment of area about its centroid:
+/// (angle in radians, elongation in [0, 1], area). `None` for a ring without area.
+pub fn long_axis(ring: &[polis_geom::DVec2]) -> Option<(f64, f64, f64)> {
+    let n = ring.len();
+    let first = *ring.first()?;
+    // Moments about the first vertex (for precision), then moved to the centroid.
+    let (mut a2, mut cx, mut cy, mut ixx, mut iyy, mut ixy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for i in 0..n {
+        let (Some(&p), Some(&q)) = (ring.get(i), ring.get((i + 1) % n)) else {
+            continue;
+        };
+        let (p, q) = (p - first, q - first);
+        let c = p.x * q.y - q.x * p.y;
+        a2 += c;
+        cx += (p.x + q.x) * c;
+        cy += (p.y + q.y) * c;
+        ixx += (p.x * p.x + p.x * q.x + q.x * q.x) * c;
+        iyy += (p.y * p.y + p.y * q.y + q.y * q.y) * c;
+        ixy += (p.x * q.y + 2.0 * p.x * p.y + 2.0 * q.x * q.y + q.x * p.y) * c;
+    }
+    let area = a2 * 0.5;
+    if area == 0.0 || !area.is_finite() {
+        return None;
+    }
+    let (cx, cy) = (cx / (3.0 * a2), cy / (3.0 * a2));
+    // ∫x² dA, ∫y² dA, ∫xy dA (signed like the area), central.
+    let sxx = ixx / 12.0 - area * cx * cx;
+    let syy = iyy / 12.0 - area * cy * cy;
+    let sxy = ixy / 24.0 - area * cx * cy;
+    let (sxx, syy, sxy) = if area < 0.0 {
+        (-sxx, -syy, -sxy)
+    } else {
+        (sxx, syy, sxy)
+    };
+    let trace = sxx + syy;
+    let diff = ((sxx - syy).powi(2) + 4.0 * sxy * sxy).sqrt();
+    let elongation = if trace > 0.0 {
+        (diff / trace).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    angle.is_finite().then_some((angle, elongation, area.abs()))
 }
 
 /// Lot metrics.
@@ -92,9 +150,16 @@ pub fn block_metrics(blocks: &[&polis_geom::PolygonWithHoles]) -> BlockMetrics {
     let mut areas = Vec::with_capacity(blocks.len());
     let mut phis = Vec::with_capacity(blocks.len());
     let mut degenerate = 0;
+    let (mut ax, mut ay, mut weights) = (0.0, 0.0, 0.0);
     for b in blocks {
         let area = b.area();
         areas.push(area);
+        if let Some((angle, elongation, a)) = long_axis(b.outer.points()) {
+            let w = a * elongation;
+            ax += w * (2.0 * angle).cos();
+            ay += w * (2.0 * angle).sin();
+            weights += w;
+        }
         let circle = min_enclosing_circle(b.outer.points());
         match circle {
             Some(c) if c.radius > 0.0 && area > 0.0 => phis.push((area / c.area()).min(1.0)),
@@ -107,6 +172,12 @@ pub fn block_metrics(blocks: &[&polis_geom::PolygonWithHoles]) -> BlockMetrics {
         shape_factor: Distribution::of(phis.iter().copied()),
         shape_factor_histogram: Histogram::of(&SHAPE_FACTOR_BINS, false, phis),
         degenerate,
+        long_axis_deg: if weights > 0.0 {
+            (0.5 * ay.atan2(ax)).to_degrees().rem_euclid(180.0) % 180.0
+        } else {
+            0.0
+        },
+        long_axis_order: ratio(ax.hypot(ay), weights).clamp(0.0, 1.0),
     }
 }
 

@@ -149,6 +149,11 @@ impl Display for CityReport {
         row(f, "area", dist(&b.area_m2, " m²", 0))?;
         row(f, "shape factor Φ", dist(&b.shape_factor, "", 3))?;
         row(f, "Φ histogram", hist(&b.shape_factor_histogram))?;
+        row(
+            f,
+            "long axis (order)",
+            format!("{:.1}° ({:.2})", b.long_axis_deg, b.long_axis_order),
+        )?;
         let l = &self.lots;
         writeln!(f, "lots")?;
         row(

@@ -67,6 +67,85 @@ fn block_shape_factor() {
     assert!((b.shape_factor.median - 0.96 * 2.0 / std::f64::consts::PI).abs() < 1e-12);
 }
 
+/// A rectangle `w × h` turned by `deg` about `at`, counter-clockwise.
+fn turned_rect(w: f64, h: f64, deg: f64, at: DVec2) -> PolygonWithHoles {
+    let (sn, c) = deg.to_radians().sin_cos();
+    let pts = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)]
+        .iter()
+        .map(|&(x, y)| at + DVec2::new(x * c - y * sn, x * sn + y * c))
+        .collect();
+    PolygonWithHoles::from(Polygon::new(pts))
+}
+
+#[test]
+fn block_long_axis() {
+    use polis_stats::parcels::{block_metrics, long_axis};
+    // A 240 × 80 m block turned by 165°: long axis at 165°, elongation (9 − 1) / 10.
+    let b = turned_rect(240.0, 80.0, 165.0, DVec2::new(500.0, -300.0));
+    let (angle, elongation, area) = long_axis(b.outer.points()).unwrap();
+    assert!(
+        (angle.to_degrees().rem_euclid(180.0) - 165.0).abs() < 1e-9,
+        "{angle}"
+    );
+    assert!((elongation - 0.8).abs() < 1e-12, "{elongation}");
+    assert!((area - 19_200.0).abs() < 1e-9);
+    // Clockwise rings give the same axis.
+    let mut cw = b.outer.clone();
+    cw.make_cw();
+    let (a2, e2, _) = long_axis(cw.points()).unwrap();
+    assert!((a2 - angle).abs() < 1e-9 && (e2 - elongation).abs() < 1e-12);
+    // A square has no long axis to vote with.
+    let sq = turned_rect(100.0, 100.0, 20.0, DVec2::ZERO);
+    assert!(long_axis(sq.outer.points()).unwrap().1 < 1e-9);
+    // A grid of blocks long the same way (axes 10° and 190° agree): order 1; squares
+    // and an empty ring do not change it.
+    let blocks = [
+        turned_rect(200.0, 60.0, 10.0, DVec2::ZERO),
+        turned_rect(150.0, 70.0, 190.0, DVec2::new(400.0, 0.0)),
+        sq.clone(),
+        PolygonWithHoles::from(Polygon::new(vec![])),
+    ];
+    let refs: Vec<&PolygonWithHoles> = blocks.iter().collect();
+    let m = block_metrics(&refs);
+    assert!((m.long_axis_deg - 10.0).abs() < 1e-9, "{}", m.long_axis_deg);
+    assert!(
+        (m.long_axis_order - 1.0).abs() < 1e-12,
+        "{}",
+        m.long_axis_order
+    );
+    // Two equal blocks at right angles: no common direction.
+    let cross = [
+        turned_rect(200.0, 50.0, 0.0, DVec2::ZERO),
+        turned_rect(200.0, 50.0, 90.0, DVec2::new(500.0, 0.0)),
+    ];
+    let refs: Vec<&PolygonWithHoles> = cross.iter().collect();
+    assert!(block_metrics(&refs).long_axis_order < 1e-9);
+    assert_eq!(block_metrics(&[]).long_axis_order, 0.0);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+    /// Any elongated rectangle, anywhere, turned any way: its long axis is its turn (mod
+    /// 180°) and its elongation `(w² − h²) / (w² + h²)`.
+    #[test]
+    fn a_rectangles_long_axis_is_its_turn(
+        w in 20.0f64..400.0,
+        ratio in 0.1f64..0.8,
+        deg in 0.0f64..360.0,
+        x in -3000.0f64..3000.0,
+        y in -3000.0f64..3000.0,
+    ) {
+        let h = w * ratio;
+        let b = turned_rect(w, h, deg, DVec2::new(x, y));
+        let (angle, elongation, _) = polis_stats::parcels::long_axis(b.outer.points()).unwrap();
+        let d = (angle.to_degrees() - deg).rem_euclid(180.0);
+        proptest::prop_assert!(d.min(180.0 - d) < 1e-6, "{} vs {}", angle.to_degrees(), deg);
+        let want = (w * w - h * h) / (w * w + h * h);
+        proptest::prop_assert!((elongation - want).abs() < 1e-9);
+    }
+}
+
 #[test]
 fn lot_frontage_depth_and_buildings() {
     let a = rect(0.0, 0.0, 10.0, 30.0);

@@ -88,6 +88,8 @@ impl SecondaryRoads {
 ///
 /// 1. The `start_sides` longest boundary sides (of any ring) are split at a *deviated
 ///    midpoint* and grow a first segment along their *deviated* inward perpendicular.
+///    When no side can place its first segment (a small cell), the sides are tried
+///    again, up to [`START_RETRIES`] rounds, with fresh draws (ours: Kelly tries once).
 /// 2. A FIFO queue of `(node, direction)`; each node taken tries `degree` directions,
 ///    the incoming one turned by `i · 360° / degree` and deviated.
 /// 3. `placeSegment` draws a deviated length (with the block aspect), asks the
@@ -137,6 +139,10 @@ pub struct SecondaryGrowth {
 /// than this are merged, so no road shorter than it is ever made (1 mm per metre of
 /// segment size, at least 1 mm).
 pub const INSERT_TOLERANCE: f64 = 1e-3;
+
+/// More rounds over the start sides when none could start a first segment (see
+/// [`SecondaryGrowth::grow`]).
+pub const START_RETRIES: u32 = 8;
 
 /// A placed segment's end, for the queue.
 struct Placed {
@@ -290,31 +296,48 @@ impl SecondaryGrowth {
         // Initial segments from deviated midpoints of the longest sides: the first
         // `start_sides` sides, longest first, whose first segment can be placed.
         let mut started = 0;
-        for &(len, _, e, inward) in &sides {
-            if started >= p.start_sides || !long_enough(len) {
+        // Kelly tries each of the longest sides once. In a small cell (sides a few snap
+        // sizes long) every first segment may end within the snap size of the side it
+        // leaves or of a neighbouring side and be refused, and the cell would grow
+        // nothing: only then are the sides tried again, up to `START_RETRIES` more rounds
+        // with fresh draws. A cell that starts in the first round draws exactly as
+        // Kelly's algorithm does.
+        for round in 0..=START_RETRIES {
+            if round > 0 && started > 0 {
                 break;
             }
-            let (a, b) = run.g.segment(e)?;
-            let u: f64 = run.rng.random::<f64>();
-            let t = 0.5 + p.segment_size_m.deviance * (u - 0.5);
-            let t = t.clamp(snap_max / len, 1.0 - snap_max / len);
-            let mid = a.lerp(b, t);
-            run.decided.clear();
-            // The perpendicular deviates by up to ± degree deviance × 45°.
-            let dir = run.deviate(inward, std::f64::consts::FRAC_PI_2);
-            // Split the side only if the first segment fits.
-            let Ok((source, piece)) = run.g.split_edge(e, mid, Junction::default()) else {
-                continue;
-            };
-            if let Some(placed) = run.place_segment(source, dir)? {
-                queue.push_back((placed.node, dir));
-                started += 1;
-            } else {
-                // Undo the split: the side stays one road.
-                let far = run.g.other_end(piece, source)?;
-                let near = run.g.other_end(e, source)?;
-                run.g.remove_node(source)?;
-                run.g.add_edge(near, far, primary)?;
+            for side in 0..sides.len() {
+                let Some(&(len, _, e, inward)) = sides.get(side) else {
+                    break;
+                };
+                if started >= p.start_sides || !long_enough(len) {
+                    break;
+                }
+                let (a, b) = run.g.segment(e)?;
+                let u: f64 = run.rng.random::<f64>();
+                let t = 0.5 + p.segment_size_m.deviance * (u - 0.5);
+                let t = t.clamp(snap_max / len, 1.0 - snap_max / len);
+                let mid = a.lerp(b, t);
+                run.decided.clear();
+                // The perpendicular deviates by up to ± degree deviance × 45°.
+                let dir = run.deviate(inward, std::f64::consts::FRAC_PI_2);
+                // Split the side only if the first segment fits.
+                let Ok((source, piece)) = run.g.split_edge(e, mid, Junction::default()) else {
+                    continue;
+                };
+                if let Some(placed) = run.place_segment(source, dir)? {
+                    queue.push_back((placed.node, dir));
+                    started += 1;
+                } else {
+                    // Undo the split: the side stays one road (a new edge id).
+                    let far = run.g.other_end(piece, source)?;
+                    let near = run.g.other_end(e, source)?;
+                    run.g.remove_node(source)?;
+                    let whole = run.g.add_edge(near, far, primary)?;
+                    if let Some(s) = sides.get_mut(side) {
+                        s.2 = whole;
+                    }
+                }
             }
         }
         // Road growth.
