@@ -630,3 +630,27 @@ fn cell_params_show_pattern_parameters_and_seed() {
         Err(Error::UnknownId { kind: "cell", .. })
     ));
 }
+
+/// P&M highways of a small map enclose no cell; the road stage closes them with the
+/// map's edge, and so must the Kelly network the editor makes of them: the editor's city
+/// has the cells of the original configuration's.
+#[test]
+fn highways_closed_by_the_map_edge_give_the_editor_its_cells() {
+    let mut c = CityConfig::preset("suburbia").unwrap();
+    c.size_m = 900.0;
+    c.roads.max_segments = 160;
+    c.facades.pixels_per_metre = 4.0;
+    c.lod = Some(1);
+    let original = polis::generate(&c).unwrap();
+    assert!(original.stats.cells > 0);
+    let ed = CityEditor::new(c).unwrap();
+    let h = 450.0;
+    assert!(
+        ed.network()
+            .nodes()
+            .any(|(_, n)| n.pos == polis::geom::DVec2::new(-h, -h)),
+        "the map's corner is a primary node"
+    );
+    assert!(!ed.cells().is_empty());
+    assert!(ed.city().stats.buildings > 0);
+}
