@@ -15,27 +15,11 @@ use crate::citygen::{District, LotOverride};
 
 /// Removed, added and changed keys between two maps (values compared with `==`).
 fn delta<K: Ord + Clone, V: PartialEq>(old: &BTreeMap<K, V>, new: &BTreeMap<K, V>) -> Delta<K> {
-    let mut d = Delta {
-        removed: Vec::new(),
-        added: Vec::new(),
-        changed: Vec::new(),
-    };
-    for (k, v) in old {
-        match new.get(k) {
-            None => d.removed.push(k.clone()),
-            Some(w) if w != v => d.changed.push(k.clone()),
-            Some(_) => {}
-        }
-    }
-    d.added = new
-        .keys()
-        .filter(|k| !old.contains_key(*k))
-        .cloned()
-        .collect();
-    d
+    delta_by(old, new, |v, w| v != w)
 }
 
-/// [`delta`] of maps whose old values carry what tells `changed` whether they differ.
+/// Removed, added and changed keys between two maps, `changed` telling whether an old
+/// value and the new one differ.
 fn delta_by<K: Ord + Clone, V, W>(
     old: &BTreeMap<K, V>,
     new: &BTreeMap<K, W>,
