@@ -19,34 +19,9 @@ use std::time::Instant;
 
 use polis::{CityConfig, Pipeline, Stage};
 
-/// CPU seconds used by this process so far (Linux; `None` elsewhere).
-fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which is in parentheses and may contain spaces).
-    let rest = stat.rsplit_once(')')?.1;
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    // utime and stime are fields 14 and 15 of the whole line: 12 and 13 here.
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    Some((utime + stime) / 100.0)
-}
-
-/// Minor page faults of this process so far (Linux; `None` elsewhere): each is a fresh
-/// page the kernel had to clear, which costs more than the work on it in a VM.
-fn page_faults() -> Option<u64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = stat.rsplit_once(')')?.1;
-    // minflt is field 10 of the whole line: 8 here.
-    rest.split_whitespace().nth(7)?.parse().ok()
-}
-
-/// Peak resident memory of this process, MiB (Linux; `None` elsewhere).
-fn peak_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / 1024.0)
-}
+#[path = "common/process.rs"]
+mod process;
+use process::{cpu_seconds, page_faults, peak_mib};
 
 /// How a benchmark city is made.
 #[derive(Clone, Copy, PartialEq)]

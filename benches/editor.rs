@@ -25,15 +25,15 @@ use polis::editor::{CityEditor, Edit};
 use polis::geom::hash::splitmix64;
 use polis::roads::secondary::Neighbourhood;
 
-/// CPU seconds used by this process so far (Linux; `None` elsewhere).
-fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = stat.rsplit_once(')')?.1;
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    Some((utime + stime) / 100.0)
-}
+// As the browser editor (examples/editor) runs: mimalloc as the global allocator. The
+// edit clones and frees hundreds of thousands of small layers; glibc's allocator spends
+// about half of an edit's CPU time in malloc and free (perf, session 10).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+#[path = "common/process.rs"]
+mod process;
+use process::cpu_seconds;
 
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {

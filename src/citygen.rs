@@ -961,7 +961,8 @@ fn primary_network(
 
 /// The configured primary network as a Kelly network on `terrain`
 /// ([`PrimaryNetwork::from_highways`](polis_roads::primary::PrimaryNetwork::from_highways)
-/// of its highway edges, primary road spec), for the editor.
+/// of its highway edges, primary road spec), for the editor. P&M highways that enclose
+/// no cell are closed by the map's edge first, as the road stage closes them.
 ///
 /// # Errors
 /// As [`citygen_network`]; a network the Kelly network cannot hold (outside the terrain).
@@ -979,7 +980,16 @@ pub fn kelly_network_of(
         })?;
         return kelly::kelly_from_text(cx, &text, path);
     }
-    let (net, _, _) = primary_network(cx)?;
+    let (mut net, _, _) = primary_network(cx)?;
+    // The map's edge closes P&M highways that enclose nothing, as in the road stage, so
+    // the editor's city has the cells `generate` gives the original configuration.
+    if matches!(cx.config.citygen.primary, PrimarySource::Highways)
+        && polis_cells::extract_with(&net, &cx.config.cells)?
+            .cells
+            .is_empty()
+    {
+        close_with_map_edge(&mut net, cx.config.size_m)?;
+    }
     polis_roads::primary::PrimaryNetwork::from_highways(
         &net,
         terrain,

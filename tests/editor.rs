@@ -105,6 +105,40 @@ fn check_outside_dirty_set(
     }
 }
 
+/// Buildings with their skins and cells, by id, as comparable text.
+fn building_texts(city: &City) -> BTreeMap<u64, String> {
+    city.buildings
+        .iter()
+        .zip(&city.dresses)
+        .zip(&city.building_cells)
+        .map(|((b, d), c)| (b.id, format!("{b:?} {d:?} {c}")))
+        .collect()
+}
+
+/// The building events (changed, added, removed) equal those of comparing every
+/// building of the two cities (the editor skips the ones its scene splice found equal).
+fn check_building_events(before: &BTreeMap<u64, String>, after: &City, ev: &ChangeEvents) {
+    let after = building_texts(after);
+    let changed: Vec<u64> = before
+        .iter()
+        .filter(|(k, v)| after.get(*k).is_some_and(|w| w != *v))
+        .map(|(k, _)| *k)
+        .collect();
+    let added: Vec<u64> = after
+        .keys()
+        .filter(|k| !before.contains_key(*k))
+        .copied()
+        .collect();
+    let removed: Vec<u64> = before
+        .keys()
+        .filter(|k| !after.contains_key(*k))
+        .copied()
+        .collect();
+    assert_eq!(ev.buildings.changed, changed, "changed buildings");
+    assert_eq!(ev.buildings.added, added, "added buildings");
+    assert_eq!(ev.buildings.removed, removed, "removed buildings");
+}
+
 /// A random edit, resolved against the editor's current state.
 #[derive(Debug, Clone)]
 enum Op {
@@ -218,6 +252,7 @@ proptest! {
                 .into_iter()
                 .map(|c| (c, [cell_content(ed.city(), c, false), cell_content(ed.city(), c, true)]))
                 .collect();
+            let before_buildings = building_texts(ed.city());
             let result = match op {
                 Op::Undo => ed.undo(),
                 Op::Redo => ed.redo(),
@@ -234,6 +269,7 @@ proptest! {
             let overridden = overridden_cells(&before_city_cfg, ed.config(), ed.city());
             let painted = before_city_cfg.citygen.paint != ed.config().citygen.paint;
             check_outside_dirty_set(&before, ed.city(), &ev, &overridden, painted);
+            check_building_events(&before_buildings, ed.city(), &ev);
             if let Some(Edit::SetCellPattern { cell, .. } | Edit::SetCellParam { cell, .. } | Edit::SetCellSeed { cell, .. }) = ed.edits().last().filter(|_| !matches!(op, Op::Undo | Op::Redo)) {
                 prop_assert!(ev.dirty_cells.iter().all(|c| c == cell), "{:?} regrew {:?}", op, ev.dirty_cells);
                 prop_assert!(ev.cells.added.is_empty() && ev.cells.removed.is_empty());
@@ -629,4 +665,28 @@ fn cell_params_show_pattern_parameters_and_seed() {
         ed.cell_params(12345),
         Err(Error::UnknownId { kind: "cell", .. })
     ));
+}
+
+/// P&M highways of a small map enclose no cell; the road stage closes them with the
+/// map's edge, and so must the Kelly network the editor makes of them: the editor's city
+/// has the cells of the original configuration's.
+#[test]
+fn highways_closed_by_the_map_edge_give_the_editor_its_cells() {
+    let mut c = CityConfig::preset("suburbia").unwrap();
+    c.size_m = 900.0;
+    c.roads.max_segments = 160;
+    c.facades.pixels_per_metre = 4.0;
+    c.lod = Some(1);
+    let original = polis::generate(&c).unwrap();
+    assert!(original.stats.cells > 0);
+    let ed = CityEditor::new(c).unwrap();
+    let h = 450.0;
+    assert!(
+        ed.network()
+            .nodes()
+            .any(|(_, n)| n.pos == polis::geom::DVec2::new(-h, -h)),
+        "the map's corner is a primary node"
+    );
+    assert!(!ed.cells().is_empty());
+    assert!(ed.city().stats.buildings > 0);
 }

@@ -4,15 +4,27 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use polis_geom::DVec2;
+use polis_geom::par;
 
 use super::edit::{ChangeEvents, Delta, Regenerated};
 use super::memo::Redone;
+use super::splice::OldScene;
 use crate::City;
 use crate::CityConfig;
 use crate::citygen::{District, LotOverride};
 
 /// Removed, added and changed keys between two maps (values compared with `==`).
 fn delta<K: Ord + Clone, V: PartialEq>(old: &BTreeMap<K, V>, new: &BTreeMap<K, V>) -> Delta<K> {
+    delta_by(old, new, |v, w| v != w)
+}
+
+/// Removed, added and changed keys between two maps, `changed` telling whether an old
+/// value and the new one differ.
+fn delta_by<K: Ord + Clone, V, W>(
+    old: &BTreeMap<K, V>,
+    new: &BTreeMap<K, W>,
+    changed: impl Fn(&V, &W) -> bool,
+) -> Delta<K> {
     let mut d = Delta {
         removed: Vec::new(),
         added: Vec::new(),
@@ -21,7 +33,7 @@ fn delta<K: Ord + Clone, V: PartialEq>(old: &BTreeMap<K, V>, new: &BTreeMap<K, V
     for (k, v) in old {
         match new.get(k) {
             None => d.removed.push(k.clone()),
-            Some(w) if w != v => d.changed.push(k.clone()),
+            Some(w) if changed(v, w) => d.changed.push(k.clone()),
             Some(_) => {}
         }
     }
@@ -56,24 +68,30 @@ fn same_roads(a: &polis_roads::RoadNetwork, b: &polis_roads::RoadNetwork) -> boo
             .all(|(x, y)| x.3 == y.3 && a.segment(x.0).ok() == b.segment(y.0).ok())
 }
 
-/// A city's buildings with their skins, by id.
-fn buildings_of(
-    c: &City,
-) -> BTreeMap<u64, (&polis_buildings::Building, Option<&crate::stages::Dress>)> {
+/// A building with its skin.
+type Dressed<'a> = (
+    &'a polis_buildings::Building,
+    Option<&'a crate::stages::Dress>,
+);
+
+/// A city's buildings with their index and skin, by id.
+fn buildings_of(c: &City) -> BTreeMap<u64, (usize, Dressed<'_>)> {
     c.buildings
         .iter()
         .enumerate()
-        .map(|(i, b)| (b.id, (b, c.dresses.get(i).and_then(Option::as_ref))))
+        .map(|(i, b)| (b.id, (i, (b, c.dresses.get(i).and_then(Option::as_ref)))))
         .collect()
 }
 
-/// The change events from `old` to `new`.
+/// The change events from `old` to `new`. `spliced` is the scene splice of the edit, if
+/// any: the buildings and blocks it found equal and reused are not compared again.
 pub(super) fn changes(
     old: &City,
     new: &City,
     old_cells: &[District],
     new_cells: &[District],
     redone: &Redone,
+    spliced: Option<&OldScene>,
 ) -> ChangeEvents {
     let ids = |d: &[District]| d.iter().map(|c| c.id).collect::<BTreeSet<u64>>();
     let (oc, nc) = (ids(old_cells), ids(new_cells));
@@ -87,15 +105,47 @@ pub(super) fn changes(
             .filter(|c| oc.contains(c) && nc.contains(c))
             .collect(),
     };
-    let lots = delta(
-        &old.lots.iter().map(|l| (l.id, l)).collect(),
-        &new.lots.iter().map(|l| (l.id, l)).collect(),
-    );
-    let buildings = delta(&buildings_of(old), &buildings_of(new));
-    let blocks = delta(&by_cell(old), &by_cell(new));
-    let block_nodes = delta(
-        &old.blocks.iter().map(|b| (b.id(), b)).collect(),
-        &new.blocks.iter().map(|b| (b.id(), b)).collect(),
+    // The old city is the one the splice indexed (or no building is known equal).
+    let spliced = spliced.filter(|s| std::ptr::eq(s.city(), old));
+    let same_building = |i: usize| spliced.is_some_and(|s| s.same_building_at(i));
+    let same_block = |i: usize| spliced.is_some_and(|s| s.same_block_at(i));
+    // The four comparisons are independent: two threads take them.
+    let ((lots, buildings), (blocks, block_nodes)) = par::join(
+        || {
+            par::join(
+                || {
+                    delta(
+                        &old.lots.iter().map(|l| (l.id, l)).collect(),
+                        &new.lots.iter().map(|l| (l.id, l)).collect(),
+                    )
+                },
+                || {
+                    let new_b: BTreeMap<u64, Dressed<'_>> = buildings_of(new)
+                        .into_iter()
+                        .map(|(k, (_, v))| (k, v))
+                        .collect();
+                    delta_by(&buildings_of(old), &new_b, |(i, v), w| {
+                        !same_building(*i) && v != w
+                    })
+                },
+            )
+        },
+        || {
+            par::join(
+                || delta(&by_cell(old), &by_cell(new)),
+                || {
+                    delta_by(
+                        &old.blocks
+                            .iter()
+                            .enumerate()
+                            .map(|(i, b)| (b.id(), (i, b)))
+                            .collect(),
+                        &new.blocks.iter().map(|b| (b.id(), b)).collect(),
+                        |(i, v), w| !same_block(*i) && v != w,
+                    )
+                },
+            )
+        },
     );
     // Scene nodes: `cell <c>` groups its blocks and buildings.
     let mut scene = Delta::<String>::default();

@@ -24,10 +24,13 @@ use crate::stages::{
     FacadeStage, KellyLots, LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
 };
 
-/// Results of one kind: those the last run used, and those this run used so far.
+/// Results of one kind: those the last run used, and those this run used so far. Each
+/// is behind an `Arc`, so a look-up holds the lock for a pointer copy only and the
+/// caller copies the result out of it with the lock released (the per-item stages look
+/// up from both threads).
 struct Store<T> {
-    last: BTreeMap<Key, T>,
-    this: BTreeMap<Key, T>,
+    last: BTreeMap<Key, Arc<T>>,
+    this: BTreeMap<Key, Arc<T>>,
 }
 
 impl<T> Default for Store<T> {
@@ -39,18 +42,18 @@ impl<T> Default for Store<T> {
     }
 }
 
-impl<T: Clone> Store<T> {
+impl<T> Store<T> {
     /// The result for `key`, if any run kept it (moved into this run's set).
-    fn get(&mut self, key: Key) -> Option<T> {
+    fn get(&mut self, key: Key) -> Option<Arc<T>> {
         if let Some(v) = self.this.get(&key) {
-            return Some(v.clone());
+            return Some(Arc::clone(v));
         }
         let v = self.last.remove(&key)?;
-        self.this.insert(key, v.clone());
+        self.this.insert(key, Arc::clone(&v));
         Some(v)
     }
 
-    fn put(&mut self, key: Key, v: T) {
+    fn put(&mut self, key: Key, v: Arc<T>) {
         self.this.insert(key, v);
     }
 
@@ -228,11 +231,12 @@ impl GrowthMemo for Memo {
         key: Key,
         grow: &(dyn Fn() -> Result<std::result::Result<SecondaryRoads, Skip>> + Sync),
     ) -> Result<std::result::Result<SecondaryRoads, Skip>> {
-        if let Some(v) = lock(&self.growth).get(key) {
-            return Ok(v);
+        let hit = lock(&self.growth).get(key);
+        if let Some(v) = hit {
+            return Ok((*v).clone());
         }
         let v = grow()?;
-        lock(&self.growth).put(key, v.clone());
+        lock(&self.growth).put(key, Arc::new(v.clone()));
         lock(&self.redone).cells.insert(id);
         Ok(v)
     }
@@ -308,11 +312,12 @@ impl LotStage for MemoLots {
         if let Some(p) = &input.lot_params {
             key = key.bytes(format!("{p:?}").as_bytes());
         }
-        if let Some(v) = lock(&self.0.lots).get(key) {
-            return Ok(v);
+        let hit = lock(&self.0.lots).get(key);
+        if let Some(v) = hit {
+            return Ok((*v).clone());
         }
         let v = KellyLots.lots(input, cx)?;
-        lock(&self.0.lots).put(key, v.clone());
+        lock(&self.0.lots).put(key, Arc::new(v.clone()));
         lock(&self.0.redone).blocks.insert(r.id);
         Ok(v)
     }
@@ -354,11 +359,12 @@ impl BuildLot for MemoBuild<'_> {
             key = key.u64(e as u64);
         }
         let key = hashed(key, &lot.kind);
-        if let Some(v) = lock(&self.memo.buildings).get(key) {
-            return Ok(v);
+        let hit = lock(&self.memo.buildings).get(key);
+        if let Some(v) = hit {
+            return Ok((*v).clone());
         }
         let v = self.inner.build(lot)?;
-        lock(&self.memo.buildings).put(key, v.clone());
+        lock(&self.memo.buildings).put(key, Arc::new(v.clone()));
         lock(&self.memo.redone).buildings += 1;
         Ok(v)
     }
@@ -429,11 +435,12 @@ impl DressBuilding for MemoDress<'_> {
                 .u64(u64::from(f.part));
             key = hashed(key, &f.role);
         }
-        if let Some(v) = lock(&self.memo.dresses).get(key) {
-            return Ok(v);
+        let hit = lock(&self.memo.dresses).get(key);
+        if let Some(v) = hit {
+            return Ok((*v).clone());
         }
         let v = self.inner.dress_styled(b, seed, style)?;
-        lock(&self.memo.dresses).put(key, v.clone());
+        lock(&self.memo.dresses).put(key, Arc::new(v.clone()));
         lock(&self.memo.redone).dresses += 1;
         Ok(v)
     }

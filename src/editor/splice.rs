@@ -13,6 +13,7 @@
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use polis_buildings::Building;
 use polis_geom::scene::NodeId;
@@ -50,6 +51,11 @@ pub(super) struct OldScene {
     buildings: BTreeMap<u64, (usize, NodeId)>,
     /// Block id → (index in the city's blocks, node).
     blocks: BTreeMap<u64, (usize, NodeId)>,
+    /// Per old building (by index): found equal to the new one (building, skin and cell)
+    /// and reused; the change events then need not compare it again.
+    same_buildings: Vec<AtomicBool>,
+    /// Per old block (by index): found equal to the new one and reused.
+    same_blocks: Vec<AtomicBool>,
 }
 
 impl OldScene {
@@ -82,11 +88,34 @@ impl OldScene {
                 blocks.insert(id, (i, node_id));
             }
         }
+        let flags = |n: usize| (0..n).map(|_| AtomicBool::new(false)).collect();
         OldScene {
+            same_buildings: flags(city.buildings.len()),
+            same_blocks: flags(city.blocks.len()),
             city,
             buildings,
             blocks,
         }
+    }
+
+    /// The city before the edit.
+    pub(super) fn city(&self) -> &City {
+        &self.city
+    }
+
+    /// Whether the old building at `index` was found equal to the new one with its id
+    /// (same building, skin and cell) while the scene was assembled.
+    pub(super) fn same_building_at(&self, index: usize) -> bool {
+        self.same_buildings
+            .get(index)
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// Whether the old block at `index` was found equal to the new one with its id.
+    pub(super) fn same_block_at(&self, index: usize) -> bool {
+        self.same_blocks
+            .get(index)
+            .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
     /// The node `n` as a reusable leaf (name, translation, metadata, meshes).
@@ -124,11 +153,19 @@ impl SceneReuse for OldScene {
         if old_dress != dress || old_cell != cell {
             return None;
         }
-        self.leaf(n)
+        let leaf = self.leaf(n)?;
+        if let Some(f) = self.same_buildings.get(i) {
+            f.store(true, Ordering::Relaxed);
+        }
+        Some(leaf)
     }
 
     fn coarse(&self, b: &Building) -> Option<Option<Mesh>> {
-        let (_, n) = self.same_building(b)?;
+        // A building reused whole was compared already.
+        let n = match self.buildings.get(&b.id) {
+            Some(&(i, n)) if self.same_building_at(i) => n,
+            _ => self.same_building(b)?.1,
+        };
         let scene = &self.city.scene;
         let node = scene.nodes.get(n.0 as usize)?;
         let lod = node.children.iter().find_map(|c| {
@@ -149,6 +186,10 @@ impl SceneReuse for OldScene {
         if self.city.blocks.get(i)? != b {
             return None;
         }
-        self.leaf(n)
+        let leaf = self.leaf(n)?;
+        if let Some(f) = self.same_blocks.get(i) {
+            f.store(true, Ordering::Relaxed);
+        }
+        Some(leaf)
     }
 }

@@ -507,8 +507,15 @@ impl CityEditor {
             }
             _ => None,
         };
-        let (city, districts, redone) = build(&self.memo, &config, reuse)?;
-        let mut events = changes(&self.city, &city, &self.districts, &districts, &redone);
+        let (city, districts, redone) = build(&self.memo, &config, reuse.clone())?;
+        let mut events = changes(
+            &self.city,
+            &city,
+            &self.districts,
+            &districts,
+            &redone,
+            reuse.as_deref(),
+        );
         let orphans = orphans(&config, &city);
         events.orphaned.clone_from(&orphans);
         if maps_changed {
@@ -516,7 +523,8 @@ impl CityEditor {
             let maps = maps_of(&config)?;
             self.primary.set_terrain(terrain_of(&config, &maps)?);
         }
-        self.city = Arc::new(city);
+        let old = std::mem::replace(&mut self.city, Arc::new(city));
+        drop_later((old, reuse));
         self.districts = districts;
         self.config = config;
         self.orphans = orphans;
@@ -752,6 +760,16 @@ fn set_style(styles: &mut KindStyles, kind: polis_buildings::BuildingKind, style
 }
 
 /// Runs the memoised pipeline on `config`.
+/// Drops `v` on a thread of its own: freeing the city before an edit (every layer and
+/// mesh of it) is taken off the edit's path. Where no thread can be started it is
+/// dropped here.
+fn drop_later<T: Send + 'static>(v: T) {
+    // On failure the closure, and `v` with it, is dropped by `spawn` itself.
+    let _ = std::thread::Builder::new()
+        .name("polis-editor-drop".into())
+        .spawn(move || drop(v));
+}
+
 fn build(
     memo: &Arc<Memo>,
     config: &CityConfig,
