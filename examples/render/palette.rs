@@ -126,8 +126,8 @@ fn widest(colours: &[Count]) -> (usize, u8) {
 fn mean<'a>(colours: impl Iterator<Item = &'a Count>) -> [u8; 3] {
     let (mut sum, mut n) = ([0u64; 3], 0u64);
     for c in colours {
-        for k in 0..3 {
-            sum[k] += u64::from(c.rgb[k]) * c.n;
+        for (s, &v) in sum.iter_mut().zip(&c.rgb) {
+            *s += u64::from(v) * c.n;
         }
         n += c.n;
     }
@@ -140,8 +140,8 @@ fn lloyd(colours: &[Count], palette: &[[u8; 3]]) -> Vec<[u8; 3]> {
     let mut sums = vec![([0u64; 3], 0u64); palette.len()];
     for c in colours {
         let (sum, n) = &mut sums[nearest(palette, c.rgb)];
-        for k in 0..3 {
-            sum[k] += u64::from(c.rgb[k]) * c.n;
+        for (s, &v) in sum.iter_mut().zip(&c.rgb) {
+            *s += u64::from(v) * c.n;
         }
         *n += c.n;
     }
