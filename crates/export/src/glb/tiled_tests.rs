@@ -706,3 +706,193 @@ fn bad_options_are_typed_errors() {
     assert!("zip".parse::<GlbProfile>().is_err());
     let _ = Vec2::ZERO;
 }
+
+/// The web profile's feature table, by column, holds exactly the plain profile's records.
+#[cfg(feature = "web")]
+#[test]
+fn web_feature_table_by_column_holds_the_plain_records() {
+    let scene = town(40);
+    let web_options = GlbOptions {
+        profile: GlbProfile::Web,
+        ..tiled()
+    };
+    let table = |bytes: &[u8]| {
+        let (json, _) = chunks(bytes);
+        let root = json["scenes"][0]["nodes"][0].as_u64().unwrap() as usize;
+        json["nodes"][root]["extras"]["features"].clone()
+    };
+    let rows = table(&write(&scene, &tiled()).0);
+    let columns = table(&write(&scene, &web_options).0);
+    let rows = rows.as_array().unwrap();
+    let columns = columns.as_object().unwrap();
+    assert!(columns.contains_key("id") && columns.contains_key("height"));
+    assert!(
+        columns
+            .keys()
+            .zip(columns.keys().skip(1))
+            .all(|(a, b)| a < b)
+    );
+    for (k, record) in rows.iter().enumerate() {
+        let mut rebuilt = serde_json::Map::new();
+        for (key, column) in columns {
+            let column = column.as_array().unwrap();
+            assert_eq!(column.len(), rows.len(), "{key}");
+            if !column[k].is_null() {
+                rebuilt.insert(key.clone(), column[k].clone());
+            }
+        }
+        let record = record.as_object().unwrap();
+        assert_eq!(rebuilt.len(), record.len(), "record {k}");
+        for (key, v) in record {
+            let w = &rebuilt[key];
+            match v.as_f64() {
+                Some(x) => assert_eq!(w.as_f64(), Some(x), "record {k} {key}"),
+                None => assert_eq!(w, v, "record {k} {key}"),
+            }
+        }
+    }
+}
+
+/// Texture coordinates of the web profile decode to the plain ones within 1/4096 of a
+/// repeat: within [0, 1] as normalized 16-bit, beyond through the exponential filter.
+#[cfg(feature = "web")]
+#[test]
+fn web_texture_coordinates_decode_close_to_the_plain_ones() {
+    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
+    let mut s = Scene::new();
+    let image = s.add_image(polis_geom::scene::Image {
+        name: "grey".into(),
+        data: polis_geom::scene::ImageData::Rgba8 {
+            width: 2,
+            height: 2,
+            pixels: vec![128; 16],
+        },
+    });
+    let texture = s
+        .add_texture(polis_geom::scene::Texture {
+            name: "grey".into(),
+            image,
+            ..Default::default()
+        })
+        .unwrap();
+    let root = s.add_root("map");
+    // Unit coordinates over a 600 m sheet (a map-wide texture) and metre coordinates
+    // on a road strip 1.9 km long, both cut by tiles.
+    let mut unit = Mesh::new(Some(s.add_material(Material {
+        base_color_texture: Some(texture),
+        ..Material::new("ground", [1.0; 4])
+    })));
+    let mut metres = Mesh::new(Some(s.add_material(Material {
+        base_color_texture: Some(texture),
+        ..Material::new("paving", [1.0; 4])
+    })));
+    for i in 0..12 {
+        for j in 0..12 {
+            let (x, z) = (i as f64 * 50.0, j as f64 * 50.0);
+            let c = [[x, z], [x, z + 50.0], [x + 50.0, z + 50.0], [x + 50.0, z]];
+            unit.add_quad(
+                c.map(|[x, z]| DVec3::new(x, 0.0, z)),
+                c.map(|[x, z]| DVec2::new(x / 600.0, z / 600.0)),
+            )
+            .unwrap();
+        }
+    }
+    for i in 0..38 {
+        let x = i as f64 * 50.0 - 950.0;
+        let c = [[x, 0.0], [x, 7.0], [x + 50.0, 7.0], [x + 50.0, 0.0]];
+        metres
+            .add_quad(
+                c.map(|[x, z]| DVec3::new(x, 0.1, z)),
+                c.map(|[x, z]| DVec2::new(x + 0.37, z * 1.13)),
+            )
+            .unwrap();
+    }
+    for (name, m) in [("ground", unit), ("roads", metres)] {
+        let n = s.add_node(root, name).unwrap();
+        let m = s.add_mesh(m);
+        s.attach_mesh(n, m).unwrap();
+    }
+    let web_options = GlbOptions {
+        profile: GlbProfile::Web,
+        ..tiled()
+    };
+    let (plain, _) = write(&s, &tiled());
+    let (web, _) = write(&s, &web_options);
+    let (pj, pbin) = chunks(&plain);
+    let (wj, wbin) = chunks(&web);
+    let mut ws = meshoptimizer_rs::Workspace::default();
+    let mut codings = BTreeSet::new();
+    let materials = |j: &serde_json::Value, p: &serde_json::Value| {
+        j["materials"][p["material"].as_u64().unwrap() as usize]["name"].clone()
+    };
+    let mut expect: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
+    for m in pj["meshes"].as_array().unwrap() {
+        for p in m["primitives"].as_array().unwrap() {
+            let uv = read(&pj, pbin, p["attributes"]["TEXCOORD_0"].as_u64().unwrap());
+            expect
+                .entry(materials(&pj, p).to_string())
+                .or_default()
+                .extend(uv.iter().map(|t| [t[0], t[1]]));
+        }
+    }
+    let mut got: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
+    for m in wj["meshes"].as_array().unwrap() {
+        for p in m["primitives"].as_array().unwrap() {
+            let a = &wj["accessors"][p["attributes"]["TEXCOORD_0"].as_u64().unwrap() as usize];
+            let v = &wj["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+            let e = &v["extensions"]["EXT_meshopt_compression"];
+            let (o, l) = (
+                e["byteOffset"].as_u64().unwrap() as usize,
+                e["byteLength"].as_u64().unwrap() as usize,
+            );
+            let filter = e["filter"].as_str().unwrap_or("NONE");
+            let (count, stride) = (
+                e["count"].as_u64().unwrap() as usize,
+                e["byteStride"].as_u64().unwrap() as usize,
+            );
+            let raw = decode_buffer_view(
+                Mode::parse(e["mode"].as_str().unwrap()).unwrap(),
+                Filter::parse(filter).unwrap(),
+                count,
+                stride,
+                &wbin[o..o + l],
+                &mut ws,
+            )
+            .unwrap();
+            let component = a["componentType"].as_u64().unwrap();
+            codings.insert((materials(&wj, p).to_string(), component, filter.to_string()));
+            let uvs = raw.chunks_exact(stride).map(|t| match component {
+                5123 => {
+                    assert_eq!(a["normalized"], true);
+                    [0, 2].map(|k| f64::from(u16::from_le_bytes([t[k], t[k + 1]])) / 65_535.0)
+                }
+                _ => [0, 4].map(|k| f64::from(f32::from_le_bytes(t[k..k + 4].try_into().unwrap()))),
+            });
+            got.entry(materials(&wj, p).to_string())
+                .or_default()
+                .extend(uvs);
+        }
+    }
+    let codings: Vec<_> = codings.into_iter().collect();
+    assert_eq!(
+        codings,
+        [
+            ("\"ground\"".to_string(), 5123, "NONE".to_string()),
+            ("\"paving\"".to_string(), 5126, "EXPONENTIAL".to_string())
+        ]
+    );
+    for (material, expect) in &expect {
+        let got = &got[material];
+        // Every decoded coordinate lies within 1/4096 of a plain one and back (the web
+        // profile reorders and may drop unused vertices, never adds any).
+        for (from, to) in [(got, expect), (expect, got)] {
+            for t in from {
+                let best = to
+                    .iter()
+                    .map(|u| (t[0] - u[0]).abs().max((t[1] - u[1]).abs()))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(best <= 1.0 / 4096.0, "{material}: {t:?} is {best} away");
+            }
+        }
+    }
+}

@@ -15,7 +15,8 @@
 //!   record of the root's `extras.features` table (its `name`, `layer` and metadata), and
 //!   the record's index is the `_FEATURE_ID_0` of every vertex it contributed. Geometry of
 //!   no feature gets the table's length (`extras.null_feature_id`); a primitive with no
-//!   feature at all has no `_FEATURE_ID_0`.
+//!   feature at all has no `_FEATURE_ID_0`. The web profile writes the table by column
+//!   ([`by_column`]).
 //! * Its **tile** is the square of side `tile_size_m` on the root's x–z plane holding the
 //!   centre of its bounding box, `(⌊x / s⌋, ⌊z / s⌋)`; an object wider or deeper than a
 //!   tile (a layer-wide surface: the road network, water, ground) is cut instead, each
@@ -29,7 +30,7 @@ use polis_geom::glam::{DMat4, DVec3, Vec3};
 use polis_geom::scene::{MaterialId, NodeId, Scene};
 use serde_json::{Map, Value, json};
 
-use super::options::GlbOptions;
+use super::options::{GlbOptions, GlbProfile};
 use super::plan::{Geometry, Plan, PlannedMesh, PlannedNode};
 use crate::ExportError;
 
@@ -436,9 +437,47 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         }
         extras.insert("layers".into(), json!(layers));
         plan.features += features.len();
-        extras.insert("features".into(), Value::Array(features));
+        let table = match options.profile {
+            GlbProfile::Plain => Value::Array(features),
+            GlbProfile::Web => by_column(features),
+        };
+        extras.insert("features".into(), table);
         plan.nodes[root_index as usize].extras = Some(extras);
     }
     plan.count_meshes(scene, &used);
     Ok(plan)
+}
+
+/// The feature records as one column per key (the web profile's table): an object of
+/// arrays as long as the table, keys in sorted order, `null` where a record lacks the
+/// key; a whole number below 2^53 is written without its fraction (`416`, not `416.0`).
+/// Record `i` is `{k: columns[k][i]}` less its nulls. The key names, written once
+/// instead of once per record, are most of what this saves (a third of a city's table).
+fn by_column(records: Vec<Value>) -> Value {
+    let n = records.len();
+    let mut columns: BTreeMap<String, Vec<Value>> = BTreeMap::new();
+    for (i, record) in records.into_iter().enumerate() {
+        let Value::Object(fields) = record else {
+            continue;
+        };
+        for (k, v) in fields {
+            let column = columns.entry(k).or_insert_with(|| vec![Value::Null; n]);
+            column[i] = compact_number(v);
+        }
+    }
+    Value::Object(
+        columns
+            .into_iter()
+            .map(|(k, v)| (k, Value::Array(v)))
+            .collect(),
+    )
+}
+
+/// A whole `f64` below 2^53 as an integer; anything else unchanged.
+fn compact_number(v: Value) -> Value {
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+    match v.as_f64() {
+        Some(x) if v.is_f64() && x.fract() == 0.0 && x.abs() < EXACT => Value::from(x as i64),
+        _ => v,
+    }
 }

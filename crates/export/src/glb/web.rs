@@ -1,15 +1,19 @@
 //! The web profile: `KHR_mesh_quantization` + `EXT_meshopt_compression`.
 //!
 //! Per glTF mesh, positions are quantized to unsigned 16-bit integers on a grid spanning
-//! the mesh's bounds (one step for all axes: the largest extent / 65,535, 4 mm over a
-//! 250 m tile, so the dequantising scale is uniform and normals keep their directions) and the
-//! nodes drawing it dequantize with their transform (scale and offset composed into
-//! their TRS, or a child node `mesh` when they have children of their own). Normals and
-//! tangents become signed normalized bytes (1/127 steps); texture coordinates stay `f32`;
+//! the mesh's bounds (one step for all axes, a power of two of metres at or above the
+//! largest extent / 65,535, 3.9 mm over a 250 m tile, so the dequantising scale is
+//! uniform and normals keep their directions) and the nodes drawing it dequantize with
+//! their transform (scale and offset composed into their TRS, or a child node `mesh` when
+//! they have children of their own). Normals and tangents go through meshopt's
+//! `OCTAHEDRAL` filter (signed normalized bytes); texture coordinates within [0, 1]
+//! become unsigned normalized 16-bit, others stay `f32` through the `EXPONENTIAL` filter
+//! at steps of at most 1/4096 of a repeat (a sixteenth of a texel of a 256 px texture);
 //! feature ids stay exact. Every vertex and index array is then encoded with
 //! meshoptimizer's codecs (vertex codec version 0, index codec version 1, as the
 //! extension specifies) and stored in the binary chunk; the views point into a fallback
-//! buffer without data, so both extensions are required.
+//! buffer without data, so both extensions are required. The tiled layout's feature
+//! table is written column by column (the glb module's docs, "Profiles").
 //!
 //! References: Khronos, *KHR_mesh_quantization*; *EXT_meshopt_compression* (2021);
 //! A. Kapoulkine, meshoptimizer (vertex and index codecs).
@@ -19,7 +23,8 @@ use std::collections::BTreeMap;
 
 use gltf::json::accessor::{ComponentType as C, Type as T};
 use meshoptimizer_rs::codec::{
-    IndexEncoding, VertexEncoding, encode_filter_oct, encode_index_buffer, encode_vertex_buffer,
+    ExpMode, IndexEncoding, VertexEncoding, encode_filter_exp, encode_filter_oct,
+    encode_index_buffer, encode_vertex_buffer,
 };
 use meshoptimizer_rs::{Limits, Workspace, optimize_vertex_cache};
 use polis_geom::glam::Vec3;
@@ -49,18 +54,34 @@ struct Grid {
 }
 
 impl Grid {
-    /// One step on all three axes (the largest extent / 65,535): a uniform scale in
-    /// the node transform leaves the normals' directions alone, where a per-axis scale
-    /// would bend them through the normal matrix.
+    /// One step on all three axes: a uniform scale in the node transform leaves the
+    /// normals' directions alone, where a per-axis scale would bend them through the
+    /// normal matrix. The step is the power of two of metres at or above the largest
+    /// extent / 65,535 (3.9 mm for a 250 m tile) and the offset a multiple of it, so
+    /// points on a map-aligned binary lattice (the terrain's quadtree corners, every
+    /// 2 m) land on the grid exactly and their coordinates' low bytes repeat, which the
+    /// vertex codec's byte deltas compress to nothing.
     fn spanning(lo: Vec3, hi: Vec3) -> Grid {
         let extent = (hi - lo).max_element();
-        let step = if extent > 0.0 && extent.is_finite() {
-            extent / GRID_MAX
-        } else {
-            1.0
-        };
+        if !(extent > 0.0 && extent.is_finite()) {
+            return Grid {
+                offset: lo,
+                scale: Vec3::ONE,
+            };
+        }
+        let mut step = 2f32.powi((extent / GRID_MAX).log2().ceil() as i32);
+        let mut offset = (lo / step).floor() * step;
+        // Aligning the offset down can add one step to the span: then a step twice as
+        // large (at most two rounds).
+        for _ in 0..2 {
+            if ((hi - offset) / step).max_element() <= GRID_MAX {
+                break;
+            }
+            step *= 2.0;
+            offset = (lo / step).floor() * step;
+        }
         Grid {
-            offset: lo,
+            offset,
             scale: Vec3::splat(step),
         }
     }
@@ -81,6 +102,48 @@ const OCTAHEDRAL: &str = "OCTAHEDRAL";
 
 /// Bits per octahedral component: 8, the signed bytes of the accessor (about 1° steps).
 const OCTAHEDRAL_BITS: u32 = 8;
+
+/// The `EXT_meshopt_compression` filter of floats on a shared exponent.
+const EXPONENTIAL: &str = "EXPONENTIAL";
+
+/// Texture coordinates keep steps of at most 2^-UV_STEP_BITS texture repeats (1/4096:
+/// a sixteenth of a texel of the 256 px web textures).
+const UV_STEP_BITS: i32 = 12;
+
+/// How a mesh's texture coordinates are stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum UvCoding {
+    /// All within [0, 1] (the ground's map-wide texture): unsigned normalized 16-bit
+    /// (`KHR_mesh_quantization`), steps of 1/65,535.
+    Unorm16,
+    /// Floats through meshopt's `EXPONENTIAL` filter with one exponent per component
+    /// over the mesh and this many mantissa bits: a fixed step of at most
+    /// 2^-[`UV_STEP_BITS`] repeats at the largest coordinate (repeating metre or
+    /// marking-period coordinates), exact lower bits dropped so the codec compresses
+    /// them.
+    Exponential(u32),
+}
+
+/// The coding of texture coordinates `uvs` (finite; a non-finite one fails the encoder).
+fn uv_coding(uvs: &[[f32; 2]]) -> UvCoding {
+    let mut largest = 0.0f32;
+    let mut unit = true;
+    for c in uvs.iter().flatten() {
+        unit &= (0.0..=1.0).contains(c);
+        largest = largest.max(c.abs());
+    }
+    if unit {
+        return UvCoding::Unorm16;
+    }
+    // The filter stores m · 2^e with a signed mantissa of `bits` bits and e shared by
+    // the component: e = ⌊log2 |largest|⌋ + 1 − (bits − 1).
+    let magnitude = if largest > 0.0 && largest.is_finite() {
+        largest.log2().floor() as i32 + 1
+    } else {
+        0
+    };
+    UvCoding::Exponential((magnitude + UV_STEP_BITS + 1).clamp(2, 24) as u32)
+}
 
 /// Unit vectors (four floats each: direction and `w`, the tangent handedness or 0) as
 /// meshopt's octahedral filter stores them: two octahedral coordinates, a constant
@@ -179,14 +242,36 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
     });
 
     if writes_uvs(scene, m.material) {
-        let mut bytes = Vec::with_capacity(8 * n);
-        for t in order.iter().filter_map(|&v| m.uvs.get(v)) {
-            bytes.extend_from_slice(&t.x.to_le_bytes());
-            bytes.extend_from_slice(&t.y.to_le_bytes());
-        }
-        out.push(Encoded {
-            array: array(Slot::Uv, T::Vec2, C::F32, false, 8, None),
-            stream: vertex(bytes, 8, &mut ws)?,
+        let uvs: Vec<[f32; 2]> = order
+            .iter()
+            .filter_map(|&v| m.uvs.get(v))
+            .map(|t| [t.x, t.y])
+            .collect();
+        out.push(match uv_coding(&uvs) {
+            UvCoding::Unorm16 => {
+                let mut bytes = Vec::with_capacity(4 * n);
+                for c in uvs.iter().flatten() {
+                    let q = (c * 65_535.0).round().clamp(0.0, 65_535.0) as u16;
+                    bytes.extend_from_slice(&q.to_le_bytes());
+                }
+                Encoded {
+                    array: array(Slot::Uv, T::Vec2, C::U16, true, 4, None),
+                    stream: vertex(bytes, 4, &mut ws)?,
+                }
+            }
+            UvCoding::Exponential(bits) => {
+                let flat: Vec<f32> = uvs.iter().flatten().copied().collect();
+                let filtered =
+                    encode_filter_exp(n, 8, bits, &flat, ExpMode::SharedComponent, &mut ws)
+                        .map_err(codec)?;
+                Encoded {
+                    array: ArrayLayout {
+                        filter: Some(EXPONENTIAL),
+                        ..array(Slot::Uv, T::Vec2, C::F32, false, 8, None)
+                    },
+                    stream: vertex(filtered, 8, &mut ws)?,
+                }
+            }
         });
     }
 

@@ -23,7 +23,10 @@
 //!   sun, filtered over 3 × 3 texels); sky and ground light fill the shadows; distant
 //!   points fade into haze. Pixels with no triangle show the ground plane or the sky.
 //! - **Colour:** material colours are linear and textures sRGB, as in glTF; the result is
-//!   encoded as sRGB.
+//!   encoded as sRGB, then quantised to a 256-colour palette (median cut and k-means,
+//!   no dithering) and written as an indexed PNG, a third of the RGB file's size.
+
+mod palette;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -833,7 +836,11 @@ fn background(world: &World, camera: &Camera, sun: &Sun, dir: Vec3) -> Vec3 {
     sky(dir)
 }
 
-/// Averages `samples × samples` blocks and encodes sRGB PNG bytes.
+/// Colours of the written PNG's palette.
+const PALETTE_SIZE: usize = 256;
+
+/// Averages `samples × samples` blocks and encodes sRGB PNG bytes, indexed on a
+/// [`PALETTE_SIZE`]-colour palette (see [`palette`]).
 fn encode(image: &[Vec3], width: usize, height: usize) -> BoxResult<Vec<u8>> {
     let samples = (image.len() / (width * height)).isqrt();
     let stride = width * samples;
@@ -850,11 +857,14 @@ fn encode(image: &[Vec3], width: usize, height: usize) -> BoxResult<Vec<u8>> {
             rgb.extend([c.x, c.y, c.z].map(|v| (linear_to_srgb(v) * 255.0).round() as u8));
         }
     }
+    let (palette, indices) = palette::quantize(&rgb, PALETTE_SIZE);
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, width as u32, height as u32);
-    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_color(png::ColorType::Indexed);
     encoder.set_depth(png::BitDepth::Eight);
-    encoder.write_header()?.write_image_data(&rgb)?;
+    encoder.set_palette(palette.concat());
+    encoder.set_compression(png::Compression::High);
+    encoder.write_header()?.write_image_data(&indices)?;
     Ok(out)
 }
 
