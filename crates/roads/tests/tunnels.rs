@@ -7,18 +7,23 @@
 use std::sync::Arc;
 
 use polis_geom::DVec2;
-use polis_geom::field::{Constant, FnField};
+use polis_geom::field::{Constant, Field, FnField};
 use polis_roads::legality::{Illegal, Legality};
 use polis_roads::tunnels::{COVER_TOLERANCE_M, tunnelable};
 use polis_roads::*;
 use proptest::prelude::*;
 
-/// Uniform population; a park where `lo ≤ x ≤ hi` (the whole height of the map).
+/// A mask field: 1 where `lo ≤ x ≤ hi` (the whole height of the map), else 0.
+fn strip(lo: f64, hi: f64) -> Arc<dyn Field> {
+    Arc::new(FnField::new(move |p: DVec2| {
+        if (lo..=hi).contains(&p.x) { 1.0 } else { 0.0 }
+    }))
+}
+
+/// Uniform population; a park where `lo ≤ x ≤ hi`.
 fn park_strip(lo: f64, hi: f64) -> RoadInputs {
     let mut i = RoadInputs::flat(Arc::new(Constant(0.5)));
-    i.parks = Arc::new(FnField::new(move |p: DVec2| {
-        if (lo..=hi).contains(&p.x) { 1.0 } else { 0.0 }
-    }));
+    i.parks = strip(lo, hi);
     i
 }
 
@@ -159,32 +164,14 @@ fn a_tunnel_over_the_limit_is_refused() {
 #[test]
 fn water_stays_bridged() {
     let mut inputs = RoadInputs::flat(Arc::new(Constant(0.5)));
-    inputs.water = Arc::new(FnField::new(|p: DVec2| {
-        if (100.0..=200.0).contains(&p.x) {
-            1.0
-        } else {
-            0.0
-        }
-    }));
+    inputs.water = strip(100.0, 200.0);
     let (s, r, stats) = propose(&RoadParams::default(), &inputs, (95.0, 0.0), 90.0);
     assert_eq!(s, QueryState::Succeed);
     assert!(r.bridge && !r.tunnel);
     assert_eq!((stats.bridges, stats.tunnels), (1, 0));
     // Water inside a park: neither a bridge (a park in the way) nor a tunnel (water).
-    inputs.parks = Arc::new(FnField::new(|p: DVec2| {
-        if (100.0..=220.0).contains(&p.x) {
-            1.0
-        } else {
-            0.0
-        }
-    }));
-    inputs.water = Arc::new(FnField::new(|p: DVec2| {
-        if (150.0..=170.0).contains(&p.x) {
-            1.0
-        } else {
-            0.0
-        }
-    }));
+    inputs.parks = strip(100.0, 220.0);
+    inputs.water = strip(150.0, 170.0);
     let (s, r, _) = propose(&RoadParams::default(), &inputs, (95.0, 0.0), 90.0);
     assert_eq!(s, QueryState::Failed, "{r:?}");
 }
@@ -192,13 +179,7 @@ fn water_stays_bridged() {
 #[test]
 fn water_is_tunnelled_where_the_parameters_say_so() {
     let mut inputs = RoadInputs::flat(Arc::new(Constant(0.5)));
-    inputs.water = Arc::new(FnField::new(|p: DVec2| {
-        if (100.0..=200.0).contains(&p.x) {
-            1.0
-        } else {
-            0.0
-        }
-    }));
+    inputs.water = strip(100.0, 200.0);
     let p = RoadParams {
         tunnel_under_water: true,
         ..RoadParams::default()
