@@ -23,9 +23,11 @@
 //! units in the last place. Edges passing within that rounding distance
 //! ([`ROUNDING_TOLERANCE`]) of a new crossing node are bent through it, so several
 //! segments through one point share one node; no node is created within that distance of
-//! another (the edge is bent through the existing node), and every piece a split or a bend
-//! creates is bent through any node it passes within that distance of. Every created or
-//! split edge is checked against the edge index before the call returns.
+//! another (the edge is bent through the existing node), and every piece a split creates is
+//! bent through any node it passes within that distance of. A bend moves an edge by up to
+//! that distance, so its two legs are inserted by this same walk (splitting any edge the
+//! move takes them across). Every created or split edge is checked against the edge index
+//! before the call returns.
 //!
 //! # Guarantees
 //! * After every successful call the graph is planar in the sense of
@@ -66,6 +68,10 @@ use crate::spatial::{SegmentHit, Shape, SpatialIndex, classify_hit};
 /// segments through one point give one node. `1e-12` is about 5,000 ulps: a 10 nm margin
 /// at 10 km from the origin.
 pub const ROUNDING_TOLERANCE: f64 = 1e-12;
+
+/// How many bends may nest inside one another (a bend's walk meeting a crossing that
+/// bends another edge, …) before insertion reports [`GeomError::GraphCorrupt`].
+const MAX_BEND_DEPTH: usize = 16;
 
 /// The rounding tolerance at `p`, in metres (see [`ROUNDING_TOLERANCE`]).
 /// Whether a planar insertion that returned `result` left a planar graph planar: it did
@@ -238,7 +244,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         if a == b {
             return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
         }
-        self.connect(a, b, (p, q), &payload, snap, &mut make_node, &mut out)?;
+        self.connect(a, b, (p, q), &payload, snap, &mut make_node, &mut out, 0)?;
         let mut touched = out.created.clone();
         for &(e, piece) in &out.split {
             touched.extend([e, piece].into_iter().filter(|&x| self.contains_edge(x)));
@@ -334,7 +340,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         match a {
             Anchor::Node(n) => Ok(n),
             Anchor::Free(p) => self.add_node(p, make_node(p)),
-            Anchor::OnEdge(e, c) => self.split_or_end(e, c, make_node, out),
+            Anchor::OnEdge(e, c) => self.split_or_end(e, c, make_node, out, 0),
         }
     }
 
@@ -352,12 +358,13 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         c: DVec2,
         make_node: &mut impl FnMut(DVec2) -> N,
         out: &mut Insertion,
+        depth: usize,
     ) -> Result<NodeId, GeomError> {
         let (a, b) = self.endpoints(e)?;
         let (pa, pb) = (self.position(a)?, self.position(b)?);
         if let Some((n, _)) = self.nearest_node(c, rounding_eps(c)) {
             if n != a && n != b {
-                self.bend_through(e, n, out)?;
+                self.reroute_through(e, n, make_node, out, depth)?;
             }
             return Ok(n);
         }
@@ -366,8 +373,8 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         if c != pa && c != pb && t > 0.0 && t < 1.0 {
             let (m, piece) = self.split_edge(e, c, make_node(c))?;
             out.split.push((e, piece));
-            self.absorb_edges_near(m, out)?;
-            self.settle(vec![e, piece], out)?;
+            self.absorb_edges_near(m, make_node, out, depth)?;
+            self.settle(&[e, piece], make_node, out, depth)?;
             Ok(m)
         } else if c.distance_squared(pa) <= c.distance_squared(pb) {
             Ok(a)
@@ -389,6 +396,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         snap: f64,
         make_node: &mut impl FnMut(DVec2) -> N,
         out: &mut Insertion,
+        depth: usize,
     ) -> Result<(), GeomError> {
         out.nodes.push(from);
         let mut cur = from;
@@ -428,7 +436,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 }
                 Some(Event::Node(x)) => targets.push(x),
                 Some(Event::Cross(e, c)) => {
-                    let x = self.split_or_end(e, c, make_node, out)?;
+                    let x = self.split_or_end(e, c, make_node, out, depth)?;
                     targets.push(x);
                 }
             }
@@ -548,10 +556,20 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     /// Bends every edge passing within rounding distance of the new node `m` (but not
     /// ending at it) through `m`, so that a computed point on several lines becomes one
     /// node of all of them.
-    fn absorb_edges_near(&mut self, m: NodeId, out: &mut Insertion) -> Result<(), GeomError> {
+    fn absorb_edges_near(
+        &mut self,
+        m: NodeId,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+        depth: usize,
+    ) -> Result<(), GeomError> {
         let pm = self.position(m)?;
         let eps = rounding_eps(pm);
         for near in self.edge_index.segments_within(pm, eps) {
+            // An earlier bend may have removed or split this edge: look at it as it is.
+            if !self.contains_edge(near.key) {
+                continue;
+            }
             let (a, b) = self.endpoints(near.key)?;
             if a == m || b == m {
                 continue;
@@ -561,36 +579,31 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 // Passes near m only at its end: two nodes within rounding; leave them.
                 continue;
             }
-            self.bend_through(near.key, m, out)?;
+            if closest_point_on_segment(pm, pa, pb).0.distance(pm) > eps {
+                continue;
+            }
+            self.reroute_through(near.key, m, make_node, out, depth)?;
         }
         Ok(())
     }
 
-    /// Bends edge `e` through node `n` (see [`reroute_through`](Self::reroute_through)),
-    /// records the new pieces in `out.split`, and settles them.
-    fn bend_through(&mut self, e: EdgeId, n: NodeId, out: &mut Insertion) -> Result<(), GeomError> {
-        let pieces = self.reroute_through(e, n)?;
-        out.split.extend(pieces.iter().map(|&piece| (e, piece)));
-        self.settle(pieces, out)
-    }
-
-    /// Edges made by a split or a bend leave the line of the edge they replace by a few
-    /// units in the last place, and so may pass within rounding of a node they do not end
-    /// at — on its wrong side, where a later edge from that node crosses them. Bends each
-    /// such edge through the node nearest its first end, and its pieces likewise, until no
-    /// edge of the work list passes within rounding of a node it does not end at.
-    fn settle(&mut self, mut work: Vec<EdgeId>, out: &mut Insertion) -> Result<(), GeomError> {
-        let limit = 64 + self.node_count();
-        let mut steps = 0usize;
-        while let Some(e) = work.pop() {
+    /// Edges made by a split leave the line of the edge they replace by a few units in
+    /// the last place, and so may pass within rounding of a node they do not end at — on
+    /// its wrong side, where a later edge from that node crosses them. Bends each such
+    /// edge through the node nearest its first end ([`reroute_through`], whose walk takes
+    /// its pieces through any further such node).
+    ///
+    /// [`reroute_through`]: Self::reroute_through
+    fn settle(
+        &mut self,
+        work: &[EdgeId],
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+        depth: usize,
+    ) -> Result<(), GeomError> {
+        for &e in work {
             if !self.contains_edge(e) {
                 continue;
-            }
-            steps += 1;
-            if steps > limit {
-                return Err(GeomError::GraphCorrupt(format!(
-                    "settling edge {e} through nearby nodes did not converge; check_invariants() may tell why"
-                )));
             }
             let (a, b) = self.endpoints(e)?;
             let (pa, pb) = (self.position(a)?, self.position(b)?);
@@ -610,27 +623,57 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 }
             });
             if let Some((_, n)) = best {
-                let pieces = self.reroute_through(e, n)?;
-                out.split.extend(pieces.iter().map(|&piece| (e, piece)));
-                work.extend(pieces);
+                self.reroute_through(e, n, make_node, out, depth)?;
             }
         }
         Ok(())
     }
 
-    /// Replaces edge `e = a–b` by new edges `a–n` and `n–b`, skipping a piece that already
-    /// exists; returns the edges created.
-    fn reroute_through(&mut self, e: EdgeId, n: NodeId) -> Result<Vec<EdgeId>, GeomError> {
+    /// Replaces edge `e = a–b` by a route `a → n → b`, recording each new edge as
+    /// `(e, piece)` in `out.split`.
+    ///
+    /// Moving an edge onto a node moves it by up to the rounding distance, which can take
+    /// it across other edges that pass just as close (fans of nearly parallel edges out of
+    /// one node). So the two legs are not added blindly: each is *inserted*, by the same
+    /// walk as a new segment with no snapping beyond rounding — existing pieces are
+    /// followed, nodes within rounding of a leg are routed through, and edges the leg
+    /// crosses are split. Walks nest (a crossing met by a leg can bend another edge); past
+    /// [`MAX_BEND_DEPTH`] levels the insertion gives up with [`GeomError::GraphCorrupt`].
+    fn reroute_through(
+        &mut self,
+        e: EdgeId,
+        n: NodeId,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+        depth: usize,
+    ) -> Result<(), GeomError> {
+        if depth >= MAX_BEND_DEPTH {
+            return Err(GeomError::GraphCorrupt(format!(
+                "bending edge {e} through node {n} nested more than {MAX_BEND_DEPTH} bends deep; check_invariants() may tell why"
+            )));
+        }
         let (a, b) = self.endpoints(e)?;
         let payload = self.remove_edge(e)?;
-        let mut pieces = Vec::with_capacity(2);
-        if self.find_edge(a, n).is_none() {
-            pieces.push(self.add_edge(a, n, payload.clone())?);
+        let mut legs = Insertion::default();
+        for (from, to) in [(a, n), (n, b)] {
+            let line = (self.position(from)?, self.position(to)?);
+            self.connect(
+                from,
+                to,
+                line,
+                &payload,
+                0.0,
+                make_node,
+                &mut legs,
+                depth + 1,
+            )?;
+            // Each leg is a walk of its own: its route does not bar the other's nodes.
+            legs.nodes.clear();
         }
-        if self.find_edge(n, b).is_none() {
-            pieces.push(self.add_edge(n, b, payload)?);
-        }
-        Ok(pieces)
+        out.split
+            .extend(legs.created.iter().map(|&piece| (e, piece)));
+        out.split.extend(legs.split);
+        Ok(())
     }
 
     /// Checks that the given edges meet other edges only at common end nodes.
