@@ -486,11 +486,18 @@ impl Pipeline {
                 let mut nearby_roads = Vec::new();
                 for e in network.edge_index().query_box(&reach) {
                     let (a, b) = network.endpoints(e)?;
-                    nearby_roads.push((
-                        network.position(a)?,
-                        network.position(b)?,
-                        network.edge_payload(e)?.width,
-                    ));
+                    let (pa, pb) = (network.position(a)?, network.position(b)?);
+                    let road = network.edge_payload(e)?;
+                    if road.tunnel {
+                        // Underground: only its portals' mouths (a road width deep) are
+                        // kept clear; lots may stand on the land above.
+                        let mouth =
+                            (pb - pa).normalize_or_zero() * road.width.min(0.5 * pa.distance(pb));
+                        nearby_roads.push((pa, pa + mouth, road.width));
+                        nearby_roads.push((pb - mouth, pb, road.width));
+                    } else {
+                        nearby_roads.push((pa, pb, road.width));
+                    }
                 }
                 // Islands touching the boundary at a node are moved apart by a
                 // micrometre so the region is a valid polygon with holes; a cell where

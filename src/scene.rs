@@ -441,9 +441,23 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         if !(inp.config.scene.road_surfaces && inp.network.edge_count() > 0) {
             return Ok(None);
         }
-        // No surface between a tunnel's portals (polis_roads::tunnels).
+        // No surface between a tunnel's portals (polis_roads::tunnels), but the open
+        // cut from each portal's junction to its frame.
         let mut roads = map_roads(inp.network)?;
+        let mut cuts = Vec::new();
+        for p in polis_roads::portals(inp.network)? {
+            if p.setback > 0.0
+                && let Some(tunnel) = roads.iter().find(|r| r.id == u64::from(p.edge.raw()))
+            {
+                cuts.push(MapRoad {
+                    points: vec![p.position, p.face()],
+                    tunnel: false,
+                    ..tunnel.clone()
+                });
+            }
+        }
         roads.retain(|r| !r.tunnel);
+        roads.extend(cuts);
         if roads.is_empty() {
             return Ok(None);
         }

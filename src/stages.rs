@@ -196,13 +196,19 @@ pub trait CellStage: Send + Sync {
     fn cells(&self, network: &RoadNetwork, cx: &StageContext<'_>) -> Result<CellDecomposition>;
 }
 
-/// Eberly's minimal cycle basis (polis-cells) with the configuration's `cells` options.
+/// Eberly's minimal cycle basis (polis-cells) with the configuration's `cells` options,
+/// on the roads at ground level: a tunnel ([`polis_roads::Road::tunnel`]) bounds no cell,
+/// since the land above it is one piece (P&M §3.3); its portals stay junctions.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct EberlyCells;
 
 impl CellStage for EberlyCells {
     fn cells(&self, network: &RoadNetwork, cx: &StageContext<'_>) -> Result<CellDecomposition> {
-        Ok(polis_cells::extract_with(network, &cx.config.cells)?)
+        Ok(polis_cells::extract_where(
+            network,
+            &cx.config.cells,
+            |road| !road.tunnel,
+        )?)
     }
 }
 

@@ -99,3 +99,107 @@ fn a_park_over_the_whole_map_is_a_typed_error() {
         "{err}"
     );
 }
+
+/// A 3 × 3 grid of 120 m blocks whose middle column's middle street (between the two
+/// centre blocks) is a tunnel.
+struct GridWithTunnel;
+
+impl polis::stages::RoadStage for GridWithTunnel {
+    fn roads(
+        &self,
+        _cx: &polis::stages::StageContext<'_>,
+    ) -> polis::Result<polis::stages::RoadsOutput> {
+        use polis::roads::{Junction, Road, RoadClass, RoadNetwork};
+        let mut net = RoadNetwork::new();
+        let mut node = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                let p = DVec2::new(f64::from(i) * 120.0 - 180.0, f64::from(j) * 120.0 - 180.0);
+                node.push(net.add_node(p, Junction::default())?);
+            }
+        }
+        let road = |tunnel| Road {
+            class: RoadClass::Street,
+            width: 8.0,
+            bridge: false,
+            tunnel,
+            step: 0,
+        };
+        for j in 0..4 {
+            for i in 0..4 {
+                let k = j * 4 + i;
+                if i < 3 {
+                    net.add_edge(node[k], node[k + 1], road(false))?;
+                }
+                if j < 3 {
+                    // The street from (−60, −60) to (−60, 60) runs underground.
+                    net.add_edge(node[k], node[k + 4], road(i == 1 && j == 1))?;
+                }
+            }
+        }
+        Ok(polis::stages::RoadsOutput {
+            network: net,
+            growth: None,
+            skipped: Vec::new(),
+            districts: Vec::new(),
+        })
+    }
+}
+
+/// The land above a tunnel is one piece: no cell (block) is bounded by a tunnel, the
+/// two blocks either side of it are one, and lots stand above it (P&M §3.3).
+#[test]
+fn no_cell_is_bounded_by_a_tunnel() {
+    let mut c = CityConfig::preset("default").unwrap();
+    c.size_m = 500.0;
+    c.maps.parks = None;
+    c.maps.water = None;
+    c.maps.elevation = None;
+    let city = polis::Pipeline::default()
+        .with_roads(GridWithTunnel)
+        .generate(&c)
+        .unwrap();
+    let tunnel = |e| city.roads.edge_payload(e).is_ok_and(|r| r.tunnel);
+    assert_eq!(city.roads.edges().filter(|(e, ..)| tunnel(*e)).count(), 1);
+    let rings = city
+        .cells
+        .cells
+        .iter()
+        .flat_map(|c| std::iter::once(&c.boundary).chain(&c.holes));
+    assert!(
+        rings.flat_map(|r| r.edges.iter()).all(|&e| !tunnel(e)),
+        "a cell ring runs along the tunnel"
+    );
+    // Nine blocks of the grid, the two either side of the tunnel joined.
+    assert_eq!(city.cells.cells.len(), 8);
+    // One block covers the land above the tunnel, ...
+    let above = DVec2::new(-60.0, 0.0);
+    assert!(
+        city.blocks.iter().any(|b| b.polygon.contains(above)),
+        "no block on the land above the tunnel"
+    );
+    // ... with lots either side of its line, none in its portals' mouths (a road width
+    // deep from each portal, ± half the road's width).
+    let west = city
+        .lots
+        .iter()
+        .filter(|l| l.lot.polygon.bbox().max.x < -60.0);
+    let east = city
+        .lots
+        .iter()
+        .filter(|l| l.lot.polygon.bbox().min.x > -60.0);
+    let merged = |l: &&polis::CityLot| {
+        let b = l.lot.polygon.bbox();
+        b.min.x > -176.0 && b.max.x < 56.0 && b.min.y > -56.0 && b.max.y < 56.0
+    };
+    assert!(west.filter(merged).count() > 0 && east.filter(merged).count() > 0);
+    for l in &city.lots {
+        for mouth in [DVec2::new(-60.0, -56.0), DVec2::new(-60.0, 56.0)] {
+            assert!(
+                !l.lot.polygon.contains(mouth),
+                "lot {} stands in a portal's mouth",
+                l.id
+            );
+        }
+    }
+}

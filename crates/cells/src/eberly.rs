@@ -313,7 +313,8 @@ mod tests {
     fn run(g: &PlanarGraph<(), ()>) -> (Topology, Sweep) {
         let mut t = Topology::default();
         let mut r = ExtractionReport::default();
-        t.build(g, &CellParams::default(), &mut r).unwrap();
+        t.build(g, &CellParams::default(), &|_| true, &mut r)
+            .unwrap();
         let mut s = Sweep::default();
         s.run(&mut t).unwrap();
         (t, s)

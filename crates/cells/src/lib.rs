@@ -155,6 +155,21 @@ pub fn extract_with<N, E>(
     CellExtractor::new().extract(graph, params)
 }
 
+/// [`extract_with`] on the edges of `graph` whose payload `keep` accepts; the others are
+/// left out as if absent (and not listed as dropped in the report). A road graph leaves
+/// out its tunnels this way: the ground above a tunnel is one piece of land, not the
+/// boundary of two cells.
+///
+/// # Errors
+/// See [`extract_with`].
+pub fn extract_where<N, E>(
+    graph: &PlanarGraph<N, E>,
+    params: &CellParams,
+    keep: impl Fn(&E) -> bool,
+) -> Result<CellDecomposition, Error> {
+    CellExtractor::new().extract_where(graph, params, keep)
+}
+
 /// A reusable cell extractor: keeps its working buffers between runs, so extracting many
 /// graphs (e.g. the secondary network of every cell) allocates only for the output.
 #[derive(Debug, Default)]
@@ -180,8 +195,22 @@ impl CellExtractor {
         graph: &PlanarGraph<N, E>,
         params: &CellParams,
     ) -> Result<CellDecomposition, Error> {
+        self.extract_where(graph, params, |_| true)
+    }
+
+    /// Extracts the cells of the edges of `graph` that `keep` accepts. See
+    /// [`extract_where`].
+    ///
+    /// # Errors
+    /// See [`extract_with`].
+    pub fn extract_where<N, E>(
+        &mut self,
+        graph: &PlanarGraph<N, E>,
+        params: &CellParams,
+        keep: impl Fn(&E) -> bool,
+    ) -> Result<CellDecomposition, Error> {
         let mut report = ExtractionReport::default();
-        self.topo.build(graph, params, &mut report)?;
+        self.topo.build(graph, params, &keep, &mut report)?;
         // The line sweep certifies planarity and, on the way, finds the edge below every
         // node (for the containment of components). Only when it finds a contact does the
         // slower grid check run, to list every conflict.
@@ -211,6 +240,30 @@ mod tests {
     use super::*;
 
     fn assert_send_sync_clone<T: Send + Sync + Clone>() {}
+
+    /// A unit square split by a diagonal: two cells; with the diagonal left out, one
+    /// (the square), and the diagonal's edge is not reported as dropped.
+    #[test]
+    fn extract_where_leaves_out_the_rejected_edges() {
+        use polis_geom::DVec2;
+        let mut g: PlanarGraph<(), bool> = PlanarGraph::new();
+        let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let n: Vec<_> = corners
+            .iter()
+            .map(|&(x, y)| g.add_node(DVec2::new(x, y), ()).unwrap())
+            .collect();
+        for i in 0..4 {
+            g.add_edge(n[i], n[(i + 1) % 4], false).unwrap();
+        }
+        let diagonal = g.add_edge(n[0], n[2], true).unwrap();
+        let params = CellParams::default();
+        assert_eq!(extract_with(&g, &params).unwrap().cells.len(), 2);
+        let kept = extract_where(&g, &params, |&tunnel| !tunnel).unwrap();
+        assert_eq!(kept.cells.len(), 1);
+        assert!((kept.cells[0].boundary.polygon.area() - 1.0).abs() < 1e-12);
+        assert!(kept.cells[0].boundary.edges.iter().all(|&e| e != diagonal));
+        assert!(kept.report.dropped_edges.is_empty());
+    }
 
     #[test]
     fn output_is_send_sync_clone() {

@@ -275,7 +275,8 @@ mod tests {
     fn topo(g: &PlanarGraph<(), ()>) -> Topology {
         let mut t = Topology::default();
         let mut r = ExtractionReport::default();
-        t.build(g, &CellParams::default(), &mut r).unwrap();
+        t.build(g, &CellParams::default(), &|_| true, &mut r)
+            .unwrap();
         t
     }
 

@@ -80,11 +80,13 @@ impl Topology {
         self.origin.len()
     }
 
-    /// Rebuilds the working graph from `g`, merging or rejecting coincident nodes.
+    /// Rebuilds the working graph from the edges of `g` that `keep` accepts, merging or
+    /// rejecting coincident nodes.
     pub(crate) fn build<N, E>(
         &mut self,
         g: &PlanarGraph<N, E>,
         params: &CellParams,
+        keep: &impl Fn(&E) -> bool,
         report: &mut ExtractionReport,
     ) -> Result<(), Error> {
         let n = g.node_bound();
@@ -152,7 +154,10 @@ impl Topology {
         self.ends.clear();
         self.ends.resize(m, [NONE; 2]);
         self.kept.clear();
-        for (e, a, b, _) in g.edges() {
+        for (e, a, b, payload) in g.edges() {
+            if !keep(payload) {
+                continue;
+            }
             let (ra, rb) = (self.rank_of[a.index()], self.rank_of[b.index()]);
             if ra == NONE || rb == NONE {
                 return Err(Error::Internal(format!("edge {e} ends at a dead node")));
@@ -232,10 +237,13 @@ impl Topology {
             for (id, _, _) in g.nodes() {
                 let r = self.rank_of[id.index()];
                 let s = self.adj_start[r as usize] as usize;
-                for (i, &e) in g.edges_at(id)?.iter().enumerate() {
-                    let k = s + i;
+                let mut k = s;
+                for &e in g.edges_at(id)? {
                     let [a, b] = self.ends.get(e.index()).copied().unwrap_or([NONE; 2]);
                     if a == NONE {
+                        if g.edge_payload(e).is_ok_and(|p| !keep(p)) {
+                            continue; // left out by the caller
+                        }
                         return Err(Error::Internal(format!("edge {e} has no ends")));
                     }
                     self.origin[k] = r;
@@ -248,6 +256,7 @@ impl Topology {
                         self.twin[k] = first;
                         self.twin[first as usize] = k as u32;
                     }
+                    k += 1;
                 }
             }
         }
@@ -444,7 +453,8 @@ mod tests {
         let e_se = g.add_edge(se, c, ()).unwrap();
         let mut t = Topology::default();
         let mut r = ExtractionReport::default();
-        t.build(&g, &CellParams::default(), &mut r).unwrap();
+        t.build(&g, &CellParams::default(), &|_| true, &mut r)
+            .unwrap();
         assert_eq!(t.node, vec![c.raw(), up.raw(), se.raw(), ne.raw()]);
         assert_eq!(t.slots(), 6);
         for k in 0..6 {
@@ -476,7 +486,8 @@ mod tests {
         g.add_edge(a2, c, ()).unwrap();
         let mut t = Topology::default();
         let mut r = ExtractionReport::default();
-        t.build(&g, &CellParams::default(), &mut r).unwrap();
+        t.build(&g, &CellParams::default(), &|_| true, &mut r)
+            .unwrap();
         assert_eq!(r.merged_nodes.len(), 1);
         assert_eq!(r.merged_nodes[0].node, a2);
         assert_eq!(r.merged_nodes[0].into, a);
@@ -497,7 +508,7 @@ mod tests {
         };
         let mut r = ExtractionReport::default();
         assert!(matches!(
-            t.build(&g, &reject, &mut r),
+            t.build(&g, &reject, &|_| true, &mut r),
             Err(Error::CoincidentNodes { .. })
         ));
     }

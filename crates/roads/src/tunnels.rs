@@ -34,7 +34,10 @@
 //! connected to it), while its portals are ordinary junctions.
 //!
 //! [`portals`] lists both ends of every tunnel; [`portal_mesh`] builds a concrete frame
-//! at each for a scene. The scene draws no road surface between the portals.
+//! at each for a scene. A frame stands set back from its junction, just far enough that
+//! it keeps clear of the junction's other roads and of other tunnels' frames there
+//! ([`Portal::setback`]); the scene draws the road surface from the junction to the frame
+//! (an open cut) and none between the frames.
 //!
 //! ## Guarantees
 //!
@@ -52,13 +55,17 @@
 //!   a flat park is not modelled (cut and cover), nor is the inside of the tunnel drawn.
 //! * Only highways tunnel (as only highways bridge). Water is bridged unless
 //!   `tunnel_under_water` is set, and then always tunnelled (no choice per crossing).
-//! * The cells and lots stages see a tunnel as any other road edge (a block boundary);
-//!   Kelly's secondary growth in a cell (`secondary`) may still meet a tunnel edge.
+//! * The facade's cell stage leaves tunnels out (`polis_cells::extract_where`): the land
+//!   above a tunnel is one block, whose lots keep out of the portals' mouths only. In the
+//!   Citygen mode, though, the primary network's city cells are still bounded by its
+//!   tunnels, so that Kelly's secondary growth (`secondary`), which knows nothing of
+//!   grade separation, never crosses one.
 //!
 //! ## References
 //!
 //! * Y. I. H. Parish, P. Müller, *Procedural Modeling of Cities*, SIGGRAPH 2001, §3.3.
 
+use polis_geom::measure::segment_distance;
 use polis_geom::mesh::Mesh;
 use polis_geom::{DVec2, EdgeId, Field, NodeId, Polygon, PolygonWithHoles};
 
@@ -79,6 +86,8 @@ pub const PORTAL_LINTEL_M: f64 = 1.5;
 pub const PORTAL_WALL_M: f64 = 1.0;
 /// How far a portal's walls reach into the ground below the road, metres.
 const PORTAL_FOOT_M: f64 = 1.0;
+/// Step of the search for a portal's setback ([`Portal::setback`]), metres.
+const SETBACK_STEP_M: f64 = 0.25;
 
 /// Whether the straight piece `a–b` may be a tunnel: `b` on legal ground, every sample
 /// (every `legality_step_m`) on land (legal or park, not outside the map; water only
@@ -161,6 +170,28 @@ pub struct Portal {
     pub into: DVec2,
     /// Carriageway width of the tunnel, metres.
     pub width: f64,
+    /// How far along the tunnel from the junction its frame stands, metres: the least
+    /// (in steps of a quarter metre) at which the frame's footprint keeps clear of every
+    /// other road's corridor at the junction (its centre line ± half its width; for
+    /// another tunnel, ± half its width and a wall, so two frames never overlap), at most
+    /// half the tunnel's length less a wall. 0 at a junction with no other road. The road
+    /// surface runs on from the junction to the frame (an open cut).
+    pub setback: f64,
+}
+
+impl Portal {
+    /// Where the frame's face stands: `position + into · setback`.
+    pub fn face(&self) -> DVec2 {
+        self.position + self.into * self.setback
+    }
+
+    /// The frame's footprint (walls and lintel): a rectangle across the road, one wall
+    /// thick, from the face into the tunnel, as its four corners.
+    pub fn footprint(&self) -> [DVec2; 4] {
+        let reach = self.into.perp() * (0.5 * self.width + PORTAL_WALL_M);
+        let (near, far) = (self.face(), self.face() + self.into * PORTAL_WALL_M);
+        [near - reach, near + reach, far + reach, far - reach]
+    }
 }
 
 /// Both portals of every tunnel edge of `network`, in edge order (the start end first).
@@ -186,29 +217,63 @@ pub fn portals(network: &RoadNetwork) -> Result<Vec<Portal>> {
             if inside || len <= 0.0 {
                 continue;
             }
-            out.push(Portal {
+            let mut portal = Portal {
                 node: n,
                 edge: e,
                 position: p,
                 into: (q - p) / len,
                 width: road.width,
-            });
+                setback: 0.0,
+            };
+            portal.setback = setback(network, &portal, len)?;
+            out.push(portal);
         }
     }
     Ok(out)
 }
 
+/// The least setback (a multiple of [`SETBACK_STEP_M`]) at which `portal`'s footprint
+/// is farther than each other road at its junction from that road's centre line than half
+/// its width (another tunnel: half its width and a wall), capped at half the tunnel's
+/// length `len` less a wall.
+fn setback(network: &RoadNetwork, portal: &Portal, len: f64) -> Result<f64> {
+    let mut others = Vec::new();
+    for &f in network.edges_at(portal.node)? {
+        if f == portal.edge {
+            continue;
+        }
+        let (a, b) = network.segment(f)?;
+        let road = network.edge_payload(f)?;
+        let reach = 0.5 * road.width + if road.tunnel { PORTAL_WALL_M } else { 0.0 };
+        others.push((a, b, reach));
+    }
+    let cap = (0.5 * len - PORTAL_WALL_M).max(0.0);
+    let clear = |setback: f64| {
+        let q = Portal { setback, ..*portal }.footprint();
+        others.iter().all(|&(a, b, reach)| {
+            (0..4).all(|i| segment_distance(q[i], q[(i + 1) % 4], a, b) > reach)
+        })
+    };
+    let steps = (cap / SETBACK_STEP_M).floor() as usize;
+    Ok((0..=steps)
+        .map(|i| i as f64 * SETBACK_STEP_M)
+        .find(|&s| clear(s))
+        .unwrap_or(cap))
+}
+
 /// A concrete frame at every portal of `network` as closed solids: two side walls
 /// ([`PORTAL_WALL_M`] wide) beside the carriageway and a lintel over it at
 /// [`PORTAL_CLEARANCE_M`], [`PORTAL_WALL_M`] thick along the road, standing on `ground`
-/// at the portal (reaching a metre into it). `None` when there is no tunnel.
+/// at the portal's face ([`Portal::face`], set back from the junction clear of its other
+/// roads; reaching a metre into the ground). `None` when there is no tunnel.
 ///
 /// # Errors
 /// A corrupt graph; the mesh builder's errors.
 pub fn portal_mesh(network: &RoadNetwork, ground: &dyn Field) -> Result<Option<Mesh>> {
     let mut mesh = Mesh::new(None);
     for p in portals(network)? {
-        let h = ground.sample(p.position);
+        let face = p.face();
+        let h = ground.sample(face);
         if !(h.is_finite() && p.width > 0.0) {
             continue;
         }
@@ -216,7 +281,7 @@ pub fn portal_mesh(network: &RoadNetwork, ground: &dyn Field) -> Result<Option<M
         let half = 0.5 * p.width;
         // A quad from `lo` to `hi` across the road (signed offsets), one wall thick.
         let quad = |lo: f64, hi: f64| {
-            let (a, b) = (p.position + side * lo, p.position + side * hi);
+            let (a, b) = (face + side * lo, face + side * hi);
             let mut poly = PolygonWithHoles::new(
                 Polygon::new(vec![
                     a,

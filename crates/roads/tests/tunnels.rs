@@ -257,8 +257,7 @@ fn a_city_tunnels_under_its_park_and_nothing_meets_the_tunnel() {
         assert!((q.into.length() - 1.0).abs() < 1e-9);
         assert_eq!(legality.point(q.position), None);
     }
-    // Each portal's frame is three closed boxes (frames of tunnels leaving one junction
-    // may overlap each other).
+    // Each portal's frame is three closed boxes.
     let mesh = portal_mesh(net, &Constant(0.0)).unwrap().unwrap();
     mesh.validate().unwrap();
     assert_eq!(mesh.triangle_count(), 3 * 12 * portals.len());
@@ -355,4 +354,80 @@ proptest! {
             prop_assert_eq!(s, QueryState::Succeed);
         }
     }
+}
+
+/// Two highway tunnels and two streets leave one junction: each frame stands back from
+/// the junction just far enough to keep clear of the streets' corridors and of the other
+/// tunnel's frame; the frames are disjoint; a portal at a junction with no other road
+/// stands at the junction.
+#[test]
+fn portal_frames_keep_clear_of_the_junctions_other_roads() {
+    use polis_geom::measure::segment_distance;
+    let mut net = RoadNetwork::new();
+    let mut node = |x: f64, y: f64| net.add_node(DVec2::new(x, y), Junction::default()).unwrap();
+    let (o, a, b, c, d) = (
+        node(0.0, 0.0),
+        node(200.0, 0.0),
+        node(120.0, 90.0),
+        node(-200.0, 30.0),
+        node(10.0, -200.0),
+    );
+    let road = |class, width, tunnel| Road {
+        class,
+        width,
+        bridge: false,
+        tunnel,
+        step: 0,
+    };
+    net.add_edge(o, a, road(RoadClass::Highway, 16.0, true))
+        .unwrap();
+    net.add_edge(o, b, road(RoadClass::Highway, 16.0, true))
+        .unwrap();
+    net.add_edge(o, c, road(RoadClass::Street, 8.0, false))
+        .unwrap();
+    net.add_edge(o, d, road(RoadClass::Street, 8.0, false))
+        .unwrap();
+    let portals = portals(&net).unwrap();
+    assert_eq!(portals.len(), 4);
+    let at_o: Vec<_> = portals.iter().filter(|p| p.node == o).collect();
+    assert_eq!(at_o.len(), 2);
+    let edges = |q: [DVec2; 4]| (0..4).map(move |i| (q[i], q[(i + 1) % 4]));
+    for p in &at_o {
+        assert!(p.setback > 0.0 && p.setback < 50.0, "{}", p.setback);
+        // Clear of the streets' corridors.
+        for far in [c, d] {
+            let (s0, s1) = (DVec2::ZERO, net.position(far).unwrap());
+            for (e0, e1) in edges(p.footprint()) {
+                assert!(segment_distance(e0, e1, s0, s1) > 4.0);
+            }
+        }
+        // The least such setback: a quarter metre nearer, something is in the way.
+        let nearer = Portal {
+            setback: p.setback - 0.25,
+            ..**p
+        };
+        let in_way = [(c, 4.0), (d, 4.0), (a, 9.0), (b, 9.0)]
+            .iter()
+            .any(|&(far, reach)| {
+                far != net.endpoints(p.edge).unwrap().1
+                    && edges(nearer.footprint()).any(|(e0, e1)| {
+                        segment_distance(e0, e1, DVec2::ZERO, net.position(far).unwrap()) <= reach
+                    })
+            });
+        assert!(in_way, "setback {} is not the least", p.setback);
+    }
+    // The two frames at the junction do not meet.
+    for (e0, e1) in edges(at_o[0].footprint()) {
+        for (f0, f1) in edges(at_o[1].footprint()) {
+            assert!(segment_distance(e0, e1, f0, f1) > 0.0);
+        }
+    }
+    // The far portals have no other road: at their junctions.
+    for p in portals.iter().filter(|p| p.node != o) {
+        assert_eq!(p.setback, 0.0);
+        assert_eq!(p.face(), p.position);
+    }
+    let mesh = portal_mesh(&net, &Constant(0.0)).unwrap().unwrap();
+    mesh.validate().unwrap();
+    assert_eq!(mesh.triangle_count(), 3 * 12 * portals.len());
 }
