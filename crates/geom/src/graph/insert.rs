@@ -373,8 +373,10 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         if c != pa && c != pb && t > 0.0 && t < 1.0 {
             let (m, piece) = self.split_edge(e, c, make_node(c))?;
             out.split.push((e, piece));
-            self.absorb_edges_near(m, make_node, out, depth)?;
+            // The pieces first: a walk of a bend that `absorb_edges_near` makes must not
+            // meet a piece that still runs through a node (it would follow it past).
             self.settle(&[e, piece], make_node, out, depth)?;
+            self.absorb_edges_near(m, make_node, out, depth)?;
             Ok(m)
         } else if c.distance_squared(pa) <= c.distance_squared(pb) {
             Ok(a)
@@ -430,6 +432,12 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                     targets.pop();
                 }
                 Some(Event::Follow(e, x)) => {
+                    // An edge bent by rounding may pass through a node (the target, say)
+                    // until it is settled; following it would go past that node.
+                    self.settle(&[e], make_node, out, depth)?;
+                    if !self.contains_edge(e) {
+                        continue;
+                    }
                     out.path.push(e);
                     out.nodes.push(x);
                     cur = x;
