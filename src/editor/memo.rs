@@ -163,16 +163,32 @@ fn hashed(k: Key, v: &impl Hash) -> Key {
     h.0
 }
 
+/// The digest of what the facade stage reads of `config`: the facade settings, the
+/// pinned styles and the seed.
+fn facades_key(config: &crate::CityConfig) -> Key {
+    let pinned: Vec<&str> = config
+        .citygen
+        .lots
+        .iter()
+        .filter_map(|o| o.style.as_deref())
+        .collect();
+    Key::new(3).bytes(format!("{:?}|{:?}|{}", config.facades, pinned, config.seed).as_bytes())
+}
+
 impl Memo {
+    /// The facade stage's dresser of the last run, if `config`'s facade inputs are that
+    /// run's (for dressing a building outside a run).
+    pub(crate) fn dresser_for(&self, config: &crate::CityConfig) -> Option<Arc<dyn DressBuilding>> {
+        let key = facades_key(config);
+        match &*lock(&self.dresser) {
+            Some((k, d)) if *k == key => Some(Arc::clone(d)),
+            _ => None,
+        }
+    }
+
     /// Starts a run on `config`: fingerprints of what the stages read globally.
     pub(crate) fn begin(&self, config: &crate::CityConfig) {
         let text = |salt: u64, s: String| Key::new(salt).bytes(s.as_bytes());
-        let pinned: Vec<&str> = config
-            .citygen
-            .lots
-            .iter()
-            .filter_map(|o| o.style.as_deref())
-            .collect();
         *lock(&self.fingerprints) = Some(Fingerprints {
             roads: roads_key(config).unwrap_or(Key::new(config.seed)),
             lots: text(
@@ -183,10 +199,7 @@ impl Memo {
                 2,
                 format!("{:?}|{}", config.effective_building_params(), config.seed),
             ),
-            facades: text(
-                3,
-                format!("{:?}|{:?}|{}", config.facades, pinned, config.seed),
-            ),
+            facades: facades_key(config),
         });
         *lock(&self.redone) = Redone::default();
     }

@@ -90,6 +90,7 @@ mod edit;
 mod file;
 pub(crate) mod key;
 mod memo;
+mod patch;
 mod splice;
 mod state;
 

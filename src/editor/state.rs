@@ -99,6 +99,9 @@ pub struct CityEditor {
     undo: Vec<Step>,
     redo: Vec<Step>,
     orphans: Vec<LotOverride>,
+    /// Look-ups into `city` for lot edits in place (see `patch.rs`); made on the first
+    /// such edit after a pipeline run.
+    index: Option<super::patch::Index>,
 }
 
 impl std::fmt::Debug for CityEditor {
@@ -193,6 +196,7 @@ impl CityEditor {
             undo: Vec::new(),
             redo: Vec::new(),
             orphans,
+            index: None,
         })
     }
 
@@ -498,6 +502,10 @@ impl CityEditor {
     /// Builds the city of `config` through the memo and, on success, makes it the
     /// editor's; returns what changed.
     fn rebuild(&mut self, config: CityConfig) -> Result<ChangeEvents> {
+        if let Some(events) = self.patch(&config) {
+            return Ok(events);
+        }
+        self.index = None;
         let maps_changed = self.maps_changed(&config);
         // Leaves of the scene whose inputs the edit left alone are spliced in from the
         // scene as it stands.
@@ -529,6 +537,29 @@ impl CityEditor {
         self.config = config;
         self.orphans = orphans;
         Ok(events)
+    }
+
+    /// An edit of lot overrides only, made in place in the city (see `patch.rs`);
+    /// `None` where the patch declines and the pipeline must run.
+    fn patch(&mut self, config: &CityConfig) -> Option<ChangeEvents> {
+        if !super::patch::lots_only(&self.config, config) {
+            return None;
+        }
+        let city = Arc::get_mut(&mut self.city)?;
+        let index = self
+            .index
+            .get_or_insert_with(|| super::patch::Index::of(city));
+        let (events, orphans) = super::patch::patch_lots(
+            city,
+            index,
+            config,
+            &self.districts,
+            &self.memo,
+            &self.orphans,
+        )?;
+        self.config = config.clone();
+        self.orphans = orphans;
+        Some(events)
     }
 
     fn maps_changed(&self, config: &CityConfig) -> bool {
