@@ -7,6 +7,7 @@
 //! cargo bench --bench editor                       # citygen preset, 20 edits per kind
 //! cargo bench --bench editor -- --edits 1000 --size 1500
 //! cargo bench --bench editor -- --edits 5 --stages  # p50 per pipeline stage too
+//! cargo bench --bench editor -- --kind "cell preset" # one kind of edit only
 //! ```
 //!
 //! With `--stages` each kind also prints the median of each pipeline stage's time
@@ -61,6 +62,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut size = None;
     let mut preset = "citygen".to_string();
     let mut stages = false;
+    let mut kinds: Vec<String> = ["move node", "cell preset", "pin building"]
+        .map(String::from)
+        .to_vec();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -68,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--size" => size = Some(args.next().ok_or("--size METRES")?.parse()?),
             "--preset" => preset = args.next().ok_or("--preset NAME")?,
             "--stages" => stages = true,
+            "--kind" => kinds = vec![args.next().ok_or("--kind NAME")?],
             "--bench" => {}
             other => return Err(format!("unknown argument {other:?}").into()),
         }
@@ -104,7 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "dirty cells",
         "CPU s"
     );
-    for kind in ["move node", "cell preset", "pin building"] {
+    for kind in kinds.iter().map(String::as_str) {
         let mut s = Stats {
             per_edit_ms: Vec::new(),
             stages_ms: vec![Vec::new(); polis::Stage::ALL.len() + 1],

@@ -9,7 +9,7 @@
 //! edit is exactly the work whose inputs it changed. After each run the memo keeps what
 //! that run used (the current city), so memory stays one city's worth of results.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeSet, HashMap};
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -28,17 +28,48 @@ use crate::stages::{
 /// is behind an `Arc`, so a look-up holds the lock for a pointer copy only and the
 /// caller copies the result out of it with the lock released (the per-item stages look
 /// up from both threads).
+///
+/// The maps are hash maps on the keys' own bits (keys are digests already); they are
+/// looked up and moved whole, never iterated into an output.
 struct Store<T> {
-    last: BTreeMap<Key, Arc<T>>,
-    this: BTreeMap<Key, Arc<T>>,
+    last: HashMap<Key, Arc<T>, KeyBits>,
+    this: HashMap<Key, Arc<T>, KeyBits>,
 }
 
 impl<T> Default for Store<T> {
     fn default() -> Self {
         Store {
-            last: BTreeMap::new(),
-            this: BTreeMap::new(),
+            last: HashMap::default(),
+            this: HashMap::default(),
         }
+    }
+}
+
+/// Hashes a [`Key`] by its own bits (it is a digest).
+#[derive(Debug, Clone, Copy, Default)]
+struct KeyBits;
+
+impl std::hash::BuildHasher for KeyBits {
+    type Hasher = KeyBitsHasher;
+    fn build_hasher(&self) -> KeyBitsHasher {
+        KeyBitsHasher(0)
+    }
+}
+
+/// The hasher of [`KeyBits`]: the words written, folded.
+struct KeyBitsHasher(u64);
+
+impl Hasher for KeyBitsHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = self.0.rotate_left(8) ^ u64::from(b);
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = self.0.rotate_left(29) ^ v;
     }
 }
 

@@ -12,7 +12,7 @@
 //! reuse only skips recomputing identical parts.
 
 use std::collections::BTreeMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use polis_buildings::Building;
@@ -44,9 +44,14 @@ pub(super) fn scene_key(config: &CityConfig) -> Option<Key> {
     Some(Key::new(0x7363_656E).bytes(text.as_bytes()))
 }
 
-/// The scene of a city before an edit, indexed for reuse.
+/// The scene of a city before an edit, indexed for reuse. Its meshes are moved out of
+/// the city (which keeps its node tree) into slots, and a reused leaf takes its meshes
+/// from their slots rather than copying them: the city before the edit is dropped when
+/// the edit succeeds, and its meshes are put back ([`OldScene::restore`]) when it fails.
 pub(super) struct OldScene {
     city: Arc<City>,
+    /// The city's scene meshes, by mesh id; `None` once taken by a reused leaf.
+    meshes: Vec<Mutex<Option<Mesh>>>,
     /// Building id → (index in the city's buildings, node).
     buildings: BTreeMap<u64, (usize, NodeId)>,
     /// Block id → (index in the city's blocks, node).
@@ -59,8 +64,9 @@ pub(super) struct OldScene {
 }
 
 impl OldScene {
-    /// Indexes `city`'s scene leaves by the ids in their names.
-    pub(super) fn new(city: Arc<City>) -> Self {
+    /// Indexes `city`'s scene leaves by the ids in their names; `meshes` are the
+    /// scene's meshes, taken out of it.
+    pub(super) fn new(city: Arc<City>, meshes: Vec<Mesh>) -> Self {
         let building_at: BTreeMap<u64, usize> = city
             .buildings
             .iter()
@@ -90,6 +96,7 @@ impl OldScene {
         }
         let flags = |n: usize| (0..n).map(|_| AtomicBool::new(false)).collect();
         OldScene {
+            meshes: meshes.into_iter().map(|m| Mutex::new(Some(m))).collect(),
             same_buildings: flags(city.buildings.len()),
             same_blocks: flags(city.blocks.len()),
             city,
@@ -118,6 +125,24 @@ impl OldScene {
             .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
+    /// The scene's meshes put back, if no leaf took one (the edit failed before the
+    /// scene was assembled); `None` otherwise.
+    pub(super) fn restore(self) -> Option<Vec<Mesh>> {
+        self.meshes
+            .into_iter()
+            .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
+            .collect()
+    }
+
+    /// Takes mesh `m` out of its slot.
+    fn take(&self, m: usize) -> Option<Mesh> {
+        self.meshes
+            .get(m)?
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+    }
+
     /// The node `n` as a reusable leaf (name, translation, metadata, meshes).
     fn leaf(&self, n: NodeId) -> Option<Reused> {
         let scene = &self.city.scene;
@@ -125,10 +150,11 @@ impl OldScene {
         let Transform::Trs { translation, .. } = node.transform else {
             return None;
         };
+        // A leaf is reused at most once (ids are unique), so its meshes are there.
         let meshes = node
             .meshes
             .iter()
-            .map(|m| scene.meshes.get(m.0 as usize).cloned())
+            .map(|m| self.take(m.0 as usize))
             .collect::<Option<Vec<Mesh>>>()?;
         Some((
             node.name.clone(),
@@ -176,7 +202,7 @@ impl SceneReuse for OldScene {
             None => Some(None),
             Some(child) => {
                 let m = child.meshes.first()?;
-                Some(Some(scene.meshes.get(m.0 as usize)?.clone()))
+                Some(Some(self.take(m.0 as usize)?))
             }
         }
     }

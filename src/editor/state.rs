@@ -511,11 +511,20 @@ impl CityEditor {
         // scene as it stands.
         let reuse = match (scene_key(&self.config), scene_key(&config)) {
             (Some(a), Some(b)) if a == b && !self.city.scene.nodes.is_empty() => {
-                Some(Arc::new(OldScene::new(Arc::clone(&self.city))))
+                // The meshes move into the splice (the city keeps its nodes).
+                Arc::get_mut(&mut self.city)
+                    .map(|c| std::mem::take(&mut c.scene.meshes))
+                    .map(|meshes| Arc::new(OldScene::new(Arc::clone(&self.city), meshes)))
             }
             _ => None,
         };
-        let (city, districts, redone) = build(&self.memo, &config, reuse.clone())?;
+        let (city, districts, redone) = match build(&self.memo, &config, reuse.clone()) {
+            Ok(built) => built,
+            Err(e) => {
+                self.restore(reuse)?;
+                return Err(e);
+            }
+        };
         let mut events = changes(
             &self.city,
             &city,
@@ -537,6 +546,22 @@ impl CityEditor {
         self.config = config;
         self.orphans = orphans;
         Ok(events)
+    }
+
+    /// After a failed run: the meshes the splice took put back into the city, or,
+    /// where a leaf had taken some, the city made again of the configuration as it
+    /// stands (the memo holds every result of it, so only the scene is made anew).
+    fn restore(&mut self, reuse: Option<Arc<OldScene>>) -> Result<()> {
+        let Some(reuse) = reuse else { return Ok(()) };
+        let meshes = Arc::try_unwrap(reuse).ok().and_then(OldScene::restore);
+        if let (Some(meshes), Some(city)) = (meshes, Arc::get_mut(&mut self.city)) {
+            city.scene.meshes = meshes;
+            return Ok(());
+        }
+        self.index = None;
+        let (city, _, _) = build(&self.memo, &self.config, None)?;
+        self.city = Arc::new(city);
+        Ok(())
     }
 
     /// An edit of lot overrides only, made in place in the city (see `patch.rs`);
