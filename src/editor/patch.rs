@@ -260,6 +260,8 @@ pub(super) fn patch_lots(
         }
         cells.insert(cell);
     }
+    // The memo's keys of the old buildings no longer describe the city's.
+    memo.forget(buildings.changed.iter().copied());
     city.stats.scene_triangles = city.scene.triangle_count();
     city.config = config.clone();
     buildings.changed.sort_unstable();

@@ -21,6 +21,7 @@ use polis_geom::{Mesh, Transform};
 use polis_lots::Block;
 
 use super::key::Key;
+use super::memo::Memo;
 use crate::City;
 use crate::CityConfig;
 use crate::scene::{Reused, SceneReuse};
@@ -52,6 +53,9 @@ pub(super) struct OldScene {
     city: Arc<City>,
     /// The city's scene meshes, by mesh id; `None` once taken by a reused leaf.
     meshes: Vec<Mutex<Option<Mesh>>>,
+    /// The editor's memo: which buildings and skins were made from the same keys as
+    /// the old city's (equal without comparing them).
+    memo: Arc<Memo>,
     /// Building id → (index in the city's buildings, node).
     buildings: BTreeMap<u64, (usize, NodeId)>,
     /// Block id → (index in the city's blocks, node).
@@ -66,7 +70,7 @@ pub(super) struct OldScene {
 impl OldScene {
     /// Indexes `city`'s scene leaves by the ids in their names; `meshes` are the
     /// scene's meshes, taken out of it.
-    pub(super) fn new(city: Arc<City>, meshes: Vec<Mesh>) -> Self {
+    pub(super) fn new(city: Arc<City>, meshes: Vec<Mesh>, memo: Arc<Memo>) -> Self {
         let building_at: BTreeMap<u64, usize> = city
             .buildings
             .iter()
@@ -97,6 +101,7 @@ impl OldScene {
         let flags = |n: usize| (0..n).map(|_| AtomicBool::new(false)).collect();
         OldScene {
             meshes: meshes.into_iter().map(|m| Mutex::new(Some(m))).collect(),
+            memo,
             same_buildings: flags(city.buildings.len()),
             same_blocks: flags(city.blocks.len()),
             city,
@@ -173,10 +178,20 @@ impl OldScene {
 
 impl SceneReuse for OldScene {
     fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused> {
-        let (i, n) = self.same_building(b)?;
-        let old_dress = self.city.dresses.get(i).and_then(Option::as_ref);
+        let &(i, n) = self.buildings.get(&b.id)?;
         let old_cell = self.city.building_cells.get(i).copied();
-        if old_dress != dress || old_cell != cell {
+        if old_cell != cell {
+            return None;
+        }
+        // Made from the same keys: equal; otherwise compared in full.
+        let same = match self.memo.same_keys(b.id) {
+            Some(same) => same,
+            None => {
+                self.city.buildings.get(i)? == b
+                    && self.city.dresses.get(i).and_then(Option::as_ref) == dress
+            }
+        };
+        if !same {
             return None;
         }
         let leaf = self.leaf(n)?;

@@ -514,7 +514,13 @@ impl CityEditor {
                 // The meshes move into the splice (the city keeps its nodes).
                 Arc::get_mut(&mut self.city)
                     .map(|c| std::mem::take(&mut c.scene.meshes))
-                    .map(|meshes| Arc::new(OldScene::new(Arc::clone(&self.city), meshes)))
+                    .map(|meshes| {
+                        Arc::new(OldScene::new(
+                            Arc::clone(&self.city),
+                            meshes,
+                            Arc::clone(&self.memo),
+                        ))
+                    })
             }
             _ => None,
         };
