@@ -12,8 +12,8 @@
 //! reuse only skips recomputing identical parts.
 
 use std::collections::BTreeMap;
-use std::sync::{Arc, Mutex, PoisonError};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 use polis_buildings::Building;
 use polis_geom::scene::NodeId;
