@@ -26,7 +26,10 @@ use super::memo::Memo;
 use crate::City;
 use crate::CityConfig;
 use crate::citygen::{District, LotOverride, lot_plan};
-use crate::scene::{BuildingLeaves, LeafPalette, building_replaceable, replace_building};
+use polis_geom::scene::MeshId;
+use polis_geom::{Mesh, Scene, Transform};
+
+use crate::scene::{BuildingLeaves, LeafPalette, Reused};
 use crate::stages::{BuildLot, Dress, LotInput, Stage, StageContext};
 
 /// Look-ups by id into a city whose lots, buildings and scene nodes an in-place patch
@@ -282,4 +285,106 @@ pub(super) fn patch_lots(
         dirty_blocks: Vec::new(),
     };
     Some((events, new_orphans))
+}
+
+/// The building node `node` of `scene` as `assemble` makes it: its run of mesh ids
+/// (first, count) and its coarse child (node and mesh), or `None` if it is not such a
+/// node (meshes not one run, children other than one `lod 0` box).
+fn building_node(scene: &Scene, node: NodeId) -> Option<(usize, usize, Option<usize>)> {
+    let old = scene.nodes.get(node.0 as usize)?;
+    let child = match old.children.as_slice() {
+        [] => None,
+        [c] => {
+            let n = scene.nodes.get(c.0 as usize)?;
+            let m = match n.meshes.as_slice() {
+                [m] if n.name == "lod 0" && n.children.is_empty() => m.0 as usize,
+                _ => return None,
+            };
+            // The coarse level's node carries the finest level's number.
+            old.metadata.get("lod")?;
+            Some(m)
+        }
+        _ => return None,
+    };
+    let first = old.meshes.first().map_or(0, |m| m.0 as usize);
+    let len = old.meshes.len();
+    let run = old
+        .meshes
+        .iter()
+        .enumerate()
+        .all(|(k, m)| m.0 as usize == first + k);
+    (run && first + len <= scene.meshes.len() && child.is_none_or(|m| m < scene.meshes.len()))
+        .then_some((first, len, child))
+}
+
+/// Whether [`replace_building`] can replace the building node `node` with a leaf of
+/// `meshes` meshes and (`boxed`) a coarse box: it is a building node of
+/// `assemble`'s and the coarse level neither appears nor disappears (the node tree
+/// would change).
+pub(crate) fn building_replaceable(
+    scene: &Scene,
+    node: NodeId,
+    meshes: usize,
+    boxed: bool,
+) -> bool {
+    building_node(scene, node)
+        .is_some_and(|(_, len, child)| child.is_some() == boxed && (len > 0 || meshes == 0))
+}
+
+/// Replaces the building node `node` of `scene` (made by `assemble`) with `leaf` and
+/// its coarse box `coarse` (from `BuildingLeaves::leaf`): name, placement, metadata,
+/// meshes (the scene's later mesh ids shift when their number changes) and the `lod 0`
+/// child's box. Returns `false`, leaving the scene unchanged, unless
+/// [`building_replaceable`].
+pub(crate) fn replace_building(
+    scene: &mut Scene,
+    node: NodeId,
+    leaf: Reused,
+    coarse: Option<Option<Mesh>>,
+) -> bool {
+    let (name, translation, mut metadata, meshes) = leaf;
+    let new_box = coarse.flatten();
+    if !building_replaceable(scene, node, meshes.len(), new_box.is_some()) {
+        return false;
+    }
+    let Some((first, len, mut child)) = building_node(scene, node) else {
+        return false;
+    };
+    if child.is_some()
+        && let Some(f) = scene
+            .nodes
+            .get(node.0 as usize)
+            .and_then(|n| n.metadata.get("lod"))
+            .cloned()
+    {
+        metadata.insert("lod", f);
+    }
+    let k = meshes.len();
+    if k == len {
+        for (slot, m) in scene.meshes[first..first + len].iter_mut().zip(meshes) {
+            *slot = m;
+        }
+    } else {
+        scene.meshes.splice(first..first + len, meshes);
+        let end = first + len;
+        let shift = |id: usize| if id >= end { id + k - len } else { id };
+        for n in &mut scene.nodes {
+            for m in &mut n.meshes {
+                *m = MeshId(shift(m.0 as usize) as u32);
+            }
+        }
+        child = child.map(shift);
+    }
+    if let (Some(m), Some(b)) = (child, new_box)
+        && let Some(slot) = scene.meshes.get_mut(m)
+    {
+        *slot = b;
+    }
+    if let Some(n) = scene.nodes.get_mut(node.0 as usize) {
+        n.name = name;
+        n.transform = Transform::from_translation(translation);
+        n.metadata = metadata;
+        n.meshes = (first..first + k).map(|i| MeshId(i as u32)).collect();
+    }
+    true
 }
