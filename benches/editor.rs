@@ -7,12 +7,14 @@
 //! cargo bench --bench editor                       # citygen preset, 20 edits per kind
 //! cargo bench --bench editor -- --edits 1000 --size 1500
 //! cargo bench --bench editor -- --edits 5 --stages  # p50 per pipeline stage too
+//! cargo bench --bench editor -- --kind "cell preset" # one kind of edit only
 //! ```
 //!
 //! With `--stages` each kind also prints the median of each pipeline stage's time
 //! (`City::stats.timings`; roads, buildings and facades preparation overlap) and the
 //! editor's own share (the edit's wall time minus the pipeline's: change events,
-//! orphans, dropping the old city).
+//! orphans, dropping the old city), over the edits that ran the pipeline; lot edits the
+//! editor patches in place run none and are counted apart.
 //!
 //! Per dirty cell = the edit's wall time divided by the number of city cells it regrew
 //! (at least 1; a pin regrows none). Refused edits (a move whose re-plotted roads would
@@ -50,6 +52,8 @@ struct Stats {
     per_cell_ms: Vec<f64>,
     dirty_cells: usize,
     refused: usize,
+    /// Edits made in place (lot edits, see the editor's `patch.rs`): no pipeline run.
+    in_place: usize,
     cpu_s: f64,
 }
 
@@ -58,6 +62,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut size = None;
     let mut preset = "citygen".to_string();
     let mut stages = false;
+    let mut kinds: Vec<String> = ["move node", "cell preset", "pin building"]
+        .map(String::from)
+        .to_vec();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -65,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--size" => size = Some(args.next().ok_or("--size METRES")?.parse()?),
             "--preset" => preset = args.next().ok_or("--preset NAME")?,
             "--stages" => stages = true,
+            "--kind" => kinds = vec![args.next().ok_or("--kind NAME")?],
             "--bench" => {}
             other => return Err(format!("unknown argument {other:?}").into()),
         }
@@ -101,13 +109,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "dirty cells",
         "CPU s"
     );
-    for kind in ["move node", "cell preset", "pin building"] {
+    for kind in kinds.iter().map(String::as_str) {
         let mut s = Stats {
             per_edit_ms: Vec::new(),
             stages_ms: vec![Vec::new(); polis::Stage::ALL.len() + 1],
             per_cell_ms: Vec::new(),
             dirty_cells: 0,
             refused: 0,
+            in_place: 0,
             cpu_s: 0.0,
         };
         while s.per_edit_ms.len() < edits && s.refused < edits * 20 {
@@ -139,6 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                 }
             };
+            let at = ed.city() as *const polis::City;
             let cpu = cpu_seconds();
             let t = Instant::now();
             match ed.apply(edit) {
@@ -146,6 +156,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let ms = t.elapsed().as_secs_f64() * 1e3;
                     s.cpu_s += cpu_seconds().zip(cpu).map_or(0.0, |(b, a)| b - a);
                     s.per_edit_ms.push(ms);
+                    s.per_cell_ms.push(ms / ev.dirty_cells.len().max(1) as f64);
+                    s.dirty_cells += ev.dirty_cells.len();
+                    // A lot edit patched in place ran no pipeline: no stage times.
+                    if std::ptr::eq(at, ed.city()) {
+                        s.in_place += 1;
+                        continue;
+                    }
                     let st = &ed.city().stats;
                     for (i, stage) in polis::Stage::ALL.iter().enumerate() {
                         let t = st.timings.iter().find(|t| t.stage == *stage);
@@ -153,8 +170,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                     s.stages_ms[polis::Stage::ALL.len()]
                         .push(ms - st.wall_time.as_secs_f64() * 1e3);
-                    s.per_cell_ms.push(ms / ev.dirty_cells.len().max(1) as f64);
-                    s.dirty_cells += ev.dirty_cells.len();
                 }
                 Err(_) => s.refused += 1,
             }
@@ -174,7 +189,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.dirty_cells as f64 / s.per_edit_ms.len().max(1) as f64,
             s.cpu_s,
         );
-        if stages {
+        if stages && s.in_place > 0 {
+            println!(
+                "  {} of {} made in place (no pipeline run)",
+                s.in_place,
+                s.per_edit_ms.len()
+            );
+        }
+        if stages && s.in_place < s.per_edit_ms.len() {
             let mut line = String::from("  p50 by stage (ms):");
             for (i, v) in s.stages_ms.iter_mut().enumerate() {
                 v.sort_by(f64::total_cmp);

@@ -41,6 +41,12 @@ struct Palette {
 }
 
 fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
+    palette_with(scene, sets, true)
+}
+
+/// The palette's materials added to `scene`; with `pixels` off the tile images are left
+/// empty (the material ids are the same: for making leaves outside a scene).
+fn palette_with(scene: &mut Scene, sets: &[TileSet], keep_pixels: bool) -> Result<Palette> {
     let mut m = |name: &str, rgb: [f32; 3]| {
         scene.add_material(Material::new(name, [rgb[0], rgb[1], rgb[2], 1.0]))
     };
@@ -69,7 +75,11 @@ fn palette(scene: &mut Scene, sets: &[TileSet]) -> Result<Palette> {
                     data: ImageData::Rgba8 {
                         width: t.width,
                         height: t.height,
-                        pixels: pixels.to_vec(),
+                        pixels: if keep_pixels {
+                            pixels.to_vec()
+                        } else {
+                            Vec::new()
+                        },
                     },
                 });
                 Ok(scene.add_texture(Texture {
@@ -427,6 +437,165 @@ pub(crate) trait SceneReuse: Sync {
 /// A reused leaf: its node's name, translation and metadata, and its meshes.
 pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
+/// How far buildings and plinths reach below the ground: the terrain's one-sided
+/// allowance (2 e) and, on graded ground (`graded`), the corridor cut and the lowering of
+/// smallest leaves that miss the bound at the foot of a bank (their diagonal's rise on
+/// the bank). Metres; 0 without terrain.
+fn foot_of(config: &CityConfig, graded: bool) -> f64 {
+    let sc = &config.scene;
+    if !sc.terrain {
+        return 0.0;
+    }
+    let graded = if graded {
+        CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
+    } else {
+        0.0
+    };
+    2.0 * sc.terrain_mesh.max_error_m + graded
+}
+
+/// What a building's leaf reads besides the building: the configuration, the ground,
+/// the palette, the tile sets and the foot ([`foot_of`]).
+pub(crate) struct LeafContext<'a> {
+    config: &'a CityConfig,
+    ground: &'a dyn Field,
+    palette: &'a Palette,
+    tile_sets: &'a [TileSet],
+    foot: f64,
+}
+
+/// The palette of a scene of `tile_sets`, as [`assemble`] makes it (same material ids),
+/// without the tile images: for [`BuildingLeaves`].
+pub(crate) struct LeafPalette(Palette);
+
+impl LeafPalette {
+    /// The palette of `tile_sets`.
+    ///
+    /// # Errors
+    /// A failing street material.
+    pub(crate) fn new(tile_sets: &[TileSet]) -> Result<Self> {
+        Ok(LeafPalette(palette_with(
+            &mut Scene::new(),
+            tile_sets,
+            false,
+        )?))
+    }
+}
+
+/// Building leaves of an existing scene, made one at a time as [`assemble`] makes them
+/// (the editor's in-place update of a scene whose ground and palette are unchanged;
+/// ungraded ground only).
+pub(crate) struct BuildingLeaves<'a> {
+    cx: LeafContext<'a>,
+}
+
+impl<'a> BuildingLeaves<'a> {
+    /// Leaves on `maps`' elevation (no graded roads) with `palette`.
+    pub(crate) fn new(
+        config: &'a CityConfig,
+        maps: &'a CityMaps,
+        palette: &'a LeafPalette,
+        tile_sets: &'a [TileSet],
+    ) -> Self {
+        BuildingLeaves {
+            cx: LeafContext {
+                config,
+                ground: maps.inputs.elevation.as_ref(),
+                palette: &palette.0,
+                tile_sets,
+                foot: foot_of(config, false),
+            },
+        }
+    }
+
+    /// The leaf of building `b` (with skin `dress`, in cell `cell`): its node's name,
+    /// translation and metadata and its meshes, and its coarse box when the scene has
+    /// coarse levels (`Some(None)`: it has none, the footprint cannot be extruded).
+    ///
+    /// # Errors
+    /// A failing mesh.
+    pub(crate) fn leaf(
+        &self,
+        b: &Building,
+        dress: Option<&Dress>,
+        cell: Option<u64>,
+    ) -> Result<(Reused, Option<Option<Mesh>>)> {
+        let (node, meshes) = building_leaf(&self.cx, b, dress, cell)?;
+        let fine = self.cx.config.effective_lod();
+        let coarse = (self.cx.config.scene.coarse_lod && fine > 0).then(|| {
+            coarse_box(
+                self.cx.config,
+                self.cx.ground,
+                self.cx.palette,
+                b,
+                self.cx.foot,
+            )
+        });
+        Ok(((node.name, node.translation, node.metadata, meshes), coarse))
+    }
+}
+
+/// Building `b`'s leaf: its node (name, placement, metadata) and meshes.
+fn building_leaf(
+    cx: &LeafContext<'_>,
+    b: &Building,
+    dress: Option<&Dress>,
+    cell: Option<u64>,
+) -> Result<(LeafNode, Vec<Mesh>)> {
+    let elevation = cx.ground;
+    let mode = foundation(cx.config, b.kind);
+    let seat = seat(elevation, b.footprint.points(), mode, cx.foot);
+    let meshes = building_meshes(b, dress, cx.palette, Some((&seat, mode, elevation)))?;
+    let base = seat.base;
+    let style = dress
+        .and_then(|d| cx.tile_sets.get(d.style))
+        .map_or("", |t| t.style.as_str());
+    let mut metadata = Metadata::from([
+        ("layer", MetaValue::from_static("buildings")),
+        // The id as text (exact in JavaScript above 2^53) and as a number.
+        ("id", MetaValue::from(b.id.to_string().as_str())),
+        ("id_number", MetaValue::from(b.id as f64)),
+        ("kind", MetaValue::from_static(kind_class(b.kind))),
+        ("type", MetaValue::from_static(b.kind.name())),
+        ("height", MetaValue::from(b.height)),
+        ("floors", MetaValue::from(f64::from(b.floors))),
+        ("lot", MetaValue::from(b.lot_id as f64)),
+        ("lot_id", MetaValue::from(b.lot_id.to_string().as_str())),
+    ]);
+    if !style.is_empty() {
+        metadata.insert("style", MetaValue::from(style));
+    }
+    if let Some(cell) = cell {
+        metadata.insert("cell", MetaValue::from(cell as f64));
+    }
+    let node = LeafNode {
+        name: format!("building {}", b.id),
+        translation: to_world(b.origin, base),
+        metadata,
+    };
+    Ok((node, meshes))
+}
+
+/// Building `b`'s coarse level: its footprint extruded to its height (`None` if the
+/// footprint cannot be extruded).
+fn coarse_box(
+    config: &CityConfig,
+    elevation: &dyn Field,
+    pal: &Palette,
+    b: &Building,
+    foot: f64,
+) -> Option<Mesh> {
+    let seat = seat(
+        elevation,
+        b.footprint.points(),
+        foundation(config, b.kind),
+        foot,
+    );
+    let local = b.footprint.translated(-b.origin);
+    let wall = pal.walls[b.kind.index().min(5)];
+    polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()
+}
+
 /// Builds the scene.
 pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     let mut scene = Scene::new();
@@ -471,17 +640,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut and the
     // lowering of smallest leaves that miss the bound at the foot of a bank (their
     // diagonal's rise on the bank).
-    let sc = &inp.config.scene;
-    let foot = if sc.terrain {
-        let graded = if inp.cut_in.is_some() {
-            CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
-        } else {
-            0.0
-        };
-        2.0 * sc.terrain_mesh.max_error_m + graded
-    } else {
-        0.0
-    };
+    let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
     // Each building's node (name, placement, metadata) and meshes.
     let buildings_job = || -> Vec<Leaf> {
@@ -504,43 +663,15 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     };
                     return Ok((node, meshes));
                 }
-                let mode = foundation(inp.config, b.kind);
-                let seat = seat(elevation, b.footprint.points(), mode, foot);
-                let meshes = building_meshes(
-                    b,
-                    inp.dresses.get(i).and_then(Option::as_ref),
-                    &pal,
-                    Some((&seat, mode, elevation)),
-                )?;
-                let base = seat.base;
-                let dress = inp.dresses.get(i).and_then(Option::as_ref);
-                let style = dress
-                    .and_then(|d| inp.tile_sets.get(d.style))
-                    .map_or("", |t| t.style.as_str());
-                let mut metadata = Metadata::from([
-                    ("layer", MetaValue::from_static("buildings")),
-                    // The id as text (exact in JavaScript above 2^53) and as a number.
-                    ("id", MetaValue::from(b.id.to_string().as_str())),
-                    ("id_number", MetaValue::from(b.id as f64)),
-                    ("kind", MetaValue::from_static(kind_class(b.kind))),
-                    ("type", MetaValue::from_static(b.kind.name())),
-                    ("height", MetaValue::from(b.height)),
-                    ("floors", MetaValue::from(f64::from(b.floors))),
-                    ("lot", MetaValue::from(b.lot_id as f64)),
-                    ("lot_id", MetaValue::from(b.lot_id.to_string().as_str())),
-                ]);
-                if !style.is_empty() {
-                    metadata.insert("style", MetaValue::from(style));
-                }
-                if let Some(&cell) = inp.building_cells.get(i) {
-                    metadata.insert("cell", MetaValue::from(cell as f64));
-                }
-                let node = LeafNode {
-                    name: format!("building {}", b.id),
-                    translation: to_world(b.origin, base),
-                    metadata,
+                let leaf = LeafContext {
+                    config: inp.config,
+                    ground: elevation,
+                    palette: &pal,
+                    tile_sets: inp.tile_sets,
+                    foot,
                 };
-                Ok((node, meshes))
+                let dress = inp.dresses.get(i).and_then(Option::as_ref);
+                building_leaf(&leaf, b, dress, inp.building_cells.get(i).copied())
             })
             .collect()
     };
@@ -734,15 +865,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                 if let Some(made) = inp.reuse.and_then(|r| r.coarse(b)) {
                     return made;
                 }
-                let seat = seat(
-                    elevation,
-                    b.footprint.points(),
-                    foundation(inp.config, b.kind),
-                    foot,
-                );
-                let local = b.footprint.translated(-b.origin);
-                let wall = pal.walls[b.kind.index().min(5)];
-                polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()
+                coarse_box(inp.config, elevation, &pal, b, foot)
             })
             .collect();
         for (k, made) in boxes.into_iter().enumerate() {

@@ -694,3 +694,68 @@ fn highways_closed_by_the_map_edge_give_the_editor_its_cells() {
     assert!(!ed.cells().is_empty());
     assert!(ed.city().stats.buildings > 0);
 }
+
+/// Lot edits (pins, reseeds, clearing an override, undo and redo of them) are made in
+/// place in the editor's city, without running the pipeline, and the city so patched
+/// is byte for byte the city `generate` makes; the building events are those of a full
+/// comparison. Removing a building (the scene's node tree changes) runs the pipeline.
+#[test]
+fn lot_edits_patch_the_city_in_place_and_equal_generate() {
+    use polis::buildings::BuildingKind;
+    let mut ed = CityEditor::new(small()).unwrap();
+    let ids: Vec<u64> = ed.city().buildings.iter().map(|b| b.id).collect();
+    let (a, b, c) = (ids[3], ids[ids.len() / 2], ids[ids.len() - 2]);
+    let edits = [
+        Edit::PinHeight {
+            lot: a,
+            height_m: 90.0,
+        },
+        Edit::PinKind {
+            lot: b,
+            kind: BuildingKind::Industrial,
+        },
+        Edit::ReseedLot { lot: a, seed: 7 },
+        Edit::PinHeight {
+            lot: a,
+            height_m: 12.0,
+        },
+        Edit::PinKind {
+            lot: c,
+            kind: BuildingKind::Skyscraper,
+        },
+        Edit::ClearLot { lot: b },
+    ];
+    let mut in_place = 0;
+    for e in edits {
+        let before = building_texts(ed.city());
+        let at = ed.city() as *const City;
+        let ev = ed.apply(e.clone()).unwrap();
+        // The patched city is the same allocation; a pipeline run makes a new one
+        // while the old is still alive.
+        in_place += usize::from(std::ptr::eq(at, ed.city()));
+        assert!(
+            ev.dirty_cells.is_empty() && ev.dirty_blocks.is_empty(),
+            "{e:?}"
+        );
+        check_building_events(&before, ed.city(), &ev);
+        assert_same_as_generate(&ed);
+    }
+    assert!(in_place >= 5, "{in_place} of 6 lot edits made in place");
+    for _ in 0..3 {
+        let at = ed.city() as *const City;
+        ed.undo().unwrap();
+        assert!(std::ptr::eq(at, ed.city()), "undo of a lot edit in place");
+    }
+    assert_same_as_generate(&ed);
+    ed.redo().unwrap();
+    assert_same_as_generate(&ed);
+    // A removal changes the scene's node tree: the pipeline runs, and the city is still
+    // the city generate makes.
+    let before = building_texts(ed.city());
+    let ev = ed.apply(Edit::RemoveBuilding { lot: c }).unwrap();
+    assert_eq!(ev.buildings.removed, vec![c]);
+    check_building_events(&before, ed.city(), &ev);
+    assert_same_as_generate(&ed);
+    ed.undo().unwrap();
+    assert_same_as_generate(&ed);
+}

@@ -45,18 +45,52 @@ fn delta_by<K: Ord + Clone, V, W>(
     d
 }
 
-/// Per road-graph cell: its blocks and lots.
-type CellContent<'a> = (Vec<&'a polis_lots::Block>, Vec<&'a crate::CityLot>);
-
-fn by_cell(city: &City) -> BTreeMap<u64, CellContent<'_>> {
-    let mut m: BTreeMap<u64, CellContent<'_>> = BTreeMap::new();
-    for b in &city.blocks {
-        m.entry(b.cell_id).or_default().0.push(b);
-    }
+/// The road-graph cells (those with blocks or lots) of a city.
+fn cells_of(city: &City) -> BTreeSet<u64> {
+    let mut cells: BTreeSet<u64> = city.blocks.iter().map(|b| b.cell_id).collect();
+    let mut last = None;
     for l in &city.lots {
-        m.entry(l.cell).or_default().1.push(l);
+        // Lots come cell by cell.
+        if last != Some(l.cell) {
+            cells.insert(l.cell);
+            last = Some(l.cell);
+        }
     }
-    m
+    cells
+}
+
+/// Road-graph cells removed, added and changed (a block or lot of theirs removed, added
+/// or changed), from the lot and block deltas: a cell is its blocks and lots, by id.
+fn cell_delta(old: &City, new: &City, lots: &Delta, block_nodes: &Delta) -> Delta {
+    let (was, is) = (cells_of(old), cells_of(new));
+    // A lot's id is its cell's id shifted left by 24 bits and its index in the cell.
+    let mut touched: BTreeSet<u64> = lots
+        .removed
+        .iter()
+        .chain(&lots.added)
+        .chain(&lots.changed)
+        .map(|id| id >> 24)
+        .collect();
+    let ids: BTreeSet<u64> = block_nodes
+        .removed
+        .iter()
+        .chain(&block_nodes.added)
+        .chain(&block_nodes.changed)
+        .copied()
+        .collect();
+    for b in old.blocks.iter().chain(&new.blocks) {
+        if ids.contains(&b.id()) {
+            touched.insert(b.cell_id);
+        }
+    }
+    Delta {
+        removed: was.difference(&is).copied().collect(),
+        added: is.difference(&was).copied().collect(),
+        changed: touched
+            .into_iter()
+            .filter(|c| was.contains(c) && is.contains(c))
+            .collect(),
+    }
 }
 
 /// Whether the two road graphs have the same edges (positions and payloads) in order.
@@ -109,8 +143,8 @@ pub(super) fn changes(
     let spliced = spliced.filter(|s| std::ptr::eq(s.city(), old));
     let same_building = |i: usize| spliced.is_some_and(|s| s.same_building_at(i));
     let same_block = |i: usize| spliced.is_some_and(|s| s.same_block_at(i));
-    // The four comparisons are independent: two threads take them.
-    let ((lots, buildings), (blocks, block_nodes)) = par::join(
+    // The three comparisons are independent: two threads take them.
+    let ((lots, buildings), block_nodes) = par::join(
         || {
             par::join(
                 || {
@@ -131,22 +165,18 @@ pub(super) fn changes(
             )
         },
         || {
-            par::join(
-                || delta(&by_cell(old), &by_cell(new)),
-                || {
-                    delta_by(
-                        &old.blocks
-                            .iter()
-                            .enumerate()
-                            .map(|(i, b)| (b.id(), (i, b)))
-                            .collect(),
-                        &new.blocks.iter().map(|b| (b.id(), b)).collect(),
-                        |(i, v), w| !same_block(*i) && v != w,
-                    )
-                },
+            delta_by(
+                &old.blocks
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| (b.id(), (i, b)))
+                    .collect(),
+                &new.blocks.iter().map(|b| (b.id(), b)).collect(),
+                |(i, v), w| !same_block(*i) && v != w,
             )
         },
     );
+    let blocks = cell_delta(old, new, &lots, &block_nodes);
     // Scene nodes: `cell <c>` groups its blocks and buildings.
     let mut scene = Delta::<String>::default();
     let name = |kind: &str, id: &u64| format!("{kind} {id}");

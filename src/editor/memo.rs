@@ -9,7 +9,7 @@
 //! edit is exactly the work whose inputs it changed. After each run the memo keeps what
 //! that run used (the current city), so memory stays one city's worth of results.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeSet, HashMap};
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -28,17 +28,48 @@ use crate::stages::{
 /// is behind an `Arc`, so a look-up holds the lock for a pointer copy only and the
 /// caller copies the result out of it with the lock released (the per-item stages look
 /// up from both threads).
+///
+/// The maps are hash maps on the keys' own bits (keys are digests already); they are
+/// looked up and moved whole, never iterated into an output.
 struct Store<T> {
-    last: BTreeMap<Key, Arc<T>>,
-    this: BTreeMap<Key, Arc<T>>,
+    last: HashMap<Key, Arc<T>, KeyBits>,
+    this: HashMap<Key, Arc<T>, KeyBits>,
 }
 
 impl<T> Default for Store<T> {
     fn default() -> Self {
         Store {
-            last: BTreeMap::new(),
-            this: BTreeMap::new(),
+            last: HashMap::default(),
+            this: HashMap::default(),
         }
+    }
+}
+
+/// Hashes a [`Key`] by its own bits (it is a digest).
+#[derive(Debug, Clone, Copy, Default)]
+struct KeyBits;
+
+impl std::hash::BuildHasher for KeyBits {
+    type Hasher = KeyBitsHasher;
+    fn build_hasher(&self) -> KeyBitsHasher {
+        KeyBitsHasher(0)
+    }
+}
+
+/// The hasher of [`KeyBits`]: the words written, folded.
+struct KeyBitsHasher(u64);
+
+impl Hasher for KeyBitsHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = self.0.rotate_left(8) ^ u64::from(b);
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = self.0.rotate_left(29) ^ v;
     }
 }
 
@@ -82,6 +113,21 @@ pub(crate) struct Redone {
     pub dresses: usize,
 }
 
+/// Per building id: the key its building was built from (recorded under the id the
+/// grammar was seeded with, which is the building's own id unless its lot was reseeded)
+/// and the key its skin was made from; for the last run and this one. Equal keys of an
+/// id in both runs mean an equal building and skin (each is a function of its key), which
+/// lets the scene splice skip comparing them. A reseeded lot's building finds no key
+/// under its own id (unless another reseeded lot's seed id collides with it, a chance of
+/// about n / 2⁶⁴), and is compared in full.
+#[derive(Default)]
+struct IdKeys {
+    last_built: HashMap<u64, Key>,
+    this_built: HashMap<u64, Key>,
+    last_dressed: HashMap<u64, Key>,
+    this_dressed: HashMap<u64, Key>,
+}
+
 /// Fingerprints of the configuration parts each stage reads besides its item.
 #[derive(Debug, Clone, Copy)]
 struct Fingerprints {
@@ -103,6 +149,8 @@ pub(crate) struct Memo {
     dresses: Mutex<Store<Option<Dress>>>,
     dresser: Mutex<Option<(Key, Arc<dyn DressBuilding>)>>,
     redone: Mutex<Redone>,
+    /// The input keys of each building and skin, by the building's id (see [`IdKeys`]).
+    ids: Mutex<IdKeys>,
     districts: Mutex<Vec<crate::citygen::District>>,
     fingerprints: Mutex<Option<Fingerprints>>,
     /// The last run's road stage output and cells, by [`Fingerprints::roads`]: an edit of
@@ -163,16 +211,51 @@ fn hashed(k: Key, v: &impl Hash) -> Key {
     h.0
 }
 
+/// The digest of what the facade stage reads of `config`: the facade settings, the
+/// pinned styles and the seed.
+fn facades_key(config: &crate::CityConfig) -> Key {
+    let pinned: Vec<&str> = config
+        .citygen
+        .lots
+        .iter()
+        .filter_map(|o| o.style.as_deref())
+        .collect();
+    Key::new(3).bytes(format!("{:?}|{:?}|{}", config.facades, pinned, config.seed).as_bytes())
+}
+
 impl Memo {
+    /// Whether building `id` and its skin were made from the same keys in the last run
+    /// and in this one (so they are equal): `None` where either run has no key for it.
+    pub(crate) fn same_keys(&self, id: u64) -> Option<bool> {
+        let ids = lock(&self.ids);
+        let built = (ids.last_built.get(&id)?, ids.this_built.get(&id)?);
+        let dressed = (ids.last_dressed.get(&id)?, ids.this_dressed.get(&id)?);
+        Some(built.0 == built.1 && dressed.0 == dressed.1)
+    }
+
+    /// Forgets the last run's keys of buildings `ids` (changed outside a run, by a lot
+    /// edit made in place).
+    pub(crate) fn forget(&self, ids: impl IntoIterator<Item = u64>) {
+        let mut keys = lock(&self.ids);
+        for id in ids {
+            keys.last_built.remove(&id);
+            keys.last_dressed.remove(&id);
+        }
+    }
+
+    /// The facade stage's dresser of the last run, if `config`'s facade inputs are that
+    /// run's (for dressing a building outside a run).
+    pub(crate) fn dresser_for(&self, config: &crate::CityConfig) -> Option<Arc<dyn DressBuilding>> {
+        let key = facades_key(config);
+        match &*lock(&self.dresser) {
+            Some((k, d)) if *k == key => Some(Arc::clone(d)),
+            _ => None,
+        }
+    }
+
     /// Starts a run on `config`: fingerprints of what the stages read globally.
     pub(crate) fn begin(&self, config: &crate::CityConfig) {
         let text = |salt: u64, s: String| Key::new(salt).bytes(s.as_bytes());
-        let pinned: Vec<&str> = config
-            .citygen
-            .lots
-            .iter()
-            .filter_map(|o| o.style.as_deref())
-            .collect();
         *lock(&self.fingerprints) = Some(Fingerprints {
             roads: roads_key(config).unwrap_or(Key::new(config.seed)),
             lots: text(
@@ -183,10 +266,7 @@ impl Memo {
                 2,
                 format!("{:?}|{}", config.effective_building_params(), config.seed),
             ),
-            facades: text(
-                3,
-                format!("{:?}|{:?}|{}", config.facades, pinned, config.seed),
-            ),
+            facades: facades_key(config),
         });
         *lock(&self.redone) = Redone::default();
     }
@@ -194,6 +274,15 @@ impl Memo {
     /// Ends a run (see [`Store::finish`]) and returns what it redid and the city cells
     /// its road stage made.
     pub(crate) fn finish(&self, ok: bool) -> (Redone, Vec<crate::citygen::District>) {
+        {
+            let mut ids = lock(&self.ids);
+            let this_built = std::mem::take(&mut ids.this_built);
+            let this_dressed = std::mem::take(&mut ids.this_dressed);
+            if ok {
+                ids.last_built = this_built;
+                ids.last_dressed = this_dressed;
+            }
+        }
         lock(&self.growth).finish(ok);
         lock(&self.lots).finish(ok);
         lock(&self.buildings).finish(ok);
@@ -359,6 +448,7 @@ impl BuildLot for MemoBuild<'_> {
             key = key.u64(e as u64);
         }
         let key = hashed(key, &lot.kind);
+        lock(&self.memo.ids).this_built.insert(lot.id, key);
         let hit = lock(&self.memo.buildings).get(key);
         if let Some(v) = hit {
             return Ok((*v).clone());
@@ -412,6 +502,32 @@ impl DressBuilding for MemoDress<'_> {
     }
 
     fn dress_styled(&self, b: &Building, seed: u64, style: Option<&str>) -> Result<Option<Dress>> {
+        let key = self.key(b, seed, style);
+        lock(&self.memo.ids).this_dressed.insert(b.id, key);
+        let hit = lock(&self.memo.dresses).get(key);
+        if let Some(v) = hit {
+            return Ok((*v).clone());
+        }
+        let v = self.inner.dress_styled(b, seed, style)?;
+        lock(&self.memo.dresses).put(key, Arc::new(v.clone()));
+        lock(&self.memo.redone).dresses += 1;
+        Ok(v)
+    }
+}
+
+impl MemoDress<'_> {
+    /// The input key of `b`'s skin: its building's key where this run built it under
+    /// its own id (see [`IdKeys`]), else a digest of its facades.
+    fn key(&self, b: &Building, seed: u64, style: Option<&str>) -> Key {
+        let built = lock(&self.memo.ids).this_built.get(&b.id).copied();
+        if let Some(k) = built {
+            return Key::new(0x6472_6B79)
+                .key(self.fingerprint)
+                .u64(seed)
+                .bytes(style.unwrap_or("\0").as_bytes())
+                .key(k)
+                .u64(b.id);
+        }
         let mut key = Key::new(0x6472_6573)
             .key(self.fingerprint)
             .u64(seed)
@@ -435,13 +551,6 @@ impl DressBuilding for MemoDress<'_> {
                 .u64(u64::from(f.part));
             key = hashed(key, &f.role);
         }
-        let hit = lock(&self.memo.dresses).get(key);
-        if let Some(v) = hit {
-            return Ok((*v).clone());
-        }
-        let v = self.inner.dress_styled(b, seed, style)?;
-        lock(&self.memo.dresses).put(key, Arc::new(v.clone()));
-        lock(&self.memo.redone).dresses += 1;
-        Ok(v)
+        key
     }
 }

@@ -34,6 +34,14 @@
 //! parameters, seed or maps changed, cells created, split or merged, and, downstream,
 //! road-graph cells whose ring or nearby roads changed.
 //!
+//! Lot edits that change only lot overrides (pin a kind or a height, reseed a lot, clear
+//! an override, and their undo and redo) do not run the pipeline at all: the editor
+//! builds and dresses the buildings of the lots whose override changed and replaces
+//! their scene leaves in the city it holds (see `patch.rs`). It falls back to the
+//! pipeline where that could differ from it: a building appearing or disappearing (a
+//! removal), a pinned style added or dropped, roads graded into the ground, a lot whose
+//! building or skin failed.
+//!
 //! Two whole stages are reused as well. The road and cell stages read the configuration
 //! but for the lot overrides, the facade settings and the level of detail, so an edit of
 //! lots, buildings or styles keeps the union graph and its cells whole (keyed by a digest
@@ -64,15 +72,17 @@
 //!
 //! # Limitations
 //!
-//! * An edit of the primary network or of a cell still builds the union graph and its
-//!   cell decomposition whole (their inputs are the whole city), and every edit walks
-//!   every item: memo look-ups copy each reused lot, building and skin, the scene copies
-//!   each reused leaf's meshes, and the change events compare the lots and blocks of the
-//!   two cities (buildings and blocks the scene splice found equal are not compared
-//!   again). The cost per edit is therefore proportional to the city's size, not to the
-//!   dirty set: about 2.5 s of CPU per edit on the full `citygen` preset (72,496
-//!   buildings), far from Kelly's 60 ms per cell; BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene is not
-//!   spliced (the ground depends on every road).
+//! * A lot edit made in place costs what it touches: about 10 ms of CPU on the full
+//!   `citygen` preset (72,442 buildings). An edit of the primary network or of a cell
+//!   still runs the pipeline: it builds the union graph and its cell decomposition whole
+//!   (their inputs are the whole city), memo look-ups copy each reused lot, building and
+//!   skin, the scene is assembled again (reused leaves take their meshes from the old
+//!   scene without copying them; the road surfaces and the ground are meshed again) and
+//!   the change events compare the lots and blocks of the two cities. Its cost is
+//!   therefore proportional to the city's size, not to the dirty set: about 1.5 s of CPU
+//!   per edit on that preset, far from Kelly's 60 ms per cell; BENCHMARKS.md gives the
+//!   profile. With roads graded into an elevation map the scene is not spliced (the
+//!   ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it
 //!   changes where later road edits are legal.
 //! * Only Citygen-mode cities are editable ([`RoadMode::Citygen`](crate::RoadMode)).
@@ -90,6 +100,7 @@ mod edit;
 mod file;
 pub(crate) mod key;
 mod memo;
+mod patch;
 mod splice;
 mod state;
 

@@ -12,8 +12,8 @@
 //! reuse only skips recomputing identical parts.
 
 use std::collections::BTreeMap;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 use polis_buildings::Building;
 use polis_geom::scene::NodeId;
@@ -21,6 +21,7 @@ use polis_geom::{Mesh, Transform};
 use polis_lots::Block;
 
 use super::key::Key;
+use super::memo::Memo;
 use crate::City;
 use crate::CityConfig;
 use crate::scene::{Reused, SceneReuse};
@@ -44,9 +45,17 @@ pub(super) fn scene_key(config: &CityConfig) -> Option<Key> {
     Some(Key::new(0x7363_656E).bytes(text.as_bytes()))
 }
 
-/// The scene of a city before an edit, indexed for reuse.
+/// The scene of a city before an edit, indexed for reuse. Its meshes are moved out of
+/// the city (which keeps its node tree) into slots, and a reused leaf takes its meshes
+/// from their slots rather than copying them: the city before the edit is dropped when
+/// the edit succeeds, and its meshes are put back ([`OldScene::restore`]) when it fails.
 pub(super) struct OldScene {
     city: Arc<City>,
+    /// The city's scene meshes, by mesh id; `None` once taken by a reused leaf.
+    meshes: Vec<Mutex<Option<Mesh>>>,
+    /// The editor's memo: which buildings and skins were made from the same keys as
+    /// the old city's (equal without comparing them).
+    memo: Arc<Memo>,
     /// Building id → (index in the city's buildings, node).
     buildings: BTreeMap<u64, (usize, NodeId)>,
     /// Block id → (index in the city's blocks, node).
@@ -59,8 +68,9 @@ pub(super) struct OldScene {
 }
 
 impl OldScene {
-    /// Indexes `city`'s scene leaves by the ids in their names.
-    pub(super) fn new(city: Arc<City>) -> Self {
+    /// Indexes `city`'s scene leaves by the ids in their names; `meshes` are the
+    /// scene's meshes, taken out of it.
+    pub(super) fn new(city: Arc<City>, meshes: Vec<Mesh>, memo: Arc<Memo>) -> Self {
         let building_at: BTreeMap<u64, usize> = city
             .buildings
             .iter()
@@ -90,6 +100,8 @@ impl OldScene {
         }
         let flags = |n: usize| (0..n).map(|_| AtomicBool::new(false)).collect();
         OldScene {
+            meshes: meshes.into_iter().map(|m| Mutex::new(Some(m))).collect(),
+            memo,
             same_buildings: flags(city.buildings.len()),
             same_blocks: flags(city.blocks.len()),
             city,
@@ -118,6 +130,24 @@ impl OldScene {
             .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
+    /// The scene's meshes put back, if no leaf took one (the edit failed before the
+    /// scene was assembled); `None` otherwise.
+    pub(super) fn restore(self) -> Option<Vec<Mesh>> {
+        self.meshes
+            .into_iter()
+            .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
+            .collect()
+    }
+
+    /// Takes mesh `m` out of its slot.
+    fn take(&self, m: usize) -> Option<Mesh> {
+        self.meshes
+            .get(m)?
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+    }
+
     /// The node `n` as a reusable leaf (name, translation, metadata, meshes).
     fn leaf(&self, n: NodeId) -> Option<Reused> {
         let scene = &self.city.scene;
@@ -125,10 +155,11 @@ impl OldScene {
         let Transform::Trs { translation, .. } = node.transform else {
             return None;
         };
+        // A leaf is reused at most once (ids are unique), so its meshes are there.
         let meshes = node
             .meshes
             .iter()
-            .map(|m| scene.meshes.get(m.0 as usize).cloned())
+            .map(|m| self.take(m.0 as usize))
             .collect::<Option<Vec<Mesh>>>()?;
         Some((
             node.name.clone(),
@@ -147,10 +178,20 @@ impl OldScene {
 
 impl SceneReuse for OldScene {
     fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused> {
-        let (i, n) = self.same_building(b)?;
-        let old_dress = self.city.dresses.get(i).and_then(Option::as_ref);
+        let &(i, n) = self.buildings.get(&b.id)?;
         let old_cell = self.city.building_cells.get(i).copied();
-        if old_dress != dress || old_cell != cell {
+        if old_cell != cell {
+            return None;
+        }
+        // Made from the same keys: equal; otherwise compared in full.
+        let same = match self.memo.same_keys(b.id) {
+            Some(same) => same,
+            None => {
+                self.city.buildings.get(i)? == b
+                    && self.city.dresses.get(i).and_then(Option::as_ref) == dress
+            }
+        };
+        if !same {
             return None;
         }
         let leaf = self.leaf(n)?;
@@ -176,7 +217,7 @@ impl SceneReuse for OldScene {
             None => Some(None),
             Some(child) => {
                 let m = child.meshes.first()?;
-                Some(Some(scene.meshes.get(m.0 as usize)?.clone()))
+                Some(Some(self.take(m.0 as usize)?))
             }
         }
     }

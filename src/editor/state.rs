@@ -99,6 +99,9 @@ pub struct CityEditor {
     undo: Vec<Step>,
     redo: Vec<Step>,
     orphans: Vec<LotOverride>,
+    /// Look-ups into `city` for lot edits in place (see `patch.rs`); made on the first
+    /// such edit after a pipeline run.
+    index: Option<super::patch::Index>,
 }
 
 impl std::fmt::Debug for CityEditor {
@@ -193,6 +196,7 @@ impl CityEditor {
             undo: Vec::new(),
             redo: Vec::new(),
             orphans,
+            index: None,
         })
     }
 
@@ -498,16 +502,35 @@ impl CityEditor {
     /// Builds the city of `config` through the memo and, on success, makes it the
     /// editor's; returns what changed.
     fn rebuild(&mut self, config: CityConfig) -> Result<ChangeEvents> {
+        if let Some(events) = self.patch(&config) {
+            return Ok(events);
+        }
+        self.index = None;
         let maps_changed = self.maps_changed(&config);
         // Leaves of the scene whose inputs the edit left alone are spliced in from the
         // scene as it stands.
         let reuse = match (scene_key(&self.config), scene_key(&config)) {
             (Some(a), Some(b)) if a == b && !self.city.scene.nodes.is_empty() => {
-                Some(Arc::new(OldScene::new(Arc::clone(&self.city))))
+                // The meshes move into the splice (the city keeps its nodes).
+                Arc::get_mut(&mut self.city)
+                    .map(|c| std::mem::take(&mut c.scene.meshes))
+                    .map(|meshes| {
+                        Arc::new(OldScene::new(
+                            Arc::clone(&self.city),
+                            meshes,
+                            Arc::clone(&self.memo),
+                        ))
+                    })
             }
             _ => None,
         };
-        let (city, districts, redone) = build(&self.memo, &config, reuse.clone())?;
+        let (city, districts, redone) = match build(&self.memo, &config, reuse.clone()) {
+            Ok(built) => built,
+            Err(e) => {
+                self.restore(reuse)?;
+                return Err(e);
+            }
+        };
         let mut events = changes(
             &self.city,
             &city,
@@ -529,6 +552,45 @@ impl CityEditor {
         self.config = config;
         self.orphans = orphans;
         Ok(events)
+    }
+
+    /// After a failed run: the meshes the splice took put back into the city, or,
+    /// where a leaf had taken some, the city made again of the configuration as it
+    /// stands (the memo holds every result of it, so only the scene is made anew).
+    fn restore(&mut self, reuse: Option<Arc<OldScene>>) -> Result<()> {
+        let Some(reuse) = reuse else { return Ok(()) };
+        let meshes = Arc::try_unwrap(reuse).ok().and_then(OldScene::restore);
+        if let (Some(meshes), Some(city)) = (meshes, Arc::get_mut(&mut self.city)) {
+            city.scene.meshes = meshes;
+            return Ok(());
+        }
+        self.index = None;
+        let (city, _, _) = build(&self.memo, &self.config, None)?;
+        self.city = Arc::new(city);
+        Ok(())
+    }
+
+    /// An edit of lot overrides only, made in place in the city (see `patch.rs`);
+    /// `None` where the patch declines and the pipeline must run.
+    fn patch(&mut self, config: &CityConfig) -> Option<ChangeEvents> {
+        if !super::patch::lots_only(&self.config, config) {
+            return None;
+        }
+        let city = Arc::get_mut(&mut self.city)?;
+        let index = self
+            .index
+            .get_or_insert_with(|| super::patch::Index::of(city));
+        let (events, orphans) = super::patch::patch_lots(
+            city,
+            index,
+            config,
+            &self.districts,
+            &self.memo,
+            &self.orphans,
+        )?;
+        self.config = config.clone();
+        self.orphans = orphans;
+        Some(events)
     }
 
     fn maps_changed(&self, config: &CityConfig) -> bool {
