@@ -171,7 +171,7 @@ fn road_statistics_agree_with_the_whole_city() {
     }
 }
 
-/// Manhattan's blocks are long across the island, its lots 25 ft wide on the street, its
+/// Manhattan's blocks are long across the island, its lots 25 × 100 ft, its
 /// median building mid-rise (issue 19's table: it was 259 m with 71 % skyscrapers and a
 /// coverage of 0.96). On a 2 km `manhattan` (the island is at 75°, so across it is 165°).
 #[test]
@@ -196,6 +196,18 @@ fn manhattan_blocks_lots_and_heights() {
         (r.lots.frontage_m.median - 7.62).abs() < 1.0,
         "{}",
         r.lots.frontage_m.median
+    );
+    // 25 × 100 ft = 232 m² (the median was 172 m² before block ends were cut into
+    // full-depth lots; 225 m² now), 100 ft = 30.5 m deep.
+    assert!(
+        (r.lots.area_m2.median - 232.0).abs() < 0.15 * 232.0,
+        "lot area median {}",
+        r.lots.area_m2.median
+    );
+    assert!(
+        (r.lots.depth_m.median - 30.48).abs() < 4.0,
+        "lot depth median {}",
+        r.lots.depth_m.median
     );
     assert!(
         (15.0..40.0).contains(&r.buildings.height_m.median),
