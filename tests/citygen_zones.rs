@@ -27,6 +27,10 @@ fn rings() -> CityConfig {
         piece_m: 150.0,
     };
     c.citygen.by_population.clear();
+    // Kelly's neighbourhoods as shipped, at the scale these 300 m rings were measured
+    // with (the `milan` preset's own unit and overrides tune it to the Europe mean).
+    c.citygen.preset_params.clear();
+    c.citygen.unit_m = 14.0;
     c.citygen.neighbourhood = Neighbourhood::Organic.into();
     c
 }

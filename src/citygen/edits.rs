@@ -49,6 +49,8 @@ pub enum CellParam {
     BuildingHint(BuildingHint),
     /// [`SecondaryParams::start_sides`]: ≥ 1.
     StartSides(u32),
+    /// [`SecondaryParams::min_angle_deg`]: degrees in [0, 90].
+    MinAngle(f64),
 }
 
 impl CellParam {
@@ -66,6 +68,7 @@ impl CellParam {
             CellParam::BuildingHeight(d) => p.building_height_m = d,
             CellParam::BuildingHint(h) => p.building_hint = h,
             CellParam::StartSides(s) => p.start_sides = s,
+            CellParam::MinAngle(a) => p.min_angle_deg = a,
         }
     }
 

@@ -131,6 +131,41 @@ fn inner_lots_without_access_are_dropped() {
     assert_eq!(s.green_spaces.len(), 1);
 }
 
+/// A Manhattan block (67 × 230 m of land inside its footpaths, streets all round) with
+/// 25 × 100 ft lots (7.62 × 30.48 m): every lot is cut across the long sides through to
+/// the middle of the block, so every lot reaches at least 0.75 lot depths behind one of
+/// its street edges. (Kelly's longest-street-edge rule alone cut the ends of the block
+/// along the cross streets into lots one or two widths deep.)
+#[test]
+fn a_long_block_gets_full_depth_lots_at_its_ends() {
+    let r = region(&Polygon::rect(v(0., 0.), v(230., 67.)));
+    let p = kelly(7.62, 30.48, 0.0);
+    let mut rng = Pcg64Mcg::seed_from_u64(0);
+    let s = subdivide(&r, 1, &p, &mut rng).unwrap();
+    check_partition(&Polygon::rect(v(0., 0.), v(230., 67.)).into(), &s).unwrap();
+    assert!(s.discarded.is_empty());
+    for l in &s.lots {
+        let pts = l.polygon.points();
+        let reach = l
+            .street_edges
+            .iter()
+            .map(|&i| {
+                let (a, b) = l.polygon.edge(i);
+                let d = (b - a).normalize();
+                pts.iter()
+                    .map(|q| d.perp_dot(*q - a).abs())
+                    .fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max);
+        assert!(reach >= 0.75 * 30.48, "{:?}", l.polygon);
+        // No shallow strip along a cross street: at least 0.65 of a full lot.
+        assert!(l.area >= 0.65 * 7.62 * 30.48, "{}", l.area);
+    }
+    // About 30 lots along each long side (Kelly's middle-most fractions are not all
+    // equal), and a few along the cross streets where an end piece was deep enough.
+    assert!((60..=70).contains(&s.lots.len()), "{}", s.lots.len());
+}
+
 #[test]
 fn street_access_is_tracked() {
     // Only the bottom edge is a street: lots are strips standing on it.

@@ -269,8 +269,10 @@ try {
     const v = window.polis.view;
     v.draw();
     const gl = v.gl;
-    const px = new Uint8Array(4 * 64);
-    gl.readPixels(Math.floor(gl.drawingBufferWidth / 2) - 32, Math.floor(gl.drawingBufferHeight / 2), 64, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    // The whole picture: a line through the middle can fall on plain ground alone.
+    const [w, h] = [gl.drawingBufferWidth, gl.drawingBufferHeight];
+    const px = new Uint8Array(4 * w * h);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
     const colours = new Set();
     for (let i = 0; i < px.length; i += 4) colours.add(`${px[i]},${px[i + 1]},${px[i + 2]}`);
     return { buffers: v.buffers.size, colours: colours.size };

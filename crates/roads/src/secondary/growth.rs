@@ -37,6 +37,9 @@ pub struct CellGrowthReport {
     pub refused_outside: u32,
     /// Proposals dropped because they ran into water or a park.
     pub refused_map: u32,
+    /// Proposals dropped because they would meet a road at their root or where they
+    /// join at a sharper angle than [`SecondaryParams::min_angle_deg`].
+    pub refused_angle: u32,
     /// Whether growth stopped at the step limit or the segment guard, not on an empty
     /// queue.
     pub stopped_early: bool,
@@ -98,6 +101,8 @@ impl SecondaryRoads {
 ///    node → with probability *connectivity*, join the node; otherwise the proposal is
 ///    dropped, the road stops short of what it met, and a node whose every direction
 ///    stops is a cul-de-sac. Joined nodes are queued too, as in Kelly's pseudo-code.
+///    With [`min_angle_deg`](SecondaryParams::min_angle_deg) above 0 (ours), a
+///    proposal that would meet a road at a sharper angle at either end is dropped.
 ///
 /// # Guarantees
 ///
@@ -519,6 +524,10 @@ impl Run<'_> {
             self.report.refused_outside += 1;
             return Ok(None);
         }
+        if self.p.min_angle_deg > 0.0 && self.too_sharp(source, a, t, &target)? {
+            self.report.refused_angle += 1;
+            return Ok(None);
+        }
         if !self.maps.segment_legal(a, t) {
             self.report.refused_map += 1;
             return Ok(None);
@@ -594,6 +603,45 @@ impl Run<'_> {
             Target::OnEdge(..) => self.report.placed_road += 1,
         }
         Ok(Some(Placed { node: end }))
+    }
+
+    /// Whether the road `a–t` from `source` would make an angle sharper than
+    /// `min_angle_deg` with a road at `a`, or with a road at its target: the node's roads,
+    /// or both halves of the road it splits.
+    fn too_sharp(
+        &self,
+        source: NodeId,
+        a: DVec2,
+        t: DVec2,
+        target: &Target,
+    ) -> Result<bool, SecondaryError> {
+        let cos_min = self.p.min_angle_deg.to_radians().cos();
+        // Whether the directions `d` and `q - p` (both from `p`) are within the angle.
+        let sharp = |p: DVec2, d: DVec2, q: DVec2| {
+            let e = q - p;
+            let (ld, le) = (d.length(), e.length());
+            ld > 0.0 && le > 0.0 && d.dot(e) > cos_min * ld * le
+        };
+        let roads_at = |n: NodeId, p: DVec2, d: DVec2| -> Result<bool, SecondaryError> {
+            for &e in self.g.edges_at(n)? {
+                let q = self.g.position(self.g.other_end(e, n)?)?;
+                if sharp(p, d, q) {
+                    return Ok(true);
+                }
+            }
+            Ok(false)
+        };
+        if roads_at(source, a, t - a)? {
+            return Ok(true);
+        }
+        match *target {
+            Target::Free(_) => Ok(false),
+            Target::Node(n) => roads_at(n, t, a - t),
+            Target::OnEdge(e, q) => {
+                let (u, v) = self.g.segment(e)?;
+                Ok(sharp(q, a - q, u) || sharp(q, a - q, v))
+            }
+        }
     }
 
     /// Kelly's connectivity test for a snap event of the node being expanded: with

@@ -391,3 +391,92 @@ fn the_flat_grid_and_the_graph_index_grow_the_same_roads() {
         }
     }
 }
+
+/// The smallest angle, degrees, between a street and any other road at either of its
+/// ends, over the whole cell graph (boundary corners between two primary roads are
+/// not a street's business and are left out).
+fn smallest_street_angle(net: &crate::network::RoadNetwork) -> f64 {
+    let mut least = 180.0f64;
+    for (e, u, v, r) in net.edges() {
+        if r.class != RoadClass::Street {
+            continue;
+        }
+        for (at, far) in [(u, v), (v, u)] {
+            let p = net.position(at).unwrap();
+            let d = net.position(far).unwrap() - p;
+            for &f in net.edges_at(at).unwrap() {
+                if f == e {
+                    continue;
+                }
+                let q = net.position(net.other_end(f, at).unwrap()).unwrap() - p;
+                least = least.min(d.angle_to(q).abs().to_degrees());
+            }
+        }
+    }
+    least
+}
+
+/// Junctions with five or more roads.
+fn five_plus(net: &crate::network::RoadNetwork) -> usize {
+    net.nodes()
+        .filter(|(n, _, _)| net.edges_at(*n).unwrap().len() >= 5)
+        .count()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// With a smallest angle, no street meets another road more sharply at either end,
+    /// whatever the cell and the preset; every other invariant still holds.
+    #[test]
+    fn no_street_meets_a_road_below_the_smallest_angle(
+        n in 3usize..12,
+        radius in 250.0f64..700.0,
+        jitter in proptest::collection::vec(0.0f64..1.0, 12),
+        preset in 0usize..5,
+        min_angle in 10.0f64..85.0,
+        seed in 0u64..1000,
+    ) {
+        let cell = SecondaryCell::new(seed, star(n, radius, 0.3, jitter, 0.0));
+        let mut params = Neighbourhood::ALL[preset].params().unwrap();
+        params.min_angle_deg = min_angle;
+        match grow_cell(&params, &cell, &CellMaps::none(), seed) {
+            Ok(roads) => {
+                check_cell(&cell, &roads);
+                let least = smallest_street_angle(&roads.network);
+                prop_assert!(least >= min_angle - 1e-6, "{least}° < {min_angle}°");
+            }
+            Err(e) => prop_assert!(e.is_skip(), "{e}"),
+        }
+    }
+}
+
+/// Kelly's snap gathers neighbouring ends onto one node: the Organic preset makes
+/// junctions of five and more roads on the fixed cells, and a smallest angle of 75°
+/// (five roads need one angle of at most 72°) leaves none; 0 (the default) draws
+/// exactly as before.
+#[test]
+fn a_smallest_angle_above_72_degrees_leaves_no_five_way_junction() {
+    let mut params = Neighbourhood::Organic.params().unwrap();
+    assert_eq!(params.min_angle_deg, 0.0);
+    let mut before = 0;
+    let mut after = 0;
+    let mut refused = 0;
+    for cell in fixed_cells() {
+        for seed in 0..2 {
+            params.min_angle_deg = 0.0;
+            let plain = grow_cell(&params, &cell, &CellMaps::none(), seed).unwrap();
+            assert_eq!(plain.report.refused_angle, 0);
+            before += five_plus(&plain.network);
+            params.min_angle_deg = 75.0;
+            let sharp = grow_cell(&params, &cell, &CellMaps::none(), seed).unwrap();
+            check_cell(&cell, &sharp);
+            after += five_plus(&sharp.network);
+            refused += sharp.report.refused_angle;
+            assert!(smallest_street_angle(&sharp.network) >= 75.0 - 1e-6);
+        }
+    }
+    assert!(before > 0, "organic growth makes five-way junctions");
+    assert_eq!(after, 0);
+    assert!(refused > 0);
+}
