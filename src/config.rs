@@ -392,6 +392,7 @@ const PRESETS: &[(&str, &str)] = &[
     ("old_town", include_str!("../presets/old_town.json")),
     ("suburbia", include_str!("../presets/suburbia.json")),
     ("citygen", include_str!("../presets/citygen.json")),
+    ("citygen_us", include_str!("../presets/citygen_us.json")),
     ("milan", include_str!("../presets/milan.json")),
 ];
 

@@ -17,9 +17,11 @@
 //! unpopulated land (its network has a few hundred streets, not a thousand), and seed 3
 //! keeps few culs-de-sac once the fringe stubs are pruned.
 //! Tunnels (issue 27) changed `san_francisco` seeds 1–2: highways pass under the hills
-//! they used to stop at. `citygen` and `milan` joined the test in session 11 (their
-//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen` seed 1's
-//! circuity is the one miss they brought).
+//! they used to stop at. `citygen_us` and `milan` joined the test in session 11 (their
+//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` seed
+//! 1's circuity is the one miss they brought). `citygen` itself is Kelly's test city
+//! (issue 18: 16 km², ≥ 15,000 roads, ≥ 57,000 buildings, the workload of issue 25's
+//! timings), whose street density no real city's band admits; it is not tested here.
 //!
 //! Determinism: the misses are the same in every fresh process and with one or two
 //! threads (checked with `street_bands --preset default` three times each with
@@ -60,7 +62,7 @@ const KNOWN_MISSES: &[(&str, u64, &str)] = &[
     ("default", 2, "P_4way"),
     ("default", 2, "circuity"),
     ("default", 3, "P_deadend"),
-    ("citygen", 1, "circuity"),
+    ("citygen_us", 1, "circuity"),
 ];
 
 fn check(preset: &str) {
@@ -125,15 +127,16 @@ fn suburbia_is_in_charlottes_band() {
     check("suburbia");
 }
 
-/// Kelly's test city against the US/Canada mean (Citygen mode: P&M highways, cells
-/// grown by a zoning map of Manhattan, Raster, Industrial and Suburbia). Its Citygen unit
+/// The Citygen pipeline against the US/Canada mean (`citygen_us`: Kelly's test city's
+/// configuration — P&M highways, cells grown by a zoning map of Manhattan, Raster,
+/// Industrial and Suburbia — at a real city's street spacing). Its Citygen unit
 /// is 26 m (Manhattan's 5-unit segments are 130 m, so junctions come about 100 m apart),
 /// its highways lean to a grid (New York weight 0.7), and Industrial and Suburbia
 /// meander more (Kelly §6.3). Seed 1 stays too straight (circuity 1.019 against
 /// 1.045 ± 0.02): its grid cells carry more of the street length.
 #[test]
-fn citygen_is_in_the_us_canada_band() {
-    check("citygen");
+fn citygen_us_is_in_the_us_canada_band() {
+    check("citygen_us");
 }
 
 /// Milan (Kelly §6.1's ring network) against the Europe mean: Citygen unit 28 m, no road
