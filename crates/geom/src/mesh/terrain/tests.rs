@@ -247,3 +247,32 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_mesh_does_not_depend_on_the_thread_count() {
+    let fbm = Fbm::new(FbmParams {
+        seed: 7,
+        wavelength_m: 60.0,
+        octaves: 4,
+        ..FbmParams::default()
+    })
+    .unwrap();
+    let field = fbm.scaled(12.0);
+    let bounds = rect(300.0, 250.0);
+    let options = TerrainOptions {
+        max_error_m: 0.05,
+        ..TerrainOptions::default()
+    };
+    let build = |threads: usize| {
+        crate::par::install(threads, || {
+            Terrain::build(&field, bounds, &options, None).unwrap()
+        })
+        .unwrap()
+    };
+    let (one, three) = (build(1), build(3));
+    assert!(one.report.leaves > 200, "{:?}", one.report);
+    assert_eq!(one.report, three.report);
+    assert_eq!(one.mesh.positions, three.mesh.positions);
+    assert_eq!(one.mesh.indices, three.mesh.indices);
+    assert_eq!(one.mesh.normals, three.mesh.normals);
+}
