@@ -33,7 +33,9 @@
 //!   largest rise above the field at their check points (at most that miss), so
 //!   `surface ≤ field` holds at every check point of every leaf (the one side that keeps
 //!   things standing on the field unburied), while a fan that misses only on one side is
-//!   lowered only as far as it rises, not to the bottom of the step.
+//!   lowered only as far as it rises, not to the bottom of the step. The vertices they
+//!   share with neighbouring leaves go down with them, so a neighbour's surface may lie
+//!   lower than `field − 2·max_error_m` near them, by at most that rise.
 //! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
 //!   directions), every triangle faces up, and it covers the rectangle exactly.
 //! * Deterministic: a pure function of the field, the rectangle and the options.

@@ -11,12 +11,14 @@
 //! 1. **Own fans**, level by level: every leaf of a level is checked on its own corners
 //!    and centre; those that miss the bound split (in level order, while the leaf budget
 //!    allows).
-//! 2. **Final fans**, pass by pass: every leaf whose border holds corners of smaller
-//!    neighbours (hanging vertices) is checked with them, against the corners at the
-//!    start of the pass; those that miss split, and passes repeat until none does. A
-//!    leaf's check depends only on the corners on its border, so a pass checks only the
-//!    leaves that are new or gained a corner since their last check and keeps the others'
-//!    results.
+//! 2. **Final fans**, pass by pass: every leaf is checked with every corner on its
+//!    border (its own and those of smaller neighbours, *hanging* vertices), against the
+//!    corners at the start of the pass; those that miss split, and passes repeat until
+//!    none does. A leaf of the first round without hanging vertices has passed already;
+//!    a child of a split of this round is checked like any other leaf, also when no
+//!    vertex hangs on its border. A leaf's check depends only on the corners on its
+//!    border, so a pass checks only the leaves that are new or gained a corner since
+//!    their last check and keeps the others' results.
 //!
 //! The checks of a level or a pass and the samples of its splits run in parallel
 //! ([`crate::par`]); the decisions run in leaf order, so the leaves do not depend on the
@@ -55,13 +57,12 @@ pub(super) struct Refined {
     pub unresolved: usize,
 }
 
-/// A leaf of the final-fan passes: its check points are `checks[slot]`; `miss` and
-/// `hanging` are its last check's.
+/// A leaf of the final-fan passes: its check points are `store[slot]`; `miss` is its
+/// last check's.
 #[derive(Clone, Copy)]
 struct Node {
     leaf: Leaf,
     slot: usize,
-    hanging: bool,
     miss: f64,
 }
 
@@ -118,7 +119,6 @@ pub(super) fn refine(
                 nodes.push(Node {
                     leaf: *leaf,
                     slot: store.len(),
-                    hanging: false,
                     miss: 0.0,
                 });
                 store.push(*checks);
@@ -143,6 +143,9 @@ pub(super) fn refine(
     let mut new_cols: Vec<(Corner, f64)> = Vec::new();
     // Root cells whose closed square holds a corner of `new_rows`.
     let mut touched = vec![false; (grid.nx * grid.ny) as usize];
+    // Slots from here on hold leaves split off in this round, whose own fans were never
+    // checked.
+    let round_two = store.len();
     loop {
         let due: Vec<usize> = (0..nodes.len())
             .into_par_iter()
@@ -154,24 +157,23 @@ pub(super) fn refine(
                         && gained_corner(n.leaf, &new_rows, &new_cols))
             })
             .collect();
-        let checked: Vec<Result<(bool, f64), GeomError>> = due
+        let checked: Vec<Result<f64, GeomError>> = due
             .par_iter()
             .map(|&k| {
                 let n = nodes[k];
-                final_miss(grid, n.leaf, &store[n.slot], &rows, &cols)
+                let own_checked = n.slot < round_two;
+                final_miss(grid, n.leaf, &store[n.slot], own_checked, &rows, &cols)
             })
             .collect();
-        for (&k, result) in due.iter().zip(checked) {
-            let (hanging, miss) = result?;
-            nodes[k].hanging = hanging;
-            nodes[k].miss = miss;
+        for (&k, miss) in due.iter().zip(checked) {
+            nodes[k].miss = miss?;
         }
         fresh = store.len();
         let mut kept: Vec<Node> = Vec::with_capacity(nodes.len());
         let mut splitting: Vec<Node> = Vec::new();
         for (done, n) in nodes.iter().enumerate() {
             let room = kept.len() + (nodes.len() - done - 1) + 4 <= max_leaves;
-            if n.hanging && n.miss > e && n.leaf.size > 2 && room {
+            if n.miss > e && n.leaf.size > 2 && room {
                 let mut children = Vec::with_capacity(4);
                 split(n.leaf, &mut children);
                 let first = store.len() + 4 * splitting.len();
@@ -179,7 +181,6 @@ pub(super) fn refine(
                     kept.push(Node {
                         leaf,
                         slot: first + c,
-                        hanging: false,
                         miss: 0.0,
                     });
                 }
@@ -190,7 +191,7 @@ pub(super) fn refine(
         }
         if splitting.is_empty() {
             for n in &nodes {
-                if n.hanging && n.miss > e {
+                if n.miss > e {
                     unresolved += 1;
                     flagged.push(n.leaf);
                 }
@@ -352,21 +353,26 @@ fn own_miss(grid: &Lattice, leaf: Leaf, checks: &Checks) -> Result<f64, GeomErro
     fan_miss(grid, leaf, &profiles, checks)
 }
 
-/// Whether the leaf's border has hanging vertices, and the miss of its final fan then
-/// (0 without them: its own fan was checked in the first round).
+/// The miss of the leaf's final fan (through every corner on its border); 0 for a leaf
+/// whose own fan was checked (`own_checked`) and whose border holds no other corner.
 fn final_miss(
     grid: &Lattice,
     leaf: Leaf,
     checks: &Checks,
+    own_checked: bool,
     rows: &[(Corner, f64)],
     cols: &[(Corner, f64)],
-) -> Result<(bool, f64), GeomError> {
+) -> Result<f64, GeomError> {
     check_vertices(grid, leaf, checks)?;
     if edge_ranges(leaf, rows, cols).iter().all(|r| r.len() <= 2) {
-        return Ok((false, 0.0));
+        return if own_checked {
+            Ok(0.0)
+        } else {
+            own_miss(grid, leaf, checks)
+        };
     }
     let profiles = edge_profiles(leaf, rows, cols);
-    Ok((true, fan_miss(grid, leaf, &profiles, checks)?))
+    fan_miss(grid, leaf, &profiles, checks)
 }
 
 /// The root cells (along one axis, `count` of them, `root` lattice units each) whose
