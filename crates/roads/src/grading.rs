@@ -525,28 +525,112 @@ pub struct CutIn<'a> {
     margin: f64,
 }
 
+impl CutIn<'_> {
+    /// How far the corridors' cut reaches beyond a centre line, metres.
+    fn reach(&self) -> f64 {
+        self.graded.corridor_reach + 2.0 * self.margin
+    }
+
+    /// The share of the cut depth piece `k` asks for at `p` (1 within the corridor and
+    /// its margin, tapering to 0 over the next margin).
+    fn share(&self, k: u32, p: DVec2) -> f64 {
+        let Some(piece) = self.graded.pieces.get(k as usize) else {
+            return 0.0;
+        };
+        let (_, d) = piece.project(p);
+        let beyond = d - piece.half_width - self.margin;
+        if beyond <= 0.0 {
+            1.0
+        } else if self.margin > 0.0 {
+            (1.0 - beyond / self.margin).max(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
 impl Field for CutIn<'_> {
     fn sample(&self, p: DVec2) -> f64 {
         let g = self.graded.sample(p);
-        let reach = self.graded.corridor_reach + 2.0 * self.margin;
         let mut sink = 0.0f64;
-        let b = Aabb2::new(p, p).expanded(reach);
+        let b = Aabb2::new(p, p).expanded(self.reach());
         self.graded.corridors.for_each_candidate(&b, |k, _| {
-            let Some(piece) = self.graded.pieces.get(k as usize) else {
-                return;
-            };
-            let (_, d) = piece.project(p);
-            let beyond = d - piece.half_width - self.margin;
-            let share = if beyond <= 0.0 {
-                1.0
-            } else if self.margin > 0.0 {
-                (1.0 - beyond / self.margin).max(0.0)
-            } else {
-                0.0
-            };
-            sink = sink.max(share);
+            sink = sink.max(self.share(k, p));
         });
         g - self.depth * sink
+    }
+
+    /// One look-up of the corridors around all the points, then the values of
+    /// [`sample`](Field::sample) (the shares are combined by `max`, so the order and a
+    /// superset of the corridors near each point change nothing).
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        self.graded.sample_many(points, out);
+        let Some(b) = points_box(points) else {
+            for (p, o) in points.iter().zip(out.iter_mut()) {
+                *o = self.sample(*p);
+            }
+            return;
+        };
+        let mut near = Vec::new();
+        // Corridors that cut nowhere in the box (at least twice the margin beyond it at
+        // its centre's distance less its half diagonal) share 0 at every point: left out.
+        let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
+        self.graded
+            .corridors
+            .for_each_candidate(&b.expanded(self.reach()), |k, _| {
+                if let Some(piece) = self.graded.pieces.get(k as usize) {
+                    let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
+                    if beyond < 2.0 * self.margin + BOX_SLACK_M {
+                        near.push(k);
+                    }
+                }
+            });
+        for (&p, o) in points.iter().zip(out.iter_mut()) {
+            let sink = near
+                .iter()
+                .fold(0.0f64, |sink, &k| sink.max(self.share(k, p)));
+            *o -= self.depth * sink;
+        }
+    }
+}
+
+/// Slack beyond rounding when a whole box of points is found out of a piece's reach by
+/// its centre's distance, metres: a piece left out would give nothing at any point of
+/// the box even with distances off by far more than rounding.
+const BOX_SLACK_M: f64 = 1e-6;
+
+/// The bounding box of `points`, `None` when there are none or one is not finite.
+fn points_box(points: &[DVec2]) -> Option<Aabb2> {
+    let first = *points.first()?;
+    let (lo, hi) = points
+        .iter()
+        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (lo.is_finite() && hi.is_finite()).then(|| Aabb2::new(lo, hi))
+}
+
+impl GradedGround<'_> {
+    /// Narrows `(lo, hi)` to the cone of piece `k` at `p`.
+    fn narrow(&self, k: u32, p: DVec2, lo: &mut f64, hi: &mut f64) {
+        let Some(piece) = self.pieces.get(k as usize) else {
+            return;
+        };
+        let (t, d) = piece.project(p);
+        let beyond = (d - piece.half_width).max(0.0);
+        if let Some(rise) = cone_rise(beyond, self.slope, self.max_bank) {
+            let r = piece.height_at(t);
+            *lo = lo.max(r - rise);
+            *hi = hi.min(r + rise);
+        }
+    }
+}
+
+/// The ground `g` clamped into the cones' common range `[lo, hi]`, or their meeting
+/// height where they leave none.
+fn clamp_into(g: f64, lo: f64, hi: f64) -> f64 {
+    if lo <= hi {
+        g.clamp(lo, hi)
+    } else {
+        0.5 * (lo + hi)
     }
 }
 
@@ -565,21 +649,49 @@ impl Field for GradedGround<'_> {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         let b = Aabb2::new(p, p).expanded(self.reach);
         self.index.for_each_candidate(&b, |k, _| {
-            let Some(piece) = self.pieces.get(k as usize) else {
-                return;
-            };
-            let (t, d) = piece.project(p);
-            let beyond = (d - piece.half_width).max(0.0);
-            if let Some(rise) = cone_rise(beyond, self.slope, self.max_bank) {
-                let r = piece.height_at(t);
-                lo = lo.max(r - rise);
-                hi = hi.min(r + rise);
-            }
+            self.narrow(k, p, &mut lo, &mut hi);
         });
-        if lo <= hi {
-            g.clamp(lo, hi)
-        } else {
-            0.5 * (lo + hi)
+        clamp_into(g, lo, hi)
+    }
+
+    /// One look-up of the pieces around all the points, then the values of
+    /// [`sample`](Field::sample): the cones are combined by `max` and `min`, so the order
+    /// and a superset of the pieces near each point change nothing (a piece beyond a
+    /// point's reach binds nowhere there).
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        self.ground.sample_many(points, out);
+        if self.index.is_empty() {
+            return;
+        }
+        let Some(b) = points_box(points) else {
+            for (p, o) in points.iter().zip(out.iter_mut()) {
+                *o = self.sample(*p);
+            }
+            return;
+        };
+        let mut near = Vec::new();
+        // Pieces whose cone binds nowhere in the box (past the bank and the wall face at
+        // its centre's distance less its half diagonal) are left out.
+        let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
+        let wall_end = self.max_bank + RETAINING_WALL_M + BOX_SLACK_M;
+        self.index
+            .for_each_candidate(&b.expanded(self.reach), |k, _| {
+                if let Some(piece) = self.pieces.get(k as usize) {
+                    let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
+                    if beyond < wall_end {
+                        near.push(k);
+                    }
+                }
+            });
+        for (&p, o) in points.iter().zip(out.iter_mut()) {
+            if !o.is_finite() {
+                continue;
+            }
+            let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+            for &k in &near {
+                self.narrow(k, p, &mut lo, &mut hi);
+            }
+            *o = clamp_into(*o, lo, hi);
         }
     }
 }

@@ -145,6 +145,21 @@ pub trait Field: Send + Sync {
     fn constant_value(&self) -> Option<f64> {
         None
     }
+
+    /// The values at many points at once: `out[k]` becomes the value at `points[k]`, for
+    /// every `k` below the shorter length (entries of `out` beyond `points` are left
+    /// alone).
+    ///
+    /// Default: one [`sample`](Field::sample) per point. Fields that look up their
+    /// neighbourhood for every sample (a spatial index around the point) override it to
+    /// look up once around the points' bounding box, which pays when the points lie close
+    /// together (a terrain leaf's check points). An override must give the values of
+    /// `sample` bit for bit.
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            *o = self.sample(*p);
+        }
+    }
 }
 
 /// The gradient of `field` at `p` by central differences with step `h` metres:
@@ -174,6 +189,9 @@ impl<F: Field + ?Sized> Field for &F {
     fn constant_value(&self) -> Option<f64> {
         (**self).constant_value()
     }
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        (**self).sample_many(points, out)
+    }
 }
 
 impl<F: Field + ?Sized> Field for Box<F> {
@@ -189,6 +207,9 @@ impl<F: Field + ?Sized> Field for Box<F> {
     fn constant_value(&self) -> Option<f64> {
         (**self).constant_value()
     }
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        (**self).sample_many(points, out)
+    }
 }
 
 impl<F: Field + ?Sized> Field for Arc<F> {
@@ -203,6 +224,9 @@ impl<F: Field + ?Sized> Field for Arc<F> {
     }
     fn constant_value(&self) -> Option<f64> {
         (**self).constant_value()
+    }
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        (**self).sample_many(points, out)
     }
 }
 

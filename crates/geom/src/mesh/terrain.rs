@@ -11,6 +11,13 @@
 //! whose border gained hanging vertices are checked again with their final fan, and split
 //! if they now miss the bound (repeated until nothing changes).
 //!
+//! Every point the refinement checks is sampled once per leaf, in batches through
+//! [`Field::sample_many`] (a split samples its leaf at twice the resolution, which gives
+//! its four children their check points); each round of checks and of splits runs in
+//! parallel through [`crate::par`], and a leaf is checked again only when its border
+//! gained a corner. The decisions are taken in leaf order, so the mesh does not depend on
+//! the thread count.
+//!
 //! The surface is **one-sided**: every vertex lies `max_error_m` *below* the field, so
 //! where the interpolation is within the bound the surface lies between `2·max_error_m`
 //! below the field and the field itself. Things that stand on the field (road surfaces a
@@ -26,7 +33,9 @@
 //!   largest rise above the field at their check points (at most that miss), so
 //!   `surface ≤ field` holds at every check point of every leaf (the one side that keeps
 //!   things standing on the field unburied), while a fan that misses only on one side is
-//!   lowered only as far as it rises, not to the bottom of the step.
+//!   lowered only as far as it rises, not to the bottom of the step. The vertices they
+//!   share with neighbouring leaves go down with them, so a neighbour's surface may lie
+//!   lower than `field − 2·max_error_m` near them, by at most that rise.
 //! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
 //!   directions), every triangle faces up, and it covers the rectangle exactly.
 //! * Deterministic: a pure function of the field, the rectangle and the options.
@@ -144,11 +153,10 @@ pub struct Terrain {
     pub report: TerrainReport,
     grid: Lattice,
     leaves: Vec<Leaf>,
-    /// Leaf corners sorted by `(y, x)` and by `(x, y)`, with the field there.
-    by_row: Vec<(u64, u64)>,
-    by_col: Vec<(u64, u64)>,
-    row_heights: Vec<f64>,
-    col_heights: Vec<f64>,
+    /// Leaf corners sorted by `(y, x)` and by `(x, y)`, with the surface's height there
+    /// (before the offset).
+    rows: Vec<(Corner, f64)>,
+    cols: Vec<(Corner, f64)>,
     centre_heights: Vec<f64>,
     /// Root cell → its leaves (indices into `leaves`).
     roots: Vec<Vec<u32>>,
@@ -224,124 +232,17 @@ impl Terrain {
             ny,
             root,
         };
-        let sample = |x: u64, y: u64| -> Result<f64, GeomError> {
-            let p = grid.point(x as f64, y as f64);
-            let v = field.sample(p);
-            if v.is_finite() && v.abs() <= MAX_COORDINATE {
-                Ok(v)
-            } else {
-                Err(GeomError::InvalidParameter {
-                    name: "field",
-                    reason: format!("the ground is {v} at {p}; it must be finite"),
-                })
-            }
-        };
         let e = options.max_error_m;
-
-        // Refinement on each leaf's own corners and centre.
-        let mut work: Vec<Leaf> = Vec::with_capacity((nx * ny) as usize);
-        for j in 0..ny {
-            for i in 0..nx {
-                work.push(Leaf {
-                    x: i * root,
-                    y: j * root,
-                    size: root,
-                });
-            }
-        }
-        let mut leaves = Vec::with_capacity(work.len());
-        let mut worst = 0.0f64;
-        let mut unresolved = 0usize;
-        // Leaves that miss the bound for good: lowered below the field at the end.
-        let mut flagged: Vec<Leaf> = Vec::new();
-        while !work.is_empty() {
-            let mut next = Vec::new();
-            let pending = work.len();
-            for (done, leaf) in work.into_iter().enumerate() {
-                let h = |dx: u64, dy: u64| sample(leaf.x + dx, leaf.y + dy);
-                let s = leaf.size;
-                let corners = [h(0, 0)?, h(s, 0)?, h(s, s)?, h(0, s)?];
-                let profiles = [
-                    vec![(0.0, corners[0]), (1.0, corners[1])],
-                    vec![(0.0, corners[1]), (1.0, corners[2])],
-                    vec![(0.0, corners[3]), (1.0, corners[2])],
-                    vec![(0.0, corners[0]), (1.0, corners[3])],
-                ];
-                let centre = centre_height(&sample, leaf)?;
-                let miss = leaf_miss(&grid, field, leaf, &profiles, centre)?;
-                // Leaves if this one splits: the settled, the next round's, the rest of
-                // this round's, and its four children.
-                let room =
-                    leaves.len() + next.len() + (pending - done - 1) + 4 <= options.max_leaves;
-                if miss > e && s > 2 && room {
-                    split(leaf, &mut next);
-                } else {
-                    if miss > e {
-                        unresolved += 1;
-                        flagged.push(leaf);
-                    }
-                    worst = worst.max(miss);
-                    leaves.push(leaf);
-                }
-            }
-            work = next;
-        }
-
-        // Check the final fans (with hanging vertices) until no leaf splits.
-        loop {
-            let (by_row, by_col) = corner_sets(&leaves);
-            let row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
-            let col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
-            let mut split_any = false;
-            let mut kept = Vec::with_capacity(leaves.len());
-            let mut next_worst = 0.0f64;
-            let mut next_unresolved = 0usize;
-            let mut next_flagged = Vec::new();
-            for (done, &leaf) in leaves.iter().enumerate() {
-                let profiles = edge_profiles(leaf, &by_row, &by_col, &row_heights, &col_heights);
-                let hanging = profiles.iter().any(|p| p.len() > 2);
-                let miss = if hanging {
-                    let centre = centre_height(&sample, leaf)?;
-                    leaf_miss(&grid, field, leaf, &profiles, centre)?
-                } else {
-                    0.0
-                };
-                let room = kept.len() + (leaves.len() - done - 1) + 4 <= options.max_leaves;
-                if hanging && miss > e && leaf.size > 2 && room {
-                    split(leaf, &mut kept);
-                    split_any = true;
-                } else {
-                    if hanging && miss > e {
-                        next_unresolved += 1;
-                        next_flagged.push(leaf);
-                    }
-                    next_worst = next_worst.max(miss);
-                    kept.push(leaf);
-                }
-            }
-            if !split_any {
-                worst = worst.max(next_worst);
-                unresolved += next_unresolved;
-                flagged.extend(next_flagged);
-                leaves = kept;
-                break;
-            }
-            leaves = kept;
-        }
-        leaves.sort_unstable_by_key(|l| (l.y, l.x));
-
-        let (by_row, by_col) = corner_sets(&leaves);
-        let mut row_heights = heights(&by_row, |&(y, x)| sample(x, y))?;
-        let mut col_heights = heights(&by_col, |&(x, y)| sample(x, y))?;
-        let mut centre_heights = Vec::with_capacity(leaves.len());
-        for &leaf in &leaves {
-            centre_heights.push(centre_height(&sample, leaf)?);
-        }
+        let refined = refine::refine(&grid, field, e, options.max_leaves)?;
+        let (leaves, checks): (Vec<Leaf>, Vec<refine::Checks>) = refined.leaves.into_iter().unzip();
+        let (mut rows, mut cols) = (refined.rows, refined.cols);
+        let mut centre_heights: Vec<f64> = checks.iter().map(|c| c[12]).collect();
         // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
         // lowered by the fan's largest rise above the field at their check points (the
         // fan is linear in its vertex heights, so it then lies below the field there);
         // lowering shared vertices only lowers neighbours. The rises are measured on the
         // unlowered fans, then applied together (order-independent).
+        let mut flagged = refined.flagged;
         flagged.sort_unstable_by_key(|l| (l.y, l.x, l.size));
         flagged.dedup();
         let mut drops: Vec<(usize, f64)> = Vec::with_capacity(flagged.len());
@@ -353,40 +254,37 @@ impl Terrain {
             if leaf.size != f.size {
                 continue;
             }
-            let profiles = edge_profiles(leaf, &by_row, &by_col, &row_heights, &col_heights);
-            let rise = leaf_rise(&grid, field, leaf, &profiles, centre_heights[k]);
+            let profiles = edge_profiles(leaf, &rows, &cols);
+            let rise = leaf_rise(&profiles, &checks[k]);
             if rise > 0.0 {
                 drops.push((k, rise));
             }
         }
-        let (row_orig, col_orig, centre_orig) = (
-            row_heights.clone(),
-            col_heights.clone(),
-            centre_heights.clone(),
-        );
+        let (row_orig, col_orig, centre_orig) =
+            (rows.clone(), cols.clone(), centre_heights.clone());
         for &(k, drop) in &drops {
             let leaf = leaves[k];
             let sz = leaf.size;
-            for (line, from, rows) in [
+            for (line, from, along_rows) in [
                 (leaf.y, leaf.x, true),
                 (leaf.y + sz, leaf.x, true),
                 (leaf.x, leaf.y, false),
                 (leaf.x + sz, leaf.y, false),
             ] {
-                let keys = if rows { &by_row } else { &by_col };
-                let lo = keys.partition_point(|&q| q < (line, from));
-                let hi = keys.partition_point(|&q| q <= (line, from + sz));
-                for &(a, b) in keys.get(lo..hi).unwrap_or_default() {
-                    let (row_key, col_key) = if rows {
+                let keys = if along_rows { &row_orig } else { &col_orig };
+                let lo = keys.partition_point(|&(q, _)| q < (line, from));
+                let hi = keys.partition_point(|&(q, _)| q <= (line, from + sz));
+                for &((a, b), _) in keys.get(lo..hi).unwrap_or_default() {
+                    let (row_key, col_key) = if along_rows {
                         ((a, b), (b, a))
                     } else {
                         ((b, a), (a, b))
                     };
-                    if let Ok(r) = by_row.binary_search(&row_key) {
-                        row_heights[r] = row_heights[r].min(row_orig[r] - drop);
+                    if let Ok(r) = row_orig.binary_search_by_key(&row_key, |&(q, _)| q) {
+                        rows[r].1 = rows[r].1.min(row_orig[r].1 - drop);
                     }
-                    if let Ok(c) = by_col.binary_search(&col_key) {
-                        col_heights[c] = col_heights[c].min(col_orig[c] - drop);
+                    if let Ok(c) = col_orig.binary_search_by_key(&col_key, |&(q, _)| q) {
+                        cols[c].1 = cols[c].1.min(col_orig[c].1 - drop);
                     }
                 }
             }
@@ -404,15 +302,13 @@ impl Terrain {
             report: TerrainReport {
                 leaves: leaves.len(),
                 triangles: 0,
-                max_error_m: worst,
-                unresolved_leaves: unresolved,
+                max_error_m: refined.worst,
+                unresolved_leaves: refined.unresolved,
             },
             grid,
             leaves,
-            by_row,
-            by_col,
-            row_heights,
-            col_heights,
+            rows,
+            cols,
             centre_heights,
             roots,
             offset: e,
@@ -440,13 +336,7 @@ impl Terrain {
             let s = leaf.size as f64;
             let (u, v) = ((lx - leaf.x as f64) / s, (ly - leaf.y as f64) / s);
             if (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v) {
-                let profiles = edge_profiles(
-                    leaf,
-                    &self.by_row,
-                    &self.by_col,
-                    &self.row_heights,
-                    &self.col_heights,
-                );
+                let profiles = edge_profiles(leaf, &self.rows, &self.cols);
                 let centre = *self.centre_heights.get(k as usize)?;
                 return Some(fan_height(&profiles, centre, u, v) - self.offset);
             }
@@ -460,16 +350,32 @@ impl Terrain {
         let size = g.max - g.min;
         let mut mesh = Mesh::with_capacity(
             material,
-            self.by_row.len() + self.leaves.len(),
+            self.rows.len() + self.leaves.len(),
             6 * self.leaves.len(),
         );
         let uv = |p: DVec2| DVec2::new((p.x - g.min.x) / size.x, (g.max.y - p.y) / size.y);
-        for (&(y, x), &h) in self.by_row.iter().zip(&self.row_heights) {
+        for &((y, x), h) in &self.rows {
             let p = g.point(x as f64, y as f64);
             mesh.add_vertex(to_world(p, h - self.offset), glam::DVec3::Y, uv(p));
         }
-        let corner = |x: u64, y: u64| -> Option<u32> {
-            self.by_row.binary_search(&(y, x)).ok().map(|i| i as u32)
+        // Vertex `k` is corner `rows[k]`; `col_ids[k]` is the vertex of corner `cols[k]`.
+        let mut col_ids: Vec<((u64, u64), u32)> = self
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(k, &((y, x), _))| ((x, y), k as u32))
+            .collect();
+        col_ids.sort_unstable_by_key(|&(key, _)| key);
+        let col_ids: Vec<u32> = col_ids.into_iter().map(|(_, k)| k).collect();
+        let row = |y: u64, a: u64, b: u64| {
+            let lo = self.rows.partition_point(|&(k, _)| k < (y, a));
+            let hi = self.rows.partition_point(|&(k, _)| k <= (y, b));
+            lo as u32..hi.max(lo) as u32
+        };
+        let col = |x: u64, a: u64, b: u64| {
+            let lo = self.cols.partition_point(|&(k, _)| k < (x, a));
+            let hi = self.cols.partition_point(|&(k, _)| k <= (x, b));
+            col_ids.get(lo..hi).unwrap_or_default()
         };
         let mut ring: Vec<u32> = Vec::new();
         for (leaf, &hc) in self.leaves.iter().zip(&self.centre_heights) {
@@ -482,38 +388,10 @@ impl Terrain {
             // The border counter-clockwise: bottom (x up), right (y up), top (x down),
             // left (y down); each corner once.
             ring.clear();
-            let row = |y: u64, a: u64, b: u64| {
-                let lo = self.by_row.partition_point(|&k| k < (y, a));
-                let hi = self.by_row.partition_point(|&k| k <= (y, b));
-                self.by_row
-                    .get(lo..hi)
-                    .unwrap_or_default()
-                    .iter()
-                    .map(|&(_, x)| x)
-            };
-            let col = |x: u64, a: u64, b: u64| {
-                let lo = self.by_col.partition_point(|&k| k < (x, a));
-                let hi = self.by_col.partition_point(|&k| k <= (x, b));
-                self.by_col
-                    .get(lo..hi)
-                    .unwrap_or_default()
-                    .iter()
-                    .map(|&(_, y)| y)
-            };
-            for x in row(leaf.y, leaf.x, leaf.x + s - 1) {
-                ring.extend(corner(x, leaf.y));
-            }
-            for y in col(leaf.x + s, leaf.y, leaf.y + s - 1) {
-                ring.extend(corner(leaf.x + s, y));
-            }
-            let top: Vec<u64> = row(leaf.y + s, leaf.x + 1, leaf.x + s).collect();
-            for &x in top.iter().rev() {
-                ring.extend(corner(x, leaf.y + s));
-            }
-            let left: Vec<u64> = col(leaf.x, leaf.y + 1, leaf.y + s).collect();
-            for &y in left.iter().rev() {
-                ring.extend(corner(leaf.x, y));
-            }
+            ring.extend(row(leaf.y, leaf.x, leaf.x + s - 1));
+            ring.extend(col(leaf.x + s, leaf.y, leaf.y + s - 1));
+            ring.extend(row(leaf.y + s, leaf.x + 1, leaf.x + s).rev());
+            ring.extend(col(leaf.x, leaf.y + 1, leaf.y + s).iter().rev());
             for k in 0..ring.len() {
                 let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
                 mesh.push_triangle(centre, a, b)?;
@@ -536,63 +414,43 @@ fn split(leaf: Leaf, out: &mut Vec<Leaf>) {
     }
 }
 
-/// The field at the leaf's centre (a lattice point: leaves are at least 2 units).
-fn centre_height(
-    sample: &dyn Fn(u64, u64) -> Result<f64, GeomError>,
+/// Where the corners on the leaf's four edges (bottom, right, top, left) lie in `rows`
+/// (the bottom and top edges) and `cols` (the right and left edges): the corners with
+/// their heights, sorted by `(y, x)` and by `(x, y)`.
+fn edge_ranges(
     leaf: Leaf,
-) -> Result<f64, GeomError> {
-    sample(leaf.x + leaf.size / 2, leaf.y + leaf.size / 2)
-}
-
-/// Sorted, deduplicated leaf corners by `(y, x)` and by `(x, y)`.
-fn corner_sets(leaves: &[Leaf]) -> (Vec<Corner>, Vec<Corner>) {
-    let mut by_row = Vec::with_capacity(4 * leaves.len());
-    for l in leaves {
-        let s = l.size;
-        by_row.extend([
-            (l.y, l.x),
-            (l.y, l.x + s),
-            (l.y + s, l.x),
-            (l.y + s, l.x + s),
-        ]);
-    }
-    by_row.sort_unstable();
-    by_row.dedup();
-    let mut by_col: Vec<(u64, u64)> = by_row.iter().map(|&(y, x)| (x, y)).collect();
-    by_col.sort_unstable();
-    (by_row, by_col)
-}
-
-fn heights<T>(keys: &[T], f: impl Fn(&T) -> Result<f64, GeomError>) -> Result<Vec<f64>, GeomError> {
-    keys.iter().map(f).collect()
+    rows: &[(Corner, f64)],
+    cols: &[(Corner, f64)],
+) -> [std::ops::Range<usize>; 4] {
+    let s = leaf.size;
+    let along = |keys: &[(Corner, f64)], line: u64, from: u64| {
+        let lo = keys.partition_point(|&(k, _)| k < (line, from));
+        let hi = keys.partition_point(|&(k, _)| k <= (line, from + s));
+        lo..hi.max(lo)
+    };
+    [
+        along(rows, leaf.y, leaf.x),
+        along(cols, leaf.x + s, leaf.y),
+        along(rows, leaf.y + s, leaf.x),
+        along(cols, leaf.x, leaf.y),
+    ]
 }
 
 /// The height profiles of the leaf's four edges (bottom, right, top, left), each
-/// parametrised from its lower-left end, through every corner on it.
-fn edge_profiles(
-    leaf: Leaf,
-    by_row: &[(u64, u64)],
-    by_col: &[(u64, u64)],
-    row_h: &[f64],
-    col_h: &[f64],
-) -> [EdgeProfile; 4] {
-    let s = leaf.size;
-    let along = |keys: &[(u64, u64)], hs: &[f64], line: u64, from: u64| -> EdgeProfile {
-        let lo = keys.partition_point(|&k| k < (line, from));
-        let hi = keys.partition_point(|&k| k <= (line, from + s));
-        keys.get(lo..hi)
+/// parametrised from its lower-left end, through every corner on it (see
+/// [`edge_ranges`]).
+fn edge_profiles(leaf: Leaf, rows: &[(Corner, f64)], cols: &[(Corner, f64)]) -> [EdgeProfile; 4] {
+    let (s, from) = (leaf.size, [leaf.x, leaf.y, leaf.x, leaf.y]);
+    let keys = [rows, cols, rows, cols];
+    let ranges = edge_ranges(leaf, rows, cols);
+    std::array::from_fn(|e| {
+        keys[e]
+            .get(ranges[e].clone())
             .unwrap_or_default()
             .iter()
-            .zip(hs.get(lo..hi).unwrap_or_default())
-            .map(|(&(_, t), &h)| ((t - from) as f64 / s as f64, h))
+            .map(|&((_, t), h)| ((t - from[e]) as f64 / s as f64, h))
             .collect()
-    };
-    [
-        along(by_row, row_h, leaf.y, leaf.x),
-        along(by_col, col_h, leaf.x + s, leaf.y),
-        along(by_row, row_h, leaf.y + s, leaf.x),
-        along(by_col, col_h, leaf.x, leaf.y),
-    ]
+    })
 }
 
 /// The height of a sorted edge profile at parameter `t`.
@@ -635,57 +493,20 @@ fn fan_height(profiles: &[EdgeProfile; 4], centre: f64, u: f64, v: f64) -> f64 {
 /// The fan's largest rise above the field at the leaf's check points (0 when it lies
 /// below the field at all of them); check points where the field is not finite are
 /// skipped.
-fn leaf_rise(
-    grid: &Lattice,
-    field: &dyn Field,
-    leaf: Leaf,
-    profiles: &[EdgeProfile; 4],
-    centre: f64,
-) -> f64 {
+fn leaf_rise(profiles: &[EdgeProfile; 4], checks: &refine::Checks) -> f64 {
     let mut worst = 0.0f64;
-    let s = leaf.size as f64;
-    for j in 0..=4u32 {
-        for i in 0..=4u32 {
-            let (u, v) = (f64::from(i) / 4.0, f64::from(j) / 4.0);
-            let p = grid.point(leaf.x as f64 + u * s, leaf.y as f64 + v * s);
-            let f = field.sample(p);
-            if f.is_finite() {
-                worst = worst.max(fan_height(profiles, centre, u, v) - f);
-            }
+    for (k, &f) in checks.iter().enumerate() {
+        let (u, v) = (
+            f64::from((k % 5) as u32) / 4.0,
+            f64::from((k / 5) as u32) / 4.0,
+        );
+        if f.is_finite() {
+            worst = worst.max(fan_height(profiles, checks[12], u, v) - f);
         }
     }
     worst
 }
 
-/// The largest miss of the leaf's fan against the field at its check points.
-fn leaf_miss(
-    grid: &Lattice,
-    field: &dyn Field,
-    leaf: Leaf,
-    profiles: &[EdgeProfile; 4],
-    centre: f64,
-) -> Result<f64, GeomError> {
-    let mut worst = 0.0f64;
-    let s = leaf.size as f64;
-    for j in 0..=4u32 {
-        for i in 0..=4u32 {
-            if (i % 4 == 0 && j % 4 == 0) || (i == 2 && j == 2) {
-                continue; // corners and centre are vertices
-            }
-            let (u, v) = (f64::from(i) / 4.0, f64::from(j) / 4.0);
-            let p = grid.point(leaf.x as f64 + u * s, leaf.y as f64 + v * s);
-            let f = field.sample(p);
-            if !f.is_finite() {
-                return Err(GeomError::InvalidParameter {
-                    name: "field",
-                    reason: format!("the ground is {f} at {p}; it must be finite"),
-                });
-            }
-            worst = worst.max((fan_height(profiles, centre, u, v) - f).abs());
-        }
-    }
-    Ok(worst)
-}
-
+mod refine;
 #[cfg(test)]
 mod tests;

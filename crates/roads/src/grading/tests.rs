@@ -324,3 +324,39 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// A batch of points, close together or spread over the map and beyond it, gets the
+    /// values of one sample each, bit for bit, from the graded ground and its cut-in.
+    #[test]
+    fn sampling_many_points_is_sampling_each(
+        seed in 0u64..500,
+        amplitude in 10.0f64..120.0,
+        centre_x in -40.0f64..260.0,
+        centre_y in -40.0f64..260.0,
+        spread in 0.0f64..200.0,
+        margin in 0.0f64..3.0,
+    ) {
+        let fbm = Fbm::new(FbmParams { seed, wavelength_m: 150.0, octaves: 3, ..FbmParams::default() }).unwrap();
+        let ground = fbm.scaled(amplitude);
+        let net = grid(4, 70.0);
+        let g = grade_roads(&net, &ground, &GradeParams::default()).unwrap();
+        prop_assert!(g.moves_ground());
+        let cut = g.cut_in(0.3, margin);
+        let points: Vec<DVec2> = (0..41u32)
+            .map(|k| {
+                let a = f64::from(k) * 2.399;
+                DVec2::new(centre_x, centre_y) + DVec2::new(a.cos(), a.sin()) * spread * f64::from(k) / 40.0
+            })
+            .collect();
+        for field in [&g as &dyn Field, &cut] {
+            let mut many = vec![f64::NAN; points.len()];
+            field.sample_many(&points, &mut many);
+            for (p, v) in points.iter().zip(&many) {
+                prop_assert_eq!(v.to_bits(), field.sample(*p).to_bits(), "at {}", p);
+            }
+        }
+    }
+}
