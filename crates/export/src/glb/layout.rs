@@ -317,7 +317,7 @@ pub(crate) fn plain(
     for g in &plan.geometries {
         let m = &g.mesh;
         let n = m.vertex_count();
-        let b = m.bbox();
+        let b = g.bbox();
         let mut arrays = Vec::with_capacity(6);
         arrays.push(ArrayLayout {
             bounds: Some((b.min.as_dvec3().to_array(), b.max.as_dvec3().to_array())),

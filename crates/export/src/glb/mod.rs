@@ -732,7 +732,7 @@ fn document(
     let first_holder = plan.nodes.len() as u32;
     for pn in &plan.nodes {
         let source = pn.source.and_then(|s| scene.nodes.get(s.index()));
-        let mut extras = match source {
+        let metadata = match source {
             Some(node) if !node.metadata.is_empty() => {
                 match serde_json::to_value(&node.metadata).map_err(ExportError::json("extras"))? {
                     serde_json::Value::Object(m) => m,
@@ -741,11 +741,8 @@ fn document(
             }
             _ => serde_json::Map::new(),
         };
-        if let Some(more) = &pn.extras {
-            for (k, v) in more {
-                extras.insert(k.clone(), v.clone());
-            }
-        }
+        let none = serde_json::Map::new();
+        let extras = Merged(&metadata, pn.extras.as_ref().unwrap_or(&none));
         let name = match source {
             Some(node) => named(&node.name),
             None => named(&pn.name),
@@ -760,6 +757,7 @@ fn document(
             extras: if extras.is_empty() {
                 None
             } else {
+                // The root's feature table is serialized from the plan, never copied.
                 Some(raw(&extras)?)
             },
             name,
@@ -806,6 +804,35 @@ fn document(
         root.scene = Some(scene_index);
     }
     Ok((root, instance_accessors))
+}
+
+/// Two JSON objects serialized as one, without copying either: keys in sorted order (as
+/// `serde_json::Map` orders them), the second object's value where both have a key.
+struct Merged<'a>(
+    &'a serde_json::Map<String, serde_json::Value>,
+    &'a serde_json::Map<String, serde_json::Value>,
+);
+
+impl Merged<'_> {
+    fn is_empty(&self) -> bool {
+        self.0.is_empty() && self.1.is_empty()
+    }
+}
+
+impl Serialize for Merged<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut keys: Vec<&String> = self.0.keys().chain(self.1.keys()).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        let mut map = s.serialize_map(Some(keys.len()))?;
+        for k in keys {
+            if let Some(v) = self.1.get(k).or_else(|| self.0.get(k)) {
+                map.serialize_entry(k, v)?;
+            }
+        }
+        map.end()
+    }
 }
 
 fn named(name: &str) -> Option<String> {

@@ -1010,3 +1010,55 @@ fn buffer_views_are_shared_by_aligned_disjoint_accessors() {
         }
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// The counting sort of the cut gives what sorting (tile, triangle) pairs gives,
+    /// on dense sheets and on sparse ones (a far triangle takes the sorted-map path).
+    #[test]
+    fn triangles_by_tile_matches_sorting_pairs(
+        corners in proptest::collection::vec(
+            ((-900.0f32..900.0, -900.0f32..900.0), (-9.0f32..9.0, -9.0f32..9.0)),
+            1..80,
+        ),
+        far in proptest::prelude::any::<bool>(),
+        size in 20.0f64..300.0,
+    ) {
+        let mut m = Mesh::new(None);
+        for ((x, z), (dx, dz)) in corners {
+            let base = m.positions.len() as u32;
+            for p in [Vec3::new(x, 0.0, z), Vec3::new(x + dx, 1.0, z), Vec3::new(x, 0.0, z + dz)] {
+                m.positions.push(p);
+                m.normals.push(Vec3::Y);
+            }
+            m.indices.extend([base, base + 1, base + 2]);
+        }
+        if far {
+            let base = m.positions.len() as u32;
+            for x in [1.0e7f32, 1.0e7 + 3.0, 1.0e7] {
+                m.positions.push(Vec3::new(x, 0.0, -4.0e6));
+                m.normals.push(Vec3::Y);
+            }
+            m.indices.extend([base, base + 1, base + 2]);
+        }
+        let mut pairs: Vec<((i64, i64), u32)> = m
+            .indices
+            .chunks_exact(3)
+            .enumerate()
+            .map(|(t, tri)| {
+                let c = (m.positions[tri[0] as usize]
+                    + m.positions[tri[1] as usize]
+                    + m.positions[tri[2] as usize])
+                    / 3.0;
+                let tile = |v: f32| (f64::from(v) / size).floor() as i64;
+                ((tile(c.x), tile(c.z)), t as u32)
+            })
+            .collect();
+        pairs.sort_unstable();
+        let mut expect: Vec<((i64, i64), Vec<u32>)> = Vec::new();
+        for run in pairs.chunk_by(|a, b| a.0 == b.0) {
+            expect.push((run[0].0, run.iter().map(|p| p.1).collect()));
+        }
+        proptest::prop_assert_eq!(tiles::triangles_by_tile(&m, size), expect);
+    }
+}

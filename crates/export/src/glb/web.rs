@@ -376,7 +376,7 @@ pub(crate) fn layout(
     for m in &plan.meshes {
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for &(g, _) in &m.primitives {
-            let b = plan.geometries[g].mesh.bbox();
+            let b = plan.geometries[g].bbox();
             lo = lo.min(b.min);
             hi = hi.max(b.max);
         }
