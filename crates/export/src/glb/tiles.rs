@@ -26,6 +26,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use polis_geom::glam::{DMat4, DVec3, Vec3};
+use polis_geom::par::prelude::*;
 use polis_geom::scene::{MaterialId, MetaValue, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
 use serde_json::{Map, Value, json};
@@ -147,6 +148,16 @@ pub(super) fn triangles_by_tile(m: &Mesh, size: f64) -> Vec<(Tile, Vec<u32>)> {
 /// `remap` (all `u32::MAX`, one per vertex of `m`) maps old to new vertices and is reset.
 fn append_triangles(target: &mut Merged, m: &Mesh, tris: &[u32], feature: u32, remap: &mut [u32]) {
     let (out, features, bounds) = target;
+    // A connected sheet has about half as many vertices as triangles; reserving one per
+    // triangle spares the doubling copies without a counting pass.
+    out.indices.reserve(3 * tris.len());
+    for v in [&mut out.positions, &mut out.normals] {
+        v.reserve(tris.len());
+    }
+    if !m.uvs.is_empty() {
+        out.uvs.reserve(tris.len());
+    }
+    features.reserve(tris.len());
     let mut touched = Vec::new();
     for &t in tris {
         for k in 0..3 {
@@ -168,6 +179,52 @@ fn append_triangles(target: &mut Merged, m: &Mesh, tris: &[u32], feature: u32, r
     for v in touched {
         remap[v] = u32::MAX;
     }
+}
+
+/// The cut of `m`: per tile of [`triangles_by_tile`] (in its order), the tile's
+/// triangles as a mesh of their own, vertices in first-use order (the numbering that
+/// appending them to an empty mesh one by one gives), and its bounds. Tiles are cut in
+/// parallel, in a few chunks with one vertex map each; the result does not depend on
+/// the number of threads.
+fn cut(m: &Mesh, size: f64) -> Vec<(Tile, Mesh, Aabb3)> {
+    let runs = triangles_by_tile(m, size);
+    let chunk = runs.len().div_ceil(CUT_CHUNKS).max(1);
+    let chunks: Vec<&[(Tile, Vec<u32>)]> = runs.chunks(chunk).collect();
+    let parts: Vec<Vec<(Tile, Mesh, Aabb3)>> = chunks
+        .into_par_iter()
+        .map(|runs| {
+            let mut remap = vec![u32::MAX; m.vertex_count()];
+            runs.iter()
+                .map(|(tile, tris)| {
+                    let mut part = (Mesh::new(m.material), Vec::new(), Aabb3::EMPTY);
+                    append_triangles(&mut part, m, tris, 0, &mut remap);
+                    (*tile, part.0, part.2)
+                })
+                .collect()
+        })
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+/// Chunks a cut is split into (each allocates a vertex map as long as the mesh).
+const CUT_CHUNKS: usize = 8;
+
+/// Appends a cut `part` with bounds `b` to `target`, feature `feature` per vertex: moved
+/// in when `target` is empty, else appended after its vertices (the same bytes as
+/// appending the triangles one by one).
+fn append_part(target: &mut Merged, part: Mesh, b: Aabb3, feature: u32) {
+    let (out, features, bounds) = target;
+    *bounds = bounds.union(&b);
+    features.resize(features.len() + part.positions.len(), feature);
+    if out.positions.is_empty() && out.indices.is_empty() {
+        *out = part;
+        return;
+    }
+    let base = out.positions.len() as u32;
+    out.positions.extend_from_slice(&part.positions);
+    out.normals.extend_from_slice(&part.normals);
+    out.uvs.extend_from_slice(&part.uvs);
+    out.indices.extend(part.indices.iter().map(|&i| base + i));
 }
 
 /// A metadata value as JSON (as its `Serialize` writes it: a non-finite number, which
@@ -230,7 +287,6 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         let mut groups: BTreeMap<(usize, Tile, Option<u32>), Group> = BTreeMap::new();
         let mut levels: Vec<u32> = Vec::new();
         let mut stack: Vec<(NodeId, DMat4, Option<PathInfo>)> = vec![(root, DMat4::IDENTITY, None)];
-        let mut remap: Vec<u32> = Vec::new();
         while let Some((id, frame, path)) = stack.pop() {
             let node = &scene.nodes[id.index()];
             let is_root = id == root;
@@ -372,14 +428,11 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     append_moved(target, m, b, DVec3::ZERO, feature);
                     continue;
                 }
-                if remap.len() < m.vertex_count() {
-                    remap.resize(m.vertex_count(), u32::MAX);
-                }
                 // Cut: triangles by the tile of their centroid.
-                for (tile, tris) in triangles_by_tile(m, size) {
+                for (tile, part, b) in cut(m, size) {
                     let key = (info.layer, tile, info.lod);
                     let target = groups.entry(key).or_default().target(m.material);
-                    append_triangles(target, m, &tris, feature, &mut remap);
+                    append_part(target, part, b, feature);
                 }
             }
         }
