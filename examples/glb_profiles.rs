@@ -5,17 +5,22 @@
 //! ```
 //!
 //! Generates each preset (default: `default` and `citygen`) once, then writes its glb
-//! into memory `--runs` times (default 5) per layout (`tiled`, the default; `cell`, the
-//! layout before tiles; `building`) and profile (`plain`, `web`) and prints, per row, the
-//! bytes, the draw calls (primitives drawn by nodes, every LOD level counted), the
-//! materials and tiles, the feature records, shared geometries and the median write time
-//! in milliseconds. The last lines check the targets of issue 26: tiled draw calls ≤ 4 ×
+//! `--runs` times (default 5) per layout (`tiled`, the default; `cell`, the layout before
+//! tiles; `building`) and profile (`plain`, `web`) into a sink that keeps nothing (the
+//! writer's own cost: no output buffer growing, no disk), and prints, per row, the bytes,
+//! the draw calls (primitives drawn by nodes, every LOD level counted), the materials and
+//! tiles, the feature records, shared geometries and the median write time in
+//! milliseconds, wall and CPU (user + system of all threads, from `/proc/self/stat` in
+//! 10 ms ticks; `-` where it cannot be read). The last lines check the targets of issue 26: tiled draw calls ≤ 4 ×
 //! materials × tiles; the web profile ≤ 25 % of the per-cell plain bytes; the tiled plain
 //! write no slower than the per-cell plain write. `--only tiled:plain` writes that one
 //! row once (for whole-process timings of one configuration). `--save DIR` also writes
 //! each row's file to `DIR/<preset>-<layout>-<profile>.glb`.
 
 use std::time::Instant;
+
+#[path = "../benches/common/process.rs"]
+mod process;
 
 use polis::CityConfig;
 use polis::export::glb::{Batching, GlbOptions, GlbProfile, write_glb};
@@ -62,7 +67,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             city.scene.materials.len()
         );
         println!(
-            "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9}",
+            "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9} {:>7}",
             "layout",
             "profile",
             "bytes",
@@ -71,7 +76,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "tiles",
             "features",
             "shared",
-            "write ms"
+            "write ms",
+            "cpu ms"
         );
         let mut rows = Vec::new();
         for (lname, batching) in LAYOUTS {
@@ -88,12 +94,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     ..GlbOptions::default()
                 };
                 let mut times = Vec::with_capacity(runs);
+                let mut cpu = Vec::with_capacity(runs);
                 let mut report = None;
                 for _ in 0..runs {
-                    let mut out = Vec::new();
+                    let c = process::cpu_seconds();
                     let t = Instant::now();
-                    let r = write_glb(&city.scene, &options, &mut out)?;
+                    let r = write_glb(&city.scene, &options, std::io::sink())?;
                     times.push(t.elapsed().as_secs_f64() * 1e3);
+                    if let (Some(a), Some(b)) = (c, process::cpu_seconds()) {
+                        cpu.push((b - a) * 1e3);
+                    }
                     report = Some(r);
                 }
                 if let Some(dir) = &save {
@@ -103,9 +113,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 times.sort_by(f64::total_cmp);
                 let ms = times[times.len() / 2];
+                cpu.sort_by(f64::total_cmp);
+                let cpu_ms = cpu
+                    .get(cpu.len() / 2)
+                    .map_or("-".to_string(), |c| format!("{c:.0}"));
                 let Some(r) = report else { continue };
                 println!(
-                    "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9.1}",
+                    "{:<9} {:<6} {:>12} {:>8} {:>5} {:>6} {:>8} {:>7} {:>9.1} {:>7}",
                     lname,
                     profile.to_string(),
                     r.bytes,
@@ -114,9 +128,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     r.tiles,
                     r.features,
                     r.shared_geometries,
-                    ms
+                    ms,
+                    cpu_ms
                 );
-                rows.push((lname, profile, r, ms));
+                rows.push((lname, profile, r, ms, cpu.get(cpu.len() / 2).copied()));
             }
         }
         let find = |l: &str, p: GlbProfile| rows.iter().find(|r| r.0 == l && r.1 == p);
@@ -145,6 +160,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 cell.3,
                 100.0 * (tiled.3 / cell.3 - 1.0)
             );
+            if let (Some(t), Some(c)) = (tiled.4, cell.4) {
+                println!(
+                    "  tiled plain write CPU {t:.0} ms vs per-cell {c:.0} ms ({:+.0} %)",
+                    100.0 * (t / c - 1.0)
+                );
+            }
         }
     }
     Ok(())

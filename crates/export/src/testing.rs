@@ -231,7 +231,16 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
         let size = acc.size();
         let start = view.offset() + acc.offset();
         assert_eq!(start % acc.data_type().size(), 0, "misaligned accessor");
-        assert_eq!(start % 4, 0, "views start on 4-byte boundaries");
+        assert_eq!(view.offset() % 4, 0, "views start on 4-byte boundaries");
+        if view.target() == Some(gltf::buffer::Target::ArrayBuffer) {
+            assert_eq!(start % 4, 0, "vertex attributes start on 4-byte boundaries");
+            // Read back to back below: the arrays read here are not interleaved.
+            assert_eq!(
+                view.stride().unwrap_or(size),
+                size,
+                "stride of {size}-byte elements"
+            );
+        }
         let end = start + acc.count() * size;
         assert!(acc.offset() + acc.count() * size <= view.length());
         assert!(view.offset() + view.length() <= blob.len());

@@ -32,7 +32,7 @@ pub(crate) enum Slot {
     Feature,
 }
 
-/// One array: its place in the buffer and its accessor.
+/// One array: its accessor and its place in its buffer view.
 #[derive(Debug)]
 pub(crate) struct ArrayLayout {
     pub slot: Slot,
@@ -42,22 +42,45 @@ pub(crate) struct ArrayLayout {
     pub normalized: bool,
     /// `min` and `max` of the accessor (positions).
     pub bounds: Option<([f64; 3], [f64; 3])>,
-    /// `byteStride` of the buffer view (vertex attributes whose elements are not
-    /// 4-byte multiples, and every vertex view of the web profile).
+    /// Bytes per vertex (the `byteStride` of the view; `None` for indices).
     pub stride: Option<usize>,
-    /// Offset and length in buffer 0 (plain) or in the fallback buffer (web).
+    /// The buffer view holding it ([`Layout::views`]) and its offset in that view (the
+    /// accessor's `byteOffset`).
+    pub view: usize,
     pub offset: u64,
+    /// Bytes in the (uncompressed) view: `count` × stride or index size.
     pub length: u64,
-    /// Web profile: `(offset, length)` of the meshopt stream in the binary chunk.
-    #[cfg_attr(not(feature = "web"), allow(dead_code))]
-    pub compressed: Option<(u64, u64)>,
     /// Web profile: the `EXT_meshopt_compression` filter the stream was encoded with
-    /// (`OCTAHEDRAL` for normals and tangents), applied by the decoder.
+    /// (`OCTAHEDRAL` for normals and tangents, `EXPONENTIAL` for wide texture
+    /// coordinates), applied by the decoder.
     #[cfg_attr(not(feature = "web"), allow(dead_code))]
     pub filter: Option<&'static str>,
 }
 
 impl ArrayLayout {
+    /// An array of `count` elements of `size` bytes each, not yet placed in a view.
+    pub fn new(
+        slot: Slot,
+        count: usize,
+        ty: json::accessor::Type,
+        component: json::accessor::ComponentType,
+        size: usize,
+    ) -> Self {
+        ArrayLayout {
+            slot,
+            count,
+            ty,
+            component,
+            normalized: false,
+            bounds: None,
+            stride: (slot != Slot::Index).then_some(size),
+            view: 0,
+            offset: 0,
+            length: (count * size) as u64,
+            filter: None,
+        }
+    }
+
     pub fn target(&self) -> json::buffer::Target {
         if self.slot == Slot::Index {
             json::buffer::Target::ElementArrayBuffer
@@ -66,24 +89,56 @@ impl ArrayLayout {
         }
     }
 
-    /// The `EXT_meshopt_compression` mode of the view.
-    #[cfg(feature = "web")]
-    pub fn meshopt_mode(&self) -> &'static str {
-        if self.slot == Slot::Index {
-            "TRIANGLES"
-        } else {
-            "ATTRIBUTES"
-        }
-    }
-
-    /// The element size the codec sees (the stride, or the index size).
-    #[cfg(feature = "web")]
+    /// The element size the view (and the codec) sees: the stride, or the index size.
     pub fn element_size(&self) -> usize {
         self.stride.unwrap_or(match self.component {
             json::accessor::ComponentType::U32 | json::accessor::ComponentType::F32 => 4,
             json::accessor::ComponentType::U16 | json::accessor::ComponentType::I16 => 2,
             _ => 1,
         })
+    }
+
+    /// Arrays with equal keys share a buffer view: indices of one size, or vertex
+    /// attributes of one stride and one meshopt filter.
+    fn view_key(&self) -> (bool, usize, Option<&'static str>) {
+        (self.slot == Slot::Index, self.element_size(), self.filter)
+    }
+}
+
+/// One buffer view: a run of arrays of one kind ([`ArrayLayout::view_key`]) from one
+/// batch of geometries, back to back.
+#[derive(Debug)]
+pub(crate) struct ViewLayout {
+    /// Offset and length in buffer 0 (plain) or in the fallback buffer (web).
+    pub offset: u64,
+    pub length: u64,
+    /// `byteStride` (vertex attributes) or `None` (indices).
+    pub stride: Option<usize>,
+    pub target: json::buffer::Target,
+    /// Elements in the view and the size of one (the meshopt stream's `count` and
+    /// `byteStride`).
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
+    pub count: usize,
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
+    pub element_size: usize,
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
+    pub filter: Option<&'static str>,
+    /// Web profile: `(offset, length)` of the meshopt stream in the binary chunk.
+    #[cfg_attr(not(feature = "web"), allow(dead_code))]
+    pub compressed: Option<(u64, u64)>,
+    /// The arrays it holds in order: (geometry of the layout, array of that geometry).
+    pub members: Vec<(usize, usize)>,
+}
+
+impl ViewLayout {
+    /// The `EXT_meshopt_compression` mode of the view.
+    #[cfg(feature = "web")]
+    pub fn meshopt_mode(&self) -> &'static str {
+        if self.stride.is_none() {
+            "TRIANGLES"
+        } else {
+            "ATTRIBUTES"
+        }
     }
 }
 
@@ -96,7 +151,11 @@ pub(crate) struct GeometryLayout {
 /// Where everything lies.
 #[derive(Debug)]
 pub(crate) struct Layout {
+    /// Per written geometry (a plan geometry, or in the web profile a geometry on one
+    /// quantisation grid), its arrays.
     pub geometries: Vec<GeometryLayout>,
+    /// The geometry buffer views, in file order.
+    pub views: Vec<ViewLayout>,
     /// Per glTF mesh, per primitive: the written geometry.
     pub primitive_geometry: Vec<Vec<usize>>,
     /// Per glTF mesh: the dequantisation `(offset, scale)` its nodes apply (web).
@@ -106,7 +165,7 @@ pub(crate) struct Layout {
     /// Length of the binary chunk (buffer 0).
     pub bin_len: u64,
     /// Web profile: length of the fallback buffer (buffer 1, no data) and the
-    /// compressed streams in chunk order.
+    /// compressed streams in chunk order (one per view).
     pub fallback_len: Option<u64>,
     pub streams: Vec<Vec<u8>>,
 }
@@ -124,6 +183,90 @@ impl Layout {
             })
             .count()
     }
+}
+
+/// Consecutive glTF meshes share buffer views until their geometry holds this many
+/// vertices: a tile of the tiled layout usually has views of its own, while small
+/// meshes (sparse tiles, the per-node layout's buildings) do not each pay for a set of
+/// view objects in the JSON (about 200 bytes each with the meshopt extension).
+const BATCH_VERTICES: usize = 8_192;
+
+/// The written geometries in batches that share buffer views: each geometry in the batch
+/// of the first mesh drawing it, in mesh and primitive order; a batch closes after a
+/// mesh once it holds [`BATCH_VERTICES`] vertices. `vertices(g)` is geometry `g`'s
+/// vertex count; geometries no mesh draws come last.
+pub(crate) fn batches(
+    primitive_geometry: &[Vec<usize>],
+    geometries: usize,
+    vertices: impl Fn(usize) -> usize,
+) -> Vec<Vec<usize>> {
+    let mut placed = vec![false; geometries];
+    let mut out = Vec::new();
+    let (mut batch, mut size) = (Vec::new(), 0usize);
+    for prims in primitive_geometry {
+        for &g in prims {
+            if let Some(p) = placed.get_mut(g)
+                && !*p
+            {
+                *p = true;
+                batch.push(g);
+                size += vertices(g);
+            }
+        }
+        if size >= BATCH_VERTICES {
+            out.push(std::mem::take(&mut batch));
+            size = 0;
+        }
+    }
+    batch.extend((0..geometries).filter(|&g| !placed[g]));
+    if !batch.is_empty() {
+        out.push(batch);
+    }
+    out
+}
+
+/// The views of one batch: its geometries' arrays grouped by kind (in the order the
+/// kinds first appear), each array's `view` (counted from `first_view`) and `offset`
+/// set; the views' own `offset` is left at 0 for the caller to place.
+pub(crate) fn batch_views(
+    batch: &[usize],
+    geometries: &mut [GeometryLayout],
+    first_view: usize,
+) -> Vec<ViewLayout> {
+    let mut views: Vec<ViewLayout> = Vec::new();
+    let mut keys = Vec::new();
+    for &g in batch {
+        for (k, a) in geometries[g].arrays.iter_mut().enumerate() {
+            let key = a.view_key();
+            let v = match keys.iter().position(|&x| x == key) {
+                Some(v) => v,
+                None => {
+                    keys.push(key);
+                    views.push(ViewLayout {
+                        offset: 0,
+                        length: 0,
+                        stride: a.stride,
+                        target: a.target(),
+                        count: 0,
+                        element_size: a.element_size(),
+                        filter: a.filter,
+                        compressed: None,
+                        members: Vec::new(),
+                    });
+                    views.len() - 1
+                }
+            };
+            let view = &mut views[v];
+            // Vertex arrays of one stride, or indices of one size: every array starts
+            // at a multiple of its element size (4-byte aligned vertex attributes).
+            a.view = first_view + v;
+            a.offset = view.length;
+            view.length += a.length;
+            view.count += a.count;
+            view.members.push((g, k));
+        }
+    }
+    views
 }
 
 pub(crate) fn pad4(n: u64) -> u64 {
@@ -162,57 +305,63 @@ pub(crate) fn feature_component(ids: &[u32]) -> Result<json::accessor::Component
     }
 }
 
-/// The plain layout: every array as its core glTF type, in one buffer.
+/// The plain layout: every array as its core glTF type, in one buffer; the arrays of a
+/// batch of meshes ([`batches`]) in one view per kind.
 pub(crate) fn plain(
     scene: &Scene,
     plan: &Plan<'_>,
     pngs: &[std::borrow::Cow<'_, [u8]>],
 ) -> Result<Layout, ExportError> {
     use json::accessor::{ComponentType as C, Type as T};
-    let mut off = 0u64;
     let mut geometries = Vec::with_capacity(plan.geometries.len());
     for g in &plan.geometries {
         let m = &g.mesh;
         let n = m.vertex_count();
-        let b = m.bbox();
+        let b = g.bbox();
         let mut arrays = Vec::with_capacity(6);
-        let mut push = |slot, count: usize, ty, component, size: u64, stride| {
-            let length = count as u64 * size;
-            arrays.push(ArrayLayout {
-                slot,
-                count,
-                ty,
-                component,
-                normalized: false,
-                bounds: (slot == Slot::Position)
-                    .then(|| (b.min.as_dvec3().to_array(), b.max.as_dvec3().to_array())),
-                stride,
-                offset: off,
-                length,
-                compressed: None,
-                filter: None,
-            });
-            off = pad4(off + length);
-        };
-        push(Slot::Position, n, T::Vec3, C::F32, 12, None);
-        push(Slot::Normal, n, T::Vec3, C::F32, 12, None);
+        arrays.push(ArrayLayout {
+            bounds: Some((b.min.as_dvec3().to_array(), b.max.as_dvec3().to_array())),
+            ..ArrayLayout::new(Slot::Position, n, T::Vec3, C::F32, 12)
+        });
+        arrays.push(ArrayLayout::new(Slot::Normal, n, T::Vec3, C::F32, 12));
         if writes_uvs(scene, m.material) {
-            push(Slot::Uv, n, T::Vec2, C::F32, 8, None);
+            arrays.push(ArrayLayout::new(Slot::Uv, n, T::Vec2, C::F32, 8));
         }
         let wide = n > U16_VERTEX_LIMIT;
         let (ic, isize) = if wide { (C::U32, 4) } else { (C::U16, 2) };
-        push(Slot::Index, m.indices.len(), T::Scalar, ic, isize, None);
+        arrays.push(ArrayLayout::new(
+            Slot::Index,
+            m.indices.len(),
+            T::Scalar,
+            ic,
+            isize,
+        ));
         if writes_tangents(scene, m.material) {
-            push(Slot::Tangent, n, T::Vec4, C::F32, 16, None);
+            arrays.push(ArrayLayout::new(Slot::Tangent, n, T::Vec4, C::F32, 16));
         }
         if let Some(ids) = &g.features {
             // Four bytes per vertex either way: u16 with a stride of 4 (vertex attribute
             // elements are 4-byte aligned), or f32.
             let c = feature_component(ids)?;
-            let stride = (c == C::U16).then_some(4);
-            push(Slot::Feature, n, T::Scalar, c, 4, stride);
+            arrays.push(ArrayLayout::new(Slot::Feature, n, T::Scalar, c, 4));
         }
         geometries.push(GeometryLayout { arrays });
+    }
+    let primitive_geometry: Vec<Vec<usize>> = plan
+        .meshes
+        .iter()
+        .map(|m| m.primitives.iter().map(|&(g, _)| g).collect())
+        .collect();
+    let mut views = Vec::new();
+    let mut off = 0u64;
+    for batch in batches(&primitive_geometry, geometries.len(), |g| {
+        plan.geometries[g].mesh.vertex_count()
+    }) {
+        for mut v in batch_views(&batch, &mut geometries, views.len()) {
+            v.offset = off;
+            off = pad4(off + v.length);
+            views.push(v);
+        }
     }
     let mut images = Vec::with_capacity(pngs.len());
     for p in pngs {
@@ -221,11 +370,8 @@ pub(crate) fn plain(
     }
     Ok(Layout {
         geometries,
-        primitive_geometry: plan
-            .meshes
-            .iter()
-            .map(|m| m.primitives.iter().map(|&(g, _)| g).collect())
-            .collect(),
+        views,
+        primitive_geometry,
         dequantize: vec![None; plan.meshes.len()],
         images,
         bin_len: off,
@@ -286,72 +432,87 @@ impl<'w, W: Write> Chunked<'w, W> {
     }
 }
 
-/// Streams one geometry's arrays (plain profile) in layout order.
-pub(crate) fn write_geometry<W: Write>(
+/// Streams one view's arrays (plain profile), padded to 4 bytes.
+pub(crate) fn write_view<W: Write>(
     w: &mut Chunked<'_, W>,
-    g: &Geometry<'_>,
-    gl: &GeometryLayout,
+    geometries: &[Geometry<'_>],
+    layout: &[GeometryLayout],
+    view: &ViewLayout,
 ) -> std::io::Result<()> {
     // 12 (header) + 8 + json + 8 (bin header) is a multiple of 4, so relative alignment
-    // in the chunk equals absolute alignment in the file; pad after each array.
+    // in the chunk equals absolute alignment in the file; views start 4-byte aligned.
+    for &(g, k) in &view.members {
+        if let (Some(g), Some(a)) = (
+            geometries.get(g),
+            layout.get(g).and_then(|l| l.arrays.get(k)),
+        ) {
+            write_array(w, g, a)?;
+        }
+    }
+    w.pad4()
+}
+
+/// Streams one array of a geometry.
+fn write_array<W: Write>(
+    w: &mut Chunked<'_, W>,
+    g: &Geometry<'_>,
+    a: &ArrayLayout,
+) -> std::io::Result<()> {
     let m = &g.mesh;
-    for a in &gl.arrays {
-        match a.slot {
-            Slot::Position | Slot::Normal => {
-                let normals = a.slot == Slot::Normal;
-                let src = if normals { &m.normals } else { &m.positions };
-                for p in src {
-                    let p = if normals { p.normalize_or_zero() } else { *p };
-                    let mut b = [0u8; 12];
-                    b[0..4].copy_from_slice(&p.x.to_le_bytes());
-                    b[4..8].copy_from_slice(&p.y.to_le_bytes());
-                    b[8..12].copy_from_slice(&p.z.to_le_bytes());
-                    w.put(&b)?;
-                }
+    match a.slot {
+        Slot::Position | Slot::Normal => {
+            let normals = a.slot == Slot::Normal;
+            let src = if normals { &m.normals } else { &m.positions };
+            for p in src {
+                let p = if normals { p.normalize_or_zero() } else { *p };
+                let mut b = [0u8; 12];
+                b[0..4].copy_from_slice(&p.x.to_le_bytes());
+                b[4..8].copy_from_slice(&p.y.to_le_bytes());
+                b[8..12].copy_from_slice(&p.z.to_le_bytes());
+                w.put(&b)?;
             }
-            Slot::Uv => {
-                for t in &m.uvs {
-                    let mut b = [0u8; 8];
-                    b[0..4].copy_from_slice(&t.x.to_le_bytes());
-                    b[4..8].copy_from_slice(&t.y.to_le_bytes());
-                    w.put(&b)?;
-                }
+        }
+        Slot::Uv => {
+            for t in &m.uvs {
+                let mut b = [0u8; 8];
+                b[0..4].copy_from_slice(&t.x.to_le_bytes());
+                b[4..8].copy_from_slice(&t.y.to_le_bytes());
+                w.put(&b)?;
             }
-            Slot::Index => {
-                if a.component == json::accessor::ComponentType::U32 {
-                    for &i in &m.indices {
-                        w.put(&i.to_le_bytes())?;
-                    }
-                } else {
-                    for &i in &m.indices {
-                        w.put(&(i as u16).to_le_bytes())?;
-                    }
+        }
+        Slot::Index => {
+            if a.component == json::accessor::ComponentType::U32 {
+                for &i in &m.indices {
+                    w.put(&i.to_le_bytes())?;
                 }
-            }
-            Slot::Tangent => {
-                for t in tangents::tangents(m) {
-                    let mut b = [0u8; 16];
-                    for (k, c) in t.to_array().into_iter().enumerate() {
-                        b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-                    }
-                    w.put(&b)?;
-                }
-            }
-            Slot::Feature => {
-                let ids = g.features.as_deref().unwrap_or_default();
-                if a.component == json::accessor::ComponentType::F32 {
-                    for &f in ids {
-                        w.put(&(f as f32).to_le_bytes())?;
-                    }
-                } else {
-                    for &f in ids {
-                        let [lo, hi] = (f as u16).to_le_bytes();
-                        w.put(&[lo, hi, 0, 0])?;
-                    }
+            } else {
+                for &i in &m.indices {
+                    w.put(&(i as u16).to_le_bytes())?;
                 }
             }
         }
-        w.pad4()?;
+        Slot::Tangent => {
+            for t in tangents::tangents(m) {
+                let mut b = [0u8; 16];
+                for (k, c) in t.to_array().into_iter().enumerate() {
+                    b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
+                }
+                w.put(&b)?;
+            }
+        }
+        Slot::Feature => {
+            let ids = g.features.as_deref().unwrap_or_default();
+            if a.component == json::accessor::ComponentType::F32 {
+                for &f in ids {
+                    w.put(&(f as f32).to_le_bytes())?;
+                }
+            } else {
+                for &f in ids {
+                    let [lo, hi] = (f as u16).to_le_bytes();
+                    w.put(&[lo, hi, 0, 0])?;
+                }
+            }
+        }
     }
     Ok(())
 }

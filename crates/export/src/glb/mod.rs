@@ -9,11 +9,18 @@
 //!   with `min`/`max`), `NORMAL` (`VEC3` f32, renormalised to unit length), `TEXCOORD_0`
 //!   (`VEC2` f32, metres, `v` down as glTF wants), indices (`u16` when the geometry has at
 //!   most 65,535 vertices, else `u32`) and, when the material has a normal texture,
-//!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`), each in its own buffer
-//!   view with the right `target`, offsets aligned to 4 bytes. `TEXCOORD_0` is written only
-//!   when the material uses it: it has a texture, or asks to keep its coordinates
+//!   `TANGENT` (`VEC4` f32, Lengyel's method, handedness in `w`). `TEXCOORD_0` is written
+//!   only when the material uses it: it has a texture, or asks to keep its coordinates
 //!   ([`Material::keep_texture_coordinates`], e.g. roads in metres); the Khronos validator
 //!   lists unused texture coordinates otherwise.
+//! * Buffer views shared by many accessors: consecutive glTF meshes form a batch (closed
+//!   after the mesh that brings it to 8,192 vertices, so a large tile has its own) and
+//!   each batch stores its arrays in one view per kind, back to back, each accessor at
+//!   its `byteOffset`: vertex attributes of one `byteStride` (and, in the web profile,
+//!   one meshopt filter) share a view, indices of one size another. Views start on
+//!   4 bytes, vertex attributes are 4-byte aligned and indices aligned to their size.
+//!   A few hundred view objects instead of one per array keep the JSON small (the
+//!   default city: 669 views for 8,672 accessors).
 //! * Materials: glTF metallic-roughness PBR (base colour, metallic, roughness, base colour,
 //!   normal and metallic-roughness textures, double-sidedness); `alphaMode` is `BLEND` when
 //!   the base colour's alpha is below 1, else `OPAQUE`. Meshes without a material use
@@ -119,7 +126,7 @@ use serde::Serialize;
 
 use crate::ExportError;
 use crate::images::png_bytes;
-use layout::{Chunked, Layout, Slot, pad4, write_geometry};
+use layout::{Chunked, Layout, Slot, pad4, write_view};
 use plan::Plan;
 
 /// What [`write_glb`] wrote.
@@ -260,8 +267,8 @@ pub fn write_glb<W: Write>(
                     w.pad4()?;
                 }
             } else {
-                for (g, gl) in plan.geometries.iter().zip(&layout.geometries) {
-                    write_geometry(&mut w, g, gl)?;
+                for v in &layout.views {
+                    write_view(&mut w, &plan.geometries, &layout.geometries, v)?;
                 }
             }
             for png in &pngs {
@@ -471,26 +478,27 @@ fn document(
             extras: None,
         })
     };
-    // One accessor per array, in layout order: position, normal, uv (when the material
-    // uses it), indices, tangents (normal-mapped materials), feature ids (tiled).
+    // The geometry views first (the web profile's extensions follow them by index),
+    // then one accessor per array, in layout order: position, normal, uv (when the
+    // material uses it), indices, tangents (normal-mapped materials), feature ids
+    // (tiled), each at its offset in its view.
+    let first_view = root.buffer_views.len() as u32;
+    for v in &layout.views {
+        view(
+            &mut root,
+            geometry_buffer,
+            v.offset,
+            v.length,
+            v.stride,
+            Some(v.target),
+        );
+    }
     let mut accessors: Vec<Vec<(Slot, json::Index<json::Accessor>)>> =
         Vec::with_capacity(layout.geometries.len());
     for gl in &layout.geometries {
         let mut ids = Vec::with_capacity(gl.arrays.len());
         for a in &gl.arrays {
-            let stride = if a.slot == Slot::Index {
-                None
-            } else {
-                a.stride
-            };
-            let v = view(
-                &mut root,
-                geometry_buffer,
-                a.offset,
-                a.length,
-                stride,
-                Some(a.target()),
-            );
+            let v = json::Index::new(first_view + a.view as u32);
             let (min, max) = match a.bounds {
                 Some((lo, hi)) => (
                     Some(json::Value::from(lo.to_vec())),
@@ -500,7 +508,7 @@ fn document(
             };
             let id = root.push(json::Accessor {
                 buffer_view: Some(v),
-                byte_offset: None,
+                byte_offset: (a.offset > 0).then_some(USize64(a.offset)),
                 count: USize64(a.count as u64),
                 component_type: Checked::Valid(json::accessor::GenericComponentType(a.component)),
                 extensions: None,
@@ -724,7 +732,7 @@ fn document(
     let first_holder = plan.nodes.len() as u32;
     for pn in &plan.nodes {
         let source = pn.source.and_then(|s| scene.nodes.get(s.index()));
-        let mut extras = match source {
+        let metadata = match source {
             Some(node) if !node.metadata.is_empty() => {
                 match serde_json::to_value(&node.metadata).map_err(ExportError::json("extras"))? {
                     serde_json::Value::Object(m) => m,
@@ -733,11 +741,8 @@ fn document(
             }
             _ => serde_json::Map::new(),
         };
-        if let Some(more) = &pn.extras {
-            for (k, v) in more {
-                extras.insert(k.clone(), v.clone());
-            }
-        }
+        let none = serde_json::Map::new();
+        let extras = Merged(&metadata, pn.extras.as_ref().unwrap_or(&none));
         let name = match source {
             Some(node) => named(&node.name),
             None => named(&pn.name),
@@ -752,6 +757,7 @@ fn document(
             extras: if extras.is_empty() {
                 None
             } else {
+                // The root's feature table is serialized from the plan, never copied.
                 Some(raw(&extras)?)
             },
             name,
@@ -798,6 +804,35 @@ fn document(
         root.scene = Some(scene_index);
     }
     Ok((root, instance_accessors))
+}
+
+/// Two JSON objects serialized as one, without copying either: keys in sorted order (as
+/// `serde_json::Map` orders them), the second object's value where both have a key.
+struct Merged<'a>(
+    &'a serde_json::Map<String, serde_json::Value>,
+    &'a serde_json::Map<String, serde_json::Value>,
+);
+
+impl Merged<'_> {
+    fn is_empty(&self) -> bool {
+        self.0.is_empty() && self.1.is_empty()
+    }
+}
+
+impl Serialize for Merged<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut keys: Vec<&String> = self.0.keys().chain(self.1.keys()).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        let mut map = s.serialize_map(Some(keys.len()))?;
+        for k in keys {
+            if let Some(v) = self.1.get(k).or_else(|| self.0.get(k)) {
+                map.serialize_entry(k, v)?;
+            }
+        }
+        map.end()
+    }
 }
 
 fn named(name: &str) -> Option<String> {

@@ -5,8 +5,8 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
 
-use polis_geom::Mesh;
 use polis_geom::scene::{MaterialId, MeshId, Metadata, NodeId, Scene};
+use polis_geom::{Aabb3, Mesh};
 
 use crate::ExportError;
 
@@ -57,6 +57,9 @@ pub(crate) struct Geometry<'a> {
     pub mesh: Cow<'a, Mesh>,
     /// `_FEATURE_ID_0` per vertex.
     pub features: Option<Vec<u32>>,
+    /// The bounds of `mesh`'s positions when the plan already knows them (the tiled
+    /// layout tracks them while merging); `None`: computed from the mesh.
+    pub bounds: Option<Aabb3>,
 }
 
 impl<'a> Geometry<'a> {
@@ -64,7 +67,13 @@ impl<'a> Geometry<'a> {
         Geometry {
             mesh,
             features: None,
+            bounds: None,
         }
+    }
+
+    /// The bounding box of the positions.
+    pub fn bbox(&self) -> Aabb3 {
+        self.bounds.unwrap_or_else(|| self.mesh.bbox())
     }
 }
 

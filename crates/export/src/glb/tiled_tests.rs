@@ -109,7 +109,8 @@ fn read(json: &serde_json::Value, bin: &[u8], accessor: u64) -> Vec<Vec<f64>> {
     let stride = v["byteStride"]
         .as_u64()
         .map_or(comps * size, |s| s as usize);
-    let base = v["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let base = v["byteOffset"].as_u64().unwrap_or(0) as usize
+        + a["byteOffset"].as_u64().unwrap_or(0) as usize;
     (0..count)
         .map(|i| {
             (0..comps)
@@ -126,6 +127,47 @@ fn read(json: &serde_json::Value, bin: &[u8], accessor: u64) -> Vec<Vec<f64>> {
                 .collect()
         })
         .collect()
+}
+
+/// One accessor of a web-profile file decoded by meshoptimizer-rs's decoder: its
+/// elements' bytes (the view's stream decoded whole, then the accessor's range of it),
+/// the element stride and the view's meshopt filter.
+#[cfg(feature = "web")]
+fn decode_accessor(
+    json: &serde_json::Value,
+    bin: &[u8],
+    accessor: u64,
+    ws: &mut meshoptimizer_rs::Workspace,
+) -> (Vec<u8>, usize, String) {
+    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
+    let a = &json["accessors"][accessor as usize];
+    let v = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let e = &v["extensions"]["EXT_meshopt_compression"];
+    let (o, l) = (
+        e["byteOffset"].as_u64().unwrap() as usize,
+        e["byteLength"].as_u64().unwrap() as usize,
+    );
+    let filter = e["filter"].as_str().unwrap_or("NONE").to_string();
+    let stride = e["byteStride"].as_u64().unwrap() as usize;
+    let count = e["count"].as_u64().unwrap() as usize;
+    assert_eq!(
+        v["byteLength"].as_u64().unwrap() as usize,
+        count * stride,
+        "the fallback view holds the decoded stream"
+    );
+    let raw = decode_buffer_view(
+        Mode::parse(e["mode"].as_str().unwrap()).unwrap(),
+        Filter::parse(&filter).unwrap(),
+        count,
+        stride,
+        &bin[o..o + l],
+        ws,
+    )
+    .unwrap();
+    let offset = a["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let n = a["count"].as_u64().unwrap() as usize;
+    assert_eq!(offset % stride, 0, "accessors start on an element");
+    (raw[offset..offset + n * stride].to_vec(), stride, filter)
 }
 
 #[test]
@@ -353,51 +395,60 @@ fn lod_levels_become_nodes_per_tile_with_switch_distances() {
     assert_eq!(report.features, 60);
 }
 
-#[test]
-fn every_layout_and_profile_reads_back_with_the_gltf_crate() {
-    let scene = town(60);
+/// The tiled options in every layout and profile.
+fn every_layout_and_profile() -> Vec<GlbOptions> {
+    let mut out = Vec::new();
     for batching in [
         Batching::Tiled,
         Batching::PerParentAndMaterial,
         Batching::PerNode,
     ] {
         for profile in [GlbProfile::Plain, GlbProfile::Web] {
-            let options = GlbOptions {
+            out.push(GlbOptions {
                 batching,
                 profile,
                 ..tiled()
-            };
-            let (bytes, report) = write(&scene, &options);
-            let (a, _) = write(&scene, &options);
-            assert_eq!(a, bytes, "deterministic");
-            let doc = match profile {
-                GlbProfile::Plain => gltf::Gltf::from_slice(&bytes).unwrap(),
-                GlbProfile::Web => {
-                    let doc = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
-                    let mut errors = Vec::new();
-                    let root = doc.document.as_json();
-                    gltf::json::validation::Validate::validate(
-                        root,
-                        root,
-                        gltf::json::Path::new,
-                        &mut |path, error| errors.push((path(), error)),
-                    );
-                    // The only complaint: the gltf crate does not decode these extensions.
-                    for (path, error) in &errors {
-                        assert_eq!(*error, gltf::json::validation::Error::Unsupported);
-                        assert!(path.as_str().starts_with("extensionsRequired"), "{path}");
-                    }
-                    assert_eq!(errors.len(), 2);
-                    doc
-                }
-            };
-            let drawn: usize = doc
-                .nodes()
-                .filter_map(|n| n.mesh())
-                .map(|m| m.primitives().len())
-                .sum();
-            assert_eq!(drawn, report.draw_calls);
+            });
         }
+    }
+    out
+}
+
+#[test]
+fn every_layout_and_profile_reads_back_with_the_gltf_crate() {
+    let scene = town(60);
+    for options in every_layout_and_profile() {
+        let profile = options.profile;
+        let (bytes, report) = write(&scene, &options);
+        let (a, _) = write(&scene, &options);
+        assert_eq!(a, bytes, "deterministic");
+        let doc = match profile {
+            GlbProfile::Plain => gltf::Gltf::from_slice(&bytes).unwrap(),
+            GlbProfile::Web => {
+                let doc = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
+                let mut errors = Vec::new();
+                let root = doc.document.as_json();
+                gltf::json::validation::Validate::validate(
+                    root,
+                    root,
+                    gltf::json::Path::new,
+                    &mut |path, error| errors.push((path(), error)),
+                );
+                // The only complaint: the gltf crate does not decode these extensions.
+                for (path, error) in &errors {
+                    assert_eq!(*error, gltf::json::validation::Error::Unsupported);
+                    assert!(path.as_str().starts_with("extensionsRequired"), "{path}");
+                }
+                assert_eq!(errors.len(), 2);
+                doc
+            }
+        };
+        let drawn: usize = doc
+            .nodes()
+            .filter_map(|n| n.mesh())
+            .map(|m| m.primitives().len())
+            .sum();
+        assert_eq!(drawn, report.draw_calls);
     }
 }
 
@@ -406,7 +457,6 @@ fn every_layout_and_profile_reads_back_with_the_gltf_crate() {
 #[cfg(feature = "web")]
 #[test]
 fn web_profile_decodes_to_the_plain_geometry() {
-    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
     let scene = town(80);
     let (plain, _) = write(&scene, &tiled());
     let web_options = GlbOptions {
@@ -430,18 +480,7 @@ fn web_profile_decodes_to_the_plain_geometry() {
     );
     let mut ws = meshoptimizer_rs::Workspace::default();
     let decode = |accessor: u64, ws: &mut meshoptimizer_rs::Workspace| {
-        let a = &wj["accessors"][accessor as usize];
-        let v = &wj["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-        let e = &v["extensions"]["EXT_meshopt_compression"];
-        let (o, l) = (
-            e["byteOffset"].as_u64().unwrap() as usize,
-            e["byteLength"].as_u64().unwrap() as usize,
-        );
-        let mode = Mode::parse(e["mode"].as_str().unwrap()).unwrap();
-        let filter = Filter::parse(e["filter"].as_str().unwrap_or("NONE")).unwrap();
-        let stride = e["byteStride"].as_u64().unwrap() as usize;
-        let count = e["count"].as_u64().unwrap() as usize;
-        let raw = decode_buffer_view(mode, filter, count, stride, &wbin[o..o + l], ws).unwrap();
+        let (raw, stride, _) = decode_accessor(&wj, wbin, accessor, ws);
         (raw, stride)
     };
     let f32s = |v: &serde_json::Value, default: f32| {
@@ -758,7 +797,6 @@ fn web_feature_table_by_column_holds_the_plain_records() {
 #[cfg(feature = "web")]
 #[test]
 fn web_texture_coordinates_decode_close_to_the_plain_ones() {
-    use meshoptimizer_rs::codec::{Filter, Mode, decode_buffer_view};
     let mut s = Scene::new();
     let image = s.add_image(polis_geom::scene::Image {
         name: "grey".into(),
@@ -838,27 +876,9 @@ fn web_texture_coordinates_decode_close_to_the_plain_ones() {
     let mut got: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
     for m in wj["meshes"].as_array().unwrap() {
         for p in m["primitives"].as_array().unwrap() {
-            let a = &wj["accessors"][p["attributes"]["TEXCOORD_0"].as_u64().unwrap() as usize];
-            let v = &wj["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-            let e = &v["extensions"]["EXT_meshopt_compression"];
-            let (o, l) = (
-                e["byteOffset"].as_u64().unwrap() as usize,
-                e["byteLength"].as_u64().unwrap() as usize,
-            );
-            let filter = e["filter"].as_str().unwrap_or("NONE");
-            let (count, stride) = (
-                e["count"].as_u64().unwrap() as usize,
-                e["byteStride"].as_u64().unwrap() as usize,
-            );
-            let raw = decode_buffer_view(
-                Mode::parse(e["mode"].as_str().unwrap()).unwrap(),
-                Filter::parse(filter).unwrap(),
-                count,
-                stride,
-                &wbin[o..o + l],
-                &mut ws,
-            )
-            .unwrap();
+            let uv = p["attributes"]["TEXCOORD_0"].as_u64().unwrap();
+            let a = &wj["accessors"][uv as usize];
+            let (raw, stride, filter) = decode_accessor(&wj, wbin, uv, &mut ws);
             let component = a["componentType"].as_u64().unwrap();
             codings.insert((materials(&wj, p).to_string(), component, filter.to_string()));
             let uvs = raw.chunks_exact(stride).map(|t| match component {
@@ -894,5 +914,151 @@ fn web_texture_coordinates_decode_close_to_the_plain_ones() {
                 assert!(best <= 1.0 / 4096.0, "{material}: {t:?} is {best} away");
             }
         }
+    }
+}
+
+/// Buffer views hold the arrays of a batch of meshes back to back, one view per kind:
+/// far fewer views than accessors, every accessor inside its view, aligned (vertex
+/// attributes on 4 bytes, indices on their size) and on a stride that is a multiple of 4,
+/// accessors of a view not overlapping, and the views of a file disjoint.
+#[test]
+fn buffer_views_are_shared_by_aligned_disjoint_accessors() {
+    let scene = town(60);
+    for options in every_layout_and_profile() {
+        let (batching, profile) = (options.batching, options.profile);
+        let (bytes, _) = write(&scene, &options);
+        let (j, _) = chunks(&bytes);
+        let views = j["bufferViews"].as_array().unwrap();
+        let accessors = j["accessors"].as_array().unwrap();
+        let geometry_views: BTreeSet<u64> = accessors
+            .iter()
+            .map(|a| a["bufferView"].as_u64().unwrap())
+            .collect();
+        let label = format!("{batching:?} {profile}");
+        assert!(
+            4 * geometry_views.len() <= accessors.len(),
+            "{label}: {} views for {} accessors",
+            geometry_views.len(),
+            accessors.len()
+        );
+        let mut ranges: BTreeMap<u64, Vec<(u64, u64)>> = BTreeMap::new();
+        for a in accessors {
+            let vi = a["bufferView"].as_u64().unwrap();
+            let v = &views[vi as usize];
+            let offset = a["byteOffset"].as_u64().unwrap_or(0);
+            let count = a["count"].as_u64().unwrap();
+            let component = match a["componentType"].as_u64().unwrap() {
+                5120 | 5121 => 1,
+                5122 | 5123 => 2,
+                _ => 4,
+            };
+            let comps = match a["type"].as_str().unwrap() {
+                "SCALAR" => 1,
+                "VEC2" => 2,
+                "VEC3" => 3,
+                _ => 4,
+            };
+            let element = component * comps;
+            let stride = v["byteStride"].as_u64().unwrap_or(element);
+            let start = v["byteOffset"].as_u64().unwrap_or(0) + offset;
+            assert_eq!(start % component, 0, "{label}: accessor alignment");
+            if v["target"] == 34962 {
+                assert_eq!(start % 4, 0, "{label}: vertex attribute alignment");
+                assert_eq!(stride % 4, 0, "{label}: stride");
+                assert!(stride >= element);
+            } else {
+                assert_eq!(v["target"], 34963, "{label}: indices");
+                assert!(v.get("byteStride").is_none(), "{label}: index view stride");
+            }
+            let end = offset + stride * (count - 1) + element;
+            assert!(
+                end <= v["byteLength"].as_u64().unwrap(),
+                "{label}: accessor past its view"
+            );
+            ranges
+                .entry(vi)
+                .or_default()
+                .push((offset, offset + stride * count));
+        }
+        for (vi, mut r) in ranges {
+            r.sort_unstable();
+            for w in r.windows(2) {
+                // Shared geometry (per node) is one accessor, not two.
+                assert!(
+                    w[0].1 <= w[1].0,
+                    "{label}: view {vi} has overlapping arrays"
+                );
+            }
+        }
+        let mut spans: Vec<(u64, u64, u64)> = views
+            .iter()
+            .map(|v| {
+                let o = v["byteOffset"].as_u64().unwrap_or(0);
+                (
+                    v["buffer"].as_u64().unwrap(),
+                    o,
+                    o + v["byteLength"].as_u64().unwrap(),
+                )
+            })
+            .collect();
+        spans.sort_unstable();
+        for w in spans.windows(2) {
+            assert!(
+                w[0].0 < w[1].0 || w[0].2 <= w[1].1,
+                "{label}: views overlap"
+            );
+        }
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// The counting sort of the cut gives what sorting (tile, triangle) pairs gives,
+    /// on dense sheets and on sparse ones (a far triangle takes the sorted-map path).
+    #[test]
+    fn triangles_by_tile_matches_sorting_pairs(
+        corners in proptest::collection::vec(
+            ((-900.0f32..900.0, -900.0f32..900.0), (-9.0f32..9.0, -9.0f32..9.0)),
+            1..80,
+        ),
+        far in proptest::prelude::any::<bool>(),
+        size in 20.0f64..300.0,
+    ) {
+        let mut m = Mesh::new(None);
+        for ((x, z), (dx, dz)) in corners {
+            let base = m.positions.len() as u32;
+            for p in [Vec3::new(x, 0.0, z), Vec3::new(x + dx, 1.0, z), Vec3::new(x, 0.0, z + dz)] {
+                m.positions.push(p);
+                m.normals.push(Vec3::Y);
+            }
+            m.indices.extend([base, base + 1, base + 2]);
+        }
+        if far {
+            let base = m.positions.len() as u32;
+            for x in [1.0e7f32, 1.0e7 + 3.0, 1.0e7] {
+                m.positions.push(Vec3::new(x, 0.0, -4.0e6));
+                m.normals.push(Vec3::Y);
+            }
+            m.indices.extend([base, base + 1, base + 2]);
+        }
+        let mut pairs: Vec<((i64, i64), u32)> = m
+            .indices
+            .chunks_exact(3)
+            .enumerate()
+            .map(|(t, tri)| {
+                let c = (m.positions[tri[0] as usize]
+                    + m.positions[tri[1] as usize]
+                    + m.positions[tri[2] as usize])
+                    / 3.0;
+                let tile = |v: f32| (f64::from(v) / size).floor() as i64;
+                ((tile(c.x), tile(c.z)), t as u32)
+            })
+            .collect();
+        pairs.sort_unstable();
+        let mut expect: Vec<((i64, i64), Vec<u32>)> = Vec::new();
+        for run in pairs.chunk_by(|a, b| a.0 == b.0) {
+            expect.push((run[0].0, run.iter().map(|p| p.1).collect()));
+        }
+        proptest::prop_assert_eq!(tiles::triangles_by_tile(&m, size), expect);
     }
 }

@@ -25,9 +25,10 @@
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 
-use polis_geom::Mesh;
 use polis_geom::glam::{DMat4, DVec3, Vec3};
-use polis_geom::scene::{MaterialId, NodeId, Scene};
+use polis_geom::par::prelude::*;
+use polis_geom::scene::{MaterialId, MetaValue, NodeId, Scene};
+use polis_geom::{Aabb3, Mesh};
 use serde_json::{Map, Value, json};
 
 use super::options::{GlbOptions, GlbProfile};
@@ -40,17 +41,32 @@ const NO_FEATURE: u32 = u32::MAX;
 /// A tile index on the x–z plane.
 type Tile = (i64, i64);
 
+/// One merged geometry: the mesh, the feature id of every vertex and the bounds of the
+/// positions (kept while appending, so no pass over the merged mesh computes them).
+type Merged = (Mesh, Vec<u32>, Aabb3);
+
 /// Merged geometry of one (layer, tile, LOD level), per material.
 #[derive(Default)]
 struct Group {
-    by_material: BTreeMap<Option<MaterialId>, (Mesh, Vec<u32>)>,
+    by_material: BTreeMap<Option<MaterialId>, Merged>,
 }
 
 impl Group {
-    fn target(&mut self, material: Option<MaterialId>) -> &mut (Mesh, Vec<u32>) {
+    fn target(&mut self, material: Option<MaterialId>) -> &mut Merged {
         self.by_material
             .entry(material)
-            .or_insert_with(|| (Mesh::new(material), Vec::new()))
+            .or_insert_with(|| (Mesh::new(material), Vec::new(), Aabb3::EMPTY))
+    }
+}
+
+/// The index of layer `name`, added when new.
+fn layer_index(layers: &mut Vec<String>, name: &str) -> usize {
+    match layers.iter().position(|l| l == name) {
+        Some(k) => k,
+        None => {
+            layers.push(name.to_string());
+            layers.len() - 1
+        }
     }
 }
 
@@ -71,16 +87,77 @@ fn tile_of(x: f32, z: f32, size: f64) -> Tile {
     )
 }
 
+/// The triangles of `m` grouped by the tile of their centroid: tiles in order, each
+/// with its triangles in index order (what sorting (tile, triangle) pairs gives). A
+/// counting sort over the tiles' bounding grid when it is no larger than a few cells per
+/// triangle (a layer-wide surface: the ground's 1.6 million triangles over a few hundred
+/// tiles), else a sorted map.
+pub(super) fn triangles_by_tile(m: &Mesh, size: f64) -> Vec<(Tile, Vec<u32>)> {
+    let tiles: Vec<Tile> = m
+        .indices
+        .chunks_exact(3)
+        .map(|tri| {
+            let c = (m.positions[tri[0] as usize]
+                + m.positions[tri[1] as usize]
+                + m.positions[tri[2] as usize])
+                / 3.0;
+            tile_of(c.x, c.z, size)
+        })
+        .collect();
+    let Some(&first) = tiles.first() else {
+        return Vec::new();
+    };
+    let (lo, hi) = tiles.iter().fold((first, first), |(lo, hi), t| {
+        (
+            (lo.0.min(t.0), lo.1.min(t.1)),
+            (hi.0.max(t.0), hi.1.max(t.1)),
+        )
+    });
+    let span = |a: i64, b: i64| i128::from(b) - i128::from(a) + 1;
+    let cells = span(lo.0, hi.0) * span(lo.1, hi.1);
+    if cells > 4 * tiles.len() as i128 + 64 {
+        let mut runs: BTreeMap<Tile, Vec<u32>> = BTreeMap::new();
+        for (t, &tile) in tiles.iter().enumerate() {
+            runs.entry(tile).or_default().push(t as u32);
+        }
+        return runs.into_iter().collect();
+    }
+    // Row-major over (i, j): the cells' order is the tiles' order.
+    let columns = span(lo.1, hi.1) as usize;
+    let cell = |t: Tile| (t.0 - lo.0) as usize * columns + (t.1 - lo.1) as usize;
+    let mut count = vec![0u32; cells as usize];
+    for &t in &tiles {
+        count[cell(t)] += 1;
+    }
+    let mut slot = vec![usize::MAX; count.len()];
+    let mut runs: Vec<(Tile, Vec<u32>)> = Vec::new();
+    for (c, &n) in count.iter().enumerate() {
+        if n > 0 {
+            slot[c] = runs.len();
+            let tile = (lo.0 + (c / columns) as i64, lo.1 + (c % columns) as i64);
+            runs.push((tile, Vec::with_capacity(n as usize)));
+        }
+    }
+    for (t, &tile) in tiles.iter().enumerate() {
+        runs[slot[cell(tile)]].1.push(t as u32);
+    }
+    runs
+}
+
 /// Appends the triangles `tris` of `m` to `target`, with feature `feature` per vertex;
 /// `remap` (all `u32::MAX`, one per vertex of `m`) maps old to new vertices and is reset.
-fn append_triangles(
-    target: &mut (Mesh, Vec<u32>),
-    m: &Mesh,
-    tris: &[u32],
-    feature: u32,
-    remap: &mut [u32],
-) {
-    let (out, features) = target;
+fn append_triangles(target: &mut Merged, m: &Mesh, tris: &[u32], feature: u32, remap: &mut [u32]) {
+    let (out, features, bounds) = target;
+    // A connected sheet has about half as many vertices as triangles; reserving one per
+    // triangle spares the doubling copies without a counting pass.
+    out.indices.reserve(3 * tris.len());
+    for v in [&mut out.positions, &mut out.normals] {
+        v.reserve(tris.len());
+    }
+    if !m.uvs.is_empty() {
+        out.uvs.reserve(tris.len());
+    }
+    features.reserve(tris.len());
     let mut touched = Vec::new();
     for &t in tris {
         for k in 0..3 {
@@ -89,6 +166,7 @@ fn append_triangles(
                 remap[v] = out.positions.len() as u32;
                 touched.push(v);
                 out.positions.push(m.positions[v]);
+                bounds.extend(m.positions[v]);
                 out.normals.push(m.normals[v]);
                 if let Some(&uv) = m.uvs.get(v) {
                     out.uvs.push(uv);
@@ -103,6 +181,62 @@ fn append_triangles(
     }
 }
 
+/// The cut of `m`: per tile of [`triangles_by_tile`] (in its order), the tile's
+/// triangles as a mesh of their own, vertices in first-use order (the numbering that
+/// appending them to an empty mesh one by one gives), and its bounds. Tiles are cut in
+/// parallel, in a few chunks with one vertex map each; the result does not depend on
+/// the number of threads.
+fn cut(m: &Mesh, size: f64) -> Vec<(Tile, Mesh, Aabb3)> {
+    let runs = triangles_by_tile(m, size);
+    let chunk = runs.len().div_ceil(CUT_CHUNKS).max(1);
+    let chunks: Vec<&[(Tile, Vec<u32>)]> = runs.chunks(chunk).collect();
+    let parts: Vec<Vec<(Tile, Mesh, Aabb3)>> = chunks
+        .into_par_iter()
+        .map(|runs| {
+            let mut remap = vec![u32::MAX; m.vertex_count()];
+            runs.iter()
+                .map(|(tile, tris)| {
+                    let mut part = (Mesh::new(m.material), Vec::new(), Aabb3::EMPTY);
+                    append_triangles(&mut part, m, tris, 0, &mut remap);
+                    (*tile, part.0, part.2)
+                })
+                .collect()
+        })
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+/// Chunks a cut is split into (each allocates a vertex map as long as the mesh).
+const CUT_CHUNKS: usize = 8;
+
+/// Appends a cut `part` with bounds `b` to `target`, feature `feature` per vertex: moved
+/// in when `target` is empty, else appended after its vertices (the same bytes as
+/// appending the triangles one by one).
+fn append_part(target: &mut Merged, part: Mesh, b: Aabb3, feature: u32) {
+    let (out, features, bounds) = target;
+    *bounds = bounds.union(&b);
+    features.resize(features.len() + part.positions.len(), feature);
+    if out.positions.is_empty() && out.indices.is_empty() {
+        *out = part;
+        return;
+    }
+    let base = out.positions.len() as u32;
+    out.positions.extend_from_slice(&part.positions);
+    out.normals.extend_from_slice(&part.normals);
+    out.uvs.extend_from_slice(&part.uvs);
+    out.indices.extend(part.indices.iter().map(|&i| base + i));
+}
+
+/// A metadata value as JSON (as its `Serialize` writes it: a non-finite number, which
+/// metadata never holds, would be `null`).
+fn meta_json(v: &MetaValue) -> Value {
+    match v {
+        MetaValue::String(s) => Value::from(s.as_ref()),
+        MetaValue::Number(x) => Value::from(*x),
+        MetaValue::Bool(b) => Value::Bool(*b),
+    }
+}
+
 /// The translation of `frame` when it only moves (its linear part is the identity).
 fn translation_only(frame: &DMat4) -> Option<DVec3> {
     let linear = polis_geom::glam::DMat3::from_mat4(*frame);
@@ -112,23 +246,25 @@ fn translation_only(frame: &DMat4) -> Option<DVec3> {
     .then(|| frame.w_axis.truncate())
 }
 
-/// Appends all of `m`, moved by `t` (as [`Mesh::transform`] moves it: in `f64`, normals
-/// renormalised), with feature `feature` per vertex.
-fn append_moved(target: &mut (Mesh, Vec<u32>), m: &Mesh, t: DVec3, feature: u32) {
-    let (out, features) = target;
+/// Appends all of `m`, moved by `t` (positions as [`Mesh::transform`] moves them, in
+/// `f64`; normals as they are: a translation turns none), with feature `feature` per
+/// vertex; `b` is `m`'s bounding box.
+fn append_moved(target: &mut Merged, m: &Mesh, b: Aabb3, t: DVec3, feature: u32) {
+    let (out, features, bounds) = target;
+    // Rounding x + t to f32 is monotone in x: the moved box is the moved corners' box,
+    // exactly (and with t = 0 the box itself).
+    *bounds = bounds.union(&Aabb3 {
+        min: (b.min.as_dvec3() + t).as_vec3(),
+        max: (b.max.as_dvec3() + t).as_vec3(),
+    });
     let base = out.positions.len() as u32;
     if t == DVec3::ZERO {
         out.positions.extend_from_slice(&m.positions);
-        out.normals.extend_from_slice(&m.normals);
     } else {
         out.positions
             .extend(m.positions.iter().map(|p| (p.as_dvec3() + t).as_vec3()));
-        out.normals.extend(
-            m.normals
-                .iter()
-                .map(|n| n.as_dvec3().normalize_or_zero().as_vec3()),
-        );
     }
+    out.normals.extend_from_slice(&m.normals);
     out.uvs.extend_from_slice(&m.uvs);
     features.resize(features.len() + m.positions.len(), feature);
     out.indices.extend(m.indices.iter().map(|&i| base + i));
@@ -151,7 +287,6 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         let mut groups: BTreeMap<(usize, Tile, Option<u32>), Group> = BTreeMap::new();
         let mut levels: Vec<u32> = Vec::new();
         let mut stack: Vec<(NodeId, DMat4, Option<PathInfo>)> = vec![(root, DMat4::IDENTITY, None)];
-        let mut remap: Vec<u32> = Vec::new();
         while let Some((id, frame, path)) = stack.pop() {
             let node = &scene.nodes[id.index()];
             let is_root = id == root;
@@ -161,18 +296,9 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             } else {
                 let inherited = path;
                 let layer = match (layer_name, inherited) {
-                    (Some(name), _) => Some(name),
-                    (None, Some(p)) => layers.get(p.layer).map(String::as_str),
-                    (None, None) => Some(node.name.as_str()),
-                }
-                .unwrap_or_default()
-                .to_string();
-                let layer = match layers.iter().position(|l| *l == layer) {
-                    Some(k) => k,
-                    None => {
-                        layers.push(layer);
-                        layers.len() - 1
-                    }
+                    (Some(name), _) => layer_index(&mut layers, name),
+                    (None, Some(p)) => p.layer,
+                    (None, None) => layer_index(&mut layers, &node.name),
                 };
                 let lod = match node.metadata.get("lod").and_then(|v| v.as_f64()) {
                     Some(l) if l >= 0.0 && l.fract() == 0.0 && l <= f64::from(u16::MAX) => {
@@ -189,7 +315,8 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     }
                     None => inherited.and_then(|p| p.lod),
                 };
-                let own_feature = node.metadata.keys().any(|k| k != "layer" && k != "lod");
+                let own_feature = !node.metadata.is_empty()
+                    && node.metadata.keys().any(|k| k != "layer" && k != "lod");
                 let feature = if own_feature {
                     Some((id, layer))
                 } else {
@@ -226,13 +353,8 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 Some(i) => i,
                 None => {
                     // Geometry on the root itself: a layer named after the root.
-                    let name = node.name.clone();
-                    let layer = layers.iter().position(|l| *l == name).unwrap_or_else(|| {
-                        layers.push(name);
-                        layers.len() - 1
-                    });
                     PathInfo {
-                        layer,
+                        layer: layer_index(&mut layers, &node.name),
                         lod: None,
                         feature: None,
                     }
@@ -248,11 +370,9 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                         let mut record = Map::new();
                         record.insert("name".into(), Value::from(owner_node.name.as_str()));
                         record.insert("layer".into(), Value::from(layers[layer].as_str()));
-                        if let Value::Object(meta) = serde_json::to_value(&owner_node.metadata)
-                            .map_err(ExportError::json("feature table"))?
-                        {
-                            for (k, v) in meta {
-                                record.entry(k).or_insert(v);
+                        for (k, v) in owner_node.metadata.iter() {
+                            if k != "name" && k != "layer" {
+                                record.insert(k.to_string(), meta_json(v));
                             }
                         }
                         features.push(Value::Object(record));
@@ -267,8 +387,8 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             let shift = translation_only(&frame);
             if let Some(t) = shift {
                 let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-                for m in &drawn {
-                    let b = m.bbox();
+                let boxes: Vec<Aabb3> = drawn.iter().map(|m| m.bbox()).collect();
+                for b in &boxes {
                     lo = lo.min(b.min.as_dvec3() + t);
                     hi = hi.max(b.max.as_dvec3() + t);
                 }
@@ -276,8 +396,8 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     let c = ((lo + hi) * 0.5).as_vec3();
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
                     let group = groups.entry(key).or_default();
-                    for m in drawn {
-                        append_moved(group.target(m.material), m, t, feature);
+                    for (m, b) in drawn.into_iter().zip(boxes) {
+                        append_moved(group.target(m.material), m, b, t, feature);
                     }
                     continue;
                 }
@@ -294,42 +414,25 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 out
             };
             let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-            for m in &placed {
-                let b = m.bbox();
+            let boxes: Vec<Aabb3> = placed.iter().map(|m| m.bbox()).collect();
+            for b in &boxes {
                 lo = lo.min(b.min);
                 hi = hi.max(b.max);
             }
             let whole = f64::from(hi.x - lo.x) <= size && f64::from(hi.z - lo.z) <= size;
-            for m in &placed {
+            for (m, &b) in placed.iter().zip(&boxes) {
                 if whole {
                     let c = (lo + hi) * 0.5;
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
                     let target = groups.entry(key).or_default().target(m.material);
-                    append_moved(target, m, DVec3::ZERO, feature);
+                    append_moved(target, m, b, DVec3::ZERO, feature);
                     continue;
                 }
-                if remap.len() < m.vertex_count() {
-                    remap.resize(m.vertex_count(), u32::MAX);
-                }
-                // Cut: triangles sorted by the tile of their centroid.
-                let mut by_tile: Vec<(Tile, u32)> = m
-                    .indices
-                    .chunks_exact(3)
-                    .enumerate()
-                    .map(|(t, tri)| {
-                        let c = (m.positions[tri[0] as usize]
-                            + m.positions[tri[1] as usize]
-                            + m.positions[tri[2] as usize])
-                            / 3.0;
-                        (tile_of(c.x, c.z, size), t as u32)
-                    })
-                    .collect();
-                by_tile.sort_unstable();
-                for run in by_tile.chunk_by(|a, b| a.0 == b.0) {
-                    let tris: Vec<u32> = run.iter().map(|&(_, t)| t).collect();
-                    let key = (info.layer, run[0].0, info.lod);
+                // Cut: triangles by the tile of their centroid.
+                for (tile, part, b) in cut(m, size) {
+                    let key = (info.layer, tile, info.lod);
                     let target = groups.entry(key).or_default().target(m.material);
-                    append_triangles(target, m, &tris, feature, &mut remap);
+                    append_part(target, part, b, feature);
                 }
             }
         }
@@ -372,7 +475,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 }
             };
             let mut primitives = Vec::with_capacity(group.by_material.len());
-            for (material, (mesh, mut ids)) in group.by_material {
+            for (material, (mesh, mut ids, bounds)) in group.by_material {
                 let features = if ids.iter().all(|&f| f == NO_FEATURE) {
                     None
                 } else {
@@ -387,6 +490,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 plan.geometries.push(Geometry {
                     mesh: Cow::Owned(mesh),
                     features,
+                    bounds: Some(bounds),
                 });
             }
             let tile_name = format!("{} {},{}", layers[layer], tile.0, tile.1);

@@ -9,9 +9,11 @@
 //! `OCTAHEDRAL` filter (signed normalized bytes); texture coordinates within [0, 1]
 //! become unsigned normalized 16-bit, others stay `f32` through the `EXPONENTIAL` filter
 //! at steps of at most 1/4096 of a repeat (a sixteenth of a texel of a 256 px texture);
-//! feature ids stay exact. Every vertex and index array is then encoded with
-//! meshoptimizer's codecs (vertex codec version 0, index codec version 1, as the
-//! extension specifies) and stored in the binary chunk; the views point into a fallback
+//! feature ids stay exact. The arrays of a batch of meshes are grouped into views by
+//! kind (stride and filter, or index size; the glb module's docs), and each view is
+//! encoded whole with meshoptimizer's codecs (vertex codec version 0, index codec
+//! version 1, as the extension specifies: one stream per view, its `count` the sum of
+//! its accessors') and stored in the binary chunk; the views point into a fallback
 //! buffer without data, so both extensions are required. The tiled layout's feature
 //! table is written column by column (the glb module's docs, "Profiles").
 //!
@@ -33,8 +35,8 @@ use polis_geom::scene::Scene;
 use serde_json::{Value, json};
 
 use super::layout::{
-    ArrayLayout, GeometryLayout, Layout, Slot, U16_VERTEX_LIMIT, feature_component, pad4,
-    writes_tangents, writes_uvs,
+    ArrayLayout, GeometryLayout, Layout, Slot, U16_VERTEX_LIMIT, ViewLayout, batch_views, batches,
+    feature_component, pad4, writes_tangents, writes_uvs,
 };
 use super::plan::{Geometry, Plan};
 use super::tangents;
@@ -153,10 +155,13 @@ fn octahedral(unit: &[f32], n: usize, ws: &mut Workspace) -> Result<Vec<u8>, Exp
     encode_filter_oct(n, 4, OCTAHEDRAL_BITS, unit, ws).map_err(codec)
 }
 
-/// One array before offsets are known: its accessor, the raw byte length, the stream.
-struct Encoded {
-    array: ArrayLayout,
-    stream: Vec<u8>,
+/// One array's data before the codec (quantized and filtered, in the order the
+/// codec sees it).
+enum Data {
+    /// Vertex attribute bytes, `stride` per vertex.
+    Vertex(Vec<u8>),
+    /// Triangle indices.
+    Index(Vec<u32>),
 }
 
 fn codec(e: meshoptimizer_rs::Error) -> ExportError {
@@ -166,13 +171,17 @@ fn codec(e: meshoptimizer_rs::Error) -> ExportError {
     }
 }
 
-/// Quantizes and encodes one geometry on `grid`.
-fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, ExportError> {
+/// Quantizes and filters one geometry on `grid`: its arrays and their data.
+fn encode(
+    scene: &Scene,
+    g: &Geometry<'_>,
+    grid: Grid,
+    ws: &mut Workspace,
+) -> Result<(GeometryLayout, Vec<Data>), ExportError> {
     let m = &g.mesh;
-    let mut ws = Workspace::new(Limits::default());
     // Triangles in vertex-cache order (Forsyth's method, meshoptimizer's), then vertices
     // in first-use order: what the codecs compress best.
-    let cached = optimize_vertex_cache(&m.indices, m.vertex_count(), &mut ws).map_err(codec)?;
+    let cached = optimize_vertex_cache(&m.indices, m.vertex_count(), ws).map_err(codec)?;
     let mut remap = vec![u32::MAX; m.vertex_count()];
     let mut order: Vec<usize> = Vec::with_capacity(m.vertex_count());
     let indices: Vec<u32> = cached
@@ -187,30 +196,12 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
         })
         .collect();
     let n = order.len();
-    let vertex = |bytes: Vec<u8>, stride: usize, ws: &mut Workspace| {
-        encode_vertex_buffer(
-            &bytes,
-            n,
-            stride,
-            VertexEncoding::new(0, 0).map_err(codec)?,
-            ws,
-        )
-        .map_err(codec)
-    };
-    let array = |slot, ty, component, normalized, stride: usize, bounds| ArrayLayout {
-        slot,
-        count: n,
-        ty,
-        component,
+    let array = |slot, ty, component, normalized, stride: usize| ArrayLayout {
         normalized,
-        bounds,
-        stride: Some(stride),
-        offset: 0,
-        length: (n * stride) as u64,
-        compressed: None,
-        filter: None,
+        ..ArrayLayout::new(slot, n, ty, component, stride)
     };
-    let mut out = Vec::with_capacity(6);
+    let mut arrays = Vec::with_capacity(6);
+    let mut data = Vec::with_capacity(6);
 
     let mut bytes = Vec::with_capacity(8 * n);
     let (mut lo, mut hi) = ([u16::MAX; 3], [0u16; 3]);
@@ -223,23 +214,21 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
         }
         bytes.extend_from_slice(&[0, 0]);
     }
-    let bounds = Some((lo.map(f64::from), hi.map(f64::from)));
-    out.push(Encoded {
-        array: array(Slot::Position, T::Vec3, C::U16, false, 8, bounds),
-        stream: vertex(bytes, 8, &mut ws)?,
+    arrays.push(ArrayLayout {
+        bounds: Some((lo.map(f64::from), hi.map(f64::from))),
+        ..array(Slot::Position, T::Vec3, C::U16, false, 8)
     });
+    data.push(Data::Vertex(bytes));
 
     let mut unit = Vec::with_capacity(4 * n);
     for nrm in order.iter().map(|&v| &m.normals[v]) {
         unit.extend_from_slice(&nrm.normalize_or_zero().extend(0.0).to_array());
     }
-    out.push(Encoded {
-        array: ArrayLayout {
-            filter: Some(OCTAHEDRAL),
-            ..array(Slot::Normal, T::Vec3, C::I8, true, 4, None)
-        },
-        stream: vertex(octahedral(&unit, n, &mut ws)?, 4, &mut ws)?,
+    arrays.push(ArrayLayout {
+        filter: Some(OCTAHEDRAL),
+        ..array(Slot::Normal, T::Vec3, C::I8, true, 4)
     });
+    data.push(Data::Vertex(octahedral(&unit, n, ws)?));
 
     if writes_uvs(scene, m.material) {
         let uvs: Vec<[f32; 2]> = order
@@ -247,53 +236,39 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
             .filter_map(|&v| m.uvs.get(v))
             .map(|t| [t.x, t.y])
             .collect();
-        out.push(match uv_coding(&uvs) {
+        match uv_coding(&uvs) {
             UvCoding::Unorm16 => {
                 let mut bytes = Vec::with_capacity(4 * n);
                 for c in uvs.iter().flatten() {
                     let q = (c * 65_535.0).round().clamp(0.0, 65_535.0) as u16;
                     bytes.extend_from_slice(&q.to_le_bytes());
                 }
-                Encoded {
-                    array: array(Slot::Uv, T::Vec2, C::U16, true, 4, None),
-                    stream: vertex(bytes, 4, &mut ws)?,
-                }
+                arrays.push(array(Slot::Uv, T::Vec2, C::U16, true, 4));
+                data.push(Data::Vertex(bytes));
             }
             UvCoding::Exponential(bits) => {
                 let flat: Vec<f32> = uvs.iter().flatten().copied().collect();
-                let filtered =
-                    encode_filter_exp(n, 8, bits, &flat, ExpMode::SharedComponent, &mut ws)
-                        .map_err(codec)?;
-                Encoded {
-                    array: ArrayLayout {
-                        filter: Some(EXPONENTIAL),
-                        ..array(Slot::Uv, T::Vec2, C::F32, false, 8, None)
-                    },
-                    stream: vertex(filtered, 8, &mut ws)?,
-                }
+                let filtered = encode_filter_exp(n, 8, bits, &flat, ExpMode::SharedComponent, ws)
+                    .map_err(codec)?;
+                arrays.push(ArrayLayout {
+                    filter: Some(EXPONENTIAL),
+                    ..array(Slot::Uv, T::Vec2, C::F32, false, 8)
+                });
+                data.push(Data::Vertex(filtered));
             }
-        });
+        }
     }
 
     let wide = n > U16_VERTEX_LIMIT;
-    let isize = if wide { 4 } else { 2 };
-    out.push(Encoded {
-        array: ArrayLayout {
-            slot: Slot::Index,
-            count: indices.len(),
-            ty: T::Scalar,
-            component: if wide { C::U32 } else { C::U16 },
-            normalized: false,
-            bounds: None,
-            stride: None,
-            offset: 0,
-            length: (indices.len() * isize) as u64,
-            compressed: None,
-            filter: None,
-        },
-        stream: encode_index_buffer(&indices, IndexEncoding::new(1).map_err(codec)?, &mut ws)
-            .map_err(codec)?,
-    });
+    let (ic, isize) = if wide { (C::U32, 4) } else { (C::U16, 2) };
+    arrays.push(ArrayLayout::new(
+        Slot::Index,
+        indices.len(),
+        T::Scalar,
+        ic,
+        isize,
+    ));
+    data.push(Data::Index(indices));
 
     if writes_tangents(scene, m.material) {
         let all = tangents::tangents(m);
@@ -302,13 +277,11 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
             let d = t.truncate().normalize_or_zero();
             unit.extend_from_slice(&d.extend(if t.w < 0.0 { -1.0 } else { 1.0 }).to_array());
         }
-        out.push(Encoded {
-            array: ArrayLayout {
-                filter: Some(OCTAHEDRAL),
-                ..array(Slot::Tangent, T::Vec4, C::I8, true, 4, None)
-            },
-            stream: vertex(octahedral(&unit, n, &mut ws)?, 4, &mut ws)?,
+        arrays.push(ArrayLayout {
+            filter: Some(OCTAHEDRAL),
+            ..array(Slot::Tangent, T::Vec4, C::I8, true, 4)
         });
+        data.push(Data::Vertex(octahedral(&unit, n, ws)?));
     }
 
     if let Some(ids) = &g.features {
@@ -322,16 +295,75 @@ fn encode(scene: &Scene, g: &Geometry<'_>, grid: Grid) -> Result<Vec<Encoded>, E
                 bytes.extend_from_slice(&[a, b, 0, 0]);
             }
         }
-        out.push(Encoded {
-            array: array(Slot::Feature, T::Scalar, c, false, 4, None),
-            stream: vertex(bytes, 4, &mut ws)?,
-        });
+        arrays.push(array(Slot::Feature, T::Scalar, c, false, 4));
+        data.push(Data::Vertex(bytes));
     }
-    Ok(out)
+    Ok((GeometryLayout { arrays }, data))
 }
 
-/// The web layout: one grid per glTF mesh, each (geometry, grid) encoded once, in
-/// parallel; streams in the binary chunk, then the images.
+/// One batch of written geometries ([`batches`]), encoded: each geometry's arrays (views
+/// counted from the batch's first) and the batch's views with their meshopt streams.
+struct EncodedBatch {
+    geometries: Vec<GeometryLayout>,
+    views: Vec<(ViewLayout, Vec<u8>)>,
+}
+
+/// Encodes the geometries `batch` (indices into `jobs`): their arrays, one view per kind
+/// holding the arrays back to back, each view's data through the codec as one stream.
+fn encode_batch(
+    scene: &Scene,
+    plan: &Plan<'_>,
+    jobs: &[(usize, Grid)],
+    batch: &[usize],
+) -> Result<EncodedBatch, ExportError> {
+    let mut ws = Workspace::new(Limits::default());
+    let mut geometries = Vec::with_capacity(batch.len());
+    let mut data = Vec::with_capacity(batch.len());
+    for &j in batch {
+        let (g, grid) = jobs[j];
+        let (layout, d) = encode(scene, &plan.geometries[g], grid, &mut ws)?;
+        geometries.push(layout);
+        data.push(d);
+    }
+    let local: Vec<usize> = (0..batch.len()).collect();
+    let mut views = Vec::new();
+    for mut v in batch_views(&local, &mut geometries, 0) {
+        let stream = if v.stride.is_none() {
+            let mut indices = Vec::with_capacity(v.count);
+            for &(g, k) in &v.members {
+                if let Some(Data::Index(i)) = data[g].get(k) {
+                    indices.extend_from_slice(i);
+                }
+            }
+            encode_index_buffer(&indices, IndexEncoding::new(1).map_err(codec)?, &mut ws)
+                .map_err(codec)?
+        } else {
+            let mut bytes = Vec::with_capacity(v.length as usize);
+            for &(g, k) in &v.members {
+                if let Some(Data::Vertex(b)) = data[g].get(k) {
+                    bytes.extend_from_slice(b);
+                }
+            }
+            encode_vertex_buffer(
+                &bytes,
+                v.count,
+                v.element_size,
+                VertexEncoding::new(0, 0).map_err(codec)?,
+                &mut ws,
+            )
+            .map_err(codec)?
+        };
+        for m in &mut v.members {
+            m.0 = batch[m.0];
+        }
+        views.push((v, stream));
+    }
+    Ok(EncodedBatch { geometries, views })
+}
+
+/// The web layout: one grid per glTF mesh, each (geometry, grid) encoded once; the
+/// geometries in batches sharing views ([`batches`]), encoded in parallel; streams in
+/// the binary chunk, then the images.
 pub(crate) fn layout(
     scene: &Scene,
     plan: &Plan<'_>,
@@ -344,7 +376,7 @@ pub(crate) fn layout(
     for m in &plan.meshes {
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for &(g, _) in &m.primitives {
-            let b = plan.geometries[g].mesh.bbox();
+            let b = plan.geometries[g].bbox();
             lo = lo.min(b.min);
             hi = hi.max(b.max);
         }
@@ -360,25 +392,38 @@ pub(crate) fn layout(
         primitive_geometry.push(prims);
         dequantize.push(Some((grid.offset, grid.scale)));
     }
-    let encoded: Vec<Vec<Encoded>> = jobs
+    let batches = batches(&primitive_geometry, jobs.len(), |j| {
+        plan.geometries[jobs[j].0].mesh.vertex_count()
+    });
+    let encoded: Vec<EncodedBatch> = batches
         .par_iter()
-        .map(|&(g, grid)| encode(scene, &plan.geometries[g], grid))
+        .map(|batch| encode_batch(scene, plan, &jobs, batch))
         .collect::<Result<_, _>>()?;
     let (mut fallback, mut bin) = (0u64, 0u64);
     let mut streams = Vec::new();
-    let mut geometries = Vec::with_capacity(encoded.len());
-    for arrays in encoded {
-        let mut out = Vec::with_capacity(arrays.len());
-        for Encoded { mut array, stream } in arrays {
-            array.offset = fallback;
-            fallback = pad4(fallback + array.length);
-            array.compressed = Some((bin, stream.len() as u64));
+    let mut views = Vec::new();
+    let mut geometries: Vec<Option<GeometryLayout>> = (0..jobs.len()).map(|_| None).collect();
+    for (batch, e) in batches.iter().zip(encoded) {
+        let first = views.len();
+        for (&j, mut g) in batch.iter().zip(e.geometries) {
+            for a in &mut g.arrays {
+                a.view += first;
+            }
+            geometries[j] = Some(g);
+        }
+        for (mut v, stream) in e.views {
+            v.offset = fallback;
+            fallback = pad4(fallback + v.length);
+            v.compressed = Some((bin, stream.len() as u64));
             bin = pad4(bin + stream.len() as u64);
             streams.push(stream);
-            out.push(array);
+            views.push(v);
         }
-        geometries.push(GeometryLayout { arrays: out });
     }
+    let geometries = geometries
+        .into_iter()
+        .map(|g| g.unwrap_or(GeometryLayout { arrays: Vec::new() }))
+        .collect();
     let mut images = Vec::with_capacity(pngs.len());
     for p in pngs {
         images.push((bin, p.len() as u64));
@@ -386,6 +431,7 @@ pub(crate) fn layout(
     }
     Ok(Layout {
         geometries,
+        views,
         primitive_geometry,
         dequantize,
         images,
@@ -411,32 +457,24 @@ pub(crate) fn images(
 }
 
 /// Adds the extension objects the typed JSON cannot hold: `EXT_meshopt_compression` on
-/// the geometry views (created first, one per array in layout order) and on the
+/// the geometry views (created first, in the layout's order) and on the
 /// fallback buffer (index 1), and both extensions as used and required.
 pub(crate) fn add_extensions(doc: &mut Value, layout: &Layout) {
-    let arrays = layout.geometries.iter().flat_map(|g| &g.arrays);
     if let Some(views) = doc.get_mut("bufferViews").and_then(Value::as_array_mut) {
-        for (view, a) in views.iter_mut().zip(arrays) {
-            if let (Some((offset, length)), Some(v)) = (a.compressed, view.as_object_mut()) {
-                v.insert(
-                    "extensions".into(),
-                    json!({ "EXT_meshopt_compression": {
-                        "buffer": 0,
-                        "byteOffset": offset,
-                        "byteLength": length,
-                        "byteStride": a.element_size(),
-                        "count": a.count,
-                        "mode": a.meshopt_mode(),
-                    }}),
-                );
-                if let (Some(f), Some(e)) = (
-                    a.filter,
-                    v.get_mut("extensions")
-                        .and_then(|e| e.get_mut("EXT_meshopt_compression"))
-                        .and_then(Value::as_object_mut),
-                ) {
+        for (view, lv) in views.iter_mut().zip(&layout.views) {
+            if let (Some((offset, length)), Some(v)) = (lv.compressed, view.as_object_mut()) {
+                let mut e = json!({
+                    "buffer": 0,
+                    "byteOffset": offset,
+                    "byteLength": length,
+                    "byteStride": lv.element_size,
+                    "count": lv.count,
+                    "mode": lv.meshopt_mode(),
+                });
+                if let (Some(f), Some(e)) = (lv.filter, e.as_object_mut()) {
                     e.insert("filter".into(), json!(f));
                 }
+                v.insert("extensions".into(), json!({ "EXT_meshopt_compression": e }));
             }
         }
     }
