@@ -434,6 +434,22 @@ pub(crate) trait SceneReuse: Sync {
     fn block(&self, b: &Block) -> Option<Reused>;
 }
 
+/// The scene node name of building `id`; [`node_id`] reads it back.
+pub(crate) fn building_node_name(id: u64) -> String {
+    format!("building {id}")
+}
+
+/// The scene node name of block `id`; [`node_id`] reads it back.
+pub(crate) fn block_node_name(id: u64) -> String {
+    format!("block {id}")
+}
+
+/// The id in a node name made by [`building_node_name`] (`kind` "building") or
+/// [`block_node_name`] (`kind` "block").
+pub(crate) fn node_id(name: &str, kind: &str) -> Option<u64> {
+    name.strip_prefix(kind)?.strip_prefix(' ')?.parse().ok()
+}
+
 /// A reused leaf: its node's name, translation and metadata, and its meshes.
 pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
@@ -569,7 +585,7 @@ fn building_leaf(
         metadata.insert("cell", MetaValue::from(cell as f64));
     }
     let node = LeafNode {
-        name: format!("building {}", b.id),
+        name: building_node_name(b.id),
         translation: to_world(b.origin, base),
         metadata,
     };
@@ -709,7 +725,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
                 };
                 let node = LeafNode {
-                    name: format!("block {}", block.id()),
+                    name: block_node_name(block.id()),
                     translation: DVec3::ZERO,
                     metadata: Metadata::from([
                         ("layer", MetaValue::from_static("blocks")),

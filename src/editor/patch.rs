@@ -63,7 +63,7 @@ impl Index {
         let lots = by_id(city.lots.iter().enumerate().map(|(i, l)| (l.id, i)));
         let buildings = by_id(city.buildings.iter().enumerate().map(|(i, b)| (b.id, i)));
         let nodes = by_id(city.scene.nodes.iter().enumerate().filter_map(|(n, node)| {
-            let id = node.name.strip_prefix("building ")?.parse::<u64>().ok()?;
+            let id = crate::scene::node_id(&node.name, "building")?;
             Some((id, NodeId(n as u32)))
         }));
         Index {
@@ -253,7 +253,9 @@ pub(super) fn patch_lots(
             stats.building_triangles = (stats.building_triangles + b.triangle_count())
                 .saturating_sub(slot.triangle_count());
             buildings.changed.push(b.id);
-            scene_nodes.changed.push(format!("building {}", b.id));
+            scene_nodes
+                .changed
+                .push(crate::scene::building_node_name(b.id));
             *slot = b;
         }
         if let Some(slot) = city.dresses.get_mut(k) {

@@ -86,13 +86,13 @@ impl OldScene {
         let mut buildings = BTreeMap::new();
         let mut blocks = BTreeMap::new();
         for (n, node) in city.scene.nodes.iter().enumerate() {
-            let id = |prefix: &str| node.name.strip_prefix(prefix)?.parse::<u64>().ok();
+            let id = |kind: &str| crate::scene::node_id(&node.name, kind);
             let node_id = NodeId(n as u32);
-            if let Some(id) = id("building ") {
+            if let Some(id) = id("building") {
                 if let Some(&i) = building_at.get(&id) {
                     buildings.insert(id, (i, node_id));
                 }
-            } else if let Some(id) = id("block ")
+            } else if let Some(id) = id("block")
                 && let Some(&i) = block_at.get(&id)
             {
                 blocks.insert(id, (i, node_id));

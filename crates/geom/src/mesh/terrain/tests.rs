@@ -218,7 +218,7 @@ proptest! {
         w in 50.0f64..200.0,
         h in 50.0f64..200.0,
     ) {
-        let fbm = Fbm::new(FbmParams { seed, wavelength_m: wavelength, octaves: 3, ..FbmParams::default() }).unwrap();
+        let fbm = fbm(seed, wavelength, 3);
         let field = fbm.scaled(amplitude);
         let bounds = rect(w, h);
         let options = TerrainOptions { max_error_m: e, max_cell_m: 32.0, min_cell_m: 1.0, ..TerrainOptions::default() };
@@ -248,15 +248,20 @@ proptest! {
     }
 }
 
-#[test]
-fn the_mesh_does_not_depend_on_the_thread_count() {
-    let fbm = Fbm::new(FbmParams {
-        seed: 7,
-        wavelength_m: 60.0,
-        octaves: 4,
+/// fBm hills of the given seed, wavelength (metres) and octave count.
+fn fbm(seed: u64, wavelength_m: f64, octaves: u32) -> Fbm {
+    Fbm::new(FbmParams {
+        seed,
+        wavelength_m,
+        octaves,
         ..FbmParams::default()
     })
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn the_mesh_does_not_depend_on_the_thread_count() {
+    let fbm = fbm(7, 60.0, 4);
     let field = fbm.scaled(12.0);
     let bounds = rect(300.0, 250.0);
     let options = TerrainOptions {
@@ -284,13 +289,7 @@ fn the_mesh_does_not_depend_on_the_thread_count() {
 /// 4 cm.
 #[test]
 fn children_of_a_final_fan_split_keep_the_bound() {
-    let fbm = Fbm::new(FbmParams {
-        seed: 57,
-        wavelength_m: 80.0,
-        octaves: 3,
-        ..FbmParams::default()
-    })
-    .unwrap();
+    let fbm = fbm(57, 80.0, 3);
     let angle = 57.0f64 * 0.7;
     let dir = DVec2::new(angle.cos(), angle.sin());
     let field = FnField(move |p: DVec2| {
