@@ -11,11 +11,12 @@
 //!    a crossing, then by id):
 //!    * an existing edge overlapping the line from the current node (collinear overlap)
 //!      is *followed*: reused, not duplicated;
-//!    * an existing node within the snap distance of the line is routed through (it
-//!      becomes an intermediate target);
+//!    * an existing node on the line (or within rounding of it) is routed through (it
+//!      becomes an intermediate target); so is a node within the snap distance of the
+//!      line and of the caller's segment, if the straight detour to it meets no edge;
 //!    * an existing edge crossing the line is split at the crossing point, which becomes
 //!      an intermediate target (if an end of that edge lies within the snap distance of
-//!      the crossing, that end is used instead);
+//!      the crossing and the detour to it meets no edge, that end is used instead);
 //!    * with no event left, a straight edge joins the current node to the target.
 //!
 //! All decisions (crossing, touching, overlap, on-segment) use exact predicates; crossing
@@ -26,8 +27,8 @@
 //! another (the edge is bent through the existing node), and every piece a split creates is
 //! bent through any node it passes within that distance of. A bend moves an edge by up to
 //! that distance, so its two legs are inserted by this same walk (splitting any edge the
-//! move takes them across). Every created or split edge is checked against the edge index
-//! before the call returns.
+//! move takes them across); all edges passing within rounding of the node are bent together.
+//! Every created or split edge is checked against the edge index before the call returns.
 //!
 //! # Guarantees
 //! * After every successful call the graph is planar in the sense of
@@ -73,13 +74,13 @@ pub const ROUNDING_TOLERANCE: f64 = 1e-12;
 /// bends another edge, …) before insertion reports [`GeomError::GraphCorrupt`].
 const MAX_BEND_DEPTH: usize = 16;
 
-/// The rounding tolerance at `p`, in metres (see [`ROUNDING_TOLERANCE`]).
 /// Whether a planar insertion that returned `result` left a planar graph planar: it did
 /// unless it reports a corrupt graph (the other errors leave the graph unchanged).
 fn keeps_planarity<T>(result: &Result<T, GeomError>) -> bool {
     !matches!(result, Err(GeomError::GraphCorrupt(_)))
 }
 
+/// The rounding tolerance at `p`, in metres (see [`ROUNDING_TOLERANCE`]).
 fn rounding_eps(p: DVec2) -> f64 {
     ROUNDING_TOLERANCE * p.abs().max_element().max(1.0)
 }
@@ -91,7 +92,8 @@ fn rounding_eps(p: DVec2) -> f64 {
 pub struct SnapOptions {
     /// Distance, in metres, within which a segment end snaps to an existing node (first)
     /// or onto an existing edge (splitting it); existing nodes within this distance of a
-    /// new segment are routed through; and a segment whose snapped ends are this close or
+    /// new segment are routed through where the detour to them crosses no edge; and a
+    /// segment whose snapped ends are this close or
     /// closer is refused as zero-length. `0` snaps only coincidences up to rounding (see
     /// [`ROUNDING_TOLERANCE`]). Must be finite and non-negative. Default: 0.01 m.
     pub snap_distance: f64,
@@ -191,7 +193,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     /// Inserts the segment `p–q` keeping the graph planar: snaps its ends to nodes or
     /// edges within [`SnapOptions::snap_distance`], splits existing edges where it crosses
     /// them, reuses existing edges it overlaps, and routes through nodes lying within the
-    /// snap distance of it (see the [module docs](self)). New nodes get
+    /// snap distance of it where the detour crosses no edge (see the [module docs](self)). New nodes get
     /// `make_node(position)`; new edges get clones of `payload`.
     ///
     /// # Errors
@@ -459,7 +461,9 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     /// A node near the line is routed through only if it is also within the snap distance
     /// of the caller's segment `line`. Measured from the current leg alone, each detour
     /// would let the next one go a snap distance further: a slanted segment near a row of
-    /// collinear nodes used to be pulled from node to node along the row.
+    /// collinear nodes used to be pulled from node to node along the row. And a node
+    /// merely within the snap distance (not within rounding) is a detour taken only where
+    /// the straight detour meets no edge ([`sees`](Self::sees)).
     fn next_event(
         &self,
         cur: NodeId,
@@ -498,9 +502,17 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             let on = point_on_segment(pn, pc, pt);
             // Within rounding of the leg, a node is on it whatever the snap bound says.
             let touching = closest.distance(pn) <= rounding_eps(pn);
-            if (on || touching || (closest.distance(pn) <= snap && near_line(pn)))
-                && t > 0.0
-                && t < 1.0
+            if !(t > 0.0 && t < 1.0) {
+                return;
+            }
+            // A node merely within the snap distance is a detour, taken only where the
+            // detour meets no edge: in a corridor of nearly parallel edges, detours to
+            // every node within the snap distance zigzag across the corridor, and each
+            // zig splits the edges it crosses into more nodes within the snap distance
+            // of the next segment — growth without bound over a few insertions.
+            if on
+                || touching
+                || (closest.distance(pn) <= snap && near_line(pn) && self.sees((cur, pc), (n, pn)))
             {
                 offer(t, Event::Node(n));
             }
@@ -522,7 +534,9 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                     if da.min(db) <= snap {
                         let (n, pn) = if da <= db { (a, pa) } else { (b, pb) };
                         let coincident = da.min(db) <= rounding_eps(pn);
-                        if fresh(n) && (coincident || near_line(pn)) {
+                        if fresh(n)
+                            && (coincident || (near_line(pn) && self.sees((cur, pc), (n, pn))))
+                        {
                             offer(hit.t, Event::Node(n));
                             return Ok(());
                         }
@@ -571,14 +585,25 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         out: &mut Insertion,
         depth: usize,
     ) -> Result<(), GeomError> {
+        let near = self.edges_passing_near(m, None)?;
+        self.reroute_through_all(&near, m, make_node, out, depth)
+    }
+
+    /// The edges passing within rounding distance of node `m` without ending at it or
+    /// within rounding of it, in index order, plus `also` (first) if given.
+    fn edges_passing_near(
+        &self,
+        m: NodeId,
+        also: Option<EdgeId>,
+    ) -> Result<Vec<EdgeId>, GeomError> {
         let pm = self.position(m)?;
         let eps = rounding_eps(pm);
-        for near in self.edge_index.segments_within(pm, eps) {
-            // An earlier bend may have removed or split this edge: look at it as it is.
-            if !self.contains_edge(near.key) {
+        let mut near: Vec<EdgeId> = also.into_iter().collect();
+        for hit in self.edge_index.segments_within(pm, eps) {
+            if near.contains(&hit.key) || !self.contains_edge(hit.key) {
                 continue;
             }
-            let (a, b) = self.endpoints(near.key)?;
+            let (a, b) = self.endpoints(hit.key)?;
             if a == m || b == m {
                 continue;
             }
@@ -590,9 +615,9 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             if closest_point_on_segment(pm, pa, pb).0.distance(pm) > eps {
                 continue;
             }
-            self.reroute_through(near.key, m, make_node, out, depth)?;
+            near.push(hit.key);
         }
-        Ok(())
+        Ok(near)
     }
 
     /// Edges made by a split leave the line of the edge they replace by a few units in
@@ -637,16 +662,10 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         Ok(())
     }
 
-    /// Replaces edge `e = a–b` by a route `a → n → b`, recording each new edge as
-    /// `(e, piece)` in `out.split`.
+    /// Replaces edge `e = a–b` by a route `a → n → b` — and, with it, every other edge
+    /// passing within rounding of `n` ([`reroute_through_all`]).
     ///
-    /// Moving an edge onto a node moves it by up to the rounding distance, which can take
-    /// it across other edges that pass just as close (fans of nearly parallel edges out of
-    /// one node). So the two legs are not added blindly: each is *inserted*, by the same
-    /// walk as a new segment with no snapping beyond rounding — existing pieces are
-    /// followed, nodes within rounding of a leg are routed through, and edges the leg
-    /// crosses are split. Walks nest (a crossing met by a leg can bend another edge); past
-    /// [`MAX_BEND_DEPTH`] levels the insertion gives up with [`GeomError::GraphCorrupt`].
+    /// [`reroute_through_all`]: Self::reroute_through_all
     fn reroute_through(
         &mut self,
         e: EdgeId,
@@ -655,32 +674,71 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         out: &mut Insertion,
         depth: usize,
     ) -> Result<(), GeomError> {
+        let near = self.edges_passing_near(n, Some(e))?;
+        self.reroute_through_all(&near, n, make_node, out, depth)
+    }
+
+    /// Replaces each edge `e = a–b` of `edges` by a route `a → n → b`, recording each new
+    /// edge as `(e, piece)` in `out.split`.
+    ///
+    /// Moving an edge onto a node moves it by up to the rounding distance, which can take
+    /// it across other edges that pass just as close (fans of nearly parallel edges out of
+    /// one node). So the two legs are not added blindly: each is *inserted*, by the same
+    /// walk as a new segment with no snapping beyond rounding — existing pieces are
+    /// followed, nodes within rounding of a leg are routed through, and edges the leg
+    /// crosses are split.
+    ///
+    /// All of `edges` are removed before any leg is walked. An edge that a leg `a → n`
+    /// crosses passes between `n` and the old edge `a–b`, so within rounding of `n`: it
+    /// belongs in `edges` itself. Bent one at a time, a bend's legs would cross the next
+    /// edge to be bent, far from `n` where it runs nearly parallel, and every such
+    /// crossing is a new node whose own absorptions bend further edges — in a dense
+    /// tangle, a cascade of thousands of nodes. Walks still nest (a crossing met by a leg
+    /// can bend another edge); past [`MAX_BEND_DEPTH`] levels the insertion gives up with
+    /// [`GeomError::GraphCorrupt`].
+    fn reroute_through_all(
+        &mut self,
+        edges: &[EdgeId],
+        n: NodeId,
+        make_node: &mut impl FnMut(DVec2) -> N,
+        out: &mut Insertion,
+        depth: usize,
+    ) -> Result<(), GeomError> {
+        if edges.is_empty() {
+            return Ok(());
+        }
         if depth >= MAX_BEND_DEPTH {
             return Err(GeomError::GraphCorrupt(format!(
-                "bending edge {e} through node {n} nested more than {MAX_BEND_DEPTH} bends deep; check_invariants() may tell why"
+                "bending edge {} through node {n} nested more than {MAX_BEND_DEPTH} bends deep; check_invariants() may tell why",
+                edges[0]
             )));
         }
-        let (a, b) = self.endpoints(e)?;
-        let payload = self.remove_edge(e)?;
-        let mut legs = Insertion::default();
-        for (from, to) in [(a, n), (n, b)] {
-            let line = (self.position(from)?, self.position(to)?);
-            self.connect(
-                from,
-                to,
-                line,
-                &payload,
-                0.0,
-                make_node,
-                &mut legs,
-                depth + 1,
-            )?;
-            // Each leg is a walk of its own: its route does not bar the other's nodes.
-            legs.nodes.clear();
+        let mut removed = Vec::with_capacity(edges.len());
+        for &e in edges {
+            let (a, b) = self.endpoints(e)?;
+            removed.push((e, a, b, self.remove_edge(e)?));
         }
-        out.split
-            .extend(legs.created.iter().map(|&piece| (e, piece)));
-        out.split.extend(legs.split);
+        for (e, a, b, payload) in removed {
+            let mut legs = Insertion::default();
+            for (from, to) in [(a, n), (n, b)] {
+                let line = (self.position(from)?, self.position(to)?);
+                self.connect(
+                    from,
+                    to,
+                    line,
+                    &payload,
+                    0.0,
+                    make_node,
+                    &mut legs,
+                    depth + 1,
+                )?;
+                // Each leg is a walk of its own: its route does not bar the other's nodes.
+                legs.nodes.clear();
+            }
+            out.split
+                .extend(legs.created.iter().map(|&piece| (e, piece)));
+            out.split.extend(legs.split);
+        }
         Ok(())
     }
 
@@ -689,30 +747,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         for &e in edges {
             let (a, b) = self.endpoints(e)?;
             let (pa, pb) = (self.position(a)?, self.position(b)?);
-            // The first offending edge in candidate order (no allocation, no sorting).
-            let mut bad: Option<SegmentHit<EdgeId>> = None;
-            self.edge_index.for_each_candidate_along(pa, pb, |key, s| {
-                if bad.is_some() || key == e {
-                    return;
-                }
-                let Shape::Segment(s0, s1) = *s else { return };
-                let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
-                    return;
-                };
-                let ok = match hit.kind {
-                    SegmentIntersection::Touching { point, .. } => {
-                        self.endpoints(key).is_ok_and(|(c, d)| {
-                            (point == pa && (c == a || d == a))
-                                || (point == pb && (c == b || d == b))
-                        })
-                    }
-                    _ => false,
-                };
-                if !ok {
-                    bad = Some(hit);
-                }
-            });
-            if let Some(hit) = bad {
+            if let Some(hit) = self.meets_elsewhere((a, pa), (b, pb), Some(e)) {
                 return Err(GeomError::GraphCorrupt(format!(
                     "after insertion, edge {e} meets edge {} away from a common node ({:?}); please report this input",
                     hit.key, hit.kind
@@ -720,5 +755,45 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             }
         }
         Ok(())
+    }
+
+    /// Whether the straight leg from node `a` to node `b` would meet no edge but at those
+    /// two nodes (an edge `a–b` itself is no obstacle).
+    fn sees(&self, a: (NodeId, DVec2), b: (NodeId, DVec2)) -> bool {
+        let skip = self.find_edge(a.0, b.0);
+        self.meets_elsewhere(a, b, skip).is_none()
+    }
+
+    /// The first edge (in candidate order: no allocation, no sorting) other than `skip`
+    /// that meets the segment between nodes `a` and `b` anywhere but at `a` or `b` by an
+    /// edge ending there.
+    fn meets_elsewhere(
+        &self,
+        (a, pa): (NodeId, DVec2),
+        (b, pb): (NodeId, DVec2),
+        skip: Option<EdgeId>,
+    ) -> Option<SegmentHit<EdgeId>> {
+        let mut bad: Option<SegmentHit<EdgeId>> = None;
+        self.edge_index.for_each_candidate_along(pa, pb, |key, s| {
+            if bad.is_some() || Some(key) == skip {
+                return;
+            }
+            let Shape::Segment(s0, s1) = *s else { return };
+            let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
+                return;
+            };
+            let ok = match hit.kind {
+                SegmentIntersection::Touching { point, .. } => {
+                    self.endpoints(key).is_ok_and(|(c, d)| {
+                        (point == pa && (c == a || d == a)) || (point == pb && (c == b || d == b))
+                    })
+                }
+                _ => false,
+            };
+            if !ok {
+                bad = Some(hit);
+            }
+        });
+        bad
     }
 }

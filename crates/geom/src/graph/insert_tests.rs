@@ -469,8 +469,12 @@ fn planar_insert_case(data: &[u8]) -> Result<(), String> {
                 v(grid(c[2]) + nudge, grid(c[3])),
             )
         };
-        if let Ok(ins) = g.insert_segment(p, q, k as u32 + 1, &options) {
-            route_within_snap(&g, &ins, p, q, snap)?;
+        match g.insert_segment(p, q, k as u32 + 1, &options) {
+            Ok(ins) => route_within_snap(&g, &ins, p, q, snap)?,
+            Err(GeomError::GraphCorrupt(e)) => {
+                return Err(format!("inserting {p}–{q} broke planarity: {e}"));
+            }
+            Err(_) => {}
         }
         g.check_invariants()
             .map_err(|e| format!("not planar after {p}–{q}: {e}"))?;
@@ -509,10 +513,17 @@ fn planar_insert_case(data: &[u8]) -> Result<(), String> {
 /// nearly parallel edges, a split piece passed exactly through a node, and a nested walk
 /// (bending an edge near the new node) followed that piece past the node and back, for
 /// ever. Split pieces are now settled before edges near the node are absorbed, and a walk
-/// settles an edge before following it.
+/// settles an edge before following it. The eighth (session 11, snap 0.05 m): a pencil
+/// of nearly parallel segments grew from 154 to 523 nodes in one insertion and to 6,049
+/// in the next, whose walk then gave up (`GraphCorrupt`, "did not converge"). The walk
+/// detoured to every node within the snap distance; in a corridor of nearly parallel
+/// edges each detour zigzagged across the corridor, splitting the edges it crossed into
+/// more nodes within the snap distance of the next segment. A node merely within the snap
+/// distance is now a detour only where the straight detour meets no edge (`sees`); the
+/// same insertions now make 76 nodes.
 #[test]
 fn planar_insert_fuzz_findings() {
-    let cases: [&str; 7] = [
+    let cases: [&str; 8] = [
         "7a428a2a8a8a0a8a8a9a003fe5255f5e5e0000ef00008a8a8abfe1",
         "2bc0fc070000f90206af000005b9277eefffffb2b37ab2b2b2ff",
         "b7a4b4b427692c6f240000140bfdff0000ffff0000c2da692c6f240000140bfdff0001ffff0000545555ff55590000000bedff004bc2da692c6f001400fd0bb40000f902114c009061294b0090f2f69e4c0090610000000000000000000000000000000000000000000000c2da2200692c6f7500ff0b0000fd14fffffff72c",
@@ -520,6 +531,7 @@ fn planar_insert_fuzz_findings() {
         "b7a4b4b427692c6f240000140bfdff0000ffff0000c2da692c6f240000140bfddf0001ffff00004bc2da692c3d000aebf40200ffff00ff0000c2da692c6f240000140bfdff0001ffff00004bc2140bfdff004bc2da692c6f001400fd0b00ffffff00004b30c2da2200692c6f00140bfdff0000fffffff72c",
         "0000000000000100031f000000ffffff1bffff848484841d84848484673b848484008b21664600000600008484673b268484008b21664600000600000000000000008484841d01f8ffff84848484662400f884841d84848484673b8401f8ffff2400f884841d848484846715ff",
         "1ef7cbcbcbcb0000f002cba1cbcbcbcbcbcbcbcb32cccbb700010006ff6699ae06cbcb26cb00cbcb3acbcb0000f002cbcbcbcbffcb32cccbcbcbcb26cb0000f002cba1ebcbcbcbcbcbcbcbce33cbcbcbce33cbcbcbcb30eb",
+        "b7a4f4b42f6fcc00692cc2002d6f69ccc22dffff2c0000c22b962c6f240000140bffff0000ffff6c00d3ff004b7ac27f00000000da692c6fff0000ffff00004bc2ca2200defcff00004bc2da2200dffc0700003dffff00c2da69306f2400cb32cb0014cbcc006bc2da2200692c6f00140bfdff5454e454545400001260fff72c",
     ];
     for hex in cases {
         let bytes: Vec<u8> = (0..hex.len() / 2)
