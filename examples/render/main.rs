@@ -9,7 +9,7 @@
 //! ```
 //!
 //! The camera looks at `--target` (layout metres: x east, y north; default the centre of
-//! the tallest buildings) from `DISTANCE` metres away, `AZIMUTH` degrees clockwise from north and
+//! the tallest buildings; at the height of the ground there) from `DISTANCE` metres away, `AZIMUTH` degrees clockwise from north and
 //! `ELEVATION` degrees above the horizon. The default writes `out/city-3d.png`, the
 //! README's rendered view.
 //!
@@ -33,7 +33,7 @@ use std::time::Instant;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
-use polis::geom::field::decode_png_rgba8;
+use polis::geom::field::{Field, decode_png_rgba8};
 use polis::geom::glam::{DVec3, Vec2, Vec3};
 use polis::geom::scene::{ImageData, Scene};
 use polis::{CityConfig, Pipeline};
@@ -224,7 +224,14 @@ fn run(args: Args) -> BoxResult<()> {
     let t = Instant::now();
     let world = World::new(&city.scene)?;
     let target = args.target.unwrap_or_else(|| downtown(&city.buildings));
-    let camera = Camera::new(&args, target);
+    // Look at the ground there, not at sea level: on hilly maps the eye would be inside
+    // a hill.
+    let ground = city
+        .maps
+        .inputs
+        .elevation
+        .sample(polis::geom::glam::DVec2::from(target));
+    let camera = Camera::new(&args, target, if ground.is_finite() { ground } else { 0.0 });
     let sun = Sun::new(&world, &camera);
     let image = render(&world, &camera, &sun, args.samples);
     let png = encode(&image, args.width, args.height)?;
@@ -493,7 +500,8 @@ struct Camera {
 const NEAR: f64 = 0.5;
 
 impl Camera {
-    fn new(args: &Args, target: [f64; 2]) -> Camera {
+    /// The camera looking at layout point `target` at height `ground` (metres).
+    fn new(args: &Args, target: [f64; 2], ground: f64) -> Camera {
         // By default the eye is on the side of the city centre, so the city fills the
         // foreground.
         let from_centre = f64::atan2(-target[0], -target[1]).to_degrees();
@@ -502,7 +510,7 @@ impl Camera {
         let distance = args.view[2].unwrap_or(900.0);
         let (az, el) = (azimuth.to_radians(), elevation.to_radians());
         // Layout: x east, y north; world: x east, y up, z south.
-        let target = DVec3::new(target[0], 0.0, -target[1]);
+        let target = DVec3::new(target[0], ground, -target[1]);
         let towards_eye = DVec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos());
         let eye = target + towards_eye * distance;
         let (width, height) = (args.width * args.samples, args.height * args.samples);
