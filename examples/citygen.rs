@@ -4,12 +4,12 @@
 //!
 //! ```text
 //! cargo run --release --example citygen -- [PRESET] [--city | --city-only] [--lod N]
-//!     [--threads N] [--out DIR] [--bench-growth RUNS [--index-search]]
+//!     [--threads N] [--out DIR] [--bench-growth RUNS]
 //! ```
 //!
 //! `--bench-growth RUNS` grows every Kelly cell serially on one thread `RUNS` times and
-//! prints CPU time and a digest of the grown graphs; `--index-search` makes the snap
-//! search use each cell graph's hashed index instead of the flat grid (same digest).
+//! prints CPU time and a digest of the grown graphs, then `RUNS` times on the thread pool
+//! (`--threads`, default all cores) and prints wall time and the digest (the serial one).
 //!
 //! `--city` also generates the whole city (without the 3-D scene) after the road part;
 //! `--city-only` only generates the whole city, scene included (for timing any preset).
@@ -35,7 +35,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut city_only = false;
     let mut lod = None;
     let mut bench_growth = 0usize;
-    let mut index_search = false;
     let mut threads = None;
     let mut out = std::path::PathBuf::from("out");
     let mut args = std::env::args().skip(1);
@@ -46,7 +45,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--bench-growth" => {
                 bench_growth = args.next().and_then(|t| t.parse().ok()).unwrap_or(5)
             }
-            "--index-search" => index_search = true,
             "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
             "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
             "--out" => out = args.next().unwrap_or_default().into(),
@@ -88,7 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (net, _) = pool.install(|| citygen_network(&cx))?;
     let total = t.elapsed();
     if bench_growth > 0 {
-        return growth_bench(&cx, &net.primary, bench_growth, !index_search);
+        return growth_bench(&cx, &net.primary, bench_growth, &pool);
     }
     let mut stats = StreetStats::default();
     let mut per_cell = Vec::new();
@@ -172,14 +170,16 @@ fn thread_cpu_ns() -> u64 {
 }
 
 /// Grows every cell of the primary network serially on this thread, `runs` times, and
-/// prints wall and CPU time per run (the inputs are prepared before the clock starts).
+/// prints wall and CPU time per run (the inputs are prepared before the clock starts);
+/// then `runs` times on `pool`'s threads, printing wall time.
 fn growth_bench(
     cx: &StageContext<'_>,
     primary: &polis::roads::RoadNetwork,
     runs: usize,
-    flat_grid: bool,
+    pool: &rayon::ThreadPool,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth};
+    use rayon::prelude::*;
     let cg = &cx.config.citygen;
     let cells = polis::cells::extract_with(primary, &cx.config.cells)?;
     let zoning = polis::citygen::zoning_of(cx)?;
@@ -220,7 +220,7 @@ fn growth_bench(
         let mut roads = 0;
         let mut digest = 0u64;
         for (cell, p) in &inputs {
-            let mut growth = SecondaryGrowth::new(p.clone())?.with_flat_grid(flat_grid);
+            let mut growth = SecondaryGrowth::new(p.clone())?;
             if let Ok(r) = growth.grow(cell, &maps, seed) {
                 roads += r.segments().count();
                 digest = polis::geom::hash::splitmix64(digest ^ graph_digest(&r.network));
@@ -234,6 +234,32 @@ fn growth_bench(
             "run {run}: {} cells, {roads} secondary roads (digest {digest:016x}), serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
             inputs.len(),
             cpu / inputs.len().max(1) as f64
+        );
+    }
+    // The same growth with the cells spread over the pool's threads (as the pipeline
+    // grows them): wall time, and the digest, which must be the serial one.
+    for run in 0..runs {
+        let t = Instant::now();
+        let grown: Vec<Option<u64>> = pool.install(|| {
+            inputs
+                .par_iter()
+                .map(|(cell, p)| {
+                    let mut growth = SecondaryGrowth::new(p.clone()).ok()?;
+                    growth
+                        .grow(cell, &maps, seed)
+                        .ok()
+                        .map(|r| graph_digest(&r.network))
+                })
+                .collect()
+        });
+        let wall = t.elapsed().as_secs_f64() * 1e3;
+        let digest = grown
+            .iter()
+            .flatten()
+            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g));
+        println!(
+            "parallel run {run}: {} threads, digest {digest:016x}, wall {wall:.2} ms",
+            pool.current_num_threads()
         );
     }
     Ok(())

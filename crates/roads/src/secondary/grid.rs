@@ -2,18 +2,63 @@
 //! the cell once, with no hashing, append-only while the cell grows.
 //!
 //! Each road is entered in every grid square its segment passes through (a conservative
-//! cover, column by column); coordinates outside the grid clamp to its border squares, so
-//! the cover stays conservative for any road. A road split or removed during growth
-//! keeps its old entries: the search reads each candidate's current segment and drops
-//! dead ids, so stale entries cost a test, never an answer. Road ids are never reused by
-//! the graph, so the roads to enter are exactly the ids above the last one entered.
+//! cover, column by column), with its end nodes and their positions copied into the
+//! entry, so a search reads no graph at all; coordinates outside the grid clamp to its
+//! border squares, so the cover stays conservative for any road.
+//!
+//! Growth only adds roads, except where it splits a road (a secondary road joining it)
+//! or removes one (an undone start split). Road ids are never reused by the graph, so
+//! the new roads to enter are exactly the ids above the last one entered
+//! ([`SnapGrid::sync`]); a road that changed is reported with [`SnapGrid::refresh`],
+//! which gives it a new version and enters its current segment under that version. The
+//! entries of older versions stay in their squares and are passed over (each costs one
+//! comparison, never an answer).
 
-use polis_geom::{Aabb2, DVec2, EdgeId};
+use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
 
 use crate::network::RoadNetwork;
 
 /// The most squares the grid is made of (the square size grows to keep within it).
 const MAX_SQUARES: usize = 1 << 16;
+
+/// A road as the grid lists it: its id, end nodes and their positions (as of the
+/// version `version`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GridRoad {
+    /// The road.
+    pub(crate) edge: EdgeId,
+    /// Its first end.
+    pub(crate) u: NodeId,
+    /// Its second end.
+    pub(crate) v: NodeId,
+    /// The first end's position.
+    pub(crate) pu: DVec2,
+    /// The second end's position.
+    pub(crate) pv: DVec2,
+    version: u32,
+}
+
+impl GridRoad {
+    /// Road `e` of `g` as it is now (`None` for a dead id).
+    pub(crate) fn of(g: &RoadNetwork, e: EdgeId) -> Option<GridRoad> {
+        let (u, v) = g.endpoints(e).ok()?;
+        Some(GridRoad {
+            edge: e,
+            u,
+            v,
+            pu: g.position(u).ok()?,
+            pv: g.position(v).ok()?,
+            version: 0,
+        })
+    }
+}
+
+/// Per road id: its current version and the query that last reported it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Mark {
+    version: u32,
+    stamp: u32,
+}
 
 /// See the [module docs](self).
 #[derive(Debug, Default, Clone)]
@@ -23,11 +68,10 @@ pub(crate) struct SnapGrid {
     inv: f64,
     nx: usize,
     ny: usize,
-    squares: Vec<Vec<EdgeId>>,
+    squares: Vec<Vec<GridRoad>>,
     /// Roads with ids below this are entered.
     entered: usize,
-    /// Per road id: the query that last reported it (de-duplication).
-    stamp: Vec<u32>,
+    marks: Vec<Mark>,
     query: u32,
 }
 
@@ -69,12 +113,15 @@ impl SnapGrid {
             self.squares.resize_with(n, Vec::new);
         }
         self.entered = 0;
-        self.stamp.clear();
+        self.marks.clear();
         self.query = 0;
     }
 
+    /// The column of `x` (clamped to the grid; `⌊·⌋` by truncation, as the value is not
+    /// negative where it is used).
+    #[inline]
     fn col(&self, x: f64) -> usize {
-        let c = ((x - self.origin.x) * self.inv).floor();
+        let c = (x - self.origin.x) * self.inv;
         if c >= 0.0 {
             (c as usize).min(self.nx - 1)
         } else {
@@ -82,8 +129,10 @@ impl SnapGrid {
         }
     }
 
+    /// The row of `y`, as [`col`](Self::col).
+    #[inline]
     fn row(&self, y: f64) -> usize {
-        let c = ((y - self.origin.y) * self.inv).floor();
+        let c = (y - self.origin.y) * self.inv;
         if c >= 0.0 {
             (c as usize).min(self.ny - 1)
         } else {
@@ -97,20 +146,42 @@ impl SnapGrid {
         if self.nx == 0 {
             self.reset(g.bbox(), 64.0);
         }
+        if self.marks.len() < bound {
+            self.marks.resize(bound, Mark::default());
+        }
         for i in self.entered..bound {
-            let e = EdgeId::from_raw(i as u32);
-            if let Ok((a, b)) = g.segment(e) {
-                self.enter(e, a, b);
-            }
+            self.enter(g, EdgeId::from_raw(i as u32));
         }
         self.entered = self.entered.max(bound);
-        if self.stamp.len() < bound {
-            self.stamp.resize(bound, 0);
-        }
     }
 
-    /// Enters road `e` from `a` to `b` in every square its segment passes through.
-    fn enter(&mut self, e: EdgeId, a: DVec2, b: DVec2) {
+    /// Road `e` (entered before) was split or removed: its entries so far are stale and
+    /// its current segment, if it is still alive, is entered again.
+    pub(crate) fn refresh(&mut self, g: &RoadNetwork, e: EdgeId) {
+        if e.index() >= self.entered {
+            return; // not entered yet: `sync` will read its current segment
+        }
+        if let Some(m) = self.marks.get_mut(e.index()) {
+            m.version = m.version.wrapping_add(1);
+        }
+        self.enter(g, e);
+    }
+
+    /// Enters road `e`'s current segment, under its current version, in every square
+    /// the segment passes through (nothing for a dead id).
+    fn enter(&mut self, g: &RoadNetwork, e: EdgeId) {
+        let (Ok((u, v)), Ok((a, b))) = (g.endpoints(e), g.segment(e)) else {
+            return;
+        };
+        let version = self.marks.get(e.index()).map_or(0, |m| m.version);
+        let road = GridRoad {
+            edge: e,
+            u,
+            v,
+            pu: a,
+            pv: b,
+            version,
+        };
         let (c0, c1) = (self.col(a.x.min(b.x)), self.col(a.x.max(b.x)));
         let (r0, r1) = (self.row(a.y.min(b.y)), self.row(a.y.max(b.y)));
         let dx = b.x - a.x;
@@ -141,39 +212,159 @@ impl SnapGrid {
             };
             for r in lo..=hi {
                 if let Some(s) = self.squares.get_mut(r * self.nx + c) {
-                    s.push(e);
+                    s.push(road);
                 }
             }
         }
     }
 
-    /// Calls `f` once with every road entered in a square under `b` (each id once per
-    /// call; possibly dead or split since: the caller reads the current segment).
-    pub(crate) fn for_each_in(&mut self, b: &Aabb2, mut f: impl FnMut(EdgeId)) {
+    /// Calls `f` once with every live road entered in a square under `b` (each road
+    /// once per call, as its current segment): every road whose segment meets `b` is
+    /// among them, and roads near `b` may be too.
+    pub(crate) fn for_each_in(&mut self, b: &Aabb2, mut f: impl FnMut(&GridRoad)) {
         if self.nx == 0 || b.is_empty() {
             return;
         }
         self.query = self.query.wrapping_add(1);
         if self.query == 0 {
-            self.stamp.fill(0);
+            for m in &mut self.marks {
+                m.stamp = 0;
+            }
             self.query = 1;
         }
         let (c0, c1) = (self.col(b.min.x), self.col(b.max.x));
         let (r0, r1) = (self.row(b.min.y), self.row(b.max.y));
         for r in r0..=r1 {
-            for c in c0..=c1 {
-                let Some(s) = self.squares.get(r * self.nx + c) else {
-                    continue;
-                };
-                for &e in s {
-                    if let Some(m) = self.stamp.get_mut(e.index())
-                        && *m != self.query
+            let Some(row) = self.squares.get(r * self.nx + c0..=r * self.nx + c1) else {
+                continue;
+            };
+            for s in row {
+                for road in s {
+                    if let Some(m) = self.marks.get_mut(road.edge.index())
+                        && m.version == road.version
+                        && m.stamp != self.query
                     {
-                        *m = self.query;
-                        f(e);
+                        m.stamp = self.query;
+                        f(road);
                     }
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::network::Junction;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    /// Whether the segment `p–q` meets the box `b` (clipping the segment's parameter range
+    /// to each slab).
+    fn meets(p: DVec2, q: DVec2, b: &Aabb2) -> bool {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (s, d, lo, hi) in [
+            (p.x, q.x - p.x, b.min.x, b.max.x),
+            (p.y, q.y - p.y, b.min.y, b.max.y),
+        ] {
+            if d == 0.0 {
+                if s < lo || s > hi {
+                    return false;
+                }
+            } else {
+                let (ta, tb) = ((lo - s) / d, (hi - s) / d);
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            }
+        }
+        t0 <= t1
+    }
+
+    /// By brute force, in id order: the live roads whose segments meet `b`, and those
+    /// whose boxes meet it.
+    fn brute(g: &RoadNetwork, b: &Aabb2) -> (Vec<EdgeId>, Vec<EdgeId>) {
+        let (mut meet, mut boxed) = (Vec::new(), Vec::new());
+        for (e, ..) in g.edges() {
+            let (u, v) = g.segment(e).unwrap();
+            if meets(u, v, b) {
+                meet.push(e);
+            }
+            if Aabb2::new(u, v).intersects(b) {
+                boxed.push(e);
+            }
+        }
+        (meet, boxed)
+    }
+
+    /// The grid's roads whose boxes meet `b`, each checked against the graph.
+    fn listed(grid: &mut SnapGrid, g: &RoadNetwork, b: &Aabb2) -> Vec<EdgeId> {
+        grid.sync(g);
+        let mut out = Vec::new();
+        grid.for_each_in(b, |r| {
+            let now = GridRoad::of(g, r.edge).unwrap();
+            assert_eq!((now.u, now.v, now.pu, now.pv), (r.u, r.v, r.pu, r.pv));
+            if Aabb2::new(r.pu, r.pv).intersects(b) {
+                out.push(r.edge);
+            }
+        });
+        out.sort_unstable();
+        out
+    }
+
+    /// Through added, split and removed roads (some reaching beyond the grid), every box
+    /// query lists every live road that meets the box, each once and as it is now, and
+    /// no road that is dead or whose box misses it.
+    #[test]
+    fn the_grid_lists_every_live_road_as_it_is() {
+        let mut rng = Pcg64Mcg::seed_from_u64(18);
+        let road = super::super::snap::tests::street();
+        let mut g = RoadNetwork::new();
+        let mut grid = SnapGrid::default();
+        grid.reset(
+            Aabb2::new(DVec2::new(0.0, 0.0), DVec2::new(400.0, 300.0)),
+            37.0,
+        );
+        let point = |rng: &mut Pcg64Mcg| {
+            DVec2::new(
+                rng.random::<f64>() * 500.0 - 50.0,
+                rng.random::<f64>() * 400.0 - 50.0,
+            )
+        };
+        for round in 0..400 {
+            let (p, q) = (point(&mut rng), point(&mut rng));
+            let q = p + (q - p) * 0.2;
+            let u = g.add_node(p, Junction::default()).unwrap();
+            let v = g.add_node(q, Junction::default()).unwrap();
+            g.add_edge(u, v, road).unwrap();
+            let live: Vec<EdgeId> = g.edge_ids().collect();
+            if round % 3 == 0 {
+                let e = live[rng.random_range(0..live.len())];
+                let (a, b) = g.segment(e).unwrap();
+                g.split_edge(e, a.lerp(b, 0.37), Junction::default())
+                    .unwrap();
+                grid.refresh(&g, e);
+            }
+            if round % 7 == 0 {
+                let e = live[rng.random_range(0..live.len())];
+                if g.contains_edge(e) {
+                    g.remove_edge(e).unwrap();
+                    grid.refresh(&g, e);
+                }
+            }
+            let c = point(&mut rng);
+            let b = Aabb2::new(c, c).expanded(rng.random::<f64>() * 60.0);
+            let got = listed(&mut grid, &g, &b);
+            let (meet, boxed) = brute(&g, &b);
+            assert!(
+                meet.iter().all(|e| got.contains(e)),
+                "round {round}: a road is missing"
+            );
+            assert!(
+                got.iter().all(|e| boxed.contains(e)),
+                "round {round}: a dead road"
+            );
         }
     }
 }

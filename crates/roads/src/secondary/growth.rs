@@ -137,7 +137,6 @@ impl SecondaryRoads {
 pub struct SecondaryGrowth {
     params: SecondaryParams,
     snapper: Snapper,
-    flat_grid: bool,
 }
 
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
@@ -171,16 +170,7 @@ impl SecondaryGrowth {
         Ok(SecondaryGrowth {
             params,
             snapper: Snapper::default(),
-            flat_grid: true,
         })
-    }
-
-    /// Whether the snap search walks a flat grid laid over each cell (default) or the
-    /// cell graph's own hashed index. A performance knob only: the grown roads are the
-    /// same to the bit either way (tested); kept for A/B measurements.
-    pub fn with_flat_grid(mut self, flat: bool) -> Self {
-        self.flat_grid = flat;
-        self
     }
 
     /// The parameters.
@@ -254,12 +244,8 @@ impl SecondaryGrowth {
             }
         }
         // The snap search's flat grid over the cell, in squares of the segment size.
-        if self.flat_grid {
-            self.snapper
-                .begin_cell(g.bbox(), p.segment_size_m.value.max(1.0));
-        } else {
-            self.snapper.end_cell();
-        }
+        self.snapper
+            .begin_cell(g.bbox(), p.segment_size_m.value.max(1.0));
         let area = region.area();
         let seg_min =
             (p.segment_size_m.value * (1.0 - p.segment_size_m.deviance) * p.aspect.min(1.0))
@@ -330,6 +316,7 @@ impl SecondaryGrowth {
                 let Ok((source, piece)) = run.g.split_edge(e, mid, Junction::default()) else {
                     continue;
                 };
+                run.snapper.touched(&run.g, e);
                 if let Some(placed) = run.place_segment(source, dir)? {
                     queue.push_back((placed.node, dir));
                     started += 1;
@@ -338,6 +325,8 @@ impl SecondaryGrowth {
                     let far = run.g.other_end(piece, source)?;
                     let near = run.g.other_end(e, source)?;
                     run.g.remove_node(source)?;
+                    run.snapper.touched(&run.g, e);
+                    run.snapper.touched(&run.g, piece);
                     let whole = run.g.add_edge(near, far, primary)?;
                     if let Some(s) = sides.get_mut(side) {
                         s.2 = whole;
@@ -391,7 +380,6 @@ impl SecondaryGrowth {
         }
         let report = run.report;
         let network = run.g;
-        self.snapper.end_cell();
         Ok(SecondaryRoads {
             cell: cell.id,
             network,
@@ -584,6 +572,9 @@ impl Run<'_> {
                     }
                     Err(e) => return Err(e.into()),
                 };
+                for &(split, _) in &ins.split {
+                    self.snapper.touched(&self.g, split);
+                }
                 if ins.created.is_empty() {
                     // The road exists already (the insertion followed existing roads).
                     self.report.refused_blocked += 1;
@@ -682,10 +673,8 @@ impl Run<'_> {
     /// `a–t` is among that query's candidates.
     fn clear(&self, source: NodeId, a: DVec2, t: DVec2, target: &Target) -> bool {
         use polis_geom::predicates::{SegmentIntersection as X, segment_intersection};
-        for &key in self.snapper.candidates() {
-            let (Ok((u, v)), Ok((pu, pv))) = (self.g.endpoints(key), self.g.segment(key)) else {
-                return false;
-            };
+        for road in self.snapper.candidates() {
+            let (key, u, v, pu, pv) = (road.edge, road.u, road.v, road.pu, road.pv);
             let at_end = |p: DVec2| p == a || p == t;
             let ok = match (segment_intersection(a, t, pu, pv), target) {
                 (X::Overlap { .. }, _) | (X::Crossing { .. }, Target::Free(_)) => false,

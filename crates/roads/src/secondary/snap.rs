@@ -5,9 +5,10 @@
 //! root `a`, measured by the parameter `r` along `a–b`:
 //!
 //! 1. **Extended bounding box exclusion** (§4.3.3.1): only roads whose boxes meet the box
-//!    of `a–b` grown by the snap size are tested (candidates come from the graph's edge
-//!    index, then Kelly's box test decides), and only their end nodes that lie in that
-//!    box (every node of a cell graph ends a road, so no node index walk is needed).
+//!    of `a–b` grown by the snap size are tested (candidates come from a flat grid over
+//!    the cell that lists every road with its ends, so the search reads no graph; then
+//!    Kelly's box test decides), and only their end nodes that lie in that box (every
+//!    node of a cell graph ends a road, so no node search is needed).
 //! 2. **Test 1, node proximity** (§4.3.3.3): for each node, `r = ap·ab / |ab|²` and
 //!    `s = ap⊥·ab / |ab|²`; a node with `0 < r ≤ 1` and `|s|·|ab| ≤ snap` is an event at
 //!    `r`; one with `1 < r ≤ 1 + snap/|ab|` is an event if it lies within the snap size of
@@ -25,16 +26,15 @@
 //! Before step 1, **test 0** (ours, not Kelly's) looks at the root's own roads only: a
 //! proposal with one of them in its snap area (the road's other end by test 1's rule, or
 //! `b` within the snap size of the road) is `Blocked` at once. With degree 18 most
-//! directions of a suburban node are such folds; answering them without the index
+//! directions of a suburban node are such folds; answering them without the grid
 //! search roughly halves the growth's time. It differs from the full search only when a
 //! non-adjacent node or road lies in the snap area nearer to the root than the fold,
 //! which the full search would have joined instead.
 
-use polis_geom::predicates::{Orientation, closest_point_on_segment, orient2d};
-use polis_geom::spatial::{Shape, SpatialIndex};
+use polis_geom::predicates::{Orientation, lerp_stable, orient2d};
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
 
-use super::grid::SnapGrid;
+use super::grid::{GridRoad, SnapGrid};
 use crate::network::RoadNetwork;
 
 /// The outcome of one snap query.
@@ -69,31 +69,26 @@ pub struct Snapper {
     scalars: Vec<NodeScalars>,
     query: u32,
     found: Vec<(NodeId, DVec2)>,
-    roads: Vec<EdgeId>,
+    roads: Vec<GridRoad>,
     /// Exact segment-intersection tests run (the rest were excluded by `r`/`s`).
     pub exact_tests: u64,
     /// Roads that passed the extended bounding box.
     pub box_hits: u64,
     /// Queries answered by test 0 (the proposal folds onto a road at its root).
     pub folded: u64,
-    /// The cell's flat grid, when [`begin_cell`](Self::begin_cell) set one up.
+    /// The flat grid of the graph being grown (see [`begin_cell`](Self::begin_cell)).
     grid: SnapGrid,
-    use_grid: bool,
 }
 
 impl Snapper {
-    /// Searches the roads of one growing cell graph through a flat grid laid over
-    /// `bounds` in squares of about `square_m` metres (instead of the graph's hashed
-    /// index) until [`end_cell`](Self::end_cell). Every query until then must be on the
-    /// same graph, which may only gain roads and split or remove them (as growth does).
+    /// Lays the snap search's flat grid over `bounds` (the cell graph's box) in squares of
+    /// about `square_m` metres, and empties it. Every query until the next call must be on
+    /// the same graph, which may only gain roads, and split or remove roads reported with
+    /// [`touched`](Self::touched) before the next query (as growth does); the grid then
+    /// lists every road of the graph as it is. Without a call, the first query lays a grid
+    /// of 64 m squares over its graph.
     pub fn begin_cell(&mut self, bounds: Aabb2, square_m: f64) {
         self.grid.reset(bounds, square_m);
-        self.use_grid = true;
-    }
-
-    /// Ends [`begin_cell`](Self::begin_cell): queries use the graph's own index again.
-    pub fn end_cell(&mut self) {
-        self.use_grid = false;
     }
 
     fn begin(&mut self, nodes: usize) {
@@ -110,6 +105,7 @@ impl Snapper {
         }
     }
 
+    #[inline]
     fn scalars(&mut self, n: NodeId, p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
         let i = n.index();
         if let (Some(&st), Some(&sc)) = (self.stamp.get(i), self.scalars.get(i))
@@ -125,10 +121,16 @@ impl Snapper {
         sc
     }
 
-    /// The roads the last query gathered (those whose boxes meet its extended box), in
-    /// id order; empty after a query answered by test 0.
-    pub fn candidates(&self) -> &[EdgeId] {
+    /// The roads the last query gathered (those whose boxes meet its extended box), with
+    /// their ends; empty after a query answered by test 0.
+    pub(crate) fn candidates(&self) -> &[GridRoad] {
         &self.roads
+    }
+
+    /// Road `e` of `g` was split or removed since the last query (see
+    /// [`begin_cell`](Self::begin_cell)).
+    pub fn touched(&mut self, g: &RoadNetwork, e: EdgeId) {
+        self.grid.refresh(g, e);
     }
 
     /// The highest-priority snap event of the proposal from node `root` (at `a`) to `b`
@@ -160,25 +162,18 @@ impl Snapper {
         // road whose box meets it, so the ends of these roads are test 1's candidates too.
         let mut roads = std::mem::take(&mut self.roads);
         roads.clear();
-        if self.use_grid {
-            self.grid.sync(g);
-            self.grid.for_each_in(&ext, |e| {
-                if let Ok((u, v)) = g.segment(e)
-                    && Aabb2::new(u, v).intersects(&ext)
-                {
-                    roads.push(e);
-                }
-            });
-        } else {
-            g.edge_index().for_each_candidate(&ext, |e, shape| {
-                if let Shape::Segment(u, v) = *shape
-                    && Aabb2::new(u, v).intersects(&ext)
-                {
-                    roads.push(e);
-                }
-            });
-        }
-        // The index reports each road once, in an order fixed by the graph's state; every
+        self.grid.sync(g);
+        self.grid.for_each_in(&ext, |road| {
+            if Aabb2::new(road.pu, road.pv).intersects(&ext) {
+                roads.push(*road);
+            }
+        });
+        debug_assert!(
+            roads.iter().all(|r| GridRoad::of(g, r.edge)
+                .is_some_and(|c| (c.u, c.v, c.pu, c.pv) == (r.u, r.v, r.pu, r.pv))),
+            "the snap grid is out of date: a split or removed road was not reported"
+        );
+        // The grid reports each road once, in an order fixed by the growth so far; every
         // choice below breaks ties by id, so the order does not matter.
         self.box_hits += roads.len() as u64;
         // Test 1: node proximity.
@@ -186,22 +181,18 @@ impl Snapper {
         let mut best_r = 1.0 + radius / len;
         let mut found = std::mem::take(&mut self.found);
         found.clear();
-        for &e in &roads {
-            if let Ok((u, v)) = g.endpoints(e) {
-                for n in [u, v] {
-                    // Each node once: `seen` is stamped with the query number.
-                    let Some(mark) = self.seen.get_mut(n.index()) else {
-                        continue;
-                    };
-                    if *mark == self.query {
-                        continue;
-                    }
-                    *mark = self.query;
-                    if let Ok(p) = g.position(n)
-                        && ext.contains(p)
-                    {
-                        found.push((n, p));
-                    }
+        for road in &roads {
+            for (n, p) in [(road.u, road.pu), (road.v, road.pv)] {
+                // Each node once: `seen` is stamped with the query number.
+                let Some(mark) = self.seen.get_mut(n.index()) else {
+                    continue;
+                };
+                if *mark == self.query {
+                    continue;
+                }
+                *mark = self.query;
+                if ext.contains(p) {
+                    found.push((n, p));
                 }
             }
         }
@@ -225,15 +216,12 @@ impl Snapper {
         self.found = found;
         // Test 2: segment intersection before the benchmark.
         let limit = best_r.min(1.0);
-        let mut cross: Option<(f64, EdgeId, DVec2)> = None;
-        for &e in &roads {
-            let Ok((u, v)) = g.endpoints(e) else { continue };
+        let mut cross: Option<(f64, usize, DVec2)> = None;
+        for (i, road) in roads.iter().enumerate() {
+            let (u, v, pu, pv) = (road.u, road.v, road.pu, road.pv);
             if u == root || v == root {
                 continue;
             }
-            let (Ok(pu), Ok(pv)) = (g.position(u), g.position(v)) else {
-                continue;
-            };
             let su = self.scalars(u, pu, a, b);
             let sv = self.scalars(v, pv, a, b);
             if su.side * sv.side >= 0 {
@@ -256,94 +244,108 @@ impl Snapper {
             if !opposite {
                 continue;
             }
-            let better = cross.is_none_or(|(cr, ce, _)| r < cr || (r == cr && e < ce));
+            let better = cross.is_none_or(|(cr, ci, _)| {
+                r < cr || (r == cr && roads.get(ci).is_none_or(|c| road.edge < c.edge))
+            });
             if better {
                 let point = pu + (pv - pu) * (wu / (wu + wv));
-                cross = Some((r, e, point));
+                cross = Some((r, i, point));
             }
         }
-        self.roads = roads;
         let adjacent = |n: NodeId| g.find_edge(root, n).is_some();
         // A crossing within the snap size of an end of the crossed road joins that end
         // (the nearer one) instead of splitting the road next to it.
-        let cross = cross.map(|(r, e, p)| {
-            let end = g.endpoints(e).ok().and_then(|(u, v)| {
-                let (pu, pv) = (g.position(u).ok()?, g.position(v).ok()?);
-                let (du, dv) = (pu.distance_squared(p), pv.distance_squared(p));
-                let (n, dn) = if (du, u) <= (dv, v) { (u, du) } else { (v, dv) };
-                (dn <= radius * radius).then_some(n)
-            });
-            (r, e, p, end)
+        let cross = cross.and_then(|(r, i, p)| {
+            let road = roads.get(i)?;
+            let (du, dv) = (road.pu.distance_squared(p), road.pv.distance_squared(p));
+            let (n, dn) = if (du, road.u) <= (dv, road.v) {
+                (road.u, du)
+            } else {
+                (road.v, dv)
+            };
+            Some((r, road.edge, p, (dn <= radius * radius).then_some(n)))
         });
         let cross_event = |e: EdgeId, p: DVec2, end: Option<NodeId>| match end {
             Some(n) if adjacent(n) => SnapEvent::Blocked,
             Some(n) => SnapEvent::Node(n),
             None => SnapEvent::Cross(e, p),
         };
-        match (best, cross) {
-            (Some((r, n)), Some((cr, e, p, end))) => {
-                if cr < r {
-                    return cross_event(e, p, end);
-                }
-                return if adjacent(n) {
-                    SnapEvent::Blocked
-                } else {
-                    SnapEvent::Node(n)
-                };
-            }
-            (Some((_, n)), None) => {
-                return if adjacent(n) {
-                    SnapEvent::Blocked
-                } else {
-                    SnapEvent::Node(n)
-                };
-            }
-            (None, Some((_, e, p, end))) => return cross_event(e, p, end),
-            (None, None) => {}
+        let decided = match (best, cross) {
+            (Some((r, n)), Some((cr, e, p, end))) => Some(if cr < r {
+                cross_event(e, p, end)
+            } else if adjacent(n) {
+                SnapEvent::Blocked
+            } else {
+                SnapEvent::Node(n)
+            }),
+            (Some((_, n)), None) => Some(if adjacent(n) {
+                SnapEvent::Blocked
+            } else {
+                SnapEvent::Node(n)
+            }),
+            (None, Some((_, e, p, end))) => Some(cross_event(e, p, end)),
+            (None, None) => None,
+        };
+        if let Some(ev) = decided {
+            self.roads = roads;
+            return ev;
         }
         // Test 3: proximity of b to a road. Every road within the snap size of `b` meets
         // the extended box, so the roads gathered for tests 1 and 2 are the candidates.
         let around = Aabb2::new(b, b).expanded(radius);
         let r2 = radius * radius;
-        let mut near: Option<(f64, EdgeId, DVec2)> = None;
-        for &e in &self.roads {
-            let Ok((u, v)) = g.segment(e) else { continue };
+        let mut near: Option<(f64, usize, DVec2)> = None;
+        for (i, road) in roads.iter().enumerate() {
+            let (u, v) = (road.pu, road.pv);
             if !Aabb2::new(u, v).intersects(&around) {
                 continue;
             }
-            let (c, _) = closest_point_on_segment(b, u, v);
+            let c = closest_point(b, u, v);
             let dist = c.distance_squared(b);
-            if dist <= r2 && near.is_none_or(|(bd, be, _)| (dist, e) < (bd, be)) {
-                near = Some((dist, e, c));
+            let better = near.is_none_or(|(bd, bi, _)| {
+                dist < bd || (dist == bd && roads.get(bi).is_none_or(|o| road.edge < o.edge))
+            });
+            if dist <= r2 && better {
+                near = Some((dist, i, c));
             }
         }
-        let Some((_, e, c)) = near else {
-            return SnapEvent::None;
-        };
-        let Ok((u, v)) = g.endpoints(e) else {
-            return SnapEvent::Blocked;
-        };
-        if u == root || v == root {
-            return SnapEvent::Blocked;
-        }
-        // The closest point is an end of the road: that is a node event.
-        for n in [u, v] {
-            if g.position(n).is_ok_and(|p| p == c) {
-                return if adjacent(n) {
-                    SnapEvent::Blocked
-                } else {
-                    SnapEvent::Node(n)
-                };
+        let event = match near.and_then(|(_, i, c)| Some((*roads.get(i)?, c))) {
+            None => SnapEvent::None,
+            Some((road, _)) if road.u == root || road.v == root => SnapEvent::Blocked,
+            Some((road, c)) => {
+                // The closest point is an end of the road: that is a node event.
+                match [(road.u, road.pu), (road.v, road.pv)]
+                    .into_iter()
+                    .find(|&(_, p)| p == c)
+                {
+                    Some((n, _)) if adjacent(n) => SnapEvent::Blocked,
+                    Some((n, _)) => SnapEvent::Node(n),
+                    None => SnapEvent::Road(road.edge, c),
+                }
             }
-        }
-        SnapEvent::Road(e, c)
+        };
+        self.roads = roads;
+        event
     }
+}
+
+/// The point of segment `u–v` closest to `p`: the arithmetic of
+/// [`closest_point_on_segment`], here where it can be inlined into the hot loops.
+#[inline]
+fn closest_point(p: DVec2, u: DVec2, v: DVec2) -> DVec2 {
+    let d = v - u;
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return u;
+    }
+    let t = ((p - u).dot(d) / len2).clamp(0.0, 1.0);
+    lerp_stable(u, v, t)
 }
 
 /// Test 0: whether the proposal `a–b` from `root` runs within `radius` of one of the
 /// root's own roads: that road's other end is in the snap area (test 1's condition), or
 /// `b` is within `radius` of the road (test 3's). Such a proposal can only fold onto the
-/// road it starts beside, so it is answered before the index is searched.
+/// road it starts beside, so it is answered before the grid is searched.
 fn folds_onto_root(g: &RoadNetwork, root: NodeId, a: DVec2, b: DVec2, radius: f64) -> bool {
     let Ok(edges) = g.edges_at(root) else {
         return false;
@@ -362,7 +364,7 @@ fn folds_onto_root(g: &RoadNetwork, root: NodeId, a: DVec2, b: DVec2, radius: f6
         } else {
             r > 1.0 && p.distance_squared(b) <= radius * radius
         };
-        node || closest_point_on_segment(b, a, p).0.distance_squared(b) <= radius * radius
+        node || closest_point(b, a, p).distance_squared(b) <= radius * radius
     })
 }
 
@@ -384,7 +386,7 @@ fn compute(p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
     use crate::network::{Junction, Road, RoadClass};
@@ -392,15 +394,20 @@ mod tests {
 
     type Seg = ((f64, f64), (f64, f64));
 
-    fn net(segs: &[Seg]) -> RoadNetwork {
-        let mut n = RoadNetwork::new();
-        let road = Road {
+    /// An 8 m street of step 0 (the payload of the test graphs here and in the grid's).
+    pub(in crate::secondary) fn street() -> Road {
+        Road {
             class: RoadClass::Street,
             width: 8.0,
             bridge: false,
             tunnel: false,
             step: 0,
-        };
+        }
+    }
+
+    fn net(segs: &[Seg]) -> RoadNetwork {
+        let mut n = RoadNetwork::new();
+        let road = street();
         for &((ax, ay), (bx, by)) in segs {
             n.insert_segment_with(
                 DVec2::new(ax, ay),
@@ -431,6 +438,7 @@ mod tests {
         let root = node_at(&g, 0.0, 0.0);
         let a = DVec2::ZERO;
         let mut s = Snapper::default();
+        s.begin_cell(g.bbox(), 64.0);
         // The crossing at x = 50 comes first.
         let ev = s.snap(&g, root, a, DVec2::new(100.0, 0.0), 5.0);
         assert!(
@@ -440,9 +448,11 @@ mod tests {
         // A short proposal ending near the node (80, 3): node event.
         let g2 = net(&[((0.0, 0.0), (-30.0, 0.0)), ((80.0, 3.0), (80.0, 30.0))]);
         let root2 = node_at(&g2, 0.0, 0.0);
+        s.begin_cell(g2.bbox(), 64.0);
         let ev = s.snap(&g2, root2, a, DVec2::new(78.0, 0.0), 5.0);
         assert_eq!(ev, SnapEvent::Node(node_at(&g2, 80.0, 3.0)));
         // Ending near the road x = 200 but not near a node: road event at the foot.
+        s.begin_cell(g.bbox(), 64.0);
         let ev = s.snap(
             &g,
             root,
