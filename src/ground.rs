@@ -12,13 +12,19 @@
 //! `2 · max_error_m` below their lowest corner) are never buried by it and reach down
 //! into it.
 //!
+//! The node `ground` holds the terrain cut into the scene's tiles
+//! ([`SceneConfig::tile_size_m`]; each triangle in the tile of its centroid, vertices on
+//! a tile border copied bit for bit into each tile using them, so the tiles meet without
+//! a seam), one mesh per tile in tile order: the tiled glb layout appends them as they
+//! are instead of cutting a map-wide mesh each time it writes.
+//!
 //! References: Kelly 2008 §4.2, §6.2 (the city on its terrain); Parish & Müller 2001 §3
 //! (elevation, water and parks as input maps).
 
 use polis_geom::mesh::Terrain;
 use polis_geom::paint::ClassGrid;
 use polis_geom::scene::{Image, ImageData, Texture, Wrap};
-use polis_geom::{Aabb2, DVec2, Field, Material, MaterialId, PolygonWithHoles, Scene};
+use polis_geom::{Aabb2, DVec2, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene};
 
 use crate::error::Result;
 use crate::{CityConfig, SceneConfig};
@@ -59,7 +65,11 @@ impl LandUse {
 
 /// What the ground layer is made of, before it joins the scene.
 pub(crate) struct Ground {
+    /// The terrain, its mesh taken into `tiles`.
     pub terrain: Terrain,
+    /// The terrain's mesh cut into the scene's tiles ([`SceneConfig::tile_size_m`],
+    /// [`Mesh::cut_into_tiles`]), in tile order.
+    pub tiles: Vec<Mesh>,
     pub land_use: ClassGrid,
 }
 
@@ -97,20 +107,31 @@ pub(crate) fn build_ground<'a>(
         || Terrain::build(elevation, bounds, &scene.terrain_mesh, None),
         paint,
     );
+    let mut terrain = terrain?;
+    // Cut here, once, rather than by every tiled glb written: the writer appends a
+    // mesh that is already one tile's cut whole.
+    let tiles = std::mem::take(&mut terrain.mesh)
+        .cut_into_tiles(scene.tile_size_m)
+        .into_iter()
+        .map(|(_, mesh, _)| mesh)
+        .collect();
     Ok(Ground {
-        terrain: terrain?,
+        terrain,
+        tiles,
         land_use,
     })
 }
 
-/// Adds the ground's texture, material and mesh to the scene under a node `ground`.
+/// Adds the ground's texture, material and meshes (one per tile) to the scene under a
+/// node `ground`.
 pub(crate) fn add_ground(
     scene: &mut Scene,
     root: polis_geom::scene::NodeId,
     ground: Ground,
 ) -> Result<()> {
     let Ground {
-        mut terrain,
+        terrain,
+        tiles,
         land_use,
     } = ground;
     let mut pixels = Vec::with_capacity(4 * land_use.cells.len());
@@ -140,11 +161,13 @@ pub(crate) fn add_ground(
         roughness: 1.0,
         ..Material::new("ground", [1.0, 1.0, 1.0, 1.0])
     });
-    terrain.mesh.material = Some(material);
     let node = scene.add_node(root, "ground")?;
     scene.set_metadata(node, "max_error_m", terrain.report.max_error_m)?;
-    let mesh = scene.add_mesh(std::mem::take(&mut terrain.mesh));
-    scene.attach_mesh(node, mesh)?;
+    for mut tile in tiles {
+        tile.material = Some(material);
+        let mesh = scene.add_mesh(tile);
+        scene.attach_mesh(node, mesh)?;
+    }
     Ok(())
 }
 

@@ -18,10 +18,14 @@ struct Sheet {
 }
 
 impl Sheet {
-    fn new(mesh: &Mesh, world: &DMat4, size: f64) -> Sheet {
-        let tris: Vec<[DVec3; 3]> = mesh
-            .triangles()
-            .map(|t| t.map(|i| world.transform_point3(mesh.positions[i as usize].as_dvec3())))
+    fn new(meshes: &[(&Mesh, DMat4)], size: f64) -> Sheet {
+        let tris: Vec<[DVec3; 3]> = meshes
+            .iter()
+            .flat_map(|(mesh, world)| {
+                mesh.triangles().map(move |t| {
+                    t.map(|i| world.transform_point3(mesh.positions[i as usize].as_dvec3()))
+                })
+            })
             .collect();
         let n = 128usize;
         let min = DVec2::splat(-size / 2.0);
@@ -121,10 +125,10 @@ fn stands_on_its_ground(city: &City) {
     let scene = &city.scene;
     let worlds = scene.world_matrices();
     let e = city.config.scene.terrain_mesh.max_error_m;
-    let (ground, w) = node_meshes(scene, &worlds, "ground")
-        .next()
-        .expect("a ground node");
-    let sheet = Sheet::new(ground, &w, city.config.size_m);
+    // The ground's tiles as one sheet.
+    let tiles: Vec<(&Mesh, DMat4)> = node_meshes(scene, &worlds, "ground").collect();
+    assert!(!tiles.is_empty(), "a ground node");
+    let sheet = Sheet::new(&tiles, city.config.size_m);
     // f32 positions at up to a kilometre and 400 m of height: a millimetre of rounding.
     let tol = 2e-3;
 

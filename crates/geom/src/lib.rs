@@ -15,7 +15,7 @@
 //! | [`spatial`] | [`SegmentIndex`]: a hashed uniform grid over points and segments (box, nearest within a radius, segments crossing a segment in order); `spatial::RTreeIndex` (feature `rtree`) as the measured alternative |
 //! | [`field`] | [`Field`]: input maps (population, water, elevation …) — constants, closures, PNG rasters, seeded simplex/fBm noise, the slides' `populationAt`, combinators, serde [`field::FieldSpec`] |
 //! | [`measure`] | minimum enclosing circle (Welzl), segment–segment and segment–polygon distances |
-//! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks |
+//! | [`mesh`] | [`Mesh`]: f32 triangle meshes in glTF axes ([`to_world`]), constrained triangulation, prisms, closedness checks, cuts into ground-plane tiles |
 //! | [`scene`] | [`Scene`]: node tree, materials, textures, images — the contract between generators and exporters |
 //! | [`par`] | the one parallel-or-serial switch (rayon with feature `parallel`, plain iterators without) used by every crate that runs loops in parallel |
 //! | [`metadata`] | [`Metadata`](metadata::Metadata): a node's small ordered map of [`MetaValue`]s (glTF `extras`, GeoJSON properties) |

@@ -6,7 +6,7 @@ use super::*;
 use polis_geom::glam::{DMat4, DVec3, Vec2};
 use polis_geom::hash::splitmix64;
 use polis_geom::mesh::prism;
-use polis_geom::scene::{Material, MetaValue};
+use polis_geom::scene::{Material, MaterialId, MetaValue};
 use polis_geom::{DVec2, Mesh, Polygon};
 
 const TILE: f64 = 250.0;
@@ -1011,6 +1011,98 @@ fn buffer_views_are_shared_by_aligned_disjoint_accessors() {
     }
 }
 
+/// A smooth-shaded hilly sheet of `n` × `n` quads of `step` metres from layout point
+/// `(origin, origin)`, placed as the terrain places it (layout `y` is world `−z`, so a
+/// row at `y = 0` has `z = −0`), each quad a fan of four up-facing triangles around its
+/// centre (so triangles straddle every tile border), with texture coordinates: a ground
+/// as the terrain builds it.
+fn hills(n: usize, step: f64, origin: f64, material: Option<MaterialId>) -> Mesh {
+    let mut m = Mesh::new(material);
+    let at = |x: f64, y: f64| {
+        let h = (x * 0.013).sin() * 4.0 + (y * 0.021).cos() * 3.0;
+        polis_geom::to_world(DVec2::new(x, y), h)
+    };
+    let uv = |p: DVec3| DVec2::new(p.x / 1000.0, -p.z / 1000.0);
+    let corner = |i: usize, j: usize| at(origin + i as f64 * step, origin + j as f64 * step);
+    let mut ids = vec![0u32; (n + 1) * (n + 1)];
+    for j in 0..=n {
+        for i in 0..=n {
+            let p = corner(i, j);
+            ids[j * (n + 1) + i] = m.add_vertex(p, DVec3::Y, uv(p));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let c = at(
+                origin + (i as f64 + 0.5) * step,
+                origin + (j as f64 + 0.5) * step,
+            );
+            let centre = m.add_vertex(c, DVec3::Y, uv(c));
+            let ring =
+                [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(a, b)| ids[b * (n + 1) + a]);
+            for k in 0..4 {
+                m.push_triangle(centre, ring[k], ring[(k + 1) % 4]).unwrap();
+            }
+        }
+    }
+    m.compute_smooth_normals().unwrap();
+    m
+}
+
+/// A ground cut into tiles where it is built ([`Mesh::cut_into_tiles`], one mesh per
+/// tile on its node) is written by the tiled layout byte for byte as the same ground in
+/// one mesh, in both profiles (the writer appends each ready tile whole instead of
+/// cutting it); a mesh cut for another tile size is cut again and still covers the
+/// same triangles.
+#[test]
+fn a_ground_cut_in_advance_writes_the_bytes_of_the_whole_ground() {
+    let build = |tiles: Option<f64>| {
+        let mut s = town(40);
+        let root = s.roots[0];
+        let grass = s.add_material(Material::new("grass", [0.3, 0.6, 0.2, 1.0]));
+        let ground = s.add_node(root, "ground").unwrap();
+        s.set_metadata(ground, "max_error_m", 0.2).unwrap();
+        let sheet = hills(29, 37.0, -74.0, Some(grass));
+        let parts = match tiles {
+            None => vec![sheet],
+            Some(size) => sheet
+                .cut_into_tiles(size)
+                .into_iter()
+                .map(|(_, m, _)| m)
+                .collect(),
+        };
+        for m in parts {
+            let m = s.add_mesh(m);
+            s.attach_mesh(ground, m).unwrap();
+        }
+        s
+    };
+    let (whole, cut, other) = (build(None), build(Some(TILE)), build(Some(170.0)));
+    assert!(
+        cut.meshes.len() > whole.meshes.len() + 8,
+        "the ground spans many tiles"
+    );
+    for profile in [GlbProfile::Plain, GlbProfile::Web] {
+        let options = GlbOptions { profile, ..tiled() };
+        let (a, ra) = write(&whole, &options);
+        let (b, _) = write(&cut, &options);
+        assert!(a == b, "{profile}: the cut ground changed the bytes");
+        let (c, rc) = write(&other, &options);
+        assert_eq!(
+            (rc.triangles, rc.tiles),
+            (ra.triangles, ra.tiles),
+            "{profile}"
+        );
+        if profile == GlbProfile::Plain {
+            assert_eq!(
+                world_triangles(&a),
+                world_triangles(&c),
+                "cut again, the same triangles"
+            );
+        }
+    }
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
     /// The counting sort of the cut gives what sorting (tile, triangle) pairs gives,
@@ -1059,6 +1151,6 @@ proptest::proptest! {
         for run in pairs.chunk_by(|a, b| a.0 == b.0) {
             expect.push((run[0].0, run.iter().map(|p| p.1).collect()));
         }
-        proptest::prop_assert_eq!(tiles::triangles_by_tile(&m, size), expect);
+        proptest::prop_assert_eq!(polis_geom::mesh::triangles_by_tile(&m, size), expect);
     }
 }

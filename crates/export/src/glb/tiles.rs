@@ -20,13 +20,16 @@
 //! * Its **tile** is the square of side `tile_size_m` on the root's x–z plane holding the
 //!   centre of its bounding box, `(⌊x / s⌋, ⌊z / s⌋)`; an object wider or deeper than a
 //!   tile (a layer-wide surface: the road network, water, ground) is cut instead, each
-//!   triangle going to the tile of its centroid.
+//!   of its meshes by [`Mesh::cut_into_tiles`] (each triangle going to the tile of its
+//!   centroid). A mesh that is already one tile's cut ([`Mesh::whole_tile`]: a polis
+//!   ground, cut into the scene's tiles where it is built) is appended whole, which
+//!   gives the same bytes as cutting it again without the vertex map.
 
 use std::borrow::Cow;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use polis_geom::glam::{DMat4, DVec3, Vec3};
-use polis_geom::par::prelude::*;
+use polis_geom::mesh::{TileIndex, tile_of};
 use polis_geom::scene::{MaterialId, MetaValue, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
 use serde_json::{Map, Value, json};
@@ -39,7 +42,7 @@ use crate::ExportError;
 const NO_FEATURE: u32 = u32::MAX;
 
 /// A tile index on the x–z plane.
-type Tile = (i64, i64);
+type Tile = TileIndex;
 
 /// One merged geometry: the mesh, the feature id of every vertex and the bounds of the
 /// positions (kept while appending, so no pass over the merged mesh computes them).
@@ -59,14 +62,21 @@ impl Group {
     }
 }
 
-/// The index of layer `name`, added when new.
-fn layer_index(layers: &mut Vec<String>, name: &str) -> usize {
-    match layers.iter().position(|l| l == name) {
-        Some(k) => k,
-        None => {
-            layers.push(name.to_string());
-            layers.len() - 1
-        }
+/// The layers of one root in first-seen order, with an index by name (a city root has
+/// a layer name per cell, so a linear search per node would cost quadratic time).
+#[derive(Default)]
+struct Layers<'a> {
+    names: Vec<String>,
+    index: HashMap<&'a str, usize>,
+}
+
+impl<'a> Layers<'a> {
+    /// The index of layer `name`, added when new.
+    fn index(&mut self, name: &'a str) -> usize {
+        *self.index.entry(name).or_insert_with(|| {
+            self.names.push(name.to_string());
+            self.names.len() - 1
+        })
     }
 }
 
@@ -78,136 +88,6 @@ struct PathInfo {
     /// The node whose record the path's geometry belongs to, and that node's layer.
     feature: Option<(NodeId, usize)>,
 }
-
-/// The tile of a point.
-fn tile_of(x: f32, z: f32, size: f64) -> Tile {
-    (
-        (f64::from(x) / size).floor() as i64,
-        (f64::from(z) / size).floor() as i64,
-    )
-}
-
-/// The triangles of `m` grouped by the tile of their centroid: tiles in order, each
-/// with its triangles in index order (what sorting (tile, triangle) pairs gives). A
-/// counting sort over the tiles' bounding grid when it is no larger than a few cells per
-/// triangle (a layer-wide surface: the ground's 1.6 million triangles over a few hundred
-/// tiles), else a sorted map.
-pub(super) fn triangles_by_tile(m: &Mesh, size: f64) -> Vec<(Tile, Vec<u32>)> {
-    let tiles: Vec<Tile> = m
-        .indices
-        .chunks_exact(3)
-        .map(|tri| {
-            let c = (m.positions[tri[0] as usize]
-                + m.positions[tri[1] as usize]
-                + m.positions[tri[2] as usize])
-                / 3.0;
-            tile_of(c.x, c.z, size)
-        })
-        .collect();
-    let Some(&first) = tiles.first() else {
-        return Vec::new();
-    };
-    let (lo, hi) = tiles.iter().fold((first, first), |(lo, hi), t| {
-        (
-            (lo.0.min(t.0), lo.1.min(t.1)),
-            (hi.0.max(t.0), hi.1.max(t.1)),
-        )
-    });
-    let span = |a: i64, b: i64| i128::from(b) - i128::from(a) + 1;
-    let cells = span(lo.0, hi.0) * span(lo.1, hi.1);
-    if cells > 4 * tiles.len() as i128 + 64 {
-        let mut runs: BTreeMap<Tile, Vec<u32>> = BTreeMap::new();
-        for (t, &tile) in tiles.iter().enumerate() {
-            runs.entry(tile).or_default().push(t as u32);
-        }
-        return runs.into_iter().collect();
-    }
-    // Row-major over (i, j): the cells' order is the tiles' order.
-    let columns = span(lo.1, hi.1) as usize;
-    let cell = |t: Tile| (t.0 - lo.0) as usize * columns + (t.1 - lo.1) as usize;
-    let mut count = vec![0u32; cells as usize];
-    for &t in &tiles {
-        count[cell(t)] += 1;
-    }
-    let mut slot = vec![usize::MAX; count.len()];
-    let mut runs: Vec<(Tile, Vec<u32>)> = Vec::new();
-    for (c, &n) in count.iter().enumerate() {
-        if n > 0 {
-            slot[c] = runs.len();
-            let tile = (lo.0 + (c / columns) as i64, lo.1 + (c % columns) as i64);
-            runs.push((tile, Vec::with_capacity(n as usize)));
-        }
-    }
-    for (t, &tile) in tiles.iter().enumerate() {
-        runs[slot[cell(tile)]].1.push(t as u32);
-    }
-    runs
-}
-
-/// Appends the triangles `tris` of `m` to `target`, with feature `feature` per vertex;
-/// `remap` (all `u32::MAX`, one per vertex of `m`) maps old to new vertices and is reset.
-fn append_triangles(target: &mut Merged, m: &Mesh, tris: &[u32], feature: u32, remap: &mut [u32]) {
-    let (out, features, bounds) = target;
-    // A connected sheet has about half as many vertices as triangles; reserving one per
-    // triangle spares the doubling copies without a counting pass.
-    out.indices.reserve(3 * tris.len());
-    for v in [&mut out.positions, &mut out.normals] {
-        v.reserve(tris.len());
-    }
-    if !m.uvs.is_empty() {
-        out.uvs.reserve(tris.len());
-    }
-    features.reserve(tris.len());
-    let mut touched = Vec::new();
-    for &t in tris {
-        for k in 0..3 {
-            let v = m.indices[3 * t as usize + k] as usize;
-            if remap[v] == u32::MAX {
-                remap[v] = out.positions.len() as u32;
-                touched.push(v);
-                out.positions.push(m.positions[v]);
-                bounds.extend(m.positions[v]);
-                out.normals.push(m.normals[v]);
-                if let Some(&uv) = m.uvs.get(v) {
-                    out.uvs.push(uv);
-                }
-                features.push(feature);
-            }
-            out.indices.push(remap[v]);
-        }
-    }
-    for v in touched {
-        remap[v] = u32::MAX;
-    }
-}
-
-/// The cut of `m`: per tile of [`triangles_by_tile`] (in its order), the tile's
-/// triangles as a mesh of their own, vertices in first-use order (the numbering that
-/// appending them to an empty mesh one by one gives), and its bounds. Tiles are cut in
-/// parallel, in a few chunks with one vertex map each; the result does not depend on
-/// the number of threads.
-fn cut(m: &Mesh, size: f64) -> Vec<(Tile, Mesh, Aabb3)> {
-    let runs = triangles_by_tile(m, size);
-    let chunk = runs.len().div_ceil(CUT_CHUNKS).max(1);
-    let chunks: Vec<&[(Tile, Vec<u32>)]> = runs.chunks(chunk).collect();
-    let parts: Vec<Vec<(Tile, Mesh, Aabb3)>> = chunks
-        .into_par_iter()
-        .map(|runs| {
-            let mut remap = vec![u32::MAX; m.vertex_count()];
-            runs.iter()
-                .map(|(tile, tris)| {
-                    let mut part = (Mesh::new(m.material), Vec::new(), Aabb3::EMPTY);
-                    append_triangles(&mut part, m, tris, 0, &mut remap);
-                    (*tile, part.0, part.2)
-                })
-                .collect()
-        })
-        .collect();
-    parts.into_iter().flatten().collect()
-}
-
-/// Chunks a cut is split into (each allocates a vertex map as long as the mesh).
-const CUT_CHUNKS: usize = 8;
 
 /// Appends a cut `part` with bounds `b` to `target`, feature `feature` per vertex: moved
 /// in when `target` is empty, else appended after its vertices (the same bytes as
@@ -250,13 +130,19 @@ fn translation_only(frame: &DMat4) -> Option<DVec3> {
 /// `f64`; normals as they are: a translation turns none), with feature `feature` per
 /// vertex; `b` is `m`'s bounding box.
 fn append_moved(target: &mut Merged, m: &Mesh, b: Aabb3, t: DVec3, feature: u32) {
-    let (out, features, bounds) = target;
     // Rounding x + t to f32 is monotone in x: the moved box is the moved corners' box,
-    // exactly (and with t = 0 the box itself).
-    *bounds = bounds.union(&Aabb3 {
+    // exactly (and with t = 0 the box itself, a −0 bound made +0).
+    let moved = Aabb3 {
         min: (b.min.as_dvec3() + t).as_vec3(),
         max: (b.max.as_dvec3() + t).as_vec3(),
-    });
+    };
+    append_at(target, m, moved, t, feature);
+}
+
+/// [`append_moved`] given the moved box `moved`.
+fn append_at(target: &mut Merged, m: &Mesh, moved: Aabb3, t: DVec3, feature: u32) {
+    let (out, features, bounds) = target;
+    *bounds = bounds.union(&moved);
     let base = out.positions.len() as u32;
     if t == DVec3::ZERO {
         out.positions.extend_from_slice(&m.positions);
@@ -281,7 +167,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         plan.nodes.push(PlannedNode::from_scene(root));
 
         // Walk the subtree in pre-order: objects, their frame, path info.
-        let mut layers: Vec<String> = Vec::new();
+        let mut layer_set = Layers::default();
         let mut features: Vec<Value> = Vec::new();
         let mut record_of: BTreeMap<NodeId, u32> = BTreeMap::new();
         let mut groups: BTreeMap<(usize, Tile, Option<u32>), Group> = BTreeMap::new();
@@ -296,9 +182,9 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             } else {
                 let inherited = path;
                 let layer = match (layer_name, inherited) {
-                    (Some(name), _) => layer_index(&mut layers, name),
+                    (Some(name), _) => layer_set.index(name),
                     (None, Some(p)) => p.layer,
-                    (None, None) => layer_index(&mut layers, &node.name),
+                    (None, None) => layer_set.index(&node.name),
                 };
                 let lod = match node.metadata.get("lod").and_then(|v| v.as_f64()) {
                     Some(l) if l >= 0.0 && l.fract() == 0.0 && l <= f64::from(u16::MAX) => {
@@ -354,7 +240,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 None => {
                     // Geometry on the root itself: a layer named after the root.
                     PathInfo {
-                        layer: layer_index(&mut layers, &node.name),
+                        layer: layer_set.index(&node.name),
                         lod: None,
                         feature: None,
                     }
@@ -369,7 +255,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                         let owner_node = &scene.nodes[owner.index()];
                         let mut record = Map::new();
                         record.insert("name".into(), Value::from(owner_node.name.as_str()));
-                        record.insert("layer".into(), Value::from(layers[layer].as_str()));
+                        record.insert("layer".into(), Value::from(layer_set.names[layer].as_str()));
                         for (k, v) in owner_node.metadata.iter() {
                             if k != "name" && k != "layer" {
                                 record.insert(k.to_string(), meta_json(v));
@@ -428,8 +314,16 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     append_moved(target, m, b, DVec3::ZERO, feature);
                     continue;
                 }
+                // Already one tile's cut (the ground, cut where it is built): appended
+                // whole, the bytes its cut would give (its box too, −0 kept).
+                if let Some(tile) = m.whole_tile(size) {
+                    let key = (info.layer, tile, info.lod);
+                    let target = groups.entry(key).or_default().target(m.material);
+                    append_at(target, m, b, DVec3::ZERO, feature);
+                    continue;
+                }
                 // Cut: triangles by the tile of their centroid.
-                for (tile, part, b) in cut(m, size) {
+                for (tile, part, b) in m.cut_into_tiles(size) {
                     let key = (info.layer, tile, info.lod);
                     let target = groups.entry(key).or_default().target(m.material);
                     append_part(target, part, b, feature);
@@ -438,6 +332,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         }
 
         // Nodes: root → layers (first-seen order) → tiles (sorted) → LOD levels.
+        let layers = layer_set.names;
         levels.sort_unstable_by(|a, b| b.cmp(a));
         let null_id = features.len() as u32;
         let mut layer_nodes: Vec<Option<u32>> = vec![None; layers.len()];

@@ -66,12 +66,14 @@ mod normals;
 mod planar;
 mod small_cdt;
 mod terrain;
+mod tiles;
 mod triangulate;
 
 pub use edge_use::{EdgeUseReport, ReportedEdge, edge_use};
 pub use extrude::{Facing, flat_polygon, prism};
 pub use planar::{FRAME_TOLERANCE, PlaneFrame};
 pub use terrain::{Terrain, TerrainOptions, TerrainReport};
+pub use tiles::{TileIndex, tile_of, triangles_by_tile};
 pub use triangulate::{RefineOptions, RefinedTriangulation, triangulate, triangulate_refined};
 
 /// Maps a layout point `p = (x, y)` at elevation `h` to 3-D world coordinates `(x, h, −y)`.

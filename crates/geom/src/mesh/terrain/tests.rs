@@ -312,3 +312,42 @@ fn children_of_a_final_fan_split_keep_the_bound() {
     check_sheet(&t, bounds);
     check_bound(&t, &field, 0.2);
 }
+
+/// The terrain cut into tiles (as the scene's ground is) has no seam: welded by their
+/// exact bits, the tiles' triangles are one sheet whose only open edges are the
+/// rectangle's border, with the whole mesh's edges, so every vertex on a tile border
+/// is the same to the bit in each tile using it. Every triangle is in exactly one tile,
+/// and each tile is what a writer appends whole ([`Mesh::whole_tile`]).
+#[test]
+fn terrain_tiles_meet_without_seams() {
+    let fbm = fbm(11, 90.0, 4);
+    let field = fbm.scaled(25.0);
+    let bounds = rect(700.0, 560.0);
+    let options = TerrainOptions {
+        max_error_m: 0.1,
+        ..TerrainOptions::default()
+    };
+    let t = Terrain::build(&field, bounds, &options, None).unwrap();
+    let size = 130.0;
+    let tiles = t.mesh.cut_into_tiles(size);
+    assert!(tiles.len() >= 20, "{} tiles", tiles.len());
+    let whole = t.mesh.edge_use();
+    let joined = crate::mesh::edge_use(tiles.iter().map(|(_, m, _)| m));
+    assert!(joined.non_manifold.is_empty() && joined.flipped.is_empty());
+    assert_eq!(joined.components, 1);
+    assert_eq!(
+        (joined.triangles, joined.vertices, joined.edges),
+        (whole.triangles, whole.vertices, whole.edges)
+    );
+    assert_eq!(joined.open, whole.open, "the tiles' seams are closed");
+    let mut seen = 0;
+    for (tile, m, b) in &tiles {
+        assert_eq!(m.whole_tile(size), Some(*tile));
+        assert_eq!(*b, m.bbox());
+        m.validate().unwrap();
+        seen += m.triangle_count();
+    }
+    assert_eq!(seen, t.mesh.triangle_count());
+    // The whole mesh is not one tile's cut.
+    assert_eq!(t.mesh.whole_tile(size), None);
+}
