@@ -170,27 +170,41 @@ impl OldScene {
     }
 
     /// The old building with `b`'s id if it equals `b`: its index and node.
-    fn same_building(&self, b: &Building) -> Option<(usize, NodeId)> {
+    fn same_building(&self, b: &Arc<Building>) -> Option<(usize, NodeId)> {
         let &(i, n) = self.buildings.get(&b.id)?;
-        (self.city.buildings.get(i)? == b).then_some((i, n))
+        let old = self.city.buildings.get(i)?;
+        (Arc::ptr_eq(old, b) || **old == **b).then_some((i, n))
     }
 }
 
 impl SceneReuse for OldScene {
-    fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused> {
+    fn building(
+        &self,
+        b: &Arc<Building>,
+        dress: Option<&Arc<Dress>>,
+        cell: Option<u64>,
+    ) -> Option<Reused> {
         let &(i, n) = self.buildings.get(&b.id)?;
         let old_cell = self.city.building_cells.get(i).copied();
         if old_cell != cell {
             return None;
         }
-        // Made from the same keys: equal; otherwise compared in full.
-        let same = match self.memo.same_keys(b.id) {
-            Some(same) => same,
-            None => {
-                self.city.buildings.get(i)? == b
-                    && self.city.dresses.get(i).and_then(Option::as_ref) == dress
-            }
-        };
+        // The same building and skin (shared with the old city, which is how the memo
+        // hands reused ones out), or made from the same keys: equal; otherwise compared
+        // in full.
+        let old = self.city.buildings.get(i)?;
+        let old_dress = self.city.dresses.get(i).and_then(Option::as_ref);
+        let shared = Arc::ptr_eq(old, b)
+            && match (old_dress, dress) {
+                (Some(x), Some(y)) => Arc::ptr_eq(x, y),
+                (None, None) => true,
+                _ => false,
+            };
+        let same = shared
+            || match self.memo.same_keys(b.id) {
+                Some(same) => same,
+                None => **old == **b && old_dress.map(|d| &**d) == dress.map(|d| &**d),
+            };
         if !same {
             return None;
         }
@@ -201,7 +215,7 @@ impl SceneReuse for OldScene {
         Some(leaf)
     }
 
-    fn coarse(&self, b: &Building) -> Option<Option<Mesh>> {
+    fn coarse(&self, b: &Arc<Building>) -> Option<Option<Mesh>> {
         // A building reused whole was compared already.
         let n = match self.buildings.get(&b.id) {
             Some(&(i, n)) if self.same_building_at(i) => n,
