@@ -3,6 +3,7 @@
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Duration;
 
 use polis_buildings::Building;
@@ -151,14 +152,18 @@ pub struct City {
     /// The lot subdivision's split lines in the order they were cut, with the id of the
     /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]).
     pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
-    /// Buildings (one per built lot; `id` = the lot's id).
-    pub buildings: Vec<Building>,
+    /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
+    /// building an edit leaves alone is shared between the cities before and after it
+    /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy
+    /// to change.
+    pub buildings: Vec<Arc<Building>>,
     /// Cell of each building (parallel to `buildings`).
     pub building_cells: Vec<u64>,
     /// Shared facade tile sets, one per style in use.
     pub tile_sets: Vec<TileSet>,
     /// Facade skin of each building (parallel to `buildings`).
-    pub dresses: Vec<Option<Dress>>,
+    /// Each is behind an `Arc`, shared like [`buildings`](Self::buildings).
+    pub dresses: Vec<Option<Arc<Dress>>>,
     /// The 3-D scene (empty when `scene` was switched off).
     pub scene: Scene,
     /// Counts and timings.

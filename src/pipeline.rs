@@ -586,7 +586,7 @@ impl Pipeline {
                     ticker.tick();
                     return Ok(None);
                 };
-                let r = builder.build(&LotInput {
+                let r = builder.build_shared(&LotInput {
                     id: plan.build_id,
                     lot: &l.lot,
                     kind: plan.kind,
@@ -597,8 +597,11 @@ impl Pipeline {
                 // A reseeded lot's building was drawn under another id: give it its own.
                 r.map(|b| {
                     b.map(|mut b| {
-                        b.id = l.id;
-                        b.lot_id = l.id;
+                        if b.id != l.id || b.lot_id != l.id {
+                            let own = Arc::make_mut(&mut b);
+                            own.id = l.id;
+                            own.lot_id = l.id;
+                        }
                         (b, plan.style)
                     })
                 })
@@ -633,7 +636,7 @@ impl Pipeline {
             .par_iter()
             .zip(&styles)
             .map(|(b, style)| {
-                let r = dresser.dress_styled(b, cx.seed(Stage::Facades, b.id), style.as_deref());
+                let r = dresser.dress_shared(b, cx.seed(Stage::Facades, b.id), style.as_deref());
                 ticker.tick();
                 r
             })
@@ -738,13 +741,17 @@ pub struct CityChunk {
     pub green_spaces: Vec<PolygonWithHoles>,
     /// The lot subdivision's split lines with their block ids, cell by cell.
     pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
-    /// Buildings (one per built lot; `id` = the lot's id).
-    pub buildings: Vec<Building>,
+    /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
+    /// building an edit leaves alone is shared between the cities before and after it
+    /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy
+    /// to change.
+    pub buildings: Vec<Arc<Building>>,
     /// Cell of each building (parallel to `buildings`).
     pub building_cells: Vec<u64>,
     /// Facade skin of each building (parallel to `buildings`), textured with the tile
     /// sets of the city [`Pipeline::stream`] returns.
-    pub dresses: Vec<Option<Dress>>,
+    /// Each is behind an `Arc`, shared like [`buildings`](Self::buildings).
+    pub dresses: Vec<Option<Arc<Dress>>>,
 }
 
 impl CityChunk {

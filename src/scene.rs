@@ -410,10 +410,10 @@ pub(crate) struct SceneInputs<'a> {
     pub maps: &'a CityMaps,
     pub network: &'a RoadNetwork,
     pub blocks: &'a [Block],
-    pub buildings: &'a [Building],
+    pub buildings: &'a [std::sync::Arc<Building>],
     /// Cell id of each building.
     pub building_cells: &'a [u64],
-    pub dresses: &'a [Option<Dress>],
+    pub dresses: &'a [Option<std::sync::Arc<Dress>>],
     pub tile_sets: &'a [TileSet],
     /// Green spaces of the lot stage (parks on the ground).
     pub green_spaces: &'a [PolygonWithHoles],
@@ -427,9 +427,14 @@ pub(crate) struct SceneInputs<'a> {
 /// ground, the palette, the configuration) are those of the earlier scene.
 pub(crate) trait SceneReuse: Sync {
     /// The leaf of building `b` (with skin `dress`, in cell `cell`).
-    fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused>;
+    fn building(
+        &self,
+        b: &std::sync::Arc<Building>,
+        dress: Option<&std::sync::Arc<Dress>>,
+        cell: Option<u64>,
+    ) -> Option<Reused>;
     /// The coarse level-of-detail box of building `b` (`Some(None)`: it had none).
-    fn coarse(&self, b: &Building) -> Option<Option<Mesh>>;
+    fn coarse(&self, b: &std::sync::Arc<Building>) -> Option<Option<Mesh>>;
     /// The leaf of block `b`.
     fn block(&self, b: &Block) -> Option<Reused>;
 }
@@ -686,7 +691,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                     tile_sets: inp.tile_sets,
                     foot,
                 };
-                let dress = inp.dresses.get(i).and_then(Option::as_ref);
+                let dress = inp.dresses.get(i).and_then(Option::as_deref);
                 building_leaf(&leaf, b, dress, inp.building_cells.get(i).copied())
             })
             .collect()
@@ -1025,7 +1030,7 @@ mod tests {
         let tiles: Vec<MaterialId> = pal.tiles.iter().flatten().copied().collect();
         let mut dressed = 0;
         for (b, dress) in city.buildings.iter().zip(&city.dresses) {
-            let meshes = building_meshes(b, dress.as_ref(), &pal, None).unwrap();
+            let meshes = building_meshes(b, dress.as_deref(), &pal, None).unwrap();
             let (skins, mass): (Vec<&Mesh>, Vec<&Mesh>) = meshes
                 .iter()
                 .partition(|m| m.material.is_some_and(|k| tiles.contains(&k)));

@@ -392,6 +392,17 @@ pub trait BuildLot: Send + Sync {
     /// # Errors
     /// Failures of this lot: the pipeline skips the lot and reports the error.
     fn build(&self, lot: &LotInput<'_>) -> Result<Option<Building>>;
+
+    /// [`build`](Self::build), the building behind an [`Arc`](std::sync::Arc) as the
+    /// city keeps it ([`City::buildings`](crate::City::buildings)). The default wraps
+    /// `build`'s result; a builder that keeps its results (the editor's memo) hands out
+    /// a pointer to one instead of a copy.
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    fn build_shared(&self, lot: &LotInput<'_>) -> Result<Option<std::sync::Arc<Building>>> {
+        self.build(lot).map(|b| b.map(std::sync::Arc::new))
+    }
 }
 
 /// The building stage: prepares (grammars, templates) once per city, then builds lots,
@@ -519,6 +530,23 @@ pub trait DressBuilding: Send + Sync {
     ) -> Result<Option<Dress>> {
         let _ = style;
         self.dress(building, seed)
+    }
+
+    /// [`dress_styled`](Self::dress_styled), the skin behind an
+    /// [`Arc`](std::sync::Arc) as the city keeps it ([`City::dresses`](crate::City::dresses)).
+    /// The default wraps `dress_styled`'s result; a dresser that keeps its results (the
+    /// editor's memo) hands out a pointer to one instead of a copy.
+    ///
+    /// # Errors
+    /// As [`dress`](Self::dress).
+    fn dress_shared(
+        &self,
+        building: &Building,
+        seed: u64,
+        style: Option<&str>,
+    ) -> Result<Option<std::sync::Arc<Dress>>> {
+        self.dress_styled(building, seed, style)
+            .map(|d| d.map(std::sync::Arc::new))
     }
 }
 

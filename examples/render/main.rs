@@ -252,7 +252,7 @@ fn run(args: Args) -> BoxResult<()> {
 
 /// Downtown: among the tallest hundredth of the buildings, the one with the most height
 /// of the others within 400 m (layout metres); the origin for a city without buildings.
-fn downtown(buildings: &[polis::buildings::Building]) -> [f64; 2] {
+fn downtown(buildings: &[std::sync::Arc<polis::buildings::Building>]) -> [f64; 2] {
     let mut by_height: Vec<_> = buildings
         .iter()
         .filter(|b| b.height.is_finite() && b.origin.is_finite())

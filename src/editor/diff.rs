@@ -2,6 +2,7 @@
 //! [`ChangeEvents`] a host applies to its meshes.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
 
 use polis_geom::DVec2;
 use polis_geom::par;
@@ -104,9 +105,20 @@ fn same_roads(a: &polis_roads::RoadNetwork, b: &polis_roads::RoadNetwork) -> boo
 
 /// A building with its skin.
 type Dressed<'a> = (
-    &'a polis_buildings::Building,
-    Option<&'a crate::stages::Dress>,
+    &'a Arc<polis_buildings::Building>,
+    Option<&'a Arc<crate::stages::Dress>>,
 );
+
+/// Whether two buildings with their skins differ: not where both are shared (the same
+/// `Arc`s, as the memo hands out reused ones), else compared in full.
+fn differ(a: &Dressed<'_>, b: &Dressed<'_>) -> bool {
+    let same_skin = match (a.1, b.1) {
+        (Some(x), Some(y)) => Arc::ptr_eq(x, y) || x == y,
+        (None, None) => true,
+        _ => false,
+    };
+    !(same_skin && (Arc::ptr_eq(a.0, b.0) || a.0 == b.0))
+}
 
 /// A city's buildings with their index and skin, by id.
 fn buildings_of(c: &City) -> BTreeMap<u64, (usize, Dressed<'_>)> {
@@ -159,7 +171,7 @@ pub(super) fn changes(
                         .map(|(k, (_, v))| (k, v))
                         .collect();
                     delta_by(&buildings_of(old), &new_b, |(i, v), w| {
-                        !same_building(*i) && v != w
+                        !same_building(*i) && differ(v, w)
                     })
                 },
             )

@@ -145,9 +145,12 @@ struct Fingerprints {
 pub(crate) struct Memo {
     growth: Mutex<Store<std::result::Result<SecondaryRoads, Skip>>>,
     lots: Mutex<Store<CellLots>>,
-    buildings: Mutex<Store<Option<Building>>>,
-    dresses: Mutex<Store<Option<Dress>>>,
+    buildings: Mutex<Store<Option<Arc<Building>>>>,
+    dresses: Mutex<Store<Option<Arc<Dress>>>>,
     dresser: Mutex<Option<(Key, Arc<dyn DressBuilding>)>>,
+    /// The building generator of the last run (its grammars parsed), by
+    /// [`Fingerprints::buildings`].
+    builder: Mutex<Option<(Key, Arc<dyn BuildLot>)>>,
     redone: Mutex<Redone>,
     /// The input keys of each building and skin, by the building's id (see [`IdKeys`]).
     ids: Mutex<IdKeys>,
@@ -416,24 +419,39 @@ struct MemoBuildings(Arc<Memo>);
 
 impl BuildingStage for MemoBuildings {
     fn prepare<'a>(&'a self, cx: &StageContext<'a>) -> Result<Box<dyn BuildLot + 'a>> {
+        let fingerprint = self.0.fingerprints().buildings;
+        let mut cached = lock(&self.0.builder);
+        let inner = match &*cached {
+            Some((k, b)) if *k == fingerprint => Arc::clone(b),
+            _ => {
+                let b: Arc<dyn BuildLot> = Arc::new(polis_buildings::BuildingGenerator::new(
+                    cx.config.effective_building_params(),
+                )?);
+                *cached = Some((fingerprint, Arc::clone(&b)));
+                b
+            }
+        };
         Ok(Box::new(MemoBuild {
             memo: &self.0,
-            inner: Box::new(polis_buildings::BuildingGenerator::new(
-                cx.config.effective_building_params(),
-            )?),
-            fingerprint: self.0.fingerprints().buildings,
+            inner,
+            fingerprint,
         }))
     }
 }
 
 struct MemoBuild<'a> {
     memo: &'a Memo,
-    inner: Box<dyn BuildLot>,
+    inner: Arc<dyn BuildLot>,
     fingerprint: Key,
 }
 
 impl BuildLot for MemoBuild<'_> {
     fn build(&self, lot: &LotInput<'_>) -> Result<Option<Building>> {
+        Ok(self.build_shared(lot)?.map(|b| (*b).clone()))
+    }
+
+    /// The building of `lot`: a pointer to the memo's where its key was seen before.
+    fn build_shared(&self, lot: &LotInput<'_>) -> Result<Option<Arc<Building>>> {
         let l = lot.lot;
         let mut key = Key::new(0x626C_6467)
             .key(self.fingerprint)
@@ -453,7 +471,7 @@ impl BuildLot for MemoBuild<'_> {
         if let Some(v) = hit {
             return Ok((*v).clone());
         }
-        let v = self.inner.build(lot)?;
+        let v = self.inner.build(lot)?.map(Arc::new);
         lock(&self.memo.buildings).put(key, Arc::new(v.clone()));
         lock(&self.memo.redone).buildings += 1;
         Ok(v)
@@ -502,13 +520,23 @@ impl DressBuilding for MemoDress<'_> {
     }
 
     fn dress_styled(&self, b: &Building, seed: u64, style: Option<&str>) -> Result<Option<Dress>> {
+        Ok(self.dress_shared(b, seed, style)?.map(|d| (*d).clone()))
+    }
+
+    /// The skin of `b`: a pointer to the memo's where its key was seen before.
+    fn dress_shared(
+        &self,
+        b: &Building,
+        seed: u64,
+        style: Option<&str>,
+    ) -> Result<Option<Arc<Dress>>> {
         let key = self.key(b, seed, style);
         lock(&self.memo.ids).this_dressed.insert(b.id, key);
         let hit = lock(&self.memo.dresses).get(key);
         if let Some(v) = hit {
             return Ok((*v).clone());
         }
-        let v = self.inner.dress_styled(b, seed, style)?;
+        let v = self.inner.dress_styled(b, seed, style)?.map(Arc::new);
         lock(&self.memo.dresses).put(key, Arc::new(v.clone()));
         lock(&self.memo.redone).dresses += 1;
         Ok(v)

@@ -209,8 +209,8 @@ pub(super) fn patch_lots(
             // A building appears or disappears.
             _ => return None,
         };
-        let same = city.buildings.get(k)? == &b
-            && city.dresses.get(k)?.as_ref() == d.as_ref()
+        let same = **city.buildings.get(k)? == b
+            && city.dresses.get(k)?.as_deref() == d.as_ref()
             && *city.building_cells.get(k)? == l.cell;
         if same {
             continue;
@@ -256,12 +256,12 @@ pub(super) fn patch_lots(
             scene_nodes
                 .changed
                 .push(crate::scene::building_node_name(b.id));
-            *slot = b;
+            *slot = std::sync::Arc::new(b);
         }
         if let Some(slot) = city.dresses.get_mut(k) {
             stats.dressed_buildings = (stats.dressed_buildings + usize::from(d.is_some()))
                 .saturating_sub(usize::from(slot.is_some()));
-            *slot = d;
+            *slot = d.map(std::sync::Arc::new);
         }
         cells.insert(cell);
     }

@@ -11,11 +11,12 @@
 //! grading on nothing is reused. The scene so made is the scene `assemble` would make:
 //! reuse only skips recomputing identical parts.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use polis_buildings::Building;
+use polis_geom::metadata::Metadata;
 use polis_geom::scene::NodeId;
 use polis_geom::{Mesh, Transform};
 use polis_lots::Block;
@@ -45,21 +46,27 @@ pub(super) fn scene_key(config: &CityConfig) -> Option<Key> {
     Some(Key::new(0x7363_656E).bytes(text.as_bytes()))
 }
 
-/// The scene of a city before an edit, indexed for reuse. Its meshes are moved out of
-/// the city (which keeps its node tree) into slots, and a reused leaf takes its meshes
-/// from their slots rather than copying them: the city before the edit is dropped when
-/// the edit succeeds, and its meshes are put back ([`OldScene::restore`]) when it fails.
+/// The scene of a city before an edit, indexed for reuse. Its meshes, and the names and
+/// metadata of its block and building leaves, are moved out of the city (which keeps its
+/// node tree) into slots, and a reused leaf takes them from their slots rather than
+/// copying them: the city before the edit is dropped when the edit succeeds, and what it
+/// lent is put back ([`OldScene::restore`]) when it fails.
 pub(super) struct OldScene {
     city: Arc<City>,
     /// The city's scene meshes, by mesh id; `None` once taken by a reused leaf.
     meshes: Vec<Mutex<Option<Mesh>>>,
+    /// The name and metadata of each indexed leaf, by its index in `buildings` then
+    /// `blocks` order of [`Lent::leaves`]; `None` once taken.
+    names: Vec<Mutex<Option<(String, Metadata)>>>,
+    /// The node each slot of `names` came from.
+    named: Vec<NodeId>,
     /// The editor's memo: which buildings and skins were made from the same keys as
     /// the old city's (equal without comparing them).
     memo: Arc<Memo>,
-    /// Building id → (index in the city's buildings, node).
-    buildings: BTreeMap<u64, (usize, NodeId)>,
-    /// Block id → (index in the city's blocks, node).
-    blocks: BTreeMap<u64, (usize, NodeId)>,
+    /// Building id → (index in the city's buildings, node, slot in `names`).
+    buildings: HashMap<u64, (usize, NodeId, usize)>,
+    /// Block id → (index in the city's blocks, node, slot in `names`).
+    blocks: HashMap<u64, (usize, NodeId, usize)>,
     /// Per old building (by index): found equal to the new one (building, skin and cell)
     /// and reused; the change events then need not compare it again.
     same_buildings: Vec<AtomicBool>,
@@ -67,46 +74,96 @@ pub(super) struct OldScene {
     same_blocks: Vec<AtomicBool>,
 }
 
+/// What [`OldScene::lend`] moved out of a city: its scene's meshes and the names and
+/// metadata of its leaves, with their index.
+pub(super) struct Lent {
+    meshes: Vec<Mesh>,
+    names: Vec<(String, Metadata)>,
+    named: Vec<NodeId>,
+    buildings: HashMap<u64, (usize, NodeId, usize)>,
+    blocks: HashMap<u64, (usize, NodeId, usize)>,
+}
+
+/// Values in slots of their own, to be taken once each.
+fn slots<T>(v: Vec<T>) -> Vec<Mutex<Option<T>>> {
+    v.into_iter().map(|m| Mutex::new(Some(m))).collect()
+}
+
+/// The values of `slots`, if none was taken.
+fn unslot_all<T>(slots: Vec<Mutex<Option<T>>>) -> Option<Vec<T>> {
+    slots
+        .into_iter()
+        .map(|slot| slot.into_inner().unwrap_or_else(PoisonError::into_inner))
+        .collect()
+}
+
 impl OldScene {
-    /// Indexes `city`'s scene leaves by the ids in their names; `meshes` are the
-    /// scene's meshes, taken out of it.
-    pub(super) fn new(city: Arc<City>, meshes: Vec<Mesh>, memo: Arc<Memo>) -> Self {
-        let building_at: BTreeMap<u64, usize> = city
+    /// Indexes `city`'s scene leaves by the ids in their names and moves out of it its
+    /// scene's meshes and its leaves' names and metadata.
+    pub(super) fn lend(city: &mut City) -> Lent {
+        let building_at: HashMap<u64, usize> = city
             .buildings
             .iter()
             .enumerate()
             .map(|(i, b)| (b.id, i))
             .collect();
-        let block_at: BTreeMap<u64, usize> = city
+        let block_at: HashMap<u64, usize> = city
             .blocks
             .iter()
             .enumerate()
             .map(|(i, b)| (b.id(), i))
             .collect();
-        let mut buildings = BTreeMap::new();
-        let mut blocks = BTreeMap::new();
-        for (n, node) in city.scene.nodes.iter().enumerate() {
+        let mut buildings = HashMap::with_capacity(building_at.len());
+        let mut blocks = HashMap::with_capacity(block_at.len());
+        let mut names = Vec::with_capacity(building_at.len() + block_at.len());
+        let mut named = Vec::with_capacity(names.capacity());
+        for (n, node) in city.scene.nodes.iter_mut().enumerate() {
             let id = |kind: &str| crate::scene::node_id(&node.name, kind);
             let node_id = NodeId(n as u32);
-            if let Some(id) = id("building") {
-                if let Some(&i) = building_at.get(&id) {
-                    buildings.insert(id, (i, node_id));
-                }
-            } else if let Some(id) = id("block")
-                && let Some(&i) = block_at.get(&id)
-            {
-                blocks.insert(id, (i, node_id));
+            let slot = names.len();
+            let indexed = if let Some(id) = id("building") {
+                building_at
+                    .get(&id)
+                    .map(|&i| buildings.insert(id, (i, node_id, slot)))
+                    .is_some()
+            } else if let Some(id) = id("block") {
+                block_at
+                    .get(&id)
+                    .map(|&i| blocks.insert(id, (i, node_id, slot)))
+                    .is_some()
+            } else {
+                false
+            };
+            if indexed {
+                names.push((
+                    std::mem::take(&mut node.name),
+                    std::mem::take(&mut node.metadata),
+                ));
+                named.push(node_id);
             }
         }
+        Lent {
+            meshes: std::mem::take(&mut city.scene.meshes),
+            names,
+            named,
+            buildings,
+            blocks,
+        }
+    }
+
+    /// The scene of `city` from what [`lend`](Self::lend) moved out of it.
+    pub(super) fn new(city: Arc<City>, lent: Lent, memo: Arc<Memo>) -> Self {
         let flags = |n: usize| (0..n).map(|_| AtomicBool::new(false)).collect();
         OldScene {
-            meshes: meshes.into_iter().map(|m| Mutex::new(Some(m))).collect(),
+            meshes: slots(lent.meshes),
+            names: slots(lent.names),
+            named: lent.named,
             memo,
             same_buildings: flags(city.buildings.len()),
             same_blocks: flags(city.blocks.len()),
             city,
-            buildings,
-            blocks,
+            buildings: lent.buildings,
+            blocks: lent.blocks,
         }
     }
 
@@ -130,13 +187,20 @@ impl OldScene {
             .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
-    /// The scene's meshes put back, if no leaf took one (the edit failed before the
-    /// scene was assembled); `None` otherwise.
-    pub(super) fn restore(self) -> Option<Vec<Mesh>> {
-        self.meshes
-            .into_iter()
-            .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
-            .collect()
+    /// What the city lent put back into it, if no leaf took any of it (the edit failed
+    /// before the scene was assembled); `false` (and `city` unchanged) otherwise.
+    pub(super) fn restore(self, city: &mut City) -> bool {
+        let (Some(meshes), Some(names)) = (unslot_all(self.meshes), unslot_all(self.names)) else {
+            return false;
+        };
+        for (n, (name, metadata)) in self.named.iter().zip(names) {
+            if let Some(node) = city.scene.nodes.get_mut(n.0 as usize) {
+                node.name = name;
+                node.metadata = metadata;
+            }
+        }
+        city.scene.meshes = meshes;
+        true
     }
 
     /// Takes mesh `m` out of its slot.
@@ -148,63 +212,79 @@ impl OldScene {
             .take()
     }
 
-    /// The node `n` as a reusable leaf (name, translation, metadata, meshes).
-    fn leaf(&self, n: NodeId) -> Option<Reused> {
+    /// The node `n` (its name and metadata in slot `slot`) as a reusable leaf (name,
+    /// translation, metadata, meshes).
+    fn leaf(&self, n: NodeId, slot: usize) -> Option<Reused> {
         let scene = &self.city.scene;
         let node = scene.nodes.get(n.0 as usize)?;
         let Transform::Trs { translation, .. } = node.transform else {
             return None;
         };
-        // A leaf is reused at most once (ids are unique), so its meshes are there.
+        // A leaf is reused at most once (ids are unique), so its parts are there.
         let meshes = node
             .meshes
             .iter()
             .map(|m| self.take(m.0 as usize))
             .collect::<Option<Vec<Mesh>>>()?;
-        Some((
-            node.name.clone(),
-            translation,
-            node.metadata.clone(),
-            meshes,
-        ))
+        let (name, metadata) = self
+            .names
+            .get(slot)?
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()?;
+        Some((name, translation, metadata, meshes))
     }
 
     /// The old building with `b`'s id if it equals `b`: its index and node.
-    fn same_building(&self, b: &Building) -> Option<(usize, NodeId)> {
-        let &(i, n) = self.buildings.get(&b.id)?;
-        (self.city.buildings.get(i)? == b).then_some((i, n))
+    fn same_building(&self, b: &Arc<Building>) -> Option<(usize, NodeId)> {
+        let &(i, n, _) = self.buildings.get(&b.id)?;
+        let old = self.city.buildings.get(i)?;
+        (Arc::ptr_eq(old, b) || **old == **b).then_some((i, n))
     }
 }
 
 impl SceneReuse for OldScene {
-    fn building(&self, b: &Building, dress: Option<&Dress>, cell: Option<u64>) -> Option<Reused> {
-        let &(i, n) = self.buildings.get(&b.id)?;
+    fn building(
+        &self,
+        b: &Arc<Building>,
+        dress: Option<&Arc<Dress>>,
+        cell: Option<u64>,
+    ) -> Option<Reused> {
+        let &(i, n, slot) = self.buildings.get(&b.id)?;
         let old_cell = self.city.building_cells.get(i).copied();
         if old_cell != cell {
             return None;
         }
-        // Made from the same keys: equal; otherwise compared in full.
-        let same = match self.memo.same_keys(b.id) {
-            Some(same) => same,
-            None => {
-                self.city.buildings.get(i)? == b
-                    && self.city.dresses.get(i).and_then(Option::as_ref) == dress
-            }
-        };
+        // The same building and skin (shared with the old city, which is how the memo
+        // hands reused ones out), or made from the same keys: equal; otherwise compared
+        // in full.
+        let old = self.city.buildings.get(i)?;
+        let old_dress = self.city.dresses.get(i).and_then(Option::as_ref);
+        let shared = Arc::ptr_eq(old, b)
+            && match (old_dress, dress) {
+                (Some(x), Some(y)) => Arc::ptr_eq(x, y),
+                (None, None) => true,
+                _ => false,
+            };
+        let same = shared
+            || match self.memo.same_keys(b.id) {
+                Some(same) => same,
+                None => **old == **b && old_dress.map(|d| &**d) == dress.map(|d| &**d),
+            };
         if !same {
             return None;
         }
-        let leaf = self.leaf(n)?;
+        let leaf = self.leaf(n, slot)?;
         if let Some(f) = self.same_buildings.get(i) {
             f.store(true, Ordering::Relaxed);
         }
         Some(leaf)
     }
 
-    fn coarse(&self, b: &Building) -> Option<Option<Mesh>> {
+    fn coarse(&self, b: &Arc<Building>) -> Option<Option<Mesh>> {
         // A building reused whole was compared already.
         let n = match self.buildings.get(&b.id) {
-            Some(&(i, n)) if self.same_building_at(i) => n,
+            Some(&(i, n, _)) if self.same_building_at(i) => n,
             _ => self.same_building(b)?.1,
         };
         let scene = &self.city.scene;
@@ -223,11 +303,11 @@ impl SceneReuse for OldScene {
     }
 
     fn block(&self, b: &Block) -> Option<Reused> {
-        let &(i, n) = self.blocks.get(&b.id())?;
+        let &(i, n, slot) = self.blocks.get(&b.id())?;
         if self.city.blocks.get(i)? != b {
             return None;
         }
-        let leaf = self.leaf(n)?;
+        let leaf = self.leaf(n, slot)?;
         if let Some(f) = self.same_blocks.get(i) {
             f.store(true, Ordering::Relaxed);
         }

@@ -511,13 +511,14 @@ impl CityEditor {
         // scene as it stands.
         let reuse = match (scene_key(&self.config), scene_key(&config)) {
             (Some(a), Some(b)) if a == b && !self.city.scene.nodes.is_empty() => {
-                // The meshes move into the splice (the city keeps its nodes).
+                // The meshes and the leaves' names move into the splice (the city keeps
+                // its node tree).
                 Arc::get_mut(&mut self.city)
-                    .map(|c| std::mem::take(&mut c.scene.meshes))
-                    .map(|meshes| {
+                    .map(OldScene::lend)
+                    .map(|lent| {
                         Arc::new(OldScene::new(
                             Arc::clone(&self.city),
-                            meshes,
+                            lent,
                             Arc::clone(&self.memo),
                         ))
                     })
@@ -559,9 +560,9 @@ impl CityEditor {
     /// stands (the memo holds every result of it, so only the scene is made anew).
     fn restore(&mut self, reuse: Option<Arc<OldScene>>) -> Result<()> {
         let Some(reuse) = reuse else { return Ok(()) };
-        let meshes = Arc::try_unwrap(reuse).ok().and_then(OldScene::restore);
-        if let (Some(meshes), Some(city)) = (meshes, Arc::get_mut(&mut self.city)) {
-            city.scene.meshes = meshes;
+        if let (Ok(reuse), Some(city)) = (Arc::try_unwrap(reuse), Arc::get_mut(&mut self.city))
+            && reuse.restore(city)
+        {
             return Ok(());
         }
         self.index = None;
