@@ -233,10 +233,25 @@ try {
   await page.click('#modes button[data-mode=node]');
   await page.click('#tools button[data-tool=select]');
   const before = await page.evaluate((a) => window.polis.state.nodes.get(a), a);
-  // Outward from the loop's centre (node a is its top corner) and a little aside: the
-  // loop grows, so its two roads at a cannot be re-plotted across each other (dragging
-  // a across the loop's inside was refused on the full citygen preset).
-  const dragTo = [before.x + 0.05 * tri.r, before.y + 0.2 * tri.r];
+  // Outward from the loop's centre (node a is its top corner) and a little aside, so the
+  // loop grows and its two roads at a cannot be re-plotted across each other. Where the
+  // roads plotted over the terrain still would cross or meet at too sharp an angle (the
+  // full citygen preset refused the first such target), the server's preview picks the
+  // first of a few targets it accepts: the drag below must then commit.
+  const dragTo = await page.evaluate(async ([a, r]) => {
+    const n = window.polis.state.nodes.get(a);
+    const candidates = [];
+    for (const scale of [0.2, 0.12, 0.3]) {
+      for (const turn of [0.05, -0.05, 0.5, -0.5, 1.0, -1.0]) {
+        candidates.push([n.x + turn * scale * r, n.y + scale * r]);
+      }
+    }
+    for (const to of candidates) {
+      const pv = await window.polis.preview({ op: 'move_node', node: a, to });
+      if (pv.ok) return to;
+    }
+    return candidates[0];
+  }, [a, tri.r]);
   rev = await revision();
   {
     const [sx, sy] = await toPage(before.x, before.y);
@@ -307,12 +322,21 @@ async function bench(page, node, tri) {
     const p = window.polis;
     const cell = p.plan.hitCell(centre[0], centre[1]);
     const start = p.state.nodes.get(node);
+    // The moves: 6 m from the node's start in 24 directions, those the server accepts
+    // from the start (asked before the clock runs; a move it would refuse re-plots no
+    // roads and regrows no cell, so it would not be the edit being timed).
+    const moves = [];
+    for (let k = 0; k < 24; k++) {
+      const a = (k / 24) * 2 * Math.PI;
+      const to = [start.x + 6 * Math.cos(a), start.y + 6 * Math.sin(a)];
+      if ((await p.preview({ op: 'move_node', node, to })).ok) moves.push(to);
+    }
+    if (moves.length === 0) moves.push([start.x, start.y]);
     const first = p.state.roundTrips.length;
     const draws = [];
     for (let i = 0; i < n; i++) {
       if (i % 2 === 0) {
-        const a = (i / n) * 2 * Math.PI;
-        await p.commit({ op: 'move_node', node, to: [start.x + 6 * Math.cos(a), start.y + 6 * Math.sin(a)] });
+        await p.commit({ op: 'move_node', node, to: moves[(i / 2) % moves.length] });
       } else {
         const c = p.state.cells.get(p.plan.hitCell(centre[0], centre[1])) ? p.plan.hitCell(centre[0], centre[1]) : cell;
         await p.commit({ op: 'set_cell_param', cell: c, param: { building_height: { value: 6 + (i % 7), deviance: 0.1 } } });
@@ -320,7 +344,7 @@ async function bench(page, node, tri) {
       await new Promise((r) => requestAnimationFrame(() => r()));
       draws.push(p.plan.drawMs);
     }
-    return { rt: p.state.roundTrips.slice(first), server: p.state.serverMs.slice(first), edit: p.state.editMs.slice(first), draws, errors: p.state.errors };
+    return { rt: p.state.roundTrips.slice(first), server: p.state.serverMs.slice(first), edit: p.state.editMs.slice(first), draws, errors: p.state.errors, moves: moves.length };
   }, [node, BENCH, tri.centre]);
   const q = (xs, f) => {
     const s = [...xs].sort((x, y) => x - y);
@@ -328,7 +352,7 @@ async function bench(page, node, tri) {
   };
   const row = (name, xs) => `${name}: p50 ${q(xs, 0.5).toFixed(1)} ms, p95 ${q(xs, 0.95).toFixed(1)} ms, max ${Math.max(...xs).toFixed(1)} ms`;
   const lines = [
-    `${result.rt.length} edits (${ARGS.join(' ')})`,
+    `${result.rt.length} edits (${ARGS.join(' ')}; node moves among ${result.moves} accepted targets)`,
     row('round trip', result.rt),
     row('server', result.server),
     row('  of which the editor (apply + regenerate)', result.edit),

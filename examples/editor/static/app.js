@@ -591,6 +591,9 @@ window.polis = {
   setMode,
   setTool,
   commit,
+  // Asks the server whether an action would be accepted, without committing it (what
+  // the cursor's preview does): {ok, message, proposed, roads, nodes}.
+  preview: async (action) => (await call('POST', '/api/preview', action)).data,
   undo: () => run('POST', '/api/undo'),
   redo: () => run('POST', '/api/redo'),
   summary: () => ({
