@@ -351,3 +351,27 @@ fn roads_are_graded_and_earthworks_reported() {
     let bare = polis::generate(&config).unwrap();
     assert!(!bare.scene.nodes.iter().any(|n| n.name == "ground"));
 }
+
+/// The bridges of `manhattan` (its two highway bridges at full size): every deck and
+/// pier in the `bridges` node is a closed, 2-manifold, outward shell by the edge-use
+/// check, one deck per bridge at least.
+#[test]
+fn bridge_decks_and_piers_are_closed_solids() {
+    let mut c = CityConfig::preset("manhattan").unwrap();
+    c.facades.pixels_per_metre = 1.0;
+    c.scene.terrain = false;
+    let city = polis::generate(&c).unwrap();
+    let bridges = city.roads.edges().filter(|(_, _, _, r)| r.bridge).count();
+    assert!(bridges > 0, "manhattan has bridges");
+    let meshes: Vec<&Mesh> = city
+        .scene
+        .nodes
+        .iter()
+        .filter(|n| n.name == "bridges")
+        .flat_map(|n| n.meshes.iter().map(|m| &city.scene.meshes[m.index()]))
+        .collect();
+    let report = polis::geom::mesh::edge_use(meshes);
+    eprintln!("{bridges} bridge roads: {report:?}");
+    assert!(report.is_solid_shells(), "{report:?}");
+    assert!(report.components >= 1 && report.components <= bridges * 64);
+}
