@@ -338,11 +338,25 @@ fn roads_are_graded_and_earthworks_reported() {
     let report = city.statistics().unwrap();
     assert_eq!(report.earthworks.cut_m3, w.cut_m3);
     assert!(report.to_string().contains("cut / fill"));
+    // The ground is its own node in the glb (the tiled layout's layer `ground`) and its
+    // own groups in the OBJ.
+    let glb_has_ground = |city: &City| {
+        let mut glb = Vec::new();
+        city.write_glb(&mut glb).unwrap();
+        let doc = polis::export::gltf::Gltf::from_slice(&glb).unwrap();
+        doc.nodes().any(|n| n.name() == Some("ground"))
+    };
+    assert!(glb_has_ground(&city));
+    let (mut obj, mut files) = (Vec::new(), polis::export::sink::MemorySink::new());
+    polis::export::obj::write_obj(&city.scene, &Default::default(), &mut obj, &mut files).unwrap();
+    let obj = String::from_utf8(obj).unwrap();
+    assert!(obj.lines().any(|l| l.starts_with("g ground_")));
     let mut config = city.config.clone();
     config.scene.terrain = false;
     config.roads.max_segments = 80;
     let bare = polis::generate(&config).unwrap();
     assert!(!bare.scene.nodes.iter().any(|n| n.name == "ground"));
+    assert!(!glb_has_ground(&bare));
 }
 
 /// The bridges of `manhattan` (its two highway bridges at full size): every deck and
