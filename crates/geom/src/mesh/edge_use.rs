@@ -13,7 +13,9 @@
 //!   (a *flipped* edge).
 //!
 //! A surface passes when no edge is open, non-manifold or flipped, no triangle is
-//! degenerate, and the enclosed volume is positive (outward orientation).
+//! degenerate, and the enclosed volume is positive (outward orientation). A mesh of
+//! several solids (a bridge's deck and piers) is checked shell by shell:
+//! [`EdgeUseReport::shell_volumes`] holds each edge-connected component's volume.
 //! [`EdgeUseReport::flipped_triangles`] counts the triangles to reverse so every
 //! component agrees (the smaller side of each component's orientation classes).
 //!
@@ -80,6 +82,10 @@ pub struct EdgeUseReport {
     /// Signed volume, m³ (divergence theorem, `f64`): positive for an outward closed
     /// surface.
     pub signed_volume: f64,
+    /// Signed volume of each component (shell), m³, in the order of each shell's first
+    /// triangle: a mesh holding several solids (a bridge's deck and piers) is a set of
+    /// outward solids when it is closed and every one of these is positive.
+    pub shell_volumes: Vec<f64>,
 }
 
 impl EdgeUseReport {
@@ -98,6 +104,13 @@ impl EdgeUseReport {
     /// outward solid.
     pub fn is_solid(&self) -> bool {
         self.is_closed_manifold() && self.signed_volume > 0.0
+    }
+
+    /// [`is_closed_manifold`](Self::is_closed_manifold) with a positive volume in every
+    /// shell: each component an outward solid (an inside-out shell inside a larger one
+    /// passes [`is_solid`](Self::is_solid), not this).
+    pub fn is_solid_shells(&self) -> bool {
+        self.is_closed_manifold() && self.shell_volumes.iter().all(|&v| v > 0.0)
     }
 }
 
@@ -152,12 +165,14 @@ pub fn edge_use<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> EdgeUseReport
     }
     // Volume in f64 about the first welded vertex.
     let origin = reps.first().map_or(glam::DVec3::ZERO, |p| p.as_dvec3());
-    let mut six = 0.0;
-    for t in &tris {
-        let [a, b, c] = t.map(|i| reps[i as usize].as_dvec3() - origin);
-        six += a.dot(b.cross(c));
-    }
-    report.signed_volume = six / 6.0;
+    let sixes: Vec<f64> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| reps[i as usize].as_dvec3() - origin);
+            a.dot(b.cross(c))
+        })
+        .collect();
+    report.signed_volume = sixes.iter().sum::<f64>() / 6.0;
     // Directed uses: (low, high, runs low → high, triangle).
     let mut uses: Vec<(u32, u32, bool, u32)> = Vec::with_capacity(3 * tris.len());
     for (ti, t) in tris.iter().enumerate() {
@@ -208,11 +223,18 @@ pub fn edge_use<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> EdgeUseReport
         }
         k = end;
     }
-    // Per component, count triangles in each orientation class.
+    // Per component, count triangles in each orientation class and sum the volume.
     let mut counts: Vec<[usize; 2]> = vec![[0, 0]; tris.len()];
-    for t in 0..tris.len() as u32 {
-        let (root, p) = find(&mut parent, &mut parity, t);
+    let mut shell_of_root = vec![u32::MAX; tris.len()];
+    for (t, &six) in sixes.iter().enumerate() {
+        let (root, p) = find(&mut parent, &mut parity, t as u32);
         counts[root as usize][p as usize] += 1;
+        let shell = &mut shell_of_root[root as usize];
+        if *shell == u32::MAX {
+            *shell = report.shell_volumes.len() as u32;
+            report.shell_volumes.push(0.0);
+        }
+        report.shell_volumes[*shell as usize] += six / 6.0;
     }
     for c in &counts {
         if c[0] + c[1] > 0 {
@@ -337,8 +359,26 @@ mod tests {
         c.transform(&DMat4::from_translation(DVec3::X * 3.0))
             .unwrap();
         let r = edge_use([&a, &c]);
-        assert!(r.is_solid());
+        assert!(r.is_solid() && r.is_solid_shells());
         assert_eq!(r.components, 2);
+        assert_eq!(r.shell_volumes.len(), 2);
+        assert!(r.shell_volumes.iter().all(|v| (v - 1.0).abs() < 1e-9));
+        // A large cube with a small inside-out one inside: positive in total, one shell
+        // negative.
+        let mut big = cube();
+        big.transform(&DMat4::from_scale(DVec3::splat(4.0)))
+            .unwrap();
+        let mut small = cube();
+        small
+            .transform(&DMat4::from_translation(DVec3::ONE))
+            .unwrap();
+        small.flip();
+        let r = edge_use([&big, &small]);
+        assert!(r.is_solid() && !r.is_solid_shells());
+        assert_eq!(r.shell_volumes.len(), 2);
+        assert!(
+            (r.shell_volumes[0] - 64.0).abs() < 1e-9 && (r.shell_volumes[1] + 1.0).abs() < 1e-9
+        );
         // An open square sheet.
         let sheet = flat_polygon(
             &PolygonWithHoles::from(Polygon::rect(DVec2::ZERO, DVec2::ONE)),
@@ -393,8 +433,10 @@ mod tests {
             proptest::prop_assume!(poly.validate().is_ok());
             let m = prism(&PolygonWithHoles::from(poly.clone()), z0, z0 + h, None).unwrap();
             let r = m.edge_use();
-            proptest::prop_assert!(r.is_solid(), "{:?}", r);
+            proptest::prop_assert!(r.is_solid() && r.is_solid_shells(), "{:?}", r);
             let volume = poly.area() * h;
+            proptest::prop_assert_eq!(r.shell_volumes.len(), 1);
+            proptest::prop_assert!((r.shell_volumes[0] - r.signed_volume).abs() < 1e-9 * volume);
             proptest::prop_assert!((r.signed_volume - volume).abs() < 1e-4 * volume.max(1.0));
             // Euler: V − E + F = 2 for one closed genus-0 shell.
             proptest::prop_assert_eq!(
