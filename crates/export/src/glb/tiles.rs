@@ -543,7 +543,16 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         if !levels.is_empty() {
             extras.insert("lod_levels".into(), json!(levels));
         }
-        extras.insert("layers".into(), json!(layers));
+        // The layers that have a node: a node directly under the root that has no
+        // `layer` entry names a layer only if geometry falls in it (a city's cells,
+        // whose buildings and blocks name their own layers, are none).
+        let named: Vec<&str> = layers
+            .iter()
+            .zip(&layer_nodes)
+            .filter(|(_, node)| node.is_some())
+            .map(|(name, _)| name.as_str())
+            .collect();
+        extras.insert("layers".into(), json!(named));
         plan.features += features.len();
         let table = match options.profile {
             GlbProfile::Plain => Value::Array(features),
