@@ -49,7 +49,10 @@
 //! `kind`, `height`, `floors`, `lot`, `style`, …). Vertex attributes survive optimisers
 //! that reorder, merge or re-index triangles, where triangle ranges do not. LOD nodes
 //! carry `extras.lod` and `extras.lod_range_m = [near, far]` (`far` null: to infinity),
-//! the camera distances between which an engine should draw them.
+//! the camera distances between which an engine should draw them. The root's extras
+//! also hold `layers` (the names of its layer nodes, in their order), `tile_size_m`,
+//! `null_feature_id` (the id of geometry that belongs to no record) and, with LOD
+//! nodes, `lod_levels` (finest first).
 //!
 //! [`Batching::PerNode`] keeps one glTF node per scene node (picking, editing); meshes
 //! with identical bytes are stored once however many nodes draw them.

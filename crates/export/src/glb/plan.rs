@@ -5,7 +5,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
 
-use polis_geom::scene::{MaterialId, MeshId, Metadata, NodeId, Scene};
+use polis_geom::scene::{MaterialId, MeshId, Metadata, Node, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
 
 use crate::ExportError;
@@ -286,23 +286,46 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
         if absorbed[i] {
             continue;
         }
-        // Material key → (merged mesh, [(object, first triangle, count)]).
+        // Material key → (merged mesh, [(object, first triangle, count)]), each mesh
+        // allocated once at its final size (counted first: no doubling re-copies).
         type Group = (Mesh, Vec<(usize, usize, usize)>);
-        let mut groups: BTreeMap<Option<MaterialId>, Group> = BTreeMap::new();
+        let own = drawn(scene, &node.meshes);
+        let children: Vec<(&Node, Vec<MeshId>)> = node
+            .children
+            .iter()
+            .filter(|c| absorbed[c.index()])
+            .map(|c| {
+                let child = &scene.nodes[c.index()];
+                (child, drawn(scene, &child.meshes))
+            })
+            .collect();
+        let mut sizes: BTreeMap<Option<MaterialId>, (usize, usize)> = BTreeMap::new();
+        for &id in own.iter().chain(children.iter().flat_map(|c| &c.1)) {
+            let m = &scene.meshes[id.index()];
+            let size = sizes.entry(m.material).or_default();
+            size.0 += m.positions.len();
+            size.1 += m.indices.len();
+        }
+        let mut groups: BTreeMap<Option<MaterialId>, Group> = sizes
+            .into_iter()
+            .map(|(material, (vertices, indices))| {
+                let mut m = Mesh::new(material);
+                m.positions.reserve_exact(vertices);
+                m.normals.reserve_exact(vertices);
+                m.uvs.reserve_exact(vertices);
+                m.indices.reserve_exact(indices);
+                (material, (m, Vec::new()))
+            })
+            .collect();
         let mut objects: Vec<BatchedObject<'_>> = Vec::new();
-        for id in drawn(scene, &node.meshes) {
+        for id in own {
             used[id.index()] = true;
             let m = &scene.meshes[id.index()];
-            let g = groups
-                .entry(m.material)
-                .or_insert_with(|| (Mesh::new(m.material), Vec::new()));
-            g.0.append(m);
-        }
-        for &c in &node.children {
-            if !absorbed[c.index()] {
-                continue;
+            if let Some(g) = groups.get_mut(&m.material) {
+                g.0.append(m);
             }
-            let child = &scene.nodes[c.index()];
+        }
+        for (child, meshes) in children {
             let object = objects.len();
             objects.push(BatchedObject {
                 name: &child.name,
@@ -310,15 +333,13 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
                 ranges: Vec::new(),
             });
             let matrix = child.transform.matrix();
-            for id in drawn(scene, &child.meshes) {
+            for id in meshes {
                 used[id.index()] = true;
-                let mut m = scene.meshes[id.index()].clone();
-                m.transform(&matrix)?;
-                let g = groups
-                    .entry(m.material)
-                    .or_insert_with(|| (Mesh::new(m.material), Vec::new()));
-                g.1.push((object, g.0.triangle_count(), m.triangle_count()));
-                g.0.append(&m);
+                let m = &scene.meshes[id.index()];
+                if let Some(g) = groups.get_mut(&m.material) {
+                    g.1.push((object, g.0.triangle_count(), m.triangle_count()));
+                    g.0.append_transformed(m, &matrix)?;
+                }
             }
         }
         let mesh = if groups.is_empty() {

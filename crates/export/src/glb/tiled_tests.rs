@@ -192,6 +192,9 @@ fn tiled_draw_calls_are_materials_per_layer_tile_and_tree_has_layers_and_tiles()
         })
         .collect();
     assert_eq!(layer_names, ["roads", "blocks", "buildings"]);
+    // The root lists the layers that have nodes, not its cells (nodes under it without
+    // a `layer` entry or geometry of their own).
+    assert_eq!(root["extras"]["layers"], serde_json::json!(layer_names));
     let mut tiles = 0;
     let mut expected_calls = 0;
     for c in root["children"].as_array().unwrap() {

@@ -44,21 +44,189 @@ const NO_FEATURE: u32 = u32::MAX;
 /// A tile index on the x–z plane.
 type Tile = TileIndex;
 
-/// One merged geometry: the mesh, the feature id of every vertex and the bounds of the
-/// positions (kept while appending, so no pass over the merged mesh computes them).
-type Merged = (Mesh, Vec<u32>, Aabb3);
+/// Where a merge group sits: (layer, tile, LOD level).
+type GroupKey = (usize, Tile, Option<u32>);
 
-/// Merged geometry of one (layer, tile, LOD level), per material.
-#[derive(Default)]
-struct Group {
-    by_material: BTreeMap<Option<MaterialId>, Merged>,
+/// One piece of a merged geometry, recorded by the walk and copied by [`Merge::fill`].
+struct Piece<'a> {
+    /// The index of its merged geometry in [`Merge::targets`].
+    target: usize,
+    source: Source<'a>,
+    /// Its feature record ([`NO_FEATURE`]: none).
+    feature: u32,
 }
 
-impl Group {
-    fn target(&mut self, material: Option<MaterialId>) -> &mut Merged {
-        self.by_material
+/// Where a piece's vertices come from.
+enum Source<'a> {
+    /// A scene mesh, its positions moved by a translation (zero: copied as they are, a
+    /// −0 kept; else each `p + t` in `f64`, as [`Mesh::transform`] moves them) and its
+    /// normals copied (a translation turns none).
+    Scene(&'a Mesh, DVec3),
+    /// A mesh made by the walk (a transformed copy, a cut part): an index into
+    /// [`Merge::owned`], copied as it is, or moved in when it is its geometry's only
+    /// piece.
+    Owned(usize),
+}
+
+/// The counted size and the bounds of one merged geometry.
+struct Target {
+    material: Option<MaterialId>,
+    vertices: usize,
+    indices: usize,
+    pieces: usize,
+    /// Whether any piece has a feature (else the primitive has no `_FEATURE_ID_0`).
+    featured: bool,
+    /// The union of the pieces' bounds, in walk order.
+    bounds: Aabb3,
+}
+
+/// The merged geometries of one root, built in two passes: the walk records every
+/// piece in order and counts each (layer, tile, LOD level, material) geometry's vertices
+/// and indices; [`fill`](Self::fill) then allocates every array once at its final size
+/// and copies the pieces in, each read once (no doubling re-copies, no bounds pass over
+/// the merged arrays). The bytes are those of appending the pieces one by one.
+#[derive(Default)]
+struct Merge<'a> {
+    groups: BTreeMap<GroupKey, BTreeMap<Option<MaterialId>, usize>>,
+    targets: Vec<Target>,
+    pieces: Vec<Piece<'a>>,
+    owned: Vec<Option<Mesh>>,
+}
+
+/// The box `b` moved by `t`: the moved corners' box, exactly (rounding `x + t` to `f32`
+/// is monotone in `x`; with `t = 0` the box itself, a −0 bound made +0).
+fn moved_box(b: Aabb3, t: DVec3) -> Aabb3 {
+    Aabb3 {
+        min: (b.min.as_dvec3() + t).as_vec3(),
+        max: (b.max.as_dvec3() + t).as_vec3(),
+    }
+}
+
+/// A merged geometry: the mesh and, when any piece has a feature, the feature id of
+/// every vertex.
+type Merged = (Mesh, Option<Vec<u32>>);
+
+/// The merged geometries of one group: (material, geometry, bounds) per material.
+type GroupGeometries = Vec<(Option<MaterialId>, Merged, Aabb3)>;
+
+impl<'a> Merge<'a> {
+    /// Records `source`, a mesh `m` (bounds `bounds`, feature `feature`), as the next
+    /// piece of the geometry of `key` and `material`.
+    fn add(&mut self, key: GroupKey, m: &Mesh, source: Source<'a>, bounds: Aabb3, feature: u32) {
+        let targets = &mut self.targets;
+        let material = m.material;
+        let target = *self
+            .groups
+            .entry(key)
+            .or_default()
             .entry(material)
-            .or_insert_with(|| (Mesh::new(material), Vec::new(), Aabb3::EMPTY))
+            .or_insert_with(|| {
+                targets.push(Target {
+                    material,
+                    vertices: 0,
+                    indices: 0,
+                    pieces: 0,
+                    featured: false,
+                    bounds: Aabb3::EMPTY,
+                });
+                targets.len() - 1
+            });
+        let t = &mut targets[target];
+        t.vertices += m.positions.len();
+        t.indices += m.indices.len();
+        t.pieces += 1;
+        t.featured |= feature != NO_FEATURE;
+        t.bounds = t.bounds.union(&bounds);
+        self.pieces.push(Piece {
+            target,
+            source,
+            feature,
+        });
+    }
+
+    /// A scene mesh `m` with bounds `b`, moved by `t`.
+    fn add_moved(&mut self, key: GroupKey, m: &'a Mesh, b: Aabb3, t: DVec3, feature: u32) {
+        self.add(key, m, Source::Scene(m, t), moved_box(b, t), feature);
+    }
+
+    /// A mesh the walk made, with bounds `b`.
+    fn add_owned(&mut self, key: GroupKey, m: Mesh, b: Aabb3, feature: u32) {
+        let k = self.owned.len();
+        self.add(key, &m, Source::Owned(k), b, feature);
+        self.owned.push(Some(m));
+    }
+
+    /// The merged geometries, per group in key order and per material in order, with
+    /// their bounds; a piece without a feature gets `null_id`.
+    fn fill(self, null_id: u32) -> Vec<(GroupKey, GroupGeometries)> {
+        let Merge {
+            groups,
+            targets,
+            pieces,
+            mut owned,
+        } = self;
+        let mut merged: Vec<Option<Merged>> = targets.iter().map(|_| None).collect();
+        for piece in pieces {
+            let spec = &targets[piece.target];
+            let feature = if piece.feature == NO_FEATURE {
+                null_id
+            } else {
+                piece.feature
+            };
+            let slot = &mut merged[piece.target];
+            if let Source::Owned(k) = piece.source
+                && spec.pieces == 1
+                && let Some(m) = owned[k].take()
+            {
+                let ids = spec.featured.then(|| vec![feature; m.positions.len()]);
+                *slot = Some((m, ids));
+                continue;
+            }
+            let (out, ids) = slot.get_or_insert_with(|| {
+                let mut m = Mesh::new(spec.material);
+                m.positions.reserve_exact(spec.vertices);
+                m.normals.reserve_exact(spec.vertices);
+                m.uvs.reserve_exact(spec.vertices);
+                m.indices.reserve_exact(spec.indices);
+                (m, spec.featured.then(|| Vec::with_capacity(spec.vertices)))
+            });
+            let (m, t) = match piece.source {
+                Source::Scene(m, t) => (m, t),
+                Source::Owned(k) => match &owned[k] {
+                    Some(m) => (m, DVec3::ZERO),
+                    None => continue,
+                },
+            };
+            let base = out.positions.len() as u32;
+            if t == DVec3::ZERO {
+                out.positions.extend_from_slice(&m.positions);
+            } else {
+                out.positions
+                    .extend(m.positions.iter().map(|p| (p.as_dvec3() + t).as_vec3()));
+            }
+            out.normals.extend_from_slice(&m.normals);
+            out.uvs.extend_from_slice(&m.uvs);
+            out.indices.extend(m.indices.iter().map(|&i| base + i));
+            if let Some(ids) = ids {
+                ids.resize(ids.len() + m.positions.len(), feature);
+            }
+            if let Source::Owned(k) = piece.source {
+                owned[k] = None;
+            }
+        }
+        groups
+            .into_iter()
+            .map(|(key, by_material)| {
+                let geometries = by_material
+                    .into_iter()
+                    .filter_map(|(material, t)| {
+                        let m = merged[t].take()?;
+                        Some((material, m, targets[t].bounds))
+                    })
+                    .collect();
+                (key, geometries)
+            })
+            .collect()
     }
 }
 
@@ -89,24 +257,6 @@ struct PathInfo {
     feature: Option<(NodeId, usize)>,
 }
 
-/// Appends a cut `part` with bounds `b` to `target`, feature `feature` per vertex: moved
-/// in when `target` is empty, else appended after its vertices (the same bytes as
-/// appending the triangles one by one).
-fn append_part(target: &mut Merged, part: Mesh, b: Aabb3, feature: u32) {
-    let (out, features, bounds) = target;
-    *bounds = bounds.union(&b);
-    features.resize(features.len() + part.positions.len(), feature);
-    if out.positions.is_empty() && out.indices.is_empty() {
-        *out = part;
-        return;
-    }
-    let base = out.positions.len() as u32;
-    out.positions.extend_from_slice(&part.positions);
-    out.normals.extend_from_slice(&part.normals);
-    out.uvs.extend_from_slice(&part.uvs);
-    out.indices.extend(part.indices.iter().map(|&i| base + i));
-}
-
 /// A metadata value as JSON (as its `Serialize` writes it: a non-finite number, which
 /// metadata never holds, would be `null`).
 fn meta_json(v: &MetaValue) -> Value {
@@ -126,36 +276,6 @@ fn translation_only(frame: &DMat4) -> Option<DVec3> {
     .then(|| frame.w_axis.truncate())
 }
 
-/// Appends all of `m`, moved by `t` (positions as [`Mesh::transform`] moves them, in
-/// `f64`; normals as they are: a translation turns none), with feature `feature` per
-/// vertex; `b` is `m`'s bounding box.
-fn append_moved(target: &mut Merged, m: &Mesh, b: Aabb3, t: DVec3, feature: u32) {
-    // Rounding x + t to f32 is monotone in x: the moved box is the moved corners' box,
-    // exactly (and with t = 0 the box itself, a −0 bound made +0).
-    let moved = Aabb3 {
-        min: (b.min.as_dvec3() + t).as_vec3(),
-        max: (b.max.as_dvec3() + t).as_vec3(),
-    };
-    append_at(target, m, moved, t, feature);
-}
-
-/// [`append_moved`] given the moved box `moved`.
-fn append_at(target: &mut Merged, m: &Mesh, moved: Aabb3, t: DVec3, feature: u32) {
-    let (out, features, bounds) = target;
-    *bounds = bounds.union(&moved);
-    let base = out.positions.len() as u32;
-    if t == DVec3::ZERO {
-        out.positions.extend_from_slice(&m.positions);
-    } else {
-        out.positions
-            .extend(m.positions.iter().map(|p| (p.as_dvec3() + t).as_vec3()));
-    }
-    out.normals.extend_from_slice(&m.normals);
-    out.uvs.extend_from_slice(&m.uvs);
-    features.resize(features.len() + m.positions.len(), feature);
-    out.indices.extend(m.indices.iter().map(|&i| base + i));
-}
-
 /// The layout described in the [module docs](self).
 pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'a>, ExportError> {
     let size = options.tile_size_m;
@@ -170,7 +290,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         let mut layer_set = Layers::default();
         let mut features: Vec<Value> = Vec::new();
         let mut record_of: BTreeMap<NodeId, u32> = BTreeMap::new();
-        let mut groups: BTreeMap<(usize, Tile, Option<u32>), Group> = BTreeMap::new();
+        let mut merge = Merge::default();
         let mut levels: Vec<u32> = Vec::new();
         let mut stack: Vec<(NodeId, DMat4, Option<PathInfo>)> = vec![(root, DMat4::IDENTITY, None)];
         while let Some((id, frame, path)) = stack.pop() {
@@ -269,7 +389,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 },
             };
             // A frame that only moves (the usual building or block under its cell):
-            // vertices are moved while they are appended, without a transformed copy.
+            // vertices are moved while they are copied, without a transformed copy.
             let shift = translation_only(&frame);
             if let Some(t) = shift {
                 let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
@@ -281,14 +401,13 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 if hi.x - lo.x <= size && hi.z - lo.z <= size {
                     let c = ((lo + hi) * 0.5).as_vec3();
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
-                    let group = groups.entry(key).or_default();
                     for (m, b) in drawn.into_iter().zip(boxes) {
-                        append_moved(group.target(m.material), m, b, t, feature);
+                        merge.add_moved(key, m, b, t, feature);
                     }
                     continue;
                 }
             }
-            let placed: Vec<Cow<'_, Mesh>> = if frame == DMat4::IDENTITY {
+            let placed: Vec<Cow<'a, Mesh>> = if frame == DMat4::IDENTITY {
                 drawn.into_iter().map(Cow::Borrowed).collect()
             } else {
                 let mut out = Vec::with_capacity(drawn.len());
@@ -306,27 +425,27 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 hi = hi.max(b.max);
             }
             let whole = f64::from(hi.x - lo.x) <= size && f64::from(hi.z - lo.z) <= size;
-            for (m, &b) in placed.iter().zip(&boxes) {
-                if whole {
+            for (m, b) in placed.into_iter().zip(boxes) {
+                // Whole (its box moved by zero: a −0 bound made +0), already one
+                // tile's cut (the ground, cut where it is built: the bytes its cut would
+                // give, its box too, −0 kept), or cut into tiles by triangle centroids.
+                let (key, b) = if whole {
                     let c = (lo + hi) * 0.5;
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
-                    let target = groups.entry(key).or_default().target(m.material);
-                    append_moved(target, m, b, DVec3::ZERO, feature);
+                    (key, moved_box(b, DVec3::ZERO))
+                } else if let Some(tile) = m.whole_tile(size) {
+                    ((info.layer, tile, info.lod), b)
+                } else {
+                    for (tile, part, b) in m.cut_into_tiles(size) {
+                        merge.add_owned((info.layer, tile, info.lod), part, b, feature);
+                    }
                     continue;
-                }
-                // Already one tile's cut (the ground, cut where it is built): appended
-                // whole, the bytes its cut would give (its box too, −0 kept).
-                if let Some(tile) = m.whole_tile(size) {
-                    let key = (info.layer, tile, info.lod);
-                    let target = groups.entry(key).or_default().target(m.material);
-                    append_at(target, m, b, DVec3::ZERO, feature);
-                    continue;
-                }
-                // Cut: triangles by the tile of their centroid.
-                for (tile, part, b) in m.cut_into_tiles(size) {
-                    let key = (info.layer, tile, info.lod);
-                    let target = groups.entry(key).or_default().target(m.material);
-                    append_part(target, part, b, feature);
+                };
+                match m {
+                    Cow::Borrowed(m) => {
+                        merge.add(key, m, Source::Scene(m, DVec3::ZERO), b, feature)
+                    }
+                    Cow::Owned(m) => merge.add_owned(key, m, b, feature),
                 }
             }
         }
@@ -337,7 +456,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         let null_id = features.len() as u32;
         let mut layer_nodes: Vec<Option<u32>> = vec![None; layers.len()];
         let mut tile_nodes: BTreeMap<(usize, Tile), u32> = BTreeMap::new();
-        for ((layer, tile, lod), group) in groups {
+        for ((layer, tile, lod), group) in merge.fill(null_id) {
             let layer_node = match layer_nodes[layer] {
                 Some(n) => n,
                 None => {
@@ -369,18 +488,8 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     n
                 }
             };
-            let mut primitives = Vec::with_capacity(group.by_material.len());
-            for (material, (mesh, mut ids, bounds)) in group.by_material {
-                let features = if ids.iter().all(|&f| f == NO_FEATURE) {
-                    None
-                } else {
-                    for f in &mut ids {
-                        if *f == NO_FEATURE {
-                            *f = null_id;
-                        }
-                    }
-                    Some(ids)
-                };
+            let mut primitives = Vec::with_capacity(group.len());
+            for (material, (mesh, features), bounds) in group {
                 primitives.push((plan.geometries.len(), material));
                 plan.geometries.push(Geometry {
                     mesh: Cow::Owned(mesh),
@@ -434,7 +543,16 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         if !levels.is_empty() {
             extras.insert("lod_levels".into(), json!(levels));
         }
-        extras.insert("layers".into(), json!(layers));
+        // The layers that have a node: a node directly under the root that has no
+        // `layer` entry names a layer only if geometry falls in it (a city's cells,
+        // whose buildings and blocks name their own layers, are none).
+        let named: Vec<&str> = layers
+            .iter()
+            .zip(&layer_nodes)
+            .filter(|(_, node)| node.is_some())
+            .map(|(name, _)| name.as_str())
+            .collect();
+        extras.insert("layers".into(), json!(named));
         plan.features += features.len();
         let table = match options.profile {
             GlbProfile::Plain => Value::Array(features),
@@ -478,5 +596,121 @@ fn compact_number(v: Value) -> Value {
     match v.as_f64() {
         Some(x) if v.is_f64() && x.fract() == 0.0 && x.abs() < EXACT => Value::from(x as i64),
         _ => v,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polis_geom::glam::Vec2;
+    use proptest::prelude::*;
+
+    /// A strip of `n` triangles with coordinates from `seed` (a −0 among them), with or
+    /// without texture coordinates.
+    fn strip(seed: u64, n: usize, material: Option<MaterialId>, uvs: bool) -> Mesh {
+        let mut m = Mesh::new(material);
+        for k in 0..n + 2 {
+            let h = polis_geom::hash::splitmix64(seed ^ k as u64);
+            let x = (h % 1000) as f32 * 0.37 - 180.0;
+            let z = if k == 0 {
+                -0.0
+            } else {
+                ((h >> 20) % 1000) as f32 * 0.41
+            };
+            m.positions.push(Vec3::new(x, (k % 3) as f32, z));
+            m.normals.push(Vec3::Y);
+            if uvs {
+                m.uvs.push(Vec2::new(x, z));
+            }
+        }
+        for k in 0..n as u32 {
+            m.indices.extend([k, k + 1, k + 2]);
+        }
+        m
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// The merge gives, per geometry, what appending its pieces one by one in walk
+        /// order gives (positions moved in `f64`, feature ids with the null id where a
+        /// piece has none, the union of the pieces' bounds), and every array it copies
+        /// into is allocated once at its final size.
+        #[test]
+        fn fill_appends_the_pieces_in_order_into_arrays_sized_once(
+            pieces in proptest::collection::vec(
+                (0usize..3, 0u32..2, 0u8..3, (-500.0f64..500.0, -500.0f64..500.0), 1usize..6, any::<bool>()),
+                1..40,
+            ),
+        ) {
+            let scene: Vec<Mesh> = pieces
+                .iter()
+                .enumerate()
+                .map(|(i, &(_, material, _, _, n, _))| {
+                    strip(i as u64, n, Some(MaterialId(material)), material == 0)
+                })
+                .collect();
+            let null_id = 99;
+            let mut merge = Merge::default();
+            // Per geometry: the mesh, feature ids and bounds of appending one by one,
+            // and the number of pieces.
+            type Expected = (Mesh, Vec<u32>, Aabb3, usize);
+            let mut expect: BTreeMap<(GroupKey, Option<MaterialId>), Expected> = BTreeMap::new();
+            for (i, &(k, _, kind, (x, z), _, featured)) in pieces.iter().enumerate() {
+                let key = (k, (k as i64, 0), None);
+                let m = &scene[i];
+                let feature = if featured { i as u32 } else { NO_FEATURE };
+                let (t, bounds) = match kind {
+                    // Moved (a translation), as it is, or a mesh the walk made.
+                    0 => (DVec3::new(x, 1.5, z), moved_box(m.bbox(), DVec3::new(x, 1.5, z))),
+                    _ => (DVec3::ZERO, m.bbox()),
+                };
+                match kind {
+                    0 => merge.add_moved(key, m, m.bbox(), t, feature),
+                    1 => merge.add(key, m, Source::Scene(m, DVec3::ZERO), bounds, feature),
+                    _ => merge.add_owned(key, m.clone(), bounds, feature),
+                }
+                let mut moved = m.clone();
+                for p in &mut moved.positions {
+                    if t != DVec3::ZERO {
+                        *p = (p.as_dvec3() + t).as_vec3();
+                    }
+                }
+                let e = expect
+                    .entry((key, m.material))
+                    .or_insert_with(|| (Mesh::new(m.material), Vec::new(), Aabb3::EMPTY, 0));
+                e.0.append(&moved);
+                let id = if featured { i as u32 } else { null_id };
+                e.1.extend(std::iter::repeat_n(id, m.positions.len()));
+                e.2 = e.2.union(&bounds);
+                e.3 += 1;
+            }
+            let mut got = BTreeMap::new();
+            for (key, geometries) in merge.fill(null_id) {
+                for (material, (mesh, ids), bounds) in geometries {
+                    prop_assert_eq!(mesh.material, material);
+                    got.insert((key, material), (mesh, ids, bounds));
+                }
+            }
+            prop_assert_eq!(got.len(), expect.len());
+            for (k, (mesh, ids, bounds, count)) in expect {
+                let (g_mesh, g_ids, g_bounds) = &got[&k];
+                prop_assert_eq!(g_mesh, &mesh);
+                prop_assert_eq!(g_bounds, &bounds);
+                match g_ids {
+                    Some(g) => prop_assert_eq!(g, &ids),
+                    None => prop_assert!(ids.iter().all(|&f| f == null_id)),
+                }
+                // A lone piece made by the walk is moved in; anything else was copied
+                // into arrays allocated at their final size.
+                if count > 1 {
+                    prop_assert_eq!(g_mesh.positions.capacity(), g_mesh.positions.len());
+                    prop_assert_eq!(g_mesh.normals.capacity(), g_mesh.normals.len());
+                    prop_assert_eq!(g_mesh.indices.capacity(), g_mesh.indices.len());
+                    if let Some(g) = g_ids {
+                        prop_assert_eq!(g.capacity(), g.len());
+                    }
+                }
+            }
+        }
     }
 }

@@ -170,6 +170,30 @@ impl Aabb3 {
     }
 }
 
+/// The matrix that turns normals under the affine transform `m` (the inverse transpose
+/// of its linear part) and whether `m` mirrors (a negative determinant); an error if `m`
+/// is not finite, not affine or singular.
+fn normal_matrix(m: &DMat4) -> Result<(DMat3, bool), GeomError> {
+    let bad = |reason: &str| GeomError::InvalidParameter {
+        name: "m",
+        reason: reason.to_string(),
+    };
+    if !m.is_finite() {
+        return Err(bad("the matrix has a non-finite entry"));
+    }
+    if m.row(3) != glam::DVec4::new(0.0, 0.0, 0.0, 1.0) {
+        return Err(bad(
+            "the matrix is projective; its last row must be (0, 0, 0, 1)",
+        ));
+    }
+    let linear = DMat3::from_mat4(*m);
+    let det = linear.determinant();
+    if det == 0.0 || !det.is_finite() {
+        return Err(bad("the matrix is singular"));
+    }
+    Ok((linear.inverse().transpose(), det < 0.0))
+}
+
 /// A triangle mesh with one material: one glTF primitive.
 ///
 /// Invariants (checked by [`validate`](Self::validate), kept by every builder method):
@@ -374,34 +398,51 @@ impl Mesh {
     ///
     /// Fails, leaving the mesh unchanged, if `m` is not finite, not affine or singular.
     pub fn transform(&mut self, m: &DMat4) -> Result<(), GeomError> {
-        let bad = |reason: &str| GeomError::InvalidParameter {
-            name: "m",
-            reason: reason.to_string(),
-        };
-        if !m.is_finite() {
-            return Err(bad("the matrix has a non-finite entry"));
-        }
-        if m.row(3) != glam::DVec4::new(0.0, 0.0, 0.0, 1.0) {
-            return Err(bad(
-                "the matrix is projective; its last row must be (0, 0, 0, 1)",
-            ));
-        }
-        let linear = DMat3::from_mat4(*m);
-        let det = linear.determinant();
-        if det == 0.0 || !det.is_finite() {
-            return Err(bad("the matrix is singular"));
-        }
-        let normal_matrix = linear.inverse().transpose();
+        let (normal_matrix, mirror) = normal_matrix(m)?;
         for p in &mut self.positions {
             *p = m.transform_point3(p.as_dvec3()).as_vec3();
         }
         for n in &mut self.normals {
             *n = (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3();
         }
-        if det < 0.0 {
+        if mirror {
             for t in self.indices.chunks_exact_mut(3) {
                 t.swap(1, 2);
             }
+        }
+        Ok(())
+    }
+
+    /// Appends the geometry of `other` transformed by `m`: the bytes of appending a copy
+    /// of `other` on which [`transform`](Self::transform) ran, without the copy (its
+    /// material is ignored, as by [`append`](Self::append)).
+    ///
+    /// Fails, leaving the mesh unchanged, if `m` is not finite, not affine or singular.
+    pub fn append_transformed(&mut self, other: &Mesh, m: &DMat4) -> Result<(), GeomError> {
+        let (normal_matrix, mirror) = normal_matrix(m)?;
+        let base = self.positions.len() as u32;
+        self.positions.extend(
+            other
+                .positions
+                .iter()
+                .map(|p| m.transform_point3(p.as_dvec3()).as_vec3()),
+        );
+        self.normals.extend(
+            other
+                .normals
+                .iter()
+                .map(|n| (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()),
+        );
+        self.uvs.extend_from_slice(&other.uvs);
+        if mirror {
+            self.indices.extend(
+                other
+                    .indices
+                    .chunks_exact(3)
+                    .flat_map(|t| [base + t[0], base + t[2], base + t[1]]),
+            );
+        } else {
+            self.indices.extend(other.indices.iter().map(|&i| base + i));
         }
         Ok(())
     }
@@ -828,6 +869,10 @@ mod tests {
         let mut m = unit_cube();
         assert!(m.transform(&DMat4::from_scale(DVec3::ZERO)).is_err());
         assert!(m.transform(&DMat4::from_scale(DVec3::NAN)).is_err());
+        assert!(
+            m.append_transformed(&unit_cube(), &DMat4::from_scale(DVec3::ZERO))
+                .is_err()
+        );
         assert_eq!(m, unit_cube());
         m.flip();
         assert!((m.signed_volume() + 1.0).abs() < 1e-9);
@@ -850,6 +895,12 @@ mod tests {
             );
             let mut cube = unit_cube();
             cube.transform(&m).unwrap();
+            // Appending transformed gives the bytes of appending the transformed copy.
+            let mut appended = unit_cube();
+            appended.append_transformed(&unit_cube(), &m).unwrap();
+            let mut expected_append = unit_cube();
+            expected_append.append(&cube);
+            proptest::prop_assert_eq!(&appended, &expected_append);
             cube.validate().unwrap();
             cube.check_closed().unwrap();
             let expected = (s.x * s.y * s.z).abs();
