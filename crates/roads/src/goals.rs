@@ -238,16 +238,9 @@ impl DefaultGoals {
                 } else {
                     self.params.max_bridge_length_m
                 };
-                let step = self.legality.step();
-                let mut s = v.t * len;
-                while s + step <= reach {
-                    s += step;
-                    if self.legality.point(p + d * s).is_none() {
-                        let landing = p + d * (s + step).min(reach);
-                        return self.legality.bridgeable(p, landing);
-                    }
-                }
-                false
+                self.legality
+                    .bridge_landing(p, d, v.t * len, reach)
+                    .is_some()
             }
         }
     }
