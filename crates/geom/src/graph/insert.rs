@@ -25,7 +25,8 @@
 //! ([`ROUNDING_TOLERANCE`]) of a new crossing node are bent through it, so several
 //! segments through one point share one node; no node is created within that distance of
 //! another (the edge is bent through the existing node), and every piece a split creates is
-//! bent through any node it passes within that distance of. A bend moves an edge by up to
+//! bent through any node it passes within that distance of (but a node already joined to
+//! one of the piece's ends: at that scale the bend would only give the piece back). A bend moves an edge by up to
 //! that distance, so its two legs are inserted by this same walk (splitting any edge the
 //! move takes them across); all edges passing within rounding of the node are bent together.
 //! Every created or split edge is checked against the edge index before the call returns.
@@ -647,6 +648,13 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             self.node_index.for_each_candidate(&bx, |n, shape| {
                 let Shape::Point(pn) = *shape else { return };
                 if n == a || n == b || !bx.contains(pn) {
+                    return;
+                }
+                // A node already joined to an end lies on a route around the edge at
+                // rounding scale: bending through it would give that route back (its
+                // second leg passes within rounding of the first end and goes through
+                // it), for ever. The edge and the two-edge route are equally good.
+                if self.find_edge(a, n).is_some() || self.find_edge(n, b).is_some() {
                     return;
                 }
                 let (closest, t) = closest_point_on_segment(pn, pa, pb);

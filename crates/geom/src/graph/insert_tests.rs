@@ -557,16 +557,16 @@ fn planar_insert_open_fuzz_finding() {
     planar_insert_case(&bytes).unwrap();
 }
 
-/// Open fuzzing finding (9) of `planar_insert` (session 13, after 6.17 million
-/// executions; ARCHITECTURE.md, "Fuzzing"). Snap 0: two segments leave one node 1.3e-10
-/// rad apart (the second 5 m long, slanted by 1e-9 m) and pass within 1e-9 m of a node
-/// where a fan of nearly horizontal edges meets, which the first one's crossings have
-/// already split into seven nodes within 1e-9 m of each other. The second insertion's
-/// walk gives up ("did not converge") and returns `GraphCorrupt`; the graph it leaves is
-/// still planar (`check_invariants` passes), so the cost is a refused segment, not a
-/// corrupt graph. Not fixed yet: run with `--ignored` to reproduce.
+/// Fuzzing finding (9) of `planar_insert` (session 13, after 6.17 million executions;
+/// ARCHITECTURE.md, "Fuzzing"). Snap 0: two segments leave one node 1.3e-10 rad apart
+/// (the second 5 m long, slanted by 1e-9 m) and pass within 1e-9 m of a node where a fan
+/// of nearly horizontal edges meets, which the first one's crossings had split into
+/// seven nodes within 1e-9 m of each other. Three of them, 4–6e-12 m apart, two joined by
+/// an edge: settling the third side bent it through the third node, whose second leg
+/// went back through the first end — the same side again, for ever, until the walk gave
+/// up (`GraphCorrupt`, "did not converge"). Settling no longer bends an edge through a
+/// node already joined to one of its ends.
 #[test]
-#[ignore = "open fuzz finding (9) of issue 22: the walk gives up on nearly collinear segments through a split fan"]
 fn planar_insert_open_fuzz_finding_9() {
     let hex = "00000018860000002d1100ffffffffffffffffff00fff2ff3f15fdbd0000ffffe437083701250014bf7c3d3d3d002cccff2b143ded000000000020000032090000000000000040000000ff0135090000000000e40100ff240000000c1000003c00ffffe40010002700ff052a000000000000e50100007d00000000213900273d";
     let bytes: Vec<u8> = (0..hex.len() / 2)
