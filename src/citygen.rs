@@ -378,6 +378,10 @@ pub struct CitygenNetwork {
     pub cells: Vec<SecondaryRoads>,
     /// Every grown cell's id, region, pattern and traits (parallel to `cells`).
     pub districts: Vec<District>,
+    /// The cells whose growth was skipped (too small or invalid for their pattern; the
+    /// reasons are in `skipped`), in cell order: still city cells an editor shows and
+    /// edits, with no secondary roads. Their traits do not reach the lot stage.
+    pub ungrown: Vec<District>,
     /// The union: primary and secondary roads in one planar graph.
     pub network: RoadNetwork,
     /// Cells that could not be grown (too small, invalid boundary), with why.
@@ -524,7 +528,8 @@ pub(crate) fn citygen_network_with(
     let ids = cell_ids(&decomposition, &primary, kelly_roads.as_deref());
     let zoning = zoning_of(cx)?;
     let started = crate::clock::Instant::now();
-    let grown: Vec<Result<std::result::Result<(SecondaryRoads, District), Skip>>> = decomposition
+    type Grown = std::result::Result<(SecondaryRoads, District), (Skip, Option<District>)>;
+    let grown: Vec<Result<Grown>> = decomposition
         .cells
         .par_iter()
         .zip(ids.par_iter())
@@ -536,7 +541,7 @@ pub(crate) fn citygen_network_with(
             };
             let region = match cell.polygon_with_holes() {
                 Ok(r) => r,
-                Err(e) => return Ok(Err(skip(format!("cell {id}: {e}")))),
+                Err(e) => return Ok(Err((skip(format!("cell {id}: {e}")), None))),
             };
             let settings = cg.cells.iter().find(|s| s.cell == id);
             let chosen = choose_pattern(cx, zoning.as_ref(), &region);
@@ -604,20 +609,27 @@ pub(crate) fn citygen_network_with(
                 }
                 _ => grow()?,
             };
-            Ok(roads.map(|r| (r, district)))
+            Ok(match roads {
+                Ok(r) => Ok((r, district)),
+                Err(s) => Err((s, Some(district))),
+            })
         })
         .collect();
     let secondary_s = started.elapsed().as_secs_f64();
     let mut cells = Vec::with_capacity(grown.len());
     let mut districts = Vec::with_capacity(grown.len());
     let mut skipped = Vec::new();
+    let mut ungrown = Vec::new();
     for g in grown {
         match g? {
             Ok((r, d)) => {
                 cells.push(r);
                 districts.push(d);
             }
-            Err(s) => skipped.push(s),
+            Err((s, d)) => {
+                skipped.push(s);
+                ungrown.extend(d);
+            }
         }
     }
     let network = union(&primary, &cells)?;
@@ -626,6 +638,7 @@ pub(crate) fn citygen_network_with(
             primary,
             cells,
             districts,
+            ungrown,
             network,
             skipped,
             secondary_s,

@@ -759,3 +759,53 @@ fn lot_edits_patch_the_city_in_place_and_equal_generate() {
     ed.undo().unwrap();
     assert_same_as_generate(&ed);
 }
+
+/// A pattern too big for a cell skips its growth, but the cell stays a city cell: listed
+/// with the reason, reported as changed (not removed), selectable, and an edit back
+/// grows it again. (Found by the key proptest: the cell used to vanish from the editor.)
+#[test]
+fn a_cell_whose_growth_is_skipped_stays_an_editable_cell() {
+    let mut ed = CityEditor::new(small()).unwrap();
+    let before = ed.cells();
+    assert!(before.iter().all(|c| c.skipped.is_none()));
+    let mut found = None;
+    for c in &before {
+        let ev = ed
+            .apply(Edit::SetCellPattern {
+                cell: c.id,
+                pattern: Neighbourhood::Manhattan.into(),
+            })
+            .unwrap();
+        assert!(
+            ev.cells.added.is_empty() && ev.cells.removed.is_empty(),
+            "{ev:?}"
+        );
+        let now = ed.cells();
+        assert_eq!(now.len(), before.len());
+        let info = now.iter().find(|x| x.id == c.id).unwrap();
+        if info.skipped.is_some() {
+            assert_eq!(ev.cells.changed, vec![c.id]);
+            found = Some((c.id, c.pattern));
+            break;
+        }
+        ed.undo().unwrap();
+    }
+    let (id, pattern) = found.expect("some cell of the small city is too small for Manhattan");
+    // Still selectable and inspectable.
+    let inside = ed.cells().into_iter().find(|c| c.id == id).unwrap();
+    let p = inside
+        .outline
+        .iter()
+        .fold([0.0, 0.0], |a, q| [a[0] + q[0], a[1] + q[1]]);
+    let n = inside.outline.len() as f64;
+    let centroid = polis::geom::DVec2::new(p[0] / n, p[1] / n);
+    assert_eq!(ed.cell_at(centroid), Some(id));
+    assert_eq!(ed.cell_params(id).unwrap().id, id);
+    assert_same_as_generate(&ed);
+    // Edited back to its own pattern, it grows again.
+    ed.apply(Edit::SetCellPattern { cell: id, pattern })
+        .unwrap();
+    let back = ed.cells().into_iter().find(|c| c.id == id).unwrap();
+    assert!(back.skipped.is_none(), "{back:?}");
+    assert_same_as_generate(&ed);
+}

@@ -158,7 +158,8 @@ pub(crate) struct Memo {
     fingerprints: Mutex<Option<Fingerprints>>,
     /// The last run's road stage output and cells, by [`Fingerprints::roads`]: an edit of
     /// lots, buildings or styles reuses the union graph and its cells whole.
-    roads: Mutex<Option<(Key, RoadsOutput)>>,
+    /// With the output, every city cell (grown, then ungrown) for the editor.
+    roads: Mutex<Option<(Key, RoadsOutput, Vec<crate::citygen::District>)>>,
     cells: Mutex<Option<(Key, polis_cells::CellDecomposition)>>,
 }
 
@@ -342,21 +343,24 @@ impl RoadStage for MemoRoads {
             return ConfiguredRoads::default().roads(cx);
         }
         let key = self.0.fingerprints().roads;
-        if let Some((k, out)) = &*lock(&self.0.roads)
+        if let Some((k, out, all)) = &*lock(&self.0.roads)
             && *k == key
         {
-            lock(&self.0.districts).clone_from(&out.districts);
+            lock(&self.0.districts).clone_from(all);
             return Ok(out.clone());
         }
         let (net, growth) = citygen_network_with(cx, Some(&*self.0))?;
-        lock(&self.0.districts).clone_from(&net.districts);
+        // The editor's cells: a cell whose growth an edit made impossible (a pattern too
+        // big for it) stays a cell the user can select and edit back.
+        let all: Vec<_> = net.districts.iter().chain(&net.ungrown).cloned().collect();
+        lock(&self.0.districts).clone_from(&all);
         let out = RoadsOutput {
             network: net.network,
             growth,
             skipped: net.skipped,
             districts: net.districts,
         };
-        *lock(&self.0.roads) = Some((key, out.clone()));
+        *lock(&self.0.roads) = Some((key, out.clone(), all));
         Ok(out)
     }
 }

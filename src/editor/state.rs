@@ -26,6 +26,10 @@ pub struct CellInfo {
     pub outline: Vec<[f64; 2]>,
     /// Its pattern.
     pub pattern: CellPatternChoice,
+    /// Why the cell has no secondary roads, if its growth was skipped (the cell is too
+    /// small or invalid for its pattern); `None` for a grown cell.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skipped: Option<String>,
 }
 
 /// Everything a cell inspector shows of a city cell (Kelly §5.5.1's property inspector):
@@ -223,7 +227,9 @@ impl CityEditor {
         self.primary.network()
     }
 
-    /// The city cells (grown ones), in the order the road stage made them.
+    /// The city cells: the grown ones in the order the road stage made them, then those
+    /// whose growth was skipped (with the reason; they stay selectable and editable, so a
+    /// pattern too big for a cell can be changed back).
     pub fn cells(&self) -> Vec<CellInfo> {
         self.districts
             .iter()
@@ -231,6 +237,13 @@ impl CityEditor {
                 id: d.id,
                 outline: d.region.outer.points().iter().map(|p| [p.x, p.y]).collect(),
                 pattern: d.pattern,
+                skipped: self
+                    .city
+                    .report
+                    .skipped
+                    .iter()
+                    .find(|s| s.stage == crate::Stage::Roads && s.id == d.id)
+                    .map(|s| s.reason.clone()),
             })
             .collect()
     }
@@ -239,7 +252,7 @@ impl CityEditor {
     /// building height, seed.
     ///
     /// # Errors
-    /// [`Error::UnknownId`] if no grown cell has that id.
+    /// [`Error::UnknownId`] if no city cell has that id.
     pub fn cell_params(&self, id: u64) -> Result<CellParams> {
         let d = self
             .districts
