@@ -56,7 +56,7 @@ pub(crate) fn skeleton_roof(
     let poly = PolygonWithHoles::from(Polygon::new(ring.to_vec()));
     let sk = StraightSkeleton::new(&poly)?;
     let times = NodeTimes::new(&sk);
-    let key = |p: DVec2| [p.x.to_bits(), p.y.to_bits()];
+    let key = polis_geom::hash::point_key;
     let time_of = |p: DVec2, edge: usize| times.time(p, ring, edge);
     let max_t = sk.nodes().iter().map(|n| n.time).fold(0.0, f64::max);
     if !(max_t > 0.0 && max_t.is_finite()) {
@@ -323,7 +323,7 @@ pub(crate) fn mansard(
 /// Chains directed edges into closed loops (each start point used once); `None` if an
 /// edge has no unique successor.
 fn chain_loops(edges: &[(DVec2, DVec2)]) -> Option<Vec<Vec<DVec2>>> {
-    let key = |p: DVec2| [p.x.to_bits(), p.y.to_bits()];
+    let key = polis_geom::hash::point_key;
     let mut by_start: Vec<([u64; 2], usize)> = edges
         .iter()
         .enumerate()
@@ -372,7 +372,7 @@ impl NodeTimes {
         let mut times: Vec<([u64; 2], f64)> = sk
             .nodes()
             .iter()
-            .map(|n| ([n.position.x.to_bits(), n.position.y.to_bits()], n.time))
+            .map(|n| (polis_geom::hash::point_key(n.position), n.time))
             .collect();
         times.sort_by_key(|t| t.0);
         NodeTimes { times }
@@ -381,7 +381,7 @@ impl NodeTimes {
     /// The time of face point `p` of input edge `edge` of `ring`: the node's, or the
     /// distance to the edge's line when no node sits there.
     fn time(&self, p: DVec2, ring: &[DVec2], edge: usize) -> f64 {
-        let k = [p.x.to_bits(), p.y.to_bits()];
+        let k = polis_geom::hash::point_key(p);
         match self.times.binary_search_by(|t| t.0.cmp(&k)) {
             Ok(i) => self.times[i].1,
             Err(_) => {

@@ -1,4 +1,18 @@
-//! [`splitmix64`]: the stateless 64-bit mix that derives seeds from seeds and ids.
+//! [`splitmix64`]: the stateless 64-bit mix that derives seeds from seeds and ids;
+//! [`point_key`]: an exact key of a point for sorting, hashing and matching.
+
+use glam::DVec2;
+
+/// An exact key for a point: the bit patterns of its coordinates, with −0 and +0 the same
+/// coordinate (adding +0.0 turns −0.0 into +0.0; every other value keeps its bits). Two
+/// points have the same key exactly when they compare equal (`==`), which raw
+/// `to_bits` keys do not give: a point computed as (−0, 5) and a copy written as (0, 5)
+/// would be two points. The key's order groups equal points; it is not the coordinates'
+/// numeric order.
+#[inline]
+pub fn point_key(p: DVec2) -> [u64; 2] {
+    [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits()]
+}
 
 /// SplitMix64 (Steele, Lea & Flood 2014) as a function: the golden-ratio increment then
 /// its finaliser. A bijection on `u64` with full avalanche, so seeds derived from nearby
@@ -15,6 +29,20 @@ pub fn splitmix64(mut z: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn point_keys_match_exactly_when_points_are_equal() {
+        let a = DVec2::new(-0.0, 5.0);
+        let b = DVec2::new(0.0, 5.0);
+        assert_eq!(a, b);
+        assert_eq!(point_key(a), point_key(b));
+        assert_eq!(point_key(DVec2::new(0.0, -0.0)), point_key(DVec2::ZERO));
+        assert_ne!(point_key(DVec2::new(1.0, 5.0)), point_key(b));
+        assert_ne!(
+            point_key(DVec2::new(f64::MIN_POSITIVE, 0.0)),
+            point_key(DVec2::ZERO)
+        );
+    }
 
     #[test]
     fn matches_the_reference_sequence() {

@@ -451,13 +451,11 @@ fn validate_ring_alone(points: &[DVec2]) -> Result<(), GeomError> {
     for (i, &p) in points.iter().enumerate() {
         validate_point(i, p)?;
     }
+    // Sorted by exact key, so equal points are neighbours (−0 and +0 included: with a
+    // `total_cmp` order a (−0, 5) vertex sorted between (−0, −5) and (0, −5) hid that
+    // repeat, and triangulation then found crossing edges in a "valid" ring).
     let mut sorted: Vec<(DVec2, usize)> = points.iter().copied().zip(0..).collect();
-    sorted.sort_by(|a, b| {
-        a.0.x
-            .total_cmp(&b.0.x)
-            .then(a.0.y.total_cmp(&b.0.y))
-            .then(a.1.cmp(&b.1))
-    });
+    sorted.sort_by_key(|&(p, i)| (crate::hash::point_key(p), i));
     let mut distinct = usize::from(!sorted.is_empty());
     let mut repeat = None;
     for w in sorted.windows(2) {
@@ -683,6 +681,21 @@ mod tests {
         assert!(matches!(
             star.validate(),
             Err(GeomError::SelfIntersection { .. })
+        ));
+    }
+
+    #[test]
+    fn a_vertex_repeated_with_a_signed_zero_is_found() {
+        // −0 sorts before +0 by `total_cmp`; with (−0, 5) between them the repeat of
+        // (−0, −5) as (0, −5) was not found (a star proptest, snapped to a 0.5 m grid).
+        let p = poly(&[(5., 0.), (-0.0, 5.), (-5., 0.), (-0.0, -5.), (0.0, -5.)]);
+        assert!(matches!(
+            p.validate(),
+            Err(GeomError::RepeatedVertex {
+                first: 3,
+                second: 4,
+                ..
+            })
         ));
     }
 

@@ -46,6 +46,7 @@
 //! outside the other region).
 
 use polis_geom::glam::{Vec2, Vec3};
+use polis_geom::hash::point_key;
 use polis_geom::lines::{ccw_cmp_from, innermost_ring_containing};
 use polis_geom::mesh::{edge_use, to_world};
 use polis_geom::polygon::ring_signed_area;
@@ -390,7 +391,7 @@ fn boundary(tris: &[Tri], reverse: bool) -> Vec<Seg> {
             edges.push(if reverse { (b, a) } else { (a, b) });
         }
     }
-    let bits = |p: DVec2| [p.x.to_bits(), p.y.to_bits()];
+    let bits = point_key;
     let mut sorted: Vec<([u64; 2], [u64; 2])> =
         edges.iter().map(|&(a, b)| (bits(a), bits(b))).collect();
     sorted.sort_unstable();
@@ -459,7 +460,10 @@ fn overlay(
     let bu = boundary(up, false);
     let bd = boundary(down, true);
     // Same region: both caps go.
-    let bits = |s: &Seg| [s.a.x, s.a.y, s.b.x, s.b.y].map(f64::to_bits);
+    let bits = |s: &Seg| {
+        let (a, b) = (point_key(s.a), point_key(s.b));
+        [a[0], a[1], b[0], b[1]]
+    };
     let mut ku: Vec<[u64; 4]> = bu.iter().map(bits).collect();
     let mut kd: Vec<[u64; 4]> = bd.iter().map(bits).collect();
     ku.sort_unstable();
@@ -471,7 +475,7 @@ fn overlay(
     let cd = cut(&bd, &bu);
     // Undirected pieces of each side, to find pieces on both boundaries.
     let pkey2 = |a: DVec2, b: DVec2| {
-        let (a, b) = ([a.x, a.y].map(f64::to_bits), [b.x, b.y].map(f64::to_bits));
+        let (a, b) = (point_key(a), point_key(b));
         if a <= b { (a, b, true) } else { (b, a, false) }
     };
     let pieces = |c: &[Vec<DVec2>]| {
@@ -558,7 +562,7 @@ fn push(up: &mut Vec<Seg>, down: &mut Vec<Seg>, which: usize, s: Seg) {
 /// Chains directed segments (region on the left) into rings and groups them into
 /// polygons with holes. `None` if the segments do not close into rings.
 fn chain(segs: &[Seg]) -> Result<Vec<PolygonWithHoles>, Why> {
-    let bits = |p: DVec2| [p.x.to_bits(), p.y.to_bits()];
+    let bits = point_key;
     let mut order: Vec<usize> = (0..segs.len()).collect();
     order.sort_by_key(|&i| bits(segs[i].a));
     let mut used = vec![false; segs.len()];

@@ -11,6 +11,7 @@
 
 use std::collections::BTreeMap;
 
+use polis_geom::hash::point_key as key;
 use polis_geom::mesh::triangulate;
 use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
@@ -97,11 +98,6 @@ pub(crate) struct Plan {
 /// The left unit normal of the direction `d`.
 pub(crate) fn left(d: DVec2) -> DVec2 {
     DVec2::new(-d.y, d.x)
-}
-
-/// An exact key for a point (−0 and +0 are the same point).
-fn key(p: DVec2) -> (u64, u64) {
-    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
 }
 
 /// One incident segment seen from its node.
