@@ -192,7 +192,7 @@ fn classify(c: DVec2, i: &End, j: &End) -> Gap {
 /// Builds the plan: segments, trims, cuts and junction polygons.
 pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
     let mut p = Plan::default();
-    let mut index: BTreeMap<(u64, u64), usize> = BTreeMap::new();
+    let mut index: BTreeMap<[u64; 2], usize> = BTreeMap::new();
     let mut node = |nodes: &mut Vec<PlanNode>, q: DVec2| -> usize {
         *index.entry(key(q)).or_insert_with(|| {
             nodes.push(PlanNode {
