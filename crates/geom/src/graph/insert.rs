@@ -26,7 +26,9 @@
 //! segments through one point share one node; no node is created within that distance of
 //! another (the edge is bent through the existing node), and every piece a split creates is
 //! bent through any node it passes within that distance of (but a node already joined to
-//! one of the piece's ends: at that scale the bend would only give the piece back). A bend moves an edge by up to
+//! one of the piece's ends: at that scale the bend would only give the piece back; an edge
+//! the walk would follow past its target, within rounding of it, is bent through the
+//! target instead). A bend moves an edge by up to
 //! that distance, so its two legs are inserted by this same walk (splitting any edge the
 //! move takes them across); all edges passing within rounding of the node are bent together.
 //! Every created or split edge is checked against the edge index before the call returns.
@@ -441,6 +443,15 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                     if !self.contains_edge(e) {
                         continue;
                     }
+                    // The target inside the edge (a split made it on the edge, within
+                    // rounding, and joined it to the edge's far end by a piece that
+                    // `settle` leaves alone): the edge is bent through the target first.
+                    // Followed, it would pass the target, and the walk from its far end
+                    // would follow it back past the target, for ever.
+                    if x != target && self.passes_within_rounding(e, target)? {
+                        self.reroute_through(e, target, make_node, out, depth)?;
+                        continue;
+                    }
                     out.path.push(e);
                     out.nodes.push(x);
                     cur = x;
@@ -748,6 +759,18 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             out.split.extend(legs.split);
         }
         Ok(())
+    }
+
+    /// Whether edge `e` passes within rounding of node `n` strictly between its ends
+    /// (`n` not an end of it).
+    fn passes_within_rounding(&self, e: EdgeId, n: NodeId) -> Result<bool, GeomError> {
+        let (a, b) = self.endpoints(e)?;
+        if n == a || n == b {
+            return Ok(false);
+        }
+        let (pa, pb, pn) = (self.position(a)?, self.position(b)?, self.position(n)?);
+        let (closest, t) = closest_point_on_segment(pn, pa, pb);
+        Ok(t > 0.0 && t < 1.0 && closest.distance(pn) <= rounding_eps(pn))
     }
 
     /// Checks that the given edges meet other edges only at common end nodes.

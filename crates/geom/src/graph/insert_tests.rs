@@ -574,3 +574,23 @@ fn planar_insert_open_fuzz_finding_9() {
         .collect();
     planar_insert_case(&bytes).unwrap();
 }
+
+/// Fuzzing finding (10) of `planar_insert` (session 14, after 4.69 million executions).
+/// Snap 0: two edges from one node 3 m away end at nodes 3.4e-12 m apart (a sliver
+/// triangle: one edge exactly on y = -0.128, the other off it by rounding). A nearly
+/// vertical segment crossed the sliver's rounded edge at a point computed exactly on the
+/// other edge; the split made a node there, on the other edge's interior, and a piece to
+/// the far end lying along that edge. Settling the near piece bent it through the sliver's
+/// other corner, and that leg's walk followed the other edge — which passes its target,
+/// the new node — to the far end, and from there back, for ever (`GraphCorrupt`, "did
+/// not converge"): settling leaves the edge alone, the node being joined to its end.
+/// A walk now bends an edge it would follow through its target when the target lies on
+/// it within rounding, before following.
+#[test]
+fn planar_insert_open_fuzz_finding_10() {
+    let hex = "000000cb0600ffffffff4500d50000233f0000000000370000233f00000000d30000000031000000f7ff0000000000000000000000000034060013000036000000000000006b6b6b6b6b6b6b6bffffff006b6b6b83000034140400";
+    let bytes: Vec<u8> = (0..hex.len() / 2)
+        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
+        .collect();
+    planar_insert_case(&bytes).unwrap();
+}
