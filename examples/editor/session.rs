@@ -155,6 +155,7 @@ impl Session {
                 ring: wire::flat(o),
                 pattern: pattern_name(&c.pattern),
                 streets: std::mem::take(s),
+                skipped: c.skipped.clone(),
             })
             .collect()
     }

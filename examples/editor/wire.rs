@@ -113,6 +113,10 @@ pub struct CellWire {
     pub pattern: String,
     /// The secondary streets inside it.
     pub streets: Vec<StreetWire>,
+    /// Why it has no secondary streets, if its growth was skipped (too small or invalid
+    /// for its pattern).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skipped: Option<String>,
 }
 
 /// A building footprint for the plan and 3-D views.

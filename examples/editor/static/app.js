@@ -91,7 +91,7 @@ async function call(method, url, body) {
 }
 
 function cellFromWire(c) {
-  return { ring: c.ring, bbox: ringBBox(c.ring), area: ringArea(c.ring), pattern: c.pattern, streets: c.streets };
+  return { ring: c.ring, bbox: ringBBox(c.ring), area: ringArea(c.ring), pattern: c.pattern, streets: c.streets, skipped: c.skipped };
 }
 
 function blockFromWire(b) {
@@ -417,6 +417,13 @@ async function updateInspector() {
       return;
     }
     head(props, `Cell ${id}`);
+    const skipped = state.cells.get(id)?.skipped;
+    if (skipped) {
+      const note = document.createElement('p');
+      note.className = 'warn';
+      note.textContent = `No secondary streets: ${skipped}`;
+      props.appendChild(note);
+    }
     const sel = document.createElement('select');
     sel.id = 'cell-preset';
     for (const p of state.presets) {
