@@ -13,13 +13,16 @@
 //! seeds 6–10 are the held-out check (BENCHMARKS.md, "Issue 19"). The misses that remain
 //! are listed in [`KNOWN_MISSES`] and the test demands exactly them: a new miss fails it,
 //! and so does a listed miss that has gone (update the list and BENCHMARKS.md then).
-//! `default` seed 2 starts in a small populated pocket on the coast, cut off by
-//! unpopulated land (its network has a few hundred streets, not a thousand), and seed 3
-//! keeps few culs-de-sac once the fringe stubs are pruned.
+//! `default` seed 2 used to start on the tip of a coastal peninsula: its highways ran into
+//! the map's edge and into water no bridge spans, and the city stayed a pocket of a few
+//! hundred streets (seed 6 of the held-out set: 26 streets, its start in a corner). Since
+//! session 13 highway rays count no population in water or parks and the axiom's second
+//! highway takes an open ray (`polis_roads::DefaultGoals::ray_open`), so both grow whole
+//! networks; seed 2 keeps one miss, its circuity (1.073 against 1.045 ± 0.02).
 //! Tunnels (issue 27) changed `san_francisco` seeds 1–2: highways pass under the hills
 //! they used to stop at. `citygen_us` and `milan` joined the test in session 11 (their
-//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` seed
-//! 1's circuity is the one miss they brought). `citygen` itself is Kelly's test city
+//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` keeps
+//! one circuity miss, seed 1's until session 13's highway rays, seed 2's since). `citygen` itself is Kelly's test city
 //! (issue 18: 16 km², ≥ 15,000 roads, ≥ 57,000 buildings, the workload of issue 25's
 //! timings), whose street density no real city's band admits; it is not tested here.
 //!
@@ -58,12 +61,8 @@ fn misses(preset: &str, seed: u64) -> Vec<String> {
 }
 
 /// (preset, seed, metric) out of band today; everything else must be in band.
-const KNOWN_MISSES: &[(&str, u64, &str)] = &[
-    ("default", 2, "P_4way"),
-    ("default", 2, "circuity"),
-    ("default", 3, "P_deadend"),
-    ("citygen_us", 1, "circuity"),
-];
+const KNOWN_MISSES: &[(&str, u64, &str)] =
+    &[("default", 2, "circuity"), ("citygen_us", 2, "circuity")];
 
 fn check(preset: &str) {
     let mut unexpected = Vec::new();
@@ -132,7 +131,7 @@ fn suburbia_is_in_charlottes_band() {
 /// Industrial and Suburbia — at a real city's street spacing). Its Citygen unit
 /// is 26 m (Manhattan's 5-unit segments are 130 m, so junctions come about 100 m apart),
 /// its highways lean to a grid (New York weight 0.7), and Industrial and Suburbia
-/// meander more (Kelly §6.3). Seed 1 stays too straight (circuity 1.019 against
+/// meander more (Kelly §6.3). Seed 2 stays too straight (circuity 1.020 against
 /// 1.045 ± 0.02): its grid cells carry more of the street length.
 #[test]
 fn citygen_us_is_in_the_us_canada_band() {

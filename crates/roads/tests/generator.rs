@@ -415,3 +415,55 @@ fn lattice_maps_keep_every_legality_property() {
         );
     }
 }
+
+/// A start on a shore (issue 19, `default` seed 2): the sea counts no population for the
+/// highway rays, though the population map goes on under it, and neither axiom highway
+/// heads into water no bridge spans, so the network grows over the land instead of
+/// stopping after a few segments.
+#[test]
+fn highways_leave_a_shore_start_over_land() {
+    // Population peaks on the shore at the origin; the sea east of x = 20 m is 2 km wide.
+    let pop = FnField::new(|p: DVec2| (-(p.length() / 800.0).powi(2)).exp());
+    let mut inputs = RoadInputs::flat(Arc::new(pop));
+    inputs.water = Arc::new(FnField::new(|p: DVec2| if p.x > 20.0 { 1.0 } else { 0.0 }));
+    let params = RoadParams {
+        max_segments: 400,
+        ..RoadParams::default()
+    };
+    let goals = DefaultGoals::new(&params, &inputs).unwrap();
+    let s = goals.start();
+    assert!(s.x <= 20.0 && s.length() < 100.0, "{s}");
+    // Eastward every ray sample lies in the sea: it scores nothing and is closed.
+    assert_eq!(goals.ray_score(s, 0.0), 0.0);
+    assert!(goals.ray_score(s, std::f64::consts::PI) > 0.0);
+    assert!(!goals.ray_open(s, 0.0, true));
+    assert!(goals.ray_open(s, std::f64::consts::PI, true));
+    let axiom = goals.axiom();
+    assert_eq!(axiom.len(), 2);
+    for (_, road) in &axiom {
+        assert!(
+            goals.ray_open(road.start, road.angle, true),
+            "{}",
+            road.angle
+        );
+        let end = road.start + DVec2::from_angle(road.angle) * params.highway_length_m;
+        assert!(end.x <= 20.0, "axiom highway into the sea: {end}");
+    }
+    // Both highways grow: the network is more than the axiom and its first branches.
+    let g = generate(&params, &inputs).unwrap();
+    let highways = g
+        .network
+        .edges()
+        .filter(|(_, _, _, r)| r.class == RoadClass::Highway)
+        .count();
+    assert!(highways >= 6, "{highways} highway edges");
+    assert_eq!(g.report.segments, 400);
+    // Nothing was built in the sea (bridges excepted, and none spans 2 km).
+    for (e, _, _, r) in g.network.edges() {
+        let (a, b) = g.network.segment(e).unwrap();
+        assert!(
+            r.bridge || (a.x <= 20.0 + 1e-6 && b.x <= 20.0 + 1e-6),
+            "{a} {b}"
+        );
+    }
+}
