@@ -219,8 +219,11 @@ impl DefaultGoals {
     /// Whether a highway can leave `p` in direction `a`: its first segment stays on legal
     /// ground, or crosses water that a bridge (or, where the parameters say so, a tunnel)
     /// within the local constraints' length limit spans, as [`DefaultConstraints`]
-    /// would build it. A park or a slope does not close a ray (the constraints rotate
-    /// round it or tunnel under it); the map's edge does if `edge_closes`.
+    /// would build it: from `p` where the water begins early in the segment, from the
+    /// shore (the last legal sample) where it begins late enough for the constraints to
+    /// prune the segment there, so that the next segment is the bridge. A park or a slope
+    /// does not close a ray (the constraints rotate round it or tunnel under it); the
+    /// map's edge does if `edge_closes`.
     ///
     /// [`DefaultConstraints`]: crate::DefaultConstraints
     pub fn ray_open(&self, p: DVec2, a: f64, edge_closes: bool) -> bool {
@@ -238,8 +241,20 @@ impl DefaultGoals {
                 } else {
                     self.params.max_bridge_length_m
                 };
+                // Where the water begins far enough along, the constraints prune the
+                // segment to the shore and the next one bridges from there, its length
+                // limit counted from the shore: a river as wide as the limit is open
+                // wherever the highway meets it.
+                let shore = v.t_legal * len;
+                let from = if shore >= (1.0 - self.params.max_prune_factor) * len
+                    && shore >= self.params.min_segment_length_m
+                {
+                    shore
+                } else {
+                    0.0
+                };
                 self.legality
-                    .bridge_landing(p, d, v.t * len, reach)
+                    .bridge_landing(p + d * from, d, v.t * len - from, reach)
                     .is_some()
             }
         }
