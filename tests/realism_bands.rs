@@ -173,6 +173,55 @@ fn road_statistics_agree_with_the_whole_city() {
     }
 }
 
+/// Bridges where the island needs them (issue 19: `manhattan` had none but chance
+/// crossings of coves). The preset's water is the island's sea up to a mainland beyond
+/// the East River (`min_of` an island and a coast: the river 400–550 m wide along the middle
+/// of the island, within the 700 m bridge limit, wider toward its tips; the Hudson side
+/// stays open water to the map's edge). On seeds 1–5
+/// the road stage bridges the river and grows streets on the far bank, which nothing but
+/// a bridge reaches: no road crosses water otherwise.
+#[test]
+fn manhattan_bridges_the_east_river() {
+    use polis::geom::DVec2;
+    use polis::stages::{RoadStage, StageContext};
+    // Across the island toward the East River (the island's axis is at 75°).
+    let east = DVec2::from_angle((-15f64).to_radians());
+    for seed in 1..=5 {
+        let mut config = CityConfig::preset("manhattan").unwrap();
+        config.seed = seed;
+        let maps = polis::CityMaps::build(
+            &config.maps,
+            polis::seed::sub_seed(seed, polis::Stage::Maps, 0),
+        )
+        .unwrap();
+        let water = |p: DVec2| maps.inputs.water.sample(p) >= 0.5;
+        // The river: land on the island's shore side, water, then the mainland.
+        assert!(!water(east * 600.0) && water(east * 1150.0) && !water(east * 1600.0));
+        let cx = StageContext {
+            config: &config,
+            maps: &maps,
+        };
+        let net = polis::citygen::ConfiguredRoads::default()
+            .roads(&cx)
+            .unwrap()
+            .network;
+        let max = config.effective_road_params().max_bridge_length_m;
+        let mut bridges = 0;
+        let mut mainland = 0;
+        for (e, _, _, r) in net.edges() {
+            let (a, b) = net.segment(e).unwrap();
+            if r.bridge {
+                bridges += 1;
+                assert!(a.distance(b) <= max + 1e-6, "seed {seed}: bridge {a} {b}");
+            } else if a.dot(east) > 1500.0 && b.dot(east) > 1500.0 {
+                mainland += 1;
+            }
+        }
+        assert!(bridges > 0, "seed {seed}: no bridge");
+        assert!(mainland > 0, "seed {seed}: no road on the mainland");
+    }
+}
+
 /// Manhattan's blocks are long across the island, its lots 25 × 100 ft, its
 /// median building mid-rise (issue 19's table: it was 259 m with 71 % skyscrapers and a
 /// coverage of 0.96). On a 2 km `manhattan` (the island is at 75°, so across it is 165°).
