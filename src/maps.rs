@@ -3,10 +3,10 @@
 //! Every map is a [`Field`] over the layout plane (metres). A configuration names each one
 //! with a [`MapSpec`]: either a [`FieldSpec`] of polis-geom (noise, the slides'
 //! population, a grey-scale PNG, constants and combinators) or one of the city-scale
-//! [`Shape`]s written here (a coastline, an island, a radial centre). The seeds written
-//! in a map are *salts*: they are mixed with the city seed, so a new city seed gives new
-//! maps while one preset file serves every seed. PNG maps take no seed and replace a
-//! procedural map exactly.
+//! [`Shape`]s written here (a coastline, an island, a radial centre, the smallest of
+//! several maps). The seeds written in a map are *salts*: they are mixed with the city
+//! seed, so a new city seed gives new maps while one preset file serves every seed. PNG
+//! maps take no seed and replace a procedural map exactly.
 
 use std::sync::Arc;
 
@@ -85,6 +85,15 @@ pub enum Shape {
         /// Seed salt. Default: 0.
         #[serde(default)]
         seed: u64,
+    },
+    /// The smallest of several maps at each point. For water maps (1 is water) the
+    /// intersection of their water: an island's sea that ends at a coast, e.g. a river
+    /// between an island and the mainland (the `manhattan` preset). Each map is built
+    /// with its own salt (its index mixed into the city's), so maps of the same kind
+    /// and seed still get different noise. NaN where any map is NaN.
+    MinOf {
+        /// The maps, at least one.
+        of: Vec<MapSpec>,
     },
 }
 
@@ -168,7 +177,7 @@ impl MapSpec {
     pub fn build_limited(&self, name: &str, salt: u64, max_pixels: u64) -> Result<Arc<dyn Field>> {
         match self {
             MapSpec::Field(spec) => Ok(Arc::from(salted(spec, salt).build_limited(max_pixels)?)),
-            MapSpec::Shape(shape) => build_shape(shape, name, salt),
+            MapSpec::Shape(shape) => build_shape(shape, name, salt, max_pixels),
         }
     }
 }
@@ -182,6 +191,12 @@ impl MapSpec {
         match self {
             MapSpec::Field(spec) => spec.value_range(),
             MapSpec::Shape(Shape::Coast { .. } | Shape::Island { .. }) => (0.0, 1.0),
+            // An empty list is refused when built; its range is empty (NaN flags it).
+            MapSpec::Shape(Shape::MinOf { of }) => of
+                .iter()
+                .map(MapSpec::value_range)
+                .reduce(|(lo, hi), (l, h)| (nan_min(lo, l), nan_min(hi, h)))
+                .unwrap_or((f64::NAN, f64::NAN)),
             MapSpec::Shape(Shape::Radial { peak, noise, .. }) => {
                 // max(peak · base · (1 + noise · n), 0) with base in [0, 1], n in [-1, 1].
                 let top = peak * (1.0 + noise.abs());
@@ -226,8 +241,42 @@ fn noise(seed: u64, wavelength_m: f64) -> Result<Fbm> {
     })?)
 }
 
-fn build_shape(shape: &Shape, name: &str, salt: u64) -> Result<Arc<dyn Field>> {
+/// The smaller of `a` and `b`, NaN if either is.
+fn nan_min(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+fn build_shape(shape: &Shape, name: &str, salt: u64, max_pixels: u64) -> Result<Arc<dyn Field>> {
     Ok(match *shape {
+        Shape::MinOf { ref of } => {
+            if of.is_empty() {
+                return Err(Error::config(
+                    format!("{name}.of"),
+                    "min_of needs at least one map".to_string(),
+                ));
+            }
+            let maps = of
+                .iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    m.build_limited(
+                        &format!("{name}.of[{i}]"),
+                        mix(salt, i as u64 + 1),
+                        max_pixels,
+                    )
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Arc::new(FnField::new(move |p: DVec2| {
+                maps.iter()
+                    .map(|m| m.sample(p))
+                    .reduce(nan_min)
+                    .unwrap_or(f64::NAN)
+            }))
+        }
         Shape::Coast {
             toward_deg,
             distance_m,
@@ -575,5 +624,55 @@ mod tests {
         .unwrap();
         assert!((r.sample(DVec2::new(100.0, 0.0)) - 1.0).abs() < 1e-12);
         assert_eq!(r.sample(DVec2::new(1200.0, 0.0)), 0.0);
+    }
+
+    /// An island and a coast combined: water only where both have water (a river between
+    /// the island and the mainland beyond the coast), ranges and errors of the parts.
+    #[test]
+    fn min_of_intersects_water_maps() {
+        let spec: MapSpec = serde_json::from_str(
+            r#"{ "kind": "min_of", "of": [
+                { "kind": "island", "radii_m": [1000, 1000], "roughness": 0 },
+                { "kind": "coast", "toward_deg": 180, "distance_m": -1500, "roughness_m": 0 }
+            ] }"#,
+        )
+        .unwrap();
+        assert_eq!(spec.value_range(), (0.0, 1.0));
+        let w = spec.build("water", 3).unwrap();
+        assert_eq!(w.sample(DVec2::ZERO), 0.0, "the island");
+        assert_eq!(w.sample(DVec2::new(1200.0, 0.0)), 1.0, "the river");
+        assert_eq!(w.sample(DVec2::new(-1200.0, 0.0)), 1.0, "the sea");
+        assert_eq!(w.sample(DVec2::new(1800.0, 0.0)), 0.0, "the mainland");
+        assert_eq!(
+            spec.build("water", 3)
+                .unwrap()
+                .sample(DVec2::new(1499.0, 7.0)),
+            w.sample(DVec2::new(1499.0, 7.0)),
+            "deterministic"
+        );
+        // A NaN part makes the point NaN, not the other part's value.
+        let nan = MapSpec::Shape(Shape::MinOf {
+            of: vec![MapSpec::constant(0.0), MapSpec::constant(f64::NAN)],
+        });
+        assert!(nan.build("m", 0).unwrap().sample(DVec2::ZERO).is_nan());
+        assert!(nan.value_range().0.is_nan());
+        let empty = MapSpec::Shape(Shape::MinOf { of: Vec::new() });
+        let err = empty.build("maps.water", 0).err().unwrap();
+        assert!(err.to_string().contains("maps.water.of"), "{err}");
+        let bad = MapSpec::Shape(Shape::MinOf {
+            of: vec![MapSpec::Shape(Shape::Island {
+                centre: [0.0, 0.0],
+                radii_m: [-1.0, 1.0],
+                angle_deg: 0.0,
+                roughness: 0.0,
+                wavelength_m: 900.0,
+                seed: 0,
+            })],
+        });
+        let err = bad.build("maps.water", 0).err().unwrap();
+        assert!(
+            err.to_string().contains("maps.water.of[0].radii_m[0]"),
+            "{err}"
+        );
     }
 }

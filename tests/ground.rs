@@ -359,7 +359,8 @@ fn roads_are_graded_and_earthworks_reported() {
     assert!(!glb_has_ground(&bare));
 }
 
-/// The bridges of `manhattan` (its two highway bridges at full size): every deck and
+/// The bridges of `manhattan` (at full size, seed 1: a highway bridge over the East
+/// River to the mainland and a short one over a cove of the west shore): every deck and
 /// pier in the `bridges` node is a closed, 2-manifold, outward shell by the edge-use
 /// check, one deck per bridge at least.
 #[test]

@@ -142,21 +142,12 @@ impl DefaultConstraints {
             && v.what == Illegal::Water
             && p.max_bridge_length_m > 0.0
             && !under_water
+            && let Some(landing) =
+                self.legality
+                    .bridge_landing(a, dir(angle), v.t * len, p.max_bridge_length_m)
         {
-            let step = self.legality.step();
-            let d = dir(angle);
-            let mut s = v.t * len;
-            while s + step <= p.max_bridge_length_m {
-                s += step;
-                if self.legality.point(a + d * s).is_none() {
-                    let landing = a + d * (s + step).min(p.max_bridge_length_m);
-                    if self.legality.bridgeable(a, landing) {
-                        self.stats.bridges += 1;
-                        return Some((landing, angle, Span::Bridge));
-                    }
-                    break;
-                }
-            }
+            self.stats.bridges += 1;
+            return Some((landing, angle, Span::Bridge));
         }
         // Rotate within the maximal angle, nearest first, left before right (roads follow
         // coastlines and park edges, not the edge of the map).

@@ -9,7 +9,7 @@ use rand::Rng;
 
 use crate::error::{Result, RoadError};
 use crate::inputs::RoadInputs;
-use crate::legality::Legality;
+use crate::legality::{Illegal, Legality};
 use crate::modules::{Proposal, RoadAttr, RuleAttr};
 use crate::network::{RoadClass, angle_diff, angle_of, dir};
 use crate::params::{Pattern, RoadParams};
@@ -50,6 +50,7 @@ const PATTERNS: [Pattern; 4] = [
 pub struct DefaultGoals {
     params: RoadParams,
     inputs: RoadInputs,
+    legality: Legality,
     start: DVec2,
     centre: DVec2,
 }
@@ -117,6 +118,7 @@ impl DefaultGoals {
         Ok(DefaultGoals {
             params: params.clone(),
             inputs: inputs.clone(),
+            legality,
             start,
             centre,
         })
@@ -162,14 +164,23 @@ impl DefaultGoals {
     }
 
     /// Inverse-distance-weighted population along the ray from `p` in direction `a`
-    /// (§3.2.1, Fig. 4).
+    /// (§3.2.1, Fig. 4). Samples in water or in a park count nothing, whatever the
+    /// population map says there (a procedural map goes on under the sea): a highway
+    /// starting on a shore otherwise aimed at the population it saw across the water,
+    /// met water no bridge spans and stopped, and the city stayed a pocket of a few
+    /// hundred streets around its start. Beyond the map's edge the samples count (the
+    /// country goes on there, and highways run on to the edge).
     pub fn ray_score(&self, p: DVec2, a: f64) -> f64 {
         let n = self.params.highway_ray_samples;
         let d = dir(a);
         let mut sum = 0.0;
         for i in 1..=n {
             let dist = self.params.highway_ray_length_m * f64::from(i) / f64::from(n);
-            let v = self.inputs.population.sample(p + d * dist);
+            let q = p + d * dist;
+            if matches!(self.legality.point(q), Some(Illegal::Water | Illegal::Park)) {
+                continue;
+            }
+            let v = self.inputs.population.sample(q);
             if v.is_finite() {
                 sum += v / dist;
             }
@@ -178,9 +189,12 @@ impl DefaultGoals {
     }
 
     /// The best of `highway_rays` rays within `±half_fan` of `a` (ties: closest to `a`).
-    pub fn best_ray(&self, p: DVec2, a: f64, half_fan: f64) -> f64 {
+    /// Rays the highway cannot take ([`ray_open`](Self::ray_open); the map's edge closes
+    /// a ray only if `edge_closes`) lose to every open one; when none is open, the best
+    /// of all (the local constraints then end the highway there).
+    pub fn best_ray(&self, p: DVec2, a: f64, half_fan: f64, edge_closes: bool) -> f64 {
         let n = self.params.highway_rays.max(1);
-        let mut best = (f64::NEG_INFINITY, a);
+        let mut best: Option<(bool, f64, f64)> = None;
         for i in 0..n {
             let off = if n == 1 {
                 0.0
@@ -189,11 +203,61 @@ impl DefaultGoals {
             };
             let cand = a + off;
             let s = self.ray_score(p, cand);
-            if s > best.0 + 1e-12 || (s >= best.0 - 1e-12 && off.abs() < angle_diff(best.1, a)) {
-                best = (s, cand);
+            let open = self.ray_open(p, cand, edge_closes);
+            let better = best.is_none_or(|(bo, bs, ba)| {
+                (open && !bo)
+                    || (open == bo
+                        && (s > bs + 1e-12 || (s >= bs - 1e-12 && off.abs() < angle_diff(ba, a))))
+            });
+            if better {
+                best = Some((open, s, cand));
             }
         }
-        best.1
+        best.map_or(a, |(_, _, ang)| ang)
+    }
+
+    /// Whether a highway can leave `p` in direction `a`: its first segment stays on legal
+    /// ground, or crosses water that a bridge (or, where the parameters say so, a tunnel)
+    /// within the local constraints' length limit spans, as [`DefaultConstraints`]
+    /// would build it: from `p` where the water begins early in the segment, from the
+    /// shore (the last legal sample) where it begins late enough for the constraints to
+    /// prune the segment there, so that the next segment is the bridge. A park or a slope
+    /// does not close a ray (the constraints rotate round it or tunnel under it); the
+    /// map's edge does if `edge_closes`.
+    ///
+    /// [`DefaultConstraints`]: crate::DefaultConstraints
+    pub fn ray_open(&self, p: DVec2, a: f64, edge_closes: bool) -> bool {
+        let d = dir(a);
+        let len = self.params.highway_length_m;
+        let Some(v) = self.legality.segment(p, p + d * len) else {
+            return true;
+        };
+        match v.what {
+            Illegal::Outside => !edge_closes,
+            Illegal::Park | Illegal::Slope => true,
+            Illegal::Water => {
+                let reach = if self.params.tunnel_under_water {
+                    self.params.max_tunnel_length_m
+                } else {
+                    self.params.max_bridge_length_m
+                };
+                // Where the water begins far enough along, the constraints prune the
+                // segment to the shore and the next one bridges from there, its length
+                // limit counted from the shore: a river as wide as the limit is open
+                // wherever the highway meets it.
+                let shore = v.t_legal * len;
+                let from = if shore >= (1.0 - self.params.max_prune_factor) * len
+                    && shore >= self.params.min_segment_length_m
+                {
+                    shore
+                } else {
+                    0.0
+                };
+                self.legality
+                    .bridge_landing(p + d * from, d, v.t * len - from, reach)
+                    .is_some()
+            }
+        }
     }
 
     fn class_length(&self, class: RoadClass) -> f64 {
@@ -222,7 +286,7 @@ impl DefaultGoals {
     fn basic(&self, p: DVec2, a: f64, class: RoadClass, branch: bool, rng: &mut Pcg64Mcg) -> Aim {
         let angle = match class {
             RoadClass::Highway if !branch => {
-                self.best_ray(p, a, self.params.highway_max_turn_deg.to_radians())
+                self.best_ray(p, a, self.params.highway_max_turn_deg.to_radians(), false)
             }
             _ => {
                 let dev = self.params.street_deviation_deg.to_radians();
@@ -411,7 +475,7 @@ impl GlobalGoals for DefaultGoals {
         let p = self.start;
         let a = match self.params.start_angle_deg {
             Some(d) => d.to_radians(),
-            None => self.best_ray(p, 0.0, PI),
+            None => self.best_ray(p, 0.0, PI, true),
         };
         let w = self.pattern_weights(p);
         // Align the axiom with the dominant pattern where it has a direction.
@@ -419,11 +483,10 @@ impl GlobalGoals for DefaultGoals {
             // The grid axis nearest the population's direction on which the axiom can be
             // laid (either way legal): on hills the nearest axis may be too steep.
             let g = self.new_york(p, a, RoadClass::Highway).angle;
-            let legality = Legality::new(&self.inputs, &self.params);
             let len = self.params.highway_length_m;
             let legal = |ang: f64| {
-                legality.segment_ok(p, p + dir(ang) * len)
-                    || legality.segment_ok(p, p - dir(ang) * len)
+                self.legality.segment_ok(p, p + dir(ang) * len)
+                    || self.legality.segment_ok(p, p - dir(ang) * len)
             };
             [0.0, FRAC_PI_2, -FRAC_PI_2]
                 .into_iter()
@@ -435,6 +498,21 @@ impl GlobalGoals for DefaultGoals {
         } else {
             a
         };
+        // The second highway leaves the other way; where that way is closed (the start
+        // lies on a shore or near the map's edge), along the best open ray within a
+        // right angle of it (a grid axis under New York), so the city does not grow
+        // from one road.
+        let b = if self.ray_open(p, a + PI, true) {
+            a + PI
+        } else if w[1] >= 0.5 {
+            let side = [a + FRAC_PI_2, a - FRAC_PI_2]
+                .into_iter()
+                .filter(|&c| self.ray_open(p, c, true))
+                .max_by(|&x, &y| self.ray_score(p, x).total_cmp(&self.ray_score(p, y)));
+            side.unwrap_or(a + PI)
+        } else {
+            self.best_ray(p, a + PI, FRAC_PI_2, true)
+        };
         let len = self.params.highway_length_m;
         vec![
             (
@@ -442,8 +520,8 @@ impl GlobalGoals for DefaultGoals {
                 RoadAttr::new(p, a, len, RoadClass::Highway),
             ),
             (
-                RuleAttr::new(RoadClass::Highway, 0, a + PI),
-                RoadAttr::new(p, a + PI, len, RoadClass::Highway),
+                RuleAttr::new(RoadClass::Highway, 0, b),
+                RoadAttr::new(p, b, len, RoadClass::Highway),
             ),
         ]
     }
@@ -658,7 +736,12 @@ mod tests {
         let params = RoadParams::default();
         let g = DefaultGoals::new(&params, &flat()).unwrap();
         // The peak is at the origin; from (1000, 0) heading north, the best ray turns west.
-        let a = g.best_ray(DVec2::new(1000.0, 0.0), FRAC_PI_2, 30f64.to_radians());
+        let a = g.best_ray(
+            DVec2::new(1000.0, 0.0),
+            FRAC_PI_2,
+            30f64.to_radians(),
+            false,
+        );
         assert!(a > FRAC_PI_2 + 0.1, "{a}");
         assert!(g.start().length() < 100.0);
         assert!(g.centre().length() < 100.0);

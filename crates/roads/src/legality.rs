@@ -189,6 +189,24 @@ impl Legality {
         })
     }
 
+    /// The landing of a bridge leaving `a` in the unit direction `d` whose first water
+    /// sample lies `water_at` metres along: one sample step past the first legal sample
+    /// within `reach` metres of `a` (capped at `reach`), if the span from `a` only crosses
+    /// water ([`bridgeable`](Self::bridgeable)); `None` when no land lies within reach or
+    /// the span crosses something else.
+    pub fn bridge_landing(&self, a: DVec2, d: DVec2, water_at: f64, reach: f64) -> Option<DVec2> {
+        let step = self.step;
+        let mut s = water_at;
+        while s + step <= reach {
+            s += step;
+            if self.point(a + d * s).is_none() {
+                let landing = a + d * (s + step).min(reach);
+                return self.bridgeable(a, landing).then_some(landing);
+            }
+        }
+        None
+    }
+
     /// The sample spacing.
     pub fn step(&self) -> f64 {
         self.step

@@ -415,3 +415,116 @@ fn lattice_maps_keep_every_legality_property() {
         );
     }
 }
+
+/// A start on a shore (issue 19, `default` seed 2): the sea counts no population for the
+/// highway rays, though the population map goes on under it, and neither axiom highway
+/// heads into water no bridge spans, so the network grows over the land instead of
+/// stopping after a few segments.
+#[test]
+fn highways_leave_a_shore_start_over_land() {
+    // Population peaks on the shore at the origin; the sea east of x = 20 m is 2 km wide.
+    let pop = FnField::new(|p: DVec2| (-(p.length() / 800.0).powi(2)).exp());
+    let mut inputs = RoadInputs::flat(Arc::new(pop));
+    inputs.water = Arc::new(FnField::new(|p: DVec2| if p.x > 20.0 { 1.0 } else { 0.0 }));
+    let params = RoadParams {
+        max_segments: 400,
+        ..RoadParams::default()
+    };
+    let goals = DefaultGoals::new(&params, &inputs).unwrap();
+    let s = goals.start();
+    assert!(s.x <= 20.0 && s.length() < 100.0, "{s}");
+    // Eastward every ray sample lies in the sea: it scores nothing and is closed.
+    assert_eq!(goals.ray_score(s, 0.0), 0.0);
+    assert!(goals.ray_score(s, std::f64::consts::PI) > 0.0);
+    assert!(!goals.ray_open(s, 0.0, true));
+    assert!(goals.ray_open(s, std::f64::consts::PI, true));
+    let axiom = goals.axiom();
+    assert_eq!(axiom.len(), 2);
+    for (_, road) in &axiom {
+        assert!(
+            goals.ray_open(road.start, road.angle, true),
+            "{}",
+            road.angle
+        );
+        let end = road.start + DVec2::from_angle(road.angle) * params.highway_length_m;
+        assert!(end.x <= 20.0, "axiom highway into the sea: {end}");
+    }
+    // Both highways grow: the network is more than the axiom and its first branches.
+    let g = generate(&params, &inputs).unwrap();
+    let highways = g
+        .network
+        .edges()
+        .filter(|(_, _, _, r)| r.class == RoadClass::Highway)
+        .count();
+    assert!(highways >= 6, "{highways} highway edges");
+    assert_eq!(g.report.segments, 400);
+    // Nothing was built in the sea (bridges excepted, and none spans 2 km).
+    for (e, _, _, r) in g.network.edges() {
+        let (a, b) = g.network.segment(e).unwrap();
+        assert!(
+            r.bridge || (a.x <= 20.0 + 1e-6 && b.x <= 20.0 + 1e-6),
+            "{a} {b}"
+        );
+    }
+}
+
+/// A highway meeting a river late in its segment (issue 19, `manhattan`'s East River):
+/// the constraints prune the segment to the shore and the next one bridges from there, so
+/// the ray is open when the river is narrower than the bridge limit counted from the
+/// shore, though the far shore lies beyond the limit counted from the highway's end; a
+/// wider river stays closed. A highway sent across the narrow river crosses it.
+#[test]
+fn a_river_met_late_in_a_segment_is_bridged_from_the_shore() {
+    let river = |far: f64| {
+        let pop = FnField::new(|p: DVec2| (-(p.length() / 1500.0).powi(2)).exp());
+        let mut inputs = RoadInputs::flat(Arc::new(pop));
+        inputs.water = Arc::new(FnField::new(move |p: DVec2| {
+            if p.x > 200.0 && p.x < far { 1.0 } else { 0.0 }
+        }));
+        inputs
+    };
+    let params = RoadParams {
+        max_segments: 600,
+        start: Some([0.0, 0.0]),
+        start_angle_deg: Some(0.0),
+        ..RoadParams::default()
+    };
+    // The shore lies 200 m ahead, past the prune limit (half of a 240 m segment); the
+    // bridge limit is 400 m.
+    assert!(params.highway_length_m * (1.0 - params.max_prune_factor) < 200.0);
+    assert_eq!(params.max_bridge_length_m, 400.0);
+    let p = DVec2::ZERO;
+    let narrow = river(550.0);
+    let goals = DefaultGoals::new(&params, &narrow).unwrap();
+    assert!(goals.ray_open(p, 0.0, true), "350 m river from the shore");
+    let wide = river(650.0);
+    let closed = DefaultGoals::new(&params, &wide).unwrap();
+    assert!(!closed.ray_open(p, 0.0, true), "450 m river");
+    // A highway sent at it is pruned to the shore and bridges from there: the network
+    // reaches the far bank.
+    let g = generate(&params, &narrow).unwrap();
+    let bridges: Vec<(DVec2, DVec2)> = g
+        .network
+        .edges()
+        .filter(|(_, _, _, r)| r.bridge)
+        .map(|(e, _, _, _)| g.network.segment(e).unwrap())
+        .collect();
+    assert!(!bridges.is_empty());
+    for (a, b) in &bridges {
+        assert!(
+            a.distance(*b) <= params.max_bridge_length_m + 1e-6,
+            "{a} {b}"
+        );
+    }
+    let far_bank = g
+        .network
+        .edges()
+        .filter(|(e, _, _, r)| {
+            !r.bridge
+                && g.network
+                    .segment(*e)
+                    .is_ok_and(|(a, b)| a.x >= 550.0 && b.x >= 550.0)
+        })
+        .count();
+    assert!(far_bank > 0, "no road on the far bank");
+}
