@@ -18,6 +18,9 @@
 //! a seam), one mesh per tile in tile order: the tiled glb layout appends them as they
 //! are instead of cutting a map-wide mesh each time it writes.
 //!
+//! The ground the terrain follows has the water bodies' bed cut in ([`crate::water`]);
+//! the bridges ([`bridges`]) climb over the water on piers standing in that bed.
+//!
 //! References: Kelly 2008 §4.2, §6.2 (the city on its terrain); Parish & Müller 2001 §3
 //! (elevation, water and parks as input maps).
 
@@ -371,7 +374,7 @@ impl Profile {
         let (s1, y1) = (a, h0 + m0 * a);
         let (s2, y2) = (len - a, h1 - m1 * a);
         let span = s2 - s1;
-        if !(span > 0.0) || (y2 - y1).abs() > grade * span {
+        if span.is_nan() || span <= 0.0 || (y2 - y1).abs() > grade * span {
             return Profile::straight(len, h0, h1);
         }
         // Between the corners: the straight line, or higher the grade-limited climb to
@@ -421,14 +424,19 @@ impl Profile {
         // Each inner corner's curve: at most the nominal half length, and no more than
         // half its neighbouring legs (all of a leg to an end, which has no curve).
         let n = kept.len();
-        let mut half = vec![0.0; n];
-        for i in 1..n.saturating_sub(1) {
-            let leg = |j: usize, k: usize| {
-                let l = kept[k].0 - kept[j].0;
-                if j == 0 || k == n - 1 { l } else { 0.5 * l }
-            };
-            half[i] = BRIDGE_CURVE_M.min(leg(i - 1, i)).min(leg(i, i + 1));
-        }
+        let leg = |j: usize, k: usize| {
+            let l = kept[k].0 - kept[j].0;
+            if j == 0 || k == n - 1 { l } else { 0.5 * l }
+        };
+        let half = (0..n)
+            .map(|i| {
+                if i == 0 || i + 1 >= n {
+                    0.0
+                } else {
+                    BRIDGE_CURVE_M.min(leg(i - 1, i)).min(leg(i, i + 1))
+                }
+            })
+            .collect();
         Profile { pvi: kept, half }
     }
 

@@ -297,7 +297,7 @@ impl Water {
             return 0.0;
         };
         let excess = e - (body.level - WATER_MAX_DEPTH_M);
-        if !(excess > 0.0) {
+        if excess.is_nan() || excess <= 0.0 {
             return 0.0; // deep enough already (or not finite: left alone)
         }
         // `bank(d) ≥ excess` from this distance on.
