@@ -308,7 +308,10 @@ impl Water {
                 d = 0.0;
             } else {
                 let m = WATER_LAND_MARGIN_M;
-                d = d.min((self.blocks.distance_within(p, d + m) - m).max(0.0));
+                let block = self.blocks.distance_within(p, d + m);
+                if block < d + m {
+                    d = d.min((block - m).max(0.0));
+                }
             }
         }
         if d > 0.0 {
@@ -318,6 +321,9 @@ impl Water {
                 let (a, q, half) = self.roads[k as usize];
                 d = d.min((distance_to_segment(p, a, q) - half - m).max(0.0));
             });
+        }
+        if d >= reach {
+            return excess; // past the bank (exactly: what a batch far from shores gives)
         }
         excess.min(bank(d))
     }
@@ -340,12 +346,58 @@ impl Field for WaterBed<'_> {
         e - self.water.depth(p, e)
     }
 
+    /// The base's values at all the points, then the depths: one containment test for
+    /// all of them where no shore, block or road comes within the widest bank of
+    /// their bounding box (every point then lies in the same body, or none, and as far
+    /// from shore and land as any bank reaches), else one per point. The same values as
+    /// [`sample`](Field::sample).
     fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
         self.base.sample_many(points, out);
-        for (&p, o) in points.iter().zip(out.iter_mut()) {
-            *o -= self.water.depth(p, *o);
+        let w = self.water;
+        let far = points_box(points).filter(|b| {
+            let m = WATER_LAND_MARGIN_M;
+            let bank = WATER_BANK_M + WATER_BANK_WALL_M;
+            let near = |index: &SegmentIndex<u32>, by: f64| {
+                let b = b.expanded(bank + by);
+                let mut hit = false;
+                index.for_each_candidate(&b, |_, s| hit |= s.intersects_box(&b));
+                hit
+            };
+            !near(&w.shore.index, 0.0)
+                && !near(&w.blocks.index, m)
+                && !near(&w.road_index, w.widest_road + m)
+        });
+        match far {
+            Some(_) => {
+                let Some(body) = points.first().and_then(|&p| w.body_at(p)) else {
+                    return; // on land (or no point): the base
+                };
+                if w.blocks.owner_at(points[0]).is_some() {
+                    return; // all inside one block
+                }
+                for o in out.iter_mut().take(points.len()) {
+                    let excess = *o - (body.level - WATER_MAX_DEPTH_M);
+                    if excess > 0.0 {
+                        *o -= excess; // past every bank
+                    }
+                }
+            }
+            None => {
+                for (&p, o) in points.iter().zip(out.iter_mut()) {
+                    *o -= w.depth(p, *o);
+                }
+            }
         }
     }
+}
+
+/// The bounding box of `points`, `None` when there are none or one is not finite.
+fn points_box(points: &[DVec2]) -> Option<Aabb2> {
+    let first = *points.first()?;
+    let (lo, hi) = points
+        .iter()
+        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (lo.is_finite() && hi.is_finite()).then(|| Aabb2::new(lo, hi))
 }
 
 #[cfg(test)]
@@ -440,6 +492,71 @@ mod tests {
                 "{p} {h}"
             );
         }
+    }
+
+    /// Many samples at once give the values of one at a time, bit for bit, in batches
+    /// of a terrain leaf's 5 × 5 check points at every scale, near and far from shores,
+    /// roads and blocks.
+    #[test]
+    fn many_samples_equal_single_ones() {
+        let lake = PolygonWithHoles::new(
+            Polygon::rect(DVec2::new(-400.0, -400.0), DVec2::new(400.0, 400.0)),
+            vec![Polygon::new(vec![
+                DVec2::new(-50.0, -50.0),
+                DVec2::new(-50.0, 50.0),
+                DVec2::new(50.0, 50.0),
+                DVec2::new(50.0, -50.0),
+            ])],
+        );
+        let mut net = RoadNetwork::new();
+        let a = net
+            .add_node(DVec2::new(-500.0, 390.0), Junction::default())
+            .unwrap();
+        let b = net
+            .add_node(DVec2::new(500.0, 390.0), Junction::default())
+            .unwrap();
+        let street = Road {
+            class: RoadClass::Street,
+            width: 10.0,
+            bridge: false,
+            tunnel: false,
+            step: 0,
+        };
+        net.add_edge(a, b, street).unwrap();
+        let block = PolygonWithHoles::from(Polygon::rect(
+            DVec2::new(-300.0, -420.0),
+            DVec2::new(-100.0, -200.0),
+        ));
+        let hills = polis_geom::field::FnField::new(|p: DVec2| 8.0 + 0.01 * p.x + 0.002 * p.y);
+        let water = Water::new(
+            vec![lake],
+            &hills,
+            square(600.0),
+            &net,
+            [&block].into_iter(),
+        )
+        .unwrap()
+        .unwrap();
+        let bed = water.bed(&hills);
+        let mut batches = 0;
+        for size in [2.0, 8.0, 64.0, 256.0] {
+            let n = (1200.0 / size) as i32;
+            for i in 0..n {
+                for j in 0..n {
+                    let lo = DVec2::new(-600.0 + size * i as f64, -600.0 + size * j as f64);
+                    let pts: Vec<DVec2> = (0..25)
+                        .map(|k| lo + DVec2::new((k % 5) as f64, (k / 5) as f64) * (size / 4.0))
+                        .collect();
+                    let mut many = vec![0.0; 25];
+                    bed.sample_many(&pts, &mut many);
+                    for (p, m) in pts.iter().zip(&many) {
+                        assert_eq!(m.to_bits(), bed.sample(*p).to_bits(), "{p} at {size}");
+                    }
+                    batches += 1;
+                }
+            }
+        }
+        assert!(batches > 1000);
     }
 
     /// Ground far above the water inside the outline: the bank steepens into a wall
