@@ -310,8 +310,10 @@ pub struct SceneConfig {
     /// distances; the per-cell and per-building layouts, the OBJ and the scene itself
     /// hold both levels, overlapping. Ignored at `lod` 0. Default: false.
     pub coarse_lod: bool,
-    /// Water bodies of the water map as flat surfaces at the level of their lowest
-    /// shore point, in a node `water` of their own (false leaves them out). Default: true.
+    /// Water bodies of the water map as flat surfaces at their level (their lowest shore
+    /// point less [`WATER_FREEBOARD_M`](crate::WATER_FREEBOARD_M); the bed under them is
+    /// part of the ground either way), in a node `water` of their own (false leaves
+    /// them out). Default: true.
     pub water_surfaces: bool,
     /// How each building kind is seated on sloping ground, in
     /// [`BuildingKind::ALL`] order. Default: [`Foundation::Highest`] for every kind.

@@ -18,6 +18,9 @@
 //! a seam), one mesh per tile in tile order: the tiled glb layout appends them as they
 //! are instead of cutting a map-wide mesh each time it writes.
 //!
+//! The ground the terrain follows has the water bodies' bed cut in ([`crate::water`]);
+//! the bridges ([`bridges`]) climb over the water on piers standing in that bed.
+//!
 //! References: Kelly 2008 §4.2, §6.2 (the city on its terrain); Parish & Müller 2001 §3
 //! (elevation, water and parks as input maps).
 
@@ -27,6 +30,7 @@ use polis_geom::scene::{Image, ImageData, Texture, Wrap};
 use polis_geom::{Aabb2, DVec2, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene};
 
 use crate::error::Result;
+use crate::water::Water;
 use crate::{CityConfig, SceneConfig};
 
 /// Land-use classes of the ground texture, and their colours (linear RGB).
@@ -191,30 +195,70 @@ pub(crate) fn validate(scene: &SceneConfig) -> std::result::Result<(), (&'static
 pub const BRIDGE_DECK_M: f64 = 1.2;
 /// Spacing of a bridge's piers along it, metres (at least one pier per bridge).
 pub const BRIDGE_PIER_SPACING_M: f64 = 40.0;
+/// Height of a bridge deck's underside above the water surface it crosses, metres,
+/// where the span allows the deck to climb that high within its grade limit.
+pub const BRIDGE_CLEARANCE_M: f64 = 8.0;
+/// Half the length of a bridge deck's vertical curves (parabolas), metres.
+pub const BRIDGE_CURVE_M: f64 = 25.0;
 /// Side of a square pier, metres.
 const PIER_SIDE_M: f64 = 2.0;
 /// How far a pier reaches into the ground below it, metres.
-const PIER_FOOT_M: f64 = 1.0;
+pub const PIER_FOOT_M: f64 = 1.0;
+/// Longest piece of a deck (and of a bridge's road profile) between two heights,
+/// metres.
+const DECK_STATION_M: f64 = 5.0;
+/// How far beyond a bridge's end the grade of the road that leads on is read, metres.
+const APPROACH_M: f64 = 10.0;
+
+/// A network's bridges: their decks and piers, and the height profile of each bridge
+/// road for its road surface.
+pub(crate) struct Bridges {
+    /// Every deck, one closed shell each; `None` without a deck.
+    pub decks: Option<Mesh>,
+    /// Every pier, one closed shell each; `None` without a pier.
+    pub piers: Option<Mesh>,
+    /// Per bridge road with a deck (by edge id): `(metres along the road from its first
+    /// point, height of the road surface before its lift)` pairs, increasing.
+    pub profiles: Vec<(u64, Vec<(f64, f64)>)>,
+}
 
 /// The decks and piers of the network's bridges (roads flagged `bridge` by the road
-/// generator), as closed solids in one mesh, one shell each: a bridge is a chain of
-/// bridge roads through nodes where exactly two bridge roads and nothing else meet (a
-/// bridge split into several roads), and its deck is **one** slab along the chain (mitred
-/// at the inner nodes, so neighbouring roads' decks neither overlap nor share a face),
-/// [`BRIDGE_DECK_M`] thick, its top just under the road surface, which runs straight by
-/// length along the chain between the ground at its two ends, as the road surfaces do
-/// (`polis_export::surfaces`); square piers every [`BRIDGE_PIER_SPACING_M`] along the
-/// chain reach from [`PIER_FOOT_M`] below the ground (or water bed) up to the deck,
-/// where the ground is below the deck. A chain whose mitred outline is not a simple
-/// polygon (a sharp zigzag of short roads) and a closed loop of bridges get one deck per
-/// road instead. `None` when there is no bridge.
-pub(crate) fn bridge_mesh(
+/// generator), as closed solids in one mesh, one shell each, and the profiles their road
+/// surfaces follow.
+///
+/// A bridge is a chain of bridge roads through nodes where exactly two bridge roads and
+/// nothing else meet (a bridge split into several roads), and its deck is **one** slab
+/// along the chain (mitred at the inner nodes, so neighbouring roads' decks neither
+/// overlap nor share a face), [`BRIDGE_DECK_M`] thick, its top just under the road
+/// surface. The road surface follows the deck's profile ([`Profile`]): from the ground
+/// at each end it climbs, within the chain's grade limit (the lowest of its roads'
+/// classes in `grading`), to [`BRIDGE_CLEARANCE_M`] above the highest water surface
+/// under it, bending over parabolic vertical curves of up to 2 · [`BRIDGE_CURVE_M`]
+/// that start tangent to the road leading on at each end; a span too short to climb
+/// that high rises as high as its grade allows; a chain with no water under it, or
+/// whose ends lie further apart in height than its grade allows, runs straight. Square
+/// piers every [`BRIDGE_PIER_SPACING_M`] along the chain reach from [`PIER_FOOT_M`]
+/// below the ground (the water bed, `ground` being the ground with the bed cut in) up
+/// to the deck's underside, where the ground is below it. A chain whose mitred outline
+/// is not a simple polygon (a sharp zigzag of short roads) and a closed loop of bridges
+/// get one deck per road instead.
+pub(crate) fn bridges(
     network: &polis_roads::RoadNetwork,
     ground: &dyn Field,
-) -> Result<Option<polis_geom::Mesh>> {
-    use polis_geom::Mesh;
-    let mut mesh = Mesh::new(None);
+    water: Option<&Water>,
+    grading: &polis_roads::grading::GradeParams,
+) -> Result<Bridges> {
+    let mut mesh = [Mesh::new(None), Mesh::new(None)];
+    let mut profiles = Vec::new();
     let mut done = vec![false; network.edge_bound()];
+    let mut add = |path: &BridgePath, chain: &[Link], mesh: &mut [Mesh; 2]| -> Result<bool> {
+        let Some(deck) = path.outline() else {
+            return Ok(false);
+        };
+        add_bridge(mesh, path, &deck, ground)?;
+        profiles.extend(path.road_profiles(chain));
+        Ok(true)
+    };
     for (e, _, _, road) in network.edges() {
         if !road.bridge || done[e.index()] {
             continue;
@@ -223,35 +267,39 @@ pub(crate) fn bridge_mesh(
         for c in &chain {
             done[c.0.index()] = true;
         }
-        let Some(path) = BridgePath::new(network, &chain, ground)? else {
+        let Some(path) = BridgePath::new(network, &chain, ground, water, grading)? else {
             continue;
         };
-        match path.outline() {
-            Some(deck) => add_bridge(&mut mesh, &path, &deck, ground)?,
+        if !add(&path, &chain, &mut mesh)? {
             // One deck per road: each its own chain of one.
-            None => {
-                for c in &chain {
-                    if let Some(one) = BridgePath::new(network, &[*c], ground)?
-                        && let Some(deck) = one.outline()
-                    {
-                        add_bridge(&mut mesh, &one, &deck, ground)?;
-                    }
+            for c in &chain {
+                if let Some(one) = BridgePath::new(network, &[*c], ground, water, grading)? {
+                    add(&one, &[*c], &mut mesh)?;
                 }
             }
         }
     }
-    Ok((!mesh.is_empty()).then_some(mesh))
+    profiles.sort_by_key(|p| p.0);
+    let [decks, piers] = mesh.map(|m| (!m.is_empty()).then_some(m));
+    Ok(Bridges {
+        decks,
+        piers,
+        profiles,
+    })
 }
 
 /// Under the road surface's lift (5 cm and the class lifts), metres.
 const DECK_TOP_M: f64 = -0.04;
 
-/// The chain of bridge roads through `first` (see [`bridge_mesh`]), in order along it,
+/// A road of a bridge chain, and whether it runs backwards along the chain.
+type Link = (polis_geom::graph::EdgeId, bool);
+
+/// The chain of bridge roads through `first` (see [`bridges`]), in order along it,
 /// each with whether it runs backwards (from its second node to its first).
 fn bridge_chain(
     network: &polis_roads::RoadNetwork,
     first: polis_geom::graph::EdgeId,
-) -> Result<Vec<(polis_geom::graph::EdgeId, bool)>> {
+) -> Result<Vec<Link>> {
     use polis_geom::graph::{EdgeId, NodeId};
     // The other bridge road at `n` when the chain runs through it.
     let through = |n: NodeId, from: EdgeId| -> Result<Option<EdgeId>> {
@@ -291,26 +339,167 @@ fn bridge_chain(
     Ok(backward)
 }
 
-/// A bridge's centre line: its points, each segment's half width, and the deck's height
-/// at each point (straight by length between the ground at the two ends).
+/// A deck's height profile along its chain: a polyline of points of intersection
+/// `(s, h)` whose inner corners are rounded by parabolas (vertical curves).
+#[derive(Debug, Clone)]
+struct Profile {
+    pvi: Vec<(f64, f64)>,
+    /// Half length of each corner's curve (0 at the two ends).
+    half: Vec<f64>,
+}
+
+impl Profile {
+    /// Straight from `h0` to `h1` over `len` metres.
+    fn straight(len: f64, h0: f64, h1: f64) -> Profile {
+        Profile {
+            pvi: vec![(0.0, h0), (len, h1)],
+            half: vec![0.0, 0.0],
+        }
+    }
+
+    /// The highest smooth profile from `h0` to `h1` over `len` metres that keeps
+    /// `grade` and climbs no higher than `top` (plus what the crest curves take back),
+    /// leaving the start at grade `m0` and reaching the end at grade `m1` (the roads
+    /// leading on, clamped to the grade), and never below the straight line between the
+    /// ends. Straight when the ends lie further apart in height than `grade` allows.
+    fn climbing(len: f64, [h0, h1]: [f64; 2], [m0, m1]: [f64; 2], grade: f64, top: f64) -> Profile {
+        let (m0, m1) = (m0.clamp(-grade, grade), m1.clamp(-grade, grade));
+        if !(len > 0.0 && grade > 0.0 && top.is_finite() && m0.is_finite() && m1.is_finite()) {
+            return Profile::straight(len, h0, h1);
+        }
+        // The curves at the ends start tangent to the roads leading on: their corners
+        // lie `a` metres in, on those roads' grades (an eighth of a short span: it
+        // climbs sooner).
+        let a = BRIDGE_CURVE_M.min(0.125 * len);
+        let (s1, y1) = (a, h0 + m0 * a);
+        let (s2, y2) = (len - a, h1 - m1 * a);
+        let span = s2 - s1;
+        if span.is_nan() || span <= 0.0 || (y2 - y1).abs() > grade * span {
+            return Profile::straight(len, h0, h1);
+        }
+        // Between the corners: the straight line, or higher the grade-limited climb to
+        // the top (raised by the most a crest curve takes back).
+        let level = top + grade * BRIDGE_CURVE_M / 4.0;
+        let sigma = (y2 - y1) / span;
+        let f = |s: f64| {
+            let up = y1 + grade * (s - s1);
+            let down = y2 + grade * (s2 - s);
+            let straight = y1 + sigma * (s - s1);
+            straight.max(level.min(up).min(down))
+        };
+        let mut breaks = vec![s1, s2];
+        breaks.push(s1 + (level - y1) / grade);
+        breaks.push(s2 - (level - y2) / grade);
+        breaks.push(0.5 * (y2 - y1 + grade * (s1 + s2)) / grade);
+        if sigma != 0.0 {
+            breaks.push(s1 + (level - y1) / sigma);
+        }
+        breaks.push((y2 - y1 + grade * s2 + sigma * s1) / (sigma + grade));
+        let mut inner: Vec<f64> = breaks
+            .into_iter()
+            .filter(|s| s.is_finite() && *s >= s1 && *s <= s2)
+            .collect();
+        inner.sort_by(f64::total_cmp);
+        inner.dedup_by(|x, y| (*x - *y).abs() < 1e-6);
+        let mut pvi = vec![(0.0, h0)];
+        pvi.extend(inner.into_iter().map(|s| (s, f(s))));
+        pvi.push((len, h1));
+        // Drop corners where the grade does not change.
+        let mut kept: Vec<(f64, f64)> = Vec::with_capacity(pvi.len());
+        for p in pvi {
+            if kept.last().is_some_and(|q| p.0 - q.0 < 1e-6) {
+                continue;
+            }
+            while kept.len() >= 2 {
+                let (q, r) = (kept[kept.len() - 2], kept[kept.len() - 1]);
+                let (m_qr, m_rp) = ((r.1 - q.1) / (r.0 - q.0), (p.1 - r.1) / (p.0 - r.0));
+                if (m_qr - m_rp).abs() < 1e-9 {
+                    kept.pop();
+                } else {
+                    break;
+                }
+            }
+            kept.push(p);
+        }
+        // Each inner corner's curve: at most the nominal half length, and no more than
+        // half its neighbouring legs (all of a leg to an end, which has no curve).
+        let n = kept.len();
+        let leg = |j: usize, k: usize| {
+            let l = kept[k].0 - kept[j].0;
+            if j == 0 || k == n - 1 { l } else { 0.5 * l }
+        };
+        let half = (0..n)
+            .map(|i| {
+                if i == 0 || i + 1 >= n {
+                    0.0
+                } else {
+                    BRIDGE_CURVE_M.min(leg(i - 1, i)).min(leg(i, i + 1))
+                }
+            })
+            .collect();
+        Profile { pvi: kept, half }
+    }
+
+    fn length(&self) -> f64 {
+        self.pvi.last().map_or(0.0, |p| p.0)
+    }
+
+    /// The height `s` metres along.
+    fn height(&self, s: f64) -> f64 {
+        let n = self.pvi.len();
+        let s = s.clamp(0.0, self.length());
+        let slope = |k: usize| {
+            let (a, b) = (self.pvi[k], self.pvi[k + 1]);
+            if b.0 > a.0 {
+                (b.1 - a.1) / (b.0 - a.0)
+            } else {
+                0.0
+            }
+        };
+        let k = self.pvi.partition_point(|p| p.0 <= s).clamp(1, n - 1) - 1;
+        // A curve around the corner at either end of leg `k`.
+        for i in [k, k + 1] {
+            let a = self.half[i];
+            let (si, hi) = self.pvi[i];
+            if i > 0 && i + 1 < n && a > 0.0 && (s - si).abs() < a {
+                let (m_in, m_out) = (slope(i - 1), slope(i));
+                let x = s - si + a;
+                return hi + m_in * (s - si) + (m_out - m_in) * x * x / (4.0 * a);
+            }
+        }
+        let (a, b) = (self.pvi[k], self.pvi[k + 1]);
+        if b.0 > a.0 {
+            a.1 + (b.1 - a.1) * (s - a.0) / (b.0 - a.0)
+        } else {
+            a.1
+        }
+    }
+}
+
+/// A bridge's centre line: its points, each segment's half width, and the deck's
+/// profile along it.
 struct BridgePath {
     points: Vec<DVec2>,
     half_widths: Vec<f64>,
     /// Length along the path at each point.
     at: Vec<f64>,
-    heights: [f64; 2],
+    profile: Profile,
 }
 
 impl BridgePath {
-    /// The path of `chain` (roads in order, with their direction); `None` when a road
-    /// has no width or length or the ground is not finite at an end.
+    /// The path of `chain` (roads in order, with their direction) on `ground`, its
+    /// profile climbing over the highest water surface under it; `None` when a road has
+    /// no width or length or the ground is not finite at an end.
     fn new(
         network: &polis_roads::RoadNetwork,
-        chain: &[(polis_geom::graph::EdgeId, bool)],
+        chain: &[Link],
         ground: &dyn Field,
+        water: Option<&Water>,
+        grading: &polis_roads::grading::GradeParams,
     ) -> Result<Option<BridgePath>> {
         let mut points = Vec::with_capacity(chain.len() + 1);
         let mut half_widths = Vec::with_capacity(chain.len());
+        let mut grade = f64::INFINITY;
         for &(e, backwards) in chain {
             let road = network.edge_payload(e)?;
             let (mut a, mut b) = network.segment(e)?;
@@ -325,6 +514,7 @@ impl BridgePath {
             }
             points.push(b);
             half_widths.push(0.5 * road.width);
+            grade = grade.min(grading.max_grade(road.class));
         }
         let mut at = vec![0.0];
         for w in points.windows(2) {
@@ -337,27 +527,49 @@ impl BridgePath {
         if !heights.iter().all(|h| h.is_finite()) {
             return Ok(None);
         }
-        Ok(Some(BridgePath {
+        let len = at.last().copied().unwrap_or(0.0);
+        let mut path = BridgePath {
             points,
             half_widths,
             at,
-            heights,
-        }))
+            profile: Profile::straight(len, heights[0], heights[1]),
+        };
+        // The highest water surface under the path (inner points every station).
+        let stations = (len / DECK_STATION_M).ceil().max(1.0) as usize;
+        let surface = water.and_then(|w| {
+            (1..stations)
+                .filter_map(|k| w.body_at(path.point_at(len * k as f64 / stations as f64)))
+                .map(|b| b.level)
+                .reduce(f64::max)
+        });
+        if let Some(surface) = surface {
+            // The grades of the roads leading on, read on the ground beyond each end.
+            let n = path.points.len();
+            let out0 = (path.points[0] - path.points[1]).normalize_or_zero();
+            let out1 = (path.points[n - 1] - path.points[n - 2]).normalize_or_zero();
+            let lead = |end: DVec2, out: DVec2, h: f64| {
+                let g = ground.sample(end + out * APPROACH_M);
+                if g.is_finite() {
+                    (h - g) / APPROACH_M
+                } else {
+                    0.0
+                }
+            };
+            let m0 = lead(first, out0, heights[0]);
+            let m1 = -lead(last, out1, heights[1]);
+            let top = surface + BRIDGE_CLEARANCE_M + BRIDGE_DECK_M - DECK_TOP_M;
+            path.profile = Profile::climbing(len, heights, [m0, m1], grade, top);
+        }
+        Ok(Some(path))
     }
 
     fn length(&self) -> f64 {
         self.at.last().copied().unwrap_or(0.0)
     }
 
-    /// The deck's height (the road surface's, before its lift) `s` metres along.
+    /// The road surface's height (before its lift) `s` metres along.
     fn height_at(&self, s: f64) -> f64 {
-        let total = self.length();
-        let f = if total > 0.0 {
-            (s / total).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        self.heights[0] + (self.heights[1] - self.heights[0]) * f
+        self.profile.height(s)
     }
 
     /// The point `s` metres along.
@@ -385,9 +597,31 @@ impl BridgePath {
         best.1
     }
 
+    /// Each road's profile (see [`Bridges::profiles`]), sampled every
+    /// [`DECK_STATION_M`] or less along it, from its own first point.
+    fn road_profiles(&self, chain: &[Link]) -> Vec<(u64, Vec<(f64, f64)>)> {
+        chain
+            .iter()
+            .zip(self.at.windows(2))
+            .map(|(&(e, backwards), w)| {
+                let len = w[1] - w[0];
+                let n = (len / DECK_STATION_M).ceil().max(1.0) as usize;
+                let samples = (0..=n)
+                    .map(|j| {
+                        let s = len * j as f64 / n as f64;
+                        let along = if backwards { w[1] - s } else { w[0] + s };
+                        (s, self.height_at(along))
+                    })
+                    .collect();
+                (u64::from(e.raw()), samples)
+            })
+            .collect()
+    }
+
     /// The deck's outline: the path offset by each segment's half width on both sides,
     /// mitred at the inner points (a mitre reaches at most four half widths from its
-    /// point); `None` when that is not a simple polygon.
+    /// point), with points every [`DECK_STATION_M`] or less along each side so the deck
+    /// follows its profile; `None` when that is not a simple polygon.
     fn outline(&self) -> Option<PolygonWithHoles> {
         let n = self.points.len();
         let dirs: Vec<DVec2> = self
@@ -421,30 +655,43 @@ impl BridgePath {
                 p + (m - p).normalize_or_zero() * reach
             }
         };
-        let mut ring: Vec<DVec2> = (0..n).map(|k| corner(k, -1.0)).collect();
-        ring.extend((0..n).rev().map(|k| corner(k, 1.0)));
+        // One side's corners with the stations between them, from the first point on.
+        let side = |sign: f64| -> Vec<DVec2> {
+            let mut out = vec![corner(0, sign)];
+            for k in 1..n {
+                let (a, b) = (corner(k - 1, sign), corner(k, sign));
+                let pieces = ((self.at[k] - self.at[k - 1]) / DECK_STATION_M)
+                    .ceil()
+                    .max(1.0) as usize;
+                out.extend((1..pieces).map(|j| a.lerp(b, j as f64 / pieces as f64)));
+                out.push(b);
+            }
+            out
+        };
+        let mut ring = side(-1.0);
+        ring.extend(side(1.0).into_iter().rev());
         let mut deck = PolygonWithHoles::new(polis_geom::Polygon::new(ring), vec![]);
         deck.normalize();
         deck.validate().is_ok().then_some(deck)
     }
 }
 
-/// Appends a bridge's deck (outline `deck`) and piers to `mesh`.
+/// Appends a bridge's deck (outline `deck`) and piers to `mesh` (decks, piers).
 fn add_bridge(
-    mesh: &mut Mesh,
+    [decks, piers]: &mut [Mesh; 2],
     path: &BridgePath,
     deck: &PolygonWithHoles,
     ground: &dyn Field,
 ) -> Result<()> {
     use polis_geom::Polygon;
     use polis_geom::mesh::RefineOptions;
-    // No refinement: the deck is straight along each segment.
+    // No refinement: the outline has its stations along the profile.
     let refine = RefineOptions {
         max_area: 1e9,
         ..RefineOptions::default()
     };
     let height = |p: DVec2| path.height_at(path.along(p));
-    mesh.add_draped_slab(
+    decks.add_draped_slab(
         deck,
         &refine,
         height,
@@ -452,19 +699,27 @@ fn add_bridge(
         DECK_TOP_M,
     )?;
     let len = path.length();
-    let piers = ((len / BRIDGE_PIER_SPACING_M).floor() as usize).max(1);
-    for k in 1..=piers {
-        let s = len * k as f64 / (piers + 1) as f64;
+    let count = ((len / BRIDGE_PIER_SPACING_M).floor() as usize).max(1);
+    for k in 1..=count {
+        let s = len * k as f64 / (count + 1) as f64;
         let c = path.point_at(s);
         let h = PIER_SIDE_M * 0.5;
         let square = PolygonWithHoles::new(
             Polygon::rect(c - DVec2::splat(h), c + DVec2::splat(h)),
             vec![],
         );
-        let deck_bottom = path.height_at(s) + DECK_TOP_M - BRIDGE_DECK_M;
+        // Up to the deck's underside at the pier's lowest corner (the deck tilts).
+        let deck_bottom = square
+            .outer
+            .points()
+            .iter()
+            .map(|&q| path.height_at(path.along(q)))
+            .fold(path.height_at(s), f64::min)
+            + DECK_TOP_M
+            - BRIDGE_DECK_M;
         let floor = ground.sample(c) - PIER_FOOT_M;
         if floor.is_finite() && floor < deck_bottom {
-            mesh.add_prism(&square, floor, deck_bottom)?;
+            piers.add_prism(&square, floor, deck_bottom)?;
         }
     }
     Ok(())
@@ -476,6 +731,7 @@ mod tests {
 
     use super::*;
     use polis_geom::field::FnField;
+    use polis_roads::grading::GradeParams;
     use polis_roads::{Junction, Road, RoadClass, RoadNetwork};
 
     fn bridge(width: f64) -> Road {
@@ -535,11 +791,13 @@ mod tests {
         net.add_edge(bent[3], bent[2], bridge(14.0)).unwrap(); // reversed
         net.add_edge(bent[3], bent[4], bridge(14.0)).unwrap();
         let ground = river();
-        let mesh = bridge_mesh(&net, &ground).unwrap().unwrap();
+        let made = bridges(&net, &ground, None, &GradeParams::default()).unwrap();
+        let mut mesh = made.decks.unwrap();
+        mesh.append(&made.piers.unwrap());
         let r = mesh.edge_use();
         assert!(r.is_solid_shells(), "{r:?}");
         // Straight: 320 m, a deck and 8 piers; bent: about 330 m, a deck and 8 piers (all
-        // over the river).
+        // over the river). Decks first, then piers.
         assert_eq!(r.shell_volumes.len(), 18, "{:?}", r.shell_volumes);
         let deck = 320.0 * 12.0 * BRIDGE_DECK_M;
         assert!(
@@ -548,12 +806,13 @@ mod tests {
             r.shell_volumes
         );
         // The piers of the straight bridge: 2 m squares from 1 m under the bed (−9 m)
-        // to the deck's bottom, straight from 10 m to 4 m.
+        // to the deck's bottom at the pier's lower side, straight from 10 m to 4 m.
         for k in 1..=8 {
-            let s = 320.0 * k as f64 / 9.0;
+            let s = 320.0 * k as f64 / 9.0 + 1.0;
             let deck_bottom = 10.0 - 6.0 * s / 320.0 + DECK_TOP_M - BRIDGE_DECK_M;
             let want = 4.0 * (deck_bottom + 9.0);
-            assert!((r.shell_volumes[k] - want).abs() < 1e-3 * want, "pier {k}");
+            let got = r.shell_volumes[1 + k];
+            assert!((got - want).abs() < 1e-3 * want, "pier {k}: {got} {want}");
         }
         // Every vertex of the decks lies within a deck's thickness under the road surface
         // straight between the banks, and nothing of the bridges is under the piers' feet.
@@ -561,6 +820,152 @@ mod tests {
             let (q, h) = polis_geom::to_layout(p.as_dvec3());
             assert!(h >= -9.0 - 1e-3, "{q} {h}");
             assert!(h <= 10.0 + DECK_TOP_M + 1e-3, "{q} {h}");
+        }
+    }
+
+    /// A straight highway bridge of one road across a river `width` metres wide (banks
+    /// at 5 m, the water bed of `crate::water`), and the bridges of that map.
+    fn river_crossing(width: f64) -> (RoadNetwork, Water, Bridges, f64) {
+        let half = 0.5 * width;
+        let mut net = RoadNetwork::new();
+        let street = Road {
+            bridge: false,
+            ..bridge(12.0)
+        };
+        let xs = [-half - 100.0, -half - 5.0, half + 5.0, half + 100.0];
+        let nodes = xs.map(|x| {
+            net.add_node(DVec2::new(x, 0.0), Junction::default())
+                .unwrap()
+        });
+        net.add_edge(nodes[0], nodes[1], street).unwrap();
+        net.add_edge(nodes[1], nodes[2], bridge(12.0)).unwrap();
+        net.add_edge(nodes[2], nodes[3], street).unwrap();
+        let river = PolygonWithHoles::from(polis_geom::Polygon::rect(
+            DVec2::new(-half, -1000.0),
+            DVec2::new(half, 1000.0),
+        ));
+        let banks = polis_geom::field::Constant(5.0);
+        let bounds = Aabb2::new(DVec2::splat(-1000.0), DVec2::splat(1000.0));
+        let water = Water::new(vec![river], &banks, bounds, &net, std::iter::empty())
+            .unwrap()
+            .unwrap();
+        let made = bridges(
+            &net,
+            &water.bed(&banks),
+            Some(&water),
+            &GradeParams::default(),
+        )
+        .unwrap();
+        (net, water, made, width + 10.0)
+    }
+
+    /// Over a wide river the deck climbs to the clearance; over a narrow one as high as
+    /// the grade allows: checked at every deck vertex over the water against the bound
+    /// the documentation states; the road profile keeps the grade limit; piers stand
+    /// on the bed (a foot into it) up to the deck's underside; every shell is closed.
+    #[test]
+    fn decks_clear_the_water_and_piers_stand_on_its_bed() {
+        let g = GradeParams::default().max_grade_highway;
+        let level = 5.0 - crate::water::WATER_FREEBOARD_M;
+        for width in [600.0, 150.0] {
+            let (_, water, made, len) = river_crossing(width);
+            let decks = made.decks.clone().unwrap();
+            let piers = made.piers.clone().unwrap();
+            for m in [&decks, &piers] {
+                let r = m.edge_use();
+                assert!(r.is_solid_shells(), "{r:?}");
+            }
+            // The profile: within the grade, from the ground at both ends.
+            let (_, profile) = &made.profiles[0];
+            assert!((profile[0].1 - 5.0).abs() < 1e-9);
+            assert!((profile[profile.len() - 1].1 - 5.0).abs() < 1e-9);
+            let steepest = profile
+                .windows(2)
+                .map(|w| ((w[1].1 - w[0].1) / (w[1].0 - w[0].0)).abs())
+                .fold(0.0, f64::max);
+            assert!(steepest <= g + 1e-9, "{steepest}");
+            // Deck bottoms over the water: at least the clearance, or the bound the span
+            // allows (`min over ends of h + g · (d − 3 A)`).
+            let x0 = -0.5 * len;
+            let mut lowest = f64::INFINITY;
+            let mut over = 0;
+            for (p, n) in decks.positions.iter().zip(&decks.normals) {
+                let (q, h) = polis_geom::to_layout(p.as_dvec3());
+                if n.y > -0.5 || water.body_at(q).is_none() {
+                    continue;
+                }
+                over += 1;
+                let d = (q.x - x0).min(len - (q.x - x0));
+                let span =
+                    5.0 + g * (d - 3.0 * BRIDGE_CURVE_M) - (BRIDGE_DECK_M - DECK_TOP_M) - level;
+                let want = BRIDGE_CLEARANCE_M.min(span);
+                assert!(
+                    h - level >= want - 1e-3,
+                    "{width}: {q} {} < {want}",
+                    h - level
+                );
+                if d > 0.5 * len - 1.0 {
+                    lowest = lowest.min(h - level);
+                }
+            }
+            assert!(over > 10, "{over}");
+            if width > 500.0 {
+                assert!(lowest >= BRIDGE_CLEARANCE_M - 1e-3, "{lowest}");
+            } else {
+                // 160 m at 6 % after 20 m curves at the ends: 3.6 m up at mid-span, less
+                // the crest curve's 0.75 m and the deck: its underside 2.1 m above the
+                // water.
+                assert!(lowest > 2.0 && lowest < BRIDGE_CLEARANCE_M, "{lowest}");
+            }
+            // Piers: from a foot below the bed up to the deck, positive heights.
+            let bed = water.bed(&polis_geom::field::Constant(5.0));
+            let r = piers.edge_use();
+            assert!(r.shell_volumes.len() >= 3);
+            for k in 0..piers.positions.len() / 24 {
+                let ps = &piers.positions[24 * k..24 * (k + 1)];
+                let lo = ps.iter().map(|p| p.y as f64).fold(f64::INFINITY, f64::min);
+                let hi = ps
+                    .iter()
+                    .map(|p| p.y as f64)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let c = ps
+                    .iter()
+                    .map(|p| polis_geom::to_layout(p.as_dvec3()).0)
+                    .sum::<DVec2>()
+                    / ps.len() as f64;
+                assert!(hi > lo, "pier {k}");
+                assert!(
+                    (lo - (bed.sample(c) - PIER_FOOT_M)).abs() < 1e-3,
+                    "pier {k} at {c}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn profiles_keep_the_grade_and_meet_their_ends() {
+        let g = 0.06;
+        let cases = [
+            (800.0, [5.0, 5.0], [0.0, 0.0]),
+            (120.0, [5.0, 9.0], [0.05, -0.02]),
+            (300.0, [20.0, 5.0], [-0.06, 0.06]),
+            (50.0, [0.0, 30.0], [0.0, 0.0]), // too steep: straight
+        ];
+        for (len, h, m) in cases {
+            let p = Profile::climbing(len, h, m, g, 14.0);
+            assert!((p.height(0.0) - h[0]).abs() < 1e-9);
+            assert!((p.height(len) - h[1]).abs() < 1e-9);
+            let straight = (h[1] - h[0]).abs() / len;
+            let mut prev = p.height(0.0);
+            for i in 1..=1000 {
+                let s = len * i as f64 / 1000.0;
+                let y = p.height(s);
+                let grade = (y - prev).abs() / (len / 1000.0);
+                assert!(grade <= g.max(straight) + 1e-6, "{len} {s} {grade}");
+                // Smooth: no jump.
+                assert!((y - prev).abs() <= g.max(straight) * len / 1000.0 + 1e-6);
+                prev = y;
+            }
         }
     }
 }

@@ -74,6 +74,7 @@ mod scene;
 pub mod seed;
 pub mod stages;
 mod streets;
+mod water;
 mod zoning;
 
 pub use city::{
@@ -86,12 +87,19 @@ pub use config::{
 };
 pub use config::{MAX_BUILDING_HEIGHT_M, MAX_ELEVATION_M, MAX_IMAGE_PIXELS, MAX_THREADS};
 pub use error::{BoxError, Error, PolisError, Result};
+pub use ground::{
+    BRIDGE_CLEARANCE_M, BRIDGE_CURVE_M, BRIDGE_DECK_M, BRIDGE_PIER_SPACING_M, PIER_FOOT_M,
+};
 pub use maps::{CityMaps, MapSpec, MapsConfig, PatternMap, Shape};
 pub use output::{Formats, TEXTURE_DIR, UnknownFormat, WriteOptions};
 pub use pipeline::{CityChunk, Pipeline, Progress, generate};
 pub use report::{reference_city_name, road_statistics, street_graph};
 pub use scene::CORRIDOR_CUT_M;
 pub use stages::{Skip, Stage};
+pub use water::{
+    WATER_BANK_M, WATER_BANK_SLOPE, WATER_BANK_WALL_M, WATER_FREEBOARD_M, WATER_LAND_MARGIN_M,
+    WATER_MAX_DEPTH_M,
+};
 pub use zoning::{AreaCap, MAX_ZONE_VALUE, MIXED_ZONE, MixedZone};
 
 // Compile the README's code blocks as doctests so the embedding example stays true.

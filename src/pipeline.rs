@@ -379,8 +379,17 @@ impl Pipeline {
             _ => maps.inputs.elevation.as_ref(),
         };
         let scene = if keep && self.scene {
+            // Water bodies at their level over their bed, with the roads and blocks as
+            // land: the bed is part of the ground everything stands on.
+            let water = crate::water::Water::of_city(config, &maps, &network, &kept.blocks)?;
+            let bed = water.as_ref().map(|w| w.bed(ground));
+            let ground: &dyn polis_geom::Field = match &bed {
+                Some(b) => b,
+                None => ground,
+            };
             assemble(&SceneInputs {
                 ground,
+                water: water.as_ref(),
                 cut_in: graded
                     .as_ref()
                     .filter(|g| g.moves_ground())

@@ -127,6 +127,7 @@ pub(crate) fn map_roads(network: &RoadNetwork) -> Result<Vec<MapRoad>> {
             width_m: road.width,
             bridge: road.bridge,
             tunnel: road.tunnel,
+            profile: None,
         });
     }
     Ok(roads)
@@ -404,8 +405,11 @@ type WaterLevels = Vec<(PolygonWithHoles, f64)>;
 pub(crate) struct SceneInputs<'a> {
     /// The ground everything stands on: the elevation map, with the roads graded into it.
     pub ground: &'a dyn Field,
-    /// The graded ground cut in under the road corridors, for the terrain mesh.
+    /// The graded ground cut in under the road corridors, for the terrain mesh (the
+    /// water bed not cut in: see `water`).
     pub cut_in: Option<polis_roads::grading::CutIn<'a>>,
+    /// The water bodies, their levels and their bed (already in `ground`).
+    pub water: Option<&'a crate::water::Water>,
     pub config: &'a CityConfig,
     pub maps: &'a CityMaps,
     pub network: &'a RoadNetwork,
@@ -625,6 +629,13 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     let root = scene.add_root(inp.config.name.clone());
     scene.set_metadata(root, "seed", inp.config.seed as f64)?;
 
+    // Bridges (closed decks on piers) first: the road surfaces follow their profiles.
+    let bridges = crate::ground::bridges(
+        inp.network,
+        elevation,
+        inp.water,
+        &inp.config.scene.road_grading,
+    )?;
     // The road surfaces (one serial pass over the network) are built while the
     // buildings' meshes are made in parallel.
     let road_mesh = || -> Result<Option<polis_export::surfaces::RoadSurfaceParts>> {
@@ -634,6 +645,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         // No surface between a tunnel's portals (polis_roads::tunnels), but the open
         // cut from each portal's junction to its frame.
         let mut roads = map_roads(inp.network)?;
+        for r in roads.iter_mut().filter(|r| r.bridge) {
+            if let Ok(k) = bridges.profiles.binary_search_by_key(&r.id, |p| p.0) {
+                r.profile = Some(bridges.profiles[k].1.clone());
+            }
+        }
         let mut cuts = Vec::new();
         for p in polis_roads::portals(inp.network)? {
             if p.setback > 0.0
@@ -742,16 +758,15 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             })
             .collect()
     };
-    // Water bodies (flat surfaces at their shore's lowest point) and the ground (terrain
-    // textured by land use, which paints the water bed).
+    // Water bodies (flat surfaces at their level, `crate::water`) and the ground
+    // (terrain textured by land use, which paints the water bed).
     let water_and_ground = || -> Result<(WaterLevels, Option<Ground>)> {
         let scene = &inp.config.scene;
         let size = inp.config.size_m;
-        let water = if inp.maps.has_water && (scene.water_surfaces || scene.terrain) {
-            crate::city::smooth_mask(inp.maps.inputs.water.as_ref(), size)?
-        } else {
-            Vec::new()
-        };
+        let water: Vec<PolygonWithHoles> = inp
+            .water
+            .map(|w| w.bodies.iter().map(|b| b.polygon.clone()).collect())
+            .unwrap_or_default();
         let terrain = if scene.terrain {
             let mut parks = if inp.maps.has_parks {
                 crate::city::smooth_mask(inp.maps.inputs.parks.as_ref(), size)?
@@ -760,9 +775,16 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             };
             parks.extend(inp.green_spaces.iter().cloned());
             let blocks = inp.blocks.iter().map(|b| &b.polygon);
-            let terrain_field: &dyn Field = match &inp.cut_in {
-                Some(c) => c,
-                None => elevation,
+            // The graded ground cut in under the corridors, with the bed: or the ground
+            // (with its bed already).
+            let cut_bed = match (&inp.cut_in, inp.water) {
+                (Some(c), Some(w)) => Some(w.bed(c)),
+                _ => None,
+            };
+            let terrain_field: &dyn Field = match (&cut_bed, &inp.cut_in) {
+                (Some(b), _) => b,
+                (None, Some(c)) => c,
+                (None, None) => elevation,
             };
             Some(build_ground(
                 inp.config,
@@ -774,16 +796,13 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         } else {
             None
         };
-        let water = if scene.water_surfaces {
-            water
-                .into_iter()
-                .map(|p| {
-                    let level = ground(elevation, p.outer.points());
-                    (p, level)
-                })
-                .collect()
-        } else {
-            Vec::new()
+        let water = match inp.water {
+            Some(w) if scene.water_surfaces => w
+                .bodies
+                .iter()
+                .map(|b| (b.polygon.clone(), b.level))
+                .collect(),
+            _ => Vec::new(),
         };
         Ok((water, terrain))
     };
@@ -804,13 +823,21 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             scene.attach_mesh(node, mesh)?;
         }
     }
-    // Bridges: closed decks on piers under the road surfaces.
-    if let Some(mut mesh) = crate::ground::bridge_mesh(inp.network, elevation)? {
-        let concrete = Material::new("bridge", [0.62, 0.60, 0.57, 1.0]);
-        mesh.material = Some(scene.add_material(concrete));
+    // Bridges: closed decks on piers under the road surfaces; the decks' mesh, then the
+    // piers' (materials `bridge` and `bridge pier`).
+    if bridges.decks.is_some() || bridges.piers.is_some() {
         let node = scene.add_node(root, "bridges")?;
-        let mesh = scene.add_mesh(mesh);
-        scene.attach_mesh(node, mesh)?;
+        let parts = [
+            (bridges.decks, "bridge", [0.62, 0.60, 0.57, 1.0]),
+            (bridges.piers, "bridge pier", [0.55, 0.54, 0.52, 1.0]),
+        ];
+        for (mesh, name, colour) in parts {
+            if let Some(mut mesh) = mesh {
+                mesh.material = Some(scene.add_material(Material::new(name, colour)));
+                let mesh = scene.add_mesh(mesh);
+                scene.attach_mesh(node, mesh)?;
+            }
+        }
     }
     // Tunnels: a concrete frame at each portal (the road surface stops there).
     if let Some(mut mesh) = polis_roads::portal_mesh(inp.network, elevation)? {

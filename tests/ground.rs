@@ -359,27 +359,234 @@ fn roads_are_graded_and_earthworks_reported() {
     assert!(!glb_has_ground(&bare));
 }
 
-/// The bridges of `manhattan` (at full size, seed 1: a highway bridge over the East
-/// River to the mainland and a short one over a cove of the west shore): every deck and
-/// pier in the `bridges` node is a closed, 2-manifold, outward shell by the edge-use
-/// check, one deck per bridge at least.
+/// The triangles of `mesh` (in world coordinates by `world`) that face down, as a mesh.
+fn facing_down(mesh: &Mesh, world: DMat4) -> Mesh {
+    let mut out = Mesh::new(None);
+    for t in mesh.triangles() {
+        let [a, b, c] = t.map(|i| world.transform_point3(mesh.positions[i as usize].as_dvec3()));
+        if (b - a).cross(c - a).y < 0.0 {
+            let base = out.positions.len() as u32;
+            out.positions.extend([a, b, c].map(|p| p.as_vec3()));
+            out.indices.extend([base, base + 1, base + 2]);
+        }
+    }
+    out
+}
+
+/// `manhattan` at full size (seed 1: a highway bridge over the East River to the
+/// mainland and a short one over a cove of the west shore):
+/// every deck and pier in the `bridges` node is a closed, 2-manifold, outward shell by
+/// the edge-use check; every deck's underside over the water is at least the clearance
+/// above the water surface, or the height its span allows within the grade limit
+/// (`min over its ends of h + g · (d − 3 · BRIDGE_CURVE_M)`, `d` the distance to the
+/// end); every pier stands from a foot into the bed (the terrain) up to the deck; no
+/// road, plinth top or building floor over a water outline lies below the water; the
+/// water surface lies under the banks (the terrain at the shore above it); no NaN.
 #[test]
-fn bridge_decks_and_piers_are_closed_solids() {
+fn bridge_decks_clear_the_water_on_piers_and_are_closed_solids() {
     let mut c = CityConfig::preset("manhattan").unwrap();
     c.facades.pixels_per_metre = 1.0;
-    c.scene.terrain = false;
     let city = polis::generate(&c).unwrap();
+    sound(&city);
+    // Roads, plinths and buildings on their ground, the bed cut in under the water.
+    stands_on_its_ground(&city);
+    let scene = &city.scene;
+    let worlds = scene.world_matrices();
     let bridges = city.roads.edges().filter(|(_, _, _, r)| r.bridge).count();
     assert!(bridges > 0, "manhattan has bridges");
-    let meshes: Vec<&Mesh> = city
-        .scene
-        .nodes
-        .iter()
-        .filter(|n| n.name == "bridges")
-        .flat_map(|n| n.meshes.iter().map(|m| &city.scene.meshes[m.index()]))
-        .collect();
-    let report = polis::geom::mesh::edge_use(meshes);
+    let in_node =
+        |name: &'static str| -> Vec<(&Mesh, DMat4)> { node_meshes(scene, &worlds, name).collect() };
+    let parts = in_node("bridges");
+    let material = |m: &Mesh| {
+        m.material
+            .map(|id| scene.materials[id.index()].name.clone())
+            .unwrap_or_default()
+    };
+    let report = polis::geom::mesh::edge_use(parts.iter().map(|p| p.0));
     eprintln!("{bridges} bridge roads: {report:?}");
     assert!(report.is_solid_shells(), "{report:?}");
     assert!(report.components >= 1 && report.components <= bridges * 64);
+
+    let water = Sheet::new(&in_node("water"), c.size_m);
+    let terrain = Sheet::new(&in_node("ground"), c.size_m);
+    let tol = 2e-3;
+    // Bridge ends: nodes with a bridge road that are not inside a chain of two.
+    let ends: Vec<DVec2> = city
+        .roads
+        .nodes()
+        .filter(|&(n, _, _)| {
+            let at = city.roads.edges_at(n).unwrap();
+            let b = at
+                .iter()
+                .filter(|&&e| city.roads.edge_payload(e).unwrap().bridge)
+                .count();
+            b > 0 && !(b == 2 && at.len() == 2)
+        })
+        .map(|(_, p, _)| p)
+        .collect();
+    let g = c
+        .scene
+        .road_grading
+        .max_grade_highway
+        .min(c.scene.road_grading.max_grade_street);
+    let (deck, worldd) = parts
+        .iter()
+        .copied()
+        .find(|p| material(p.0) == "bridge")
+        .expect("decks");
+    let underside = facing_down(deck, worldd);
+    let (mut over, mut lowest_mid, mut highest) = (0, f64::INFINITY, f64::NEG_INFINITY);
+    for p in &underside.positions {
+        let (q, h) = to_layout(p.as_dvec3());
+        let Some(level) = water.height(q) else {
+            continue;
+        };
+        over += 1;
+        let (d, end) = ends
+            .iter()
+            .map(|&e| (e.distance(q), e))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap();
+        let h_end = terrain.height(end).unwrap();
+        let span =
+            h_end + g * (d - 3.0 * polis::BRIDGE_CURVE_M) - (polis::BRIDGE_DECK_M + 0.04) - level;
+        let want = polis::BRIDGE_CLEARANCE_M.min(span);
+        assert!(
+            h - level >= want - tol,
+            "deck at {q}: {} above the water < {want}",
+            h - level
+        );
+        if span > polis::BRIDGE_CLEARANCE_M {
+            lowest_mid = lowest_mid.min(h - level);
+        }
+        highest = highest.max(h - level);
+    }
+    for (e, _, _, r) in city.roads.edges().filter(|(_, _, _, r)| r.bridge) {
+        let (a, b) = city.roads.segment(e).unwrap();
+        eprintln!(
+            "bridge road {a} – {b}: {:.1} m, {:?}",
+            a.distance(b),
+            r.class
+        );
+    }
+    eprintln!("highest underside above the water {highest} m");
+    eprintln!(
+        "{over} deck underside vertices over the water; lowest where the span allows the clearance: {lowest_mid} m"
+    );
+    assert!(over > 100, "{over}");
+    // Manhattan's bridges are short (35 and 100 m): the span limits them (the full
+    // clearance over a wide river: `ground::tests`); the longer one clears the water.
+    assert!(lowest_mid >= polis::BRIDGE_CLEARANCE_M - tol);
+    assert!(highest > 0.5, "{highest}");
+
+    // Piers (24 vertices each): from a foot into the bed up to the deck's underside.
+    let deck_bottom = Sheet::new(&[(&underside, DMat4::IDENTITY)], c.size_m);
+    let (pier, worldp) = parts
+        .iter()
+        .copied()
+        .find(|p| material(p.0) == "bridge pier")
+        .expect("piers");
+    let e = c.scene.terrain_mesh.max_error_m;
+    let n_piers = pier.positions.len() / 24;
+    assert!(n_piers >= 2, "{n_piers} piers");
+    for k in 0..n_piers {
+        let ps: Vec<DVec3> = pier.positions[24 * k..24 * (k + 1)]
+            .iter()
+            .map(|p| worldp.transform_point3(p.as_dvec3()))
+            .collect();
+        let lo = ps.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+        let hi = ps.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+        let centre = ps.iter().map(|&p| to_layout(p).0).sum::<DVec2>() / 24.0;
+        let bed = terrain.height(centre).unwrap();
+        let top = deck_bottom.height(centre).unwrap();
+        assert!(hi > lo, "pier {k}");
+        // The terrain lies up to 2 e under the bed it follows.
+        assert!(
+            lo <= bed - polis::PIER_FOOT_M + 2.0 * e + tol && lo >= bed - polis::PIER_FOOT_M - tol,
+            "pier {k} at {centre}: foot {lo}, bed {bed}"
+        );
+        assert!(
+            hi <= top + tol && hi >= top - 0.2,
+            "pier {k} at {centre}: top {hi}, deck {top}"
+        );
+        if let Some(level) = water.height(centre) {
+            assert!(bed < level, "pier {k} at {centre} stands in the water");
+        }
+    }
+
+    // Nothing on land under the water: road vertices (off bridges), plinth tops and
+    // building floors over a water outline lie at or above its surface.
+    let bridge_roads: Vec<(DVec2, DVec2, f64)> = city
+        .roads
+        .edges()
+        .filter(|(_, _, _, r)| r.bridge)
+        .map(|(e, _, _, r)| {
+            let (a, b) = city.roads.segment(e).unwrap();
+            (a, b, r.width)
+        })
+        .collect();
+    let near_bridge = |q: DVec2| {
+        bridge_roads.iter().any(|&(a, b, w)| {
+            let d = b - a;
+            let t = ((q - a).dot(d) / d.length_squared().max(1e-12)).clamp(0.0, 1.0);
+            q.distance(a + d * t) <= w
+        })
+    };
+    let mut wet = [0usize; 3];
+    for (k, prefix) in ["roads", "block "].into_iter().enumerate() {
+        for (mesh, w) in node_meshes(scene, &worlds, prefix) {
+            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+                let (q, h) = to_layout(w.transform_point3(p.as_dvec3()));
+                if (k == 1 && n.y < 0.5) || (k == 0 && near_bridge(q)) {
+                    continue;
+                }
+                if let Some(level) = water.height(q) {
+                    wet[k] += 1;
+                    assert!(
+                        h >= level - tol,
+                        "{prefix} vertex at {q}: {h} under {level}"
+                    );
+                }
+            }
+        }
+    }
+    for (b, (k, _)) in city.buildings.iter().zip(
+        scene
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.name.starts_with("building ")),
+    ) {
+        let floor = worlds[k].transform_point3(DVec3::ZERO).y;
+        for &corner in b.footprint.points() {
+            if let Some(level) = water.height(corner) {
+                wet[2] += 1;
+                assert!(
+                    floor >= level - tol,
+                    "building {} at {corner}: {floor} < {level}",
+                    b.id
+                );
+            }
+        }
+    }
+    eprintln!(
+        "over a water outline: {} road vertices, {} plinth tops, {} building corners",
+        wet[0], wet[1], wet[2]
+    );
+    // The water runs under its banks: at the shore (the outline) the terrain stands
+    // above the water surface.
+    let water_mesh = in_node("water");
+    let (mut shore, mut dry) = (0, 0);
+    for (mesh, w) in &water_mesh {
+        for p in &mesh.positions {
+            let (q, level) = to_layout(w.transform_point3(p.as_dvec3()));
+            let border = q.x.abs().max(q.y.abs()) > 0.5 * c.size_m - 1.0;
+            if let (false, Some(ground)) = (border, terrain.height(q)) {
+                shore += 1;
+                dry += usize::from(ground > level);
+            }
+        }
+    }
+    eprintln!("{dry} of {shore} shoreline vertices with the terrain above the water");
+    assert!(shore > 100 && dry == shore, "{dry} of {shore}");
 }

@@ -157,6 +157,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             width_m,
             bridge,
             tunnel: false,
+            profile: None,
         });
     }
     // The roads meet where they share a point (the crossing at (50, 0), the T at

@@ -120,6 +120,13 @@ pub struct MapRoad {
     /// road surface is drawn for it; maps draw it dashed. Default: `false`.
     #[cfg_attr(feature = "serde", serde(default))]
     pub tunnel: bool,
+    /// A bridge's height profile: `(metres along the centre line from its first point,
+    /// height of the road surface before its lift)` pairs, increasing along the road.
+    /// The road surface over the bridge follows it (linearly between the pairs, held
+    /// at the first and last height beyond them) instead of running straight between
+    /// the ground at the bridge's ends. Ignored on other roads. Default: `None`.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub profile: Option<Vec<(f64, f64)>>,
 }
 
 impl MapRoad {
@@ -132,7 +139,28 @@ impl MapRoad {
             width_m,
             bridge: false,
             tunnel: false,
+            profile: None,
         }
+    }
+
+    /// The height of [`profile`](Self::profile) `s` metres along the road: linear
+    /// between its pairs, held beyond them; `None` without a profile (or an empty one).
+    pub fn profile_height(&self, s: f64) -> Option<f64> {
+        let p = self.profile.as_deref()?;
+        let (first, last) = (p.first()?, p.last()?);
+        if s <= first.0 {
+            return Some(first.1);
+        }
+        if s >= last.0 {
+            return Some(last.1);
+        }
+        let k = p.partition_point(|q| q.0 <= s).clamp(1, p.len() - 1);
+        let (a, b) = (p[k - 1], p[k]);
+        Some(if b.0 > a.0 {
+            a.1 + (b.1 - a.1) * (s - a.0) / (b.0 - a.0)
+        } else {
+            b.1
+        })
     }
 }
 

@@ -195,6 +195,7 @@ fn map() -> impl Strategy<Value = MapLayers> {
                     width_m,
                     bridge,
                     tunnel: false,
+                    profile: None,
                 })
                 .collect(),
             footprints: footprints

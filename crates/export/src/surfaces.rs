@@ -34,7 +34,8 @@
 //! * **Draping.** Every vertex is lifted to the elevation field at its own layout point
 //!   plus [`RoadSurfaceOptions::lift_m`]; segments longer than
 //!   [`RoadSurfaceOptions::max_segment_m`] are subdivided. Bridges instead run straight
-//!   between their cut ends, and a node all of whose roads are bridges is a flat deck:
+//!   between their cut ends (or follow their [`MapRoad::profile`] where they have one),
+//!   and a node all of whose roads are bridges is a flat deck:
 //!   inside a chain of bridge segments (one bridge road with several points, or a bridge
 //!   split into several roads) at the height interpolated by length between the chain's
 //!   ends on land; at a dead end or a branching of bridges, at the terrain height under
@@ -344,6 +345,7 @@ impl<'a> Drape<'a> {
         let n = plan.nodes.len();
         let mut node_lift = vec![f64::NEG_INFINITY; n];
         let mut all_bridges = vec![true; n];
+        let mut profiled = vec![true; n];
         let mut sum = vec![0.0; n];
         let mut count = vec![0usize; n];
         for (v, node) in plan.nodes.iter().enumerate() {
@@ -355,6 +357,7 @@ impl<'a> Drape<'a> {
                 if !road.bridge {
                     all_bridges[r] = false;
                 } else if all_bridges[r] {
+                    profiled[r] &= road.profile.is_some();
                     let s = edge.s_a + if starts { 0.0 } else { edge.len };
                     sum[r] += bridge_height(road, edge.road, s, elevation)?;
                     count[r] += 1;
@@ -381,8 +384,9 @@ impl<'a> Drape<'a> {
         let mut chained = deck.clone();
         let mut done = vec![false; plan.nodes.len()];
         for (v, n) in plan.nodes.iter().enumerate() {
-            if done[v] || deck[v].is_none() || n.ends.len() != 2 {
-                continue;
+            let r = plan.rep.get(v).copied().unwrap_or(v);
+            if done[v] || deck[v].is_none() || n.ends.len() != 2 || profiled[r] {
+                continue; // (a deck node of profiled bridges has its profiles' height)
             }
             done[v] = true;
             let walks = [
@@ -486,8 +490,8 @@ fn walk_chain(plan: &junctions::Plan, deck: &[Option<f64>], v: usize, e: usize) 
     Chain { end: None, inner }
 }
 
-/// The deck height of bridge `road` at `s` metres along its centre line: straight between
-/// the terrain at its two end points.
+/// The deck height of bridge `road` at `s` metres along its centre line: its profile's
+/// ([`MapRoad::profile`]), or straight between the terrain at its two end points.
 fn bridge_height(
     road: &MapRoad,
     index: usize,
@@ -500,6 +504,9 @@ fn bridge_height(
             "a bridge needs at least two points",
         ));
     };
+    if let Some(h) = road.profile_height(s) {
+        return Ok(h);
+    }
     let total: f64 = road.points.windows(2).map(|w| (w[1] - w[0]).length()).sum();
     let (h0, h1) = (sample(elevation, first)?, sample(elevation, last)?);
     let f = if total > 0.0 {
@@ -544,10 +551,14 @@ fn add_ribbon(
     let station = |j: usize| -> Result<(DVec3, DVec3, f64), ExportError> {
         let t = j as f64 / pieces as f64;
         let (r, l) = (ra.lerp(rb, t), la.lerp(lb, t));
+        let s = e.s_a + e.trim[0] + inner * t;
+        let profiled = road.bridge.then(|| road.profile_height(s)).flatten();
         let (hr, hl) = if j == 0 {
             (ends[0][0], ends[0][1])
         } else if j == pieces {
             (ends[1][0], ends[1][1])
+        } else if let Some(h) = profiled {
+            (h + lift, h + lift)
         } else if road.bridge {
             (
                 ends[0][0] + (ends[1][0] - ends[0][0]) * t,
@@ -556,7 +567,6 @@ fn add_ribbon(
         } else {
             (drape.ground(r)? + lift, drape.ground(l)? + lift)
         };
-        let s = e.s_a + e.trim[0] + inner * t;
         Ok((to_world(l, hl), to_world(r, hr), s))
     };
     let mut prev = station(0)?;

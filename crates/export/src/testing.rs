@@ -470,6 +470,7 @@ pub fn sample_map() -> crate::map::MapLayers {
         width_m: w,
         bridge,
         tunnel: false,
+        profile: None,
     };
     m.roads.push(road(
         1,

@@ -85,8 +85,37 @@ fn drapes_on_terrain_and_bridges_span() {
     let m = road_surfaces(std::slice::from_ref(&r), &valley, &o, None).unwrap();
     assert!(m.positions.iter().any(|p| p.y == -10.0));
     let bridge = MapRoad { bridge: true, ..r };
-    let m = road_surfaces(&[bridge], &valley, &o, None).unwrap();
+    let m = road_surfaces(std::slice::from_ref(&bridge), &valley, &o, None).unwrap();
     assert!(m.positions.iter().all(|p| p.y == 0.0));
+    // With a profile (a hump 4 m high at 20 m), the bridge follows it: linear between
+    // its pairs at every station inside the ribbon, the ground at its ends.
+    let hump = vec![
+        (0.0, 0.0),
+        (10.0, 3.0),
+        (20.0, 4.0),
+        (30.0, 3.0),
+        (40.0, 0.0),
+    ];
+    let humped = MapRoad {
+        profile: Some(hump),
+        ..bridge
+    };
+    assert_eq!(humped.profile_height(25.0), Some(3.5));
+    assert_eq!(humped.profile_height(-1.0), Some(0.0));
+    let m = road_surfaces(std::slice::from_ref(&humped), &valley, &o, None).unwrap();
+    m.validate().unwrap();
+    for p in &m.positions {
+        let want = humped.profile_height(f64::from(p.x)).unwrap();
+        assert!((f64::from(p.y) - want).abs() < 1e-5, "{p} {want}");
+    }
+    assert!(m.positions.iter().any(|p| p.y == 4.0));
+    // A road that is not a bridge ignores its profile.
+    let ignored = MapRoad {
+        bridge: false,
+        ..humped
+    };
+    let m = road_surfaces(&[ignored], &valley, &o, None).unwrap();
+    assert!(m.positions.iter().any(|p| p.y == -10.0));
 }
 
 #[test]
