@@ -572,6 +572,31 @@ impl BridgePath {
         self.profile.height(s)
     }
 
+    /// The deck's height (before its lift) `s` metres along as the deck is built: the
+    /// profile at the outline's stations ([`outline`](Self::outline)), straight between
+    /// them. On a crest curve the chord runs below the profile (by up to the curve's
+    /// sag over one station), and a pier sized to the profile would poke into the deck.
+    fn deck_height_at(&self, s: f64) -> f64 {
+        let n = self.points.len();
+        if n < 2 {
+            return self.height_at(s);
+        }
+        let k = self.at.partition_point(|&a| a <= s).clamp(1, n - 1);
+        let (a0, a1) = (self.at[k - 1], self.at[k]);
+        let span = a1 - a0;
+        if !(span > 0.0) {
+            return self.height_at(s);
+        }
+        let pieces = (span / DECK_STATION_M).ceil().max(1.0);
+        let step = span / pieces;
+        let j = ((s - a0) / step).floor().clamp(0.0, pieces - 1.0);
+        let s0 = a0 + j * step;
+        let s1 = if j + 1.0 >= pieces { a1 } else { s0 + step };
+        let t = ((s - s0) / (s1 - s0)).clamp(0.0, 1.0);
+        let (h0, h1) = (self.height_at(s0), self.height_at(s1));
+        h0 + (h1 - h0) * t
+    }
+
     /// The point `s` metres along.
     fn point_at(&self, s: f64) -> DVec2 {
         let k = self
@@ -708,13 +733,15 @@ fn add_bridge(
             Polygon::rect(c - DVec2::splat(h), c + DVec2::splat(h)),
             vec![],
         );
-        // Up to the deck's underside at the pier's lowest corner (the deck tilts).
+        // Up to the deck's underside at the pier's lowest corner (the deck tilts), as
+        // built (straight between stations) or as profiled, whichever is lower.
+        let under = |a: f64| path.height_at(a).min(path.deck_height_at(a));
         let deck_bottom = square
             .outer
             .points()
             .iter()
-            .map(|&q| path.height_at(path.along(q)))
-            .fold(path.height_at(s), f64::min)
+            .map(|&q| under(path.along(q)))
+            .fold(under(s), f64::min)
             + DECK_TOP_M
             - BRIDGE_DECK_M;
         let floor = ground.sample(c) - PIER_FOOT_M;
