@@ -584,7 +584,7 @@ impl BridgePath {
         let k = self.at.partition_point(|&a| a <= s).clamp(1, n - 1);
         let (a0, a1) = (self.at[k - 1], self.at[k]);
         let span = a1 - a0;
-        if !(span > 0.0) {
+        if span.is_nan() || span <= 0.0 {
             return self.height_at(s);
         }
         let pieces = (span / DECK_STATION_M).ceil().max(1.0);
