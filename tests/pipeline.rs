@@ -542,8 +542,9 @@ fn water_is_a_surface_and_the_maps_trace_it_smoothly() {
     let mesh = &city.scene.meshes[node.meshes[0].0 as usize];
     mesh.validate().unwrap();
     assert!((mesh.surface_area() - water_area).abs() < 1e-3 * water_area);
-    // Manhattan's ground is flat at 5 m: so is the water.
-    assert!(mesh.positions.iter().all(|p| p.y == 5.0));
+    // Manhattan's ground is flat at 5 m: the water lies flat, the freeboard below it.
+    let level = (5.0 - polis::WATER_FREEBOARD_M) as f32;
+    assert!(mesh.positions.iter().all(|p| p.y == level));
     assert!(mesh.normals.iter().all(|n| n.y == 1.0));
     // Smooth: no staircase of 10 m cells (far fewer vertices than a cell outline).
     let vertices: usize = map.water.iter().map(|p| p.outer.len()).sum();
