@@ -743,3 +743,27 @@ proptest! {
         }
     }
 }
+
+/// Found at 1,000 cases of `lots_with_near_duplicate_vertices_build` (session 14), open:
+/// a lot 7.4 km from the origin with two vertices 8.7e-5 m apart; its building fails
+/// with "triangle 0 has zero area" (the mesh's `f32` vertices, about 0.5 mm apart there,
+/// merge). To fix by building in local coordinates, not in the test.
+#[test]
+#[ignore = "open finding: near-duplicate lot vertices far from the origin merge in f32"]
+fn near_duplicate_vertices_far_from_the_origin_open_finding() {
+    let mut l = lot(vec![
+        DVec2::new(-7370.3714215750215, 3704.700537352875),
+        DVec2::new(-7428.915901271114, 3738.5012084649807),
+        DVec2::new(-7428.915901271114, 3670.8998662407694),
+        DVec2::new(-7428.915814668574, 3670.8999162407695),
+        DVec2::new(-7399.643661423068, 3687.800201796822),
+    ]);
+    l.street_edges = vec![0, 1, 2, 3];
+    l.polygon.validate().unwrap();
+    let g = BuildingGenerator::new(BuildingParams::default()).unwrap();
+    match g.build(&l, 3, BuildingKind::ALL[0], 80.0, 6) {
+        Ok(Some(b)) => check(&b, &l, 80.0),
+        Ok(None) => {}
+        Err(e) => assert!(matches!(e, BuildingsError::Lots(_)), "{e}"),
+    }
+}

@@ -444,6 +444,34 @@ mod tests {
             len in 5.0..60.0f64,
             branch in proptest::option::of((0.2..0.9f64, 10.0..80.0f64, any::<bool>(), 5.0..30.0f64)),
         ) {
+            cul_de_sac_tree(len, branch)?;
+        }
+    }
+
+    /// Found at 1,500 cases (session 14), open: the branch leaves the 8 m trunk at 13°
+    /// and ends 1.6 m from its tip; a block comes 3.915 m from the trunk's centreline,
+    /// 8.5 cm into its corridor. Not yet fixed (the weighted inset at such a junction).
+    #[test]
+    #[ignore = "open finding: a block 8.5 cm into a corridor at a 13-degree cul-de-sac junction"]
+    fn culs_de_sac_tree_open_finding() {
+        cul_de_sac_tree(
+            10.157574376039125,
+            Some((
+                0.36378793773186674,
+                77.26097278861138,
+                false,
+                7.218541294199881,
+            )),
+        )
+        .unwrap();
+    }
+
+    /// The checks of `culs_de_sac_trees_give_valid_cells` for one tree.
+    fn cul_de_sac_tree(
+        len: f64,
+        branch: Option<(f64, f64, bool, f64)>,
+    ) -> Result<(), TestCaseError> {
+        {
             let c = square();
             let tip = v(50., len);
             let mut fs = vec![cul_de_sac(len)];
@@ -452,31 +480,50 @@ mod tests {
                 let at = v(50., len * t);
                 // Split the trunk at the branch point.
                 fs = vec![
-                    FilamentRoad { points: vec![v(50., 0.), at], widths: vec![8.0] },
-                    FilamentRoad { points: vec![at, tip], widths: vec![8.0] },
+                    FilamentRoad {
+                        points: vec![v(50., 0.), at],
+                        widths: vec![8.0],
+                    },
+                    FilamentRoad {
+                        points: vec![at, tip],
+                        widths: vec![8.0],
+                    },
                 ];
                 let a = angle.to_radians();
                 let end = at + DVec2::new(a.cos(), a.sin()) * l;
-                fs.push(FilamentRoad { points: vec![at, end], widths: vec![6.0] });
+                fs.push(FilamentRoad {
+                    points: vec![at, end],
+                    widths: vec![6.0],
+                });
             }
             let s = with_filaments(&c, &fs).unwrap();
             prop_assert!(s.polygon.validate().is_ok());
-            prop_assert_eq!(s.road_widths.len(), s.polygon.rings().map(|(_, r)| r.len()).sum::<usize>());
+            prop_assert_eq!(
+                s.road_widths.len(),
+                s.polygon.rings().map(|(_, r)| r.len()).sum::<usize>()
+            );
             let total: f64 = fs.iter().map(|f| f.points[0].distance(f.points[1])).sum();
             let lost = c.polygon.area() - s.polygon.area();
             // The slits and the slivers at moved attachment points (at most 4 cm off
             // a ring edge of at most 100 m, two sides).
-            prop_assert!(lost > 0.0 && lost <= 2.0 * SLIT_HALF_M * total * 4.0 + 4.0, "{lost}");
+            prop_assert!(
+                lost > 0.0 && lost <= 2.0 * SLIT_HALF_M * total * 4.0 + 4.0,
+                "{lost}"
+            );
             if let Ok(b) = blocks(&s, &BlockParams::default()) {
                 for block in &b {
                     for f in &fs {
                         let d = polis_geom::measure::polygon_segment_distance(
-                            &block.polygon.outer, f.points[0], f.points[1]);
+                            &block.polygon.outer,
+                            f.points[0],
+                            f.points[1],
+                        );
                         // Corridor half width minus rounding.
                         prop_assert!(d >= f.widths[0] * 0.5 - 1e-6, "{d}");
                     }
                 }
             }
         }
+        Ok(())
     }
 }
