@@ -354,7 +354,7 @@ impl Field for WaterBed<'_> {
     fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
         self.base.sample_many(points, out);
         let w = self.water;
-        let far = points_box(points).filter(|b| {
+        let far = Aabb2::of_finite_points(points).filter(|b| {
             let m = WATER_LAND_MARGIN_M;
             let bank = WATER_BANK_M + WATER_BANK_WALL_M;
             let near = |index: &SegmentIndex<u32>, by: f64| {
@@ -389,15 +389,6 @@ impl Field for WaterBed<'_> {
             }
         }
     }
-}
-
-/// The bounding box of `points`, `None` when there are none or one is not finite.
-fn points_box(points: &[DVec2]) -> Option<Aabb2> {
-    let first = *points.first()?;
-    let (lo, hi) = points
-        .iter()
-        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    (lo.is_finite() && hi.is_finite()).then(|| Aabb2::new(lo, hi))
 }
 
 #[cfg(test)]

@@ -45,6 +45,19 @@ impl Aabb2 {
         b
     }
 
+    /// The smallest box containing all `points`, `None` when there are none or one is
+    /// not finite (a NaN coordinate would otherwise vanish in `min`/`max`).
+    pub fn of_finite_points(points: &[DVec2]) -> Option<Self> {
+        let first = *points.first()?;
+        let (lo, hi) = points
+            .iter()
+            .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        points
+            .iter()
+            .all(|p| p.is_finite())
+            .then(|| Aabb2::new(lo, hi))
+    }
+
     /// Whether the box contains no point.
     #[inline]
     pub fn is_empty(&self) -> bool {
@@ -139,6 +152,18 @@ impl Aabb2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn of_finite_points_refuses_none_and_non_finite() {
+        let b = Aabb2::of_finite_points(&[DVec2::new(1.0, -2.0), DVec2::new(-3.0, 4.0)]).unwrap();
+        assert_eq!(
+            (b.min, b.max),
+            (DVec2::new(-3.0, -2.0), DVec2::new(1.0, 4.0))
+        );
+        assert!(Aabb2::of_finite_points(&[]).is_none());
+        assert!(Aabb2::of_finite_points(&[DVec2::ZERO, DVec2::new(f64::NAN, 0.0)]).is_none());
+        assert!(Aabb2::of_finite_points(&[DVec2::new(f64::INFINITY, 0.0)]).is_none());
+    }
 
     #[test]
     fn empty_and_extend() {

@@ -565,7 +565,7 @@ impl Field for CutIn<'_> {
     /// superset of the corridors near each point change nothing).
     fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
         self.graded.sample_many(points, out);
-        let Some(b) = points_box(points) else {
+        let Some(b) = Aabb2::of_finite_points(points) else {
             for (p, o) in points.iter().zip(out.iter_mut()) {
                 *o = self.sample(*p);
             }
@@ -598,15 +598,6 @@ impl Field for CutIn<'_> {
 /// its centre's distance, metres: a piece left out would give nothing at any point of
 /// the box even with distances off by far more than rounding.
 const BOX_SLACK_M: f64 = 1e-6;
-
-/// The bounding box of `points`, `None` when there are none or one is not finite.
-fn points_box(points: &[DVec2]) -> Option<Aabb2> {
-    let first = *points.first()?;
-    let (lo, hi) = points
-        .iter()
-        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    (lo.is_finite() && hi.is_finite()).then(|| Aabb2::new(lo, hi))
-}
 
 impl GradedGround<'_> {
     /// Narrows `(lo, hi)` to the cone of piece `k` at `p`.
@@ -663,7 +654,7 @@ impl Field for GradedGround<'_> {
         if self.index.is_empty() {
             return;
         }
-        let Some(b) = points_box(points) else {
+        let Some(b) = Aabb2::of_finite_points(points) else {
             for (p, o) in points.iter().zip(out.iter_mut()) {
                 *o = self.sample(*p);
             }
