@@ -168,58 +168,68 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
     // triangulation of a simple ring has n − 2): the mesh is sized exactly.
     let mut m = Mesh::with_capacity(None, 6 * n, 4 * n - 4);
     let after = |i: usize| if i + 1 < n { i + 1 } else { 0 };
-    let convex = (0..n).all(|i| {
-        let (j, k) = (after(i), after(after(i)));
-        orient2d(ring[i], ring[j], ring[k]) == Orientation::CounterClockwise
-    });
-    // Triangles can still collapse when rounded to f32: a convex prism is checked whole
-    // (walls and fans), a triangulated one on its caps; each triangle is checked from
-    // the f32 corners it is written with, as they are stored.
-    let mut collapsed = false;
-    let mut along = 0.0;
-    for i in 0..n {
-        let (a, b) = (ring[i], ring[after(i)]);
-        let len = a.distance(b);
-        if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || a.as_vec2() == b.as_vec2()
-        {
-            return Err(GeomError::DegenerateTriangle {
-                triangle: m.triangle_count(),
-            });
-        }
-        let d = (b - a) / len;
-        let normal = to_world(DVec2::new(d.y, -d.x), 0.0).as_vec3();
-        let base = m.positions.len() as u32;
-        // One slice per attribute (a capacity check each, not one per vertex).
-        let corners = [
-            (a, z0, along),
-            (b, z0, along + len),
-            (b, z1, along + len),
-            (a, z1, along),
-        ];
-        let p = corners.map(|(p, h, _)| to_world(p, h).as_vec3());
-        if convex {
-            collapsed |= flat(p[0], p[1], p[2]) || flat(p[0], p[2], p[3]);
-        }
-        m.positions.extend_from_slice(&p);
-        m.normals.extend_from_slice(&[normal; 4]);
-        m.uvs
-            .extend_from_slice(&corners.map(|(_, h, u)| DVec2::new(u, -h).as_vec2()));
-        m.indices
-            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
-        along += len;
-    }
-    // One triangulation serves both caps (reversed for the bottom): a fan for a convex
-    // ring, as in `add_face`, else ear clipping or CDT. The ring is simple: a validated
-    // lot, an inset of one, or a checked shrink.
     with_work(|w| {
         let TriWork {
-            tris, left, poly, ..
+            exact,
+            tris,
+            left,
+            poly,
         } = w;
+        // Convexity and the caps' triangles are decided on the ring as the mesh stores it
+        // (rounded to `f32`, which `to_world` keeps exact): a corner that rounding makes
+        // straight is then not fanned from, and ear clipping never takes it as the tip
+        // of a zero-area triangle.
+        exact.clear();
+        exact.extend(ring.iter().map(|p| p.as_vec2().as_dvec2()));
+        let convex = (0..n).all(|i| {
+            let (j, k) = (after(i), after(after(i)));
+            orient2d(exact[i], exact[j], exact[k]) == Orientation::CounterClockwise
+        });
+        // Triangles can still collapse when rounded to f32: a convex prism is checked
+        // whole (walls and fans), a triangulated one on its caps; each triangle is checked
+        // from the f32 corners it is written with, as they are stored.
+        let mut collapsed = false;
+        let mut along = 0.0;
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[after(i)]);
+            let len = a.distance(b);
+            if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+                || a.as_vec2() == b.as_vec2()
+            {
+                return Err(GeomError::DegenerateTriangle {
+                    triangle: m.triangle_count(),
+                });
+            }
+            let d = (b - a) / len;
+            let normal = to_world(DVec2::new(d.y, -d.x), 0.0).as_vec3();
+            let base = m.positions.len() as u32;
+            // One slice per attribute (a capacity check each, not one per vertex).
+            let corners = [
+                (a, z0, along),
+                (b, z0, along + len),
+                (b, z1, along + len),
+                (a, z1, along),
+            ];
+            let p = corners.map(|(p, h, _)| to_world(p, h).as_vec3());
+            if convex {
+                collapsed |= flat(p[0], p[1], p[2]) || flat(p[0], p[2], p[3]);
+            }
+            m.positions.extend_from_slice(&p);
+            m.normals.extend_from_slice(&[normal; 4]);
+            m.uvs
+                .extend_from_slice(&corners.map(|(_, h, u)| DVec2::new(u, -h).as_vec2()));
+            m.indices
+                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+            along += len;
+        }
+        // One triangulation serves both caps (reversed for the bottom): a fan for a
+        // convex ring, as in `add_face`, else ear clipping or CDT. The ring is simple: a
+        // validated lot, an inset of one, or a checked shrink.
         if convex {
             tris.clear();
             tris.extend((1..n as u32 - 1).map(|k| [0, k, k + 1]));
         } else {
-            triangulate_into(ring, true, left, poly, tris)
+            triangulate_into(exact, true, left, poly, tris)
                 .ok_or(GeomError::DegenerateTriangle { triangle: 0 })??;
         }
         for (h, up) in [(z1, true), (z0, false)] {
@@ -239,11 +249,11 @@ pub(crate) fn prism(ring: &[DVec2], z0: f64, z1: f64) -> Result<Mesh, GeomError>
                 collapsed = collapsed || flat(at(a), at(b), at(c));
             }
         }
-        Ok::<(), GeomError>(())
+        if collapsed {
+            return Err(GeomError::DegenerateTriangle { triangle: 0 });
+        }
+        Ok(())
     })?;
-    if collapsed {
-        return Err(GeomError::DegenerateTriangle { triangle: 0 });
-    }
     Ok(m)
 }
 
@@ -392,6 +402,23 @@ pub(crate) fn cone(ring: &[DVec2], z0: f64, apex: DVec2, z1: f64) -> Result<Mesh
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_corner_straight_only_in_f32_is_not_fanned_from() {
+        // Convex in f64 (corner 3 lies 1.6e-15 rad off the line from corner 2 to 0),
+        // straight once rounded to f32: a fan from corner 0 would hold a flat triangle.
+        let ring = [
+            DVec2::new(39.02965313072855, 0.0),
+            DVec2::new(-19.514826565364274, 33.80067111210565),
+            DVec2::new(-19.514826565364274, -33.80067111210565),
+            DVec2::new(9.757413282682137, -16.90033555605305),
+        ];
+        let m = prism(&ring, 0.0, 80.0).unwrap();
+        m.validate().unwrap();
+        m.check_closed().unwrap();
+        let area = Polygon::new(ring.to_vec()).area();
+        assert!((m.signed_volume() / (80.0 * area) - 1.0).abs() < 1e-6);
+    }
 
     #[test]
     fn prism_uvs_are_metres_and_solid_is_closed() {

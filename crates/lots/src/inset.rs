@@ -205,17 +205,21 @@ fn convex_before_any_event(
             return None;
         }
     }
-    let mut ring = InsetRing {
+    let ring = InsetRing {
         points: (0..n).map(|i| pts[i] + velocity[i] * (d - 0.0)).collect(),
         sources: (0..n).map(Some).collect(),
     };
-    Some(match finish_ring(&mut ring, eps) {
-        Some(true) => vec![InsetShape {
-            outer: ring,
-            holes: Vec::new(),
-        }],
-        _ => Vec::new(),
-    })
+    // A convex wavefront does not touch itself: one ring or nothing.
+    Some(
+        finish_ring(ring, eps)
+            .into_iter()
+            .filter(|(_, outer)| *outer)
+            .map(|(outer, _)| InsetShape {
+                outer,
+                holes: Vec::new(),
+            })
+            .collect(),
+    )
 }
 
 /// The rings of the wavefront at time `d`, grouped into shapes.
@@ -243,10 +247,12 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
                 break;
             }
         }
-        match finish_ring(&mut ring, engine.eps) {
-            Some(true) => outers.push(ring),
-            Some(false) => holes.push(ring),
-            None => {}
+        for (ring, outer) in finish_ring(ring, engine.eps) {
+            if outer {
+                outers.push(ring);
+            } else {
+                holes.push(ring);
+            }
         }
     }
     let mut shapes: Vec<InsetShape> = outers
@@ -265,29 +271,35 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
     shapes
 }
 
-/// Cleans a wavefront ring (zero-length edges, pinches) and tells whether it is an outer
-/// ring (`true`) or a hole (`false`); `None` when nothing of it is left.
-fn finish_ring(ring: &mut InsetRing, eps: f64) -> Option<bool> {
-    clean_ring(ring, eps);
-    separate_pinches(ring, eps);
-    if ring.points.len() < 3 {
-        return None;
+/// Cleans a wavefront ring (zero-length edges, pinches) into simple rings, each with
+/// whether it is an outer ring (`true`) or a hole (`false`); rings of no area are dropped.
+fn finish_ring(mut ring: InsetRing, eps: f64) -> Vec<(InsetRing, bool)> {
+    clean_ring(&mut ring, eps);
+    let mut finished = Vec::new();
+    let mut pending = vec![ring];
+    while let Some(mut ring) = pending.pop() {
+        if let Some((a, b)) = split_lobes(&ring, eps) {
+            // Depth first, the first piece next: the order follows the ring's.
+            pending.push(b);
+            pending.push(a);
+            continue;
+        }
+        separate_pinches(&mut ring, eps);
+        if ring.points.len() < 3 {
+            continue;
+        }
+        let area = polis_geom::polygon::ring_signed_area(&ring.points);
+        if area.abs() > eps * eps {
+            finished.push((ring, area > 0.0));
+        }
     }
-    let area = polis_geom::polygon::ring_signed_area(&ring.points);
-    if area.abs() <= eps * eps {
-        return None;
-    }
-    Some(area > 0.0)
+    finished
 }
 
-/// At the exact time of an event a ring can touch itself in a point (a hole meeting the
-/// outside, two parts about to separate). Each visit of such a point is moved by `2·eps`
-/// into its own corner, which makes the ring simple and changes no edge by more than that.
-fn separate_pinches(ring: &mut InsetRing, eps: f64) {
+/// Points of `ring` within `eps` of another point of it (each pair once, `i < j`), in
+/// the order of the sweep by `x`.
+fn pinch_pairs(ring: &InsetRing, eps: f64) -> Vec<(usize, usize)> {
     let n = ring.points.len();
-    if n < 4 {
-        return;
-    }
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| {
         let (p, q) = (ring.points[a], ring.points[b]);
@@ -295,7 +307,7 @@ fn separate_pinches(ring: &mut InsetRing, eps: f64) {
             .then(p.y.total_cmp(&q.y))
             .then(a.cmp(&b))
     });
-    let mut pinched: Vec<usize> = Vec::new();
+    let mut pairs = Vec::new();
     for (k, &i) in order.iter().enumerate() {
         let p = ring.points[i];
         for &j in &order[k + 1..] {
@@ -304,11 +316,79 @@ fn separate_pinches(ring: &mut InsetRing, eps: f64) {
                 break;
             }
             if p.distance(q) <= eps {
-                pinched.push(i);
-                pinched.push(j);
+                pairs.push((i.min(j), i.max(j)));
             }
         }
     }
+    pairs
+}
+
+/// A ring that touches itself in a point is two loops joined there. When the loops lie
+/// side by side — two outer lobes (a part about to separate from another), an island
+/// inside a hole, or a loop of no area (a spike out and back) — the exact answer is two
+/// rings, returned here: the loop from the first visit to the second, and the rest.
+/// `None` when there is no such point; a hole loop inside an outer loop (or two holes
+/// touching) is left to [`separate_pinches`], which keeps it one ring.
+fn split_lobes(ring: &InsetRing, eps: f64) -> Option<(InsetRing, InsetRing)> {
+    let n = ring.points.len();
+    if n < 4 {
+        return None;
+    }
+    let tiny = eps * eps;
+    let sign = |a: f64| {
+        if a > tiny {
+            1
+        } else if a < -tiny {
+            -1
+        } else {
+            0
+        }
+    };
+    let area = polis_geom::polygon::ring_signed_area;
+    for (i, j) in pinch_pairs(ring, eps) {
+        if j - i < 2 || n - (j - i) < 2 {
+            // Neighbours within `eps` are merged by `clean_ring`; a loop needs two edges.
+            continue;
+        }
+        let inner = area(&ring.points[i..j]);
+        let rest: Vec<DVec2> = ring.points[j..]
+            .iter()
+            .chain(&ring.points[..i])
+            .copied()
+            .collect();
+        let outer = area(&rest);
+        let split = match (sign(inner), sign(outer)) {
+            (0, _) | (_, 0) | (1, 1) => true,
+            // One loop inside the other: a hole in an outer ring stays one ring; an
+            // outer loop inside a hole is an island of its own.
+            (a, b) if a != b => inner + outer < 0.0,
+            _ => false,
+        };
+        if split {
+            let piece = |range: &mut dyn Iterator<Item = usize>| {
+                let (points, sources) = range.map(|k| (ring.points[k], ring.sources[k])).unzip();
+                InsetRing { points, sources }
+            };
+            return Some((piece(&mut (i..j)), piece(&mut (j..n).chain(0..i))));
+        }
+    }
+    None
+}
+
+/// A ring can touch itself in a point where a hole loop meets the outer loop around it
+/// (or two hole loops meet). Each visit of such a point is moved by `2·eps` into its own
+/// corner — there the visits' corners are the ring's separate interior wedges — which
+/// makes the ring simple and changes no edge by more than that. (Loops side by side are
+/// split apart first by [`split_lobes`]: their visits' corners overlap.)
+fn separate_pinches(ring: &mut InsetRing, eps: f64) {
+    let n = ring.points.len();
+    if n < 4 {
+        return;
+    }
+    let mut pinched: Vec<usize> = pinch_pairs(ring, eps)
+        .into_iter()
+        .flat_map(|(i, j)| [i, j])
+        .collect();
     pinched.sort_unstable();
     pinched.dedup();
     let moved: Vec<(usize, DVec2)> = pinched
@@ -373,6 +453,113 @@ mod tests {
         crate::skeleton::prepare(&mut engine, polygon, weights).unwrap();
         engine.run_through(d).unwrap();
         wavefront_at(&engine, d)
+    }
+
+    fn ring(points: &[(f64, f64)]) -> InsetRing {
+        InsetRing {
+            points: points.iter().map(|&(x, y)| DVec2::new(x, y)).collect(),
+            sources: (0..points.len()).map(Some).collect(),
+        }
+    }
+
+    fn is_valid(r: &InsetRing) -> bool {
+        PolygonWithHoles::from(Polygon::new(r.points.clone()))
+            .validate()
+            .is_ok()
+    }
+
+    #[test]
+    fn lobes_side_by_side_are_split_at_the_point_they_touch() {
+        // Two squares touching corner to corner, as one ring; both visits of the
+        // origin are reflex corners, so moving them into their corners would cross.
+        let eps = 1e-9;
+        let eight = ring(&[
+            (0.0, 0.0),
+            (1.0, -1.0),
+            (2.0, 0.0),
+            (1.0, 1.0),
+            (0.0, 0.0),
+            (-1.0, 1.0),
+            (-2.0, 0.0),
+            (-1.0, -1.0),
+        ]);
+        let rings = finish_ring(eight, eps);
+        assert_eq!(rings.len(), 2);
+        for (r, outer) in &rings {
+            assert!(outer);
+            assert!(is_valid(r));
+            assert_eq!(r.points.len(), 4);
+            assert!((ring_area(r) - 2.0).abs() < 1e-15);
+            // The sources follow their edges: each ring's are consecutive edges.
+            assert_eq!(r.sources[1], r.sources[0].map(|s| s + 1));
+        }
+        // The visits are within `eps` but not equal: still split, nothing moved.
+        let mut near = ring(&[
+            (0.0, 0.0),
+            (1.0, -1.0),
+            (2.0, 0.0),
+            (1.0, 1.0),
+            (3e-10, -4e-10),
+            (-1.0, 1.0),
+            (-2.0, 0.0),
+            (-1.0, -1.0),
+        ]);
+        let before = near.points.clone();
+        let rings = finish_ring(std::mem::replace(&mut near, ring(&[])), eps);
+        assert_eq!(rings.len(), 2);
+        for (r, _) in &rings {
+            assert!(is_valid(r));
+            assert!(r.points.iter().all(|p| before.contains(p)));
+        }
+    }
+
+    #[test]
+    fn a_hole_touching_its_outer_ring_stays_one_simple_ring() {
+        // A 4 × 4 square whose bottom edge touches, at (2, 0), a diamond hole above it.
+        let eps = 1e-9;
+        let pinched = ring(&[
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (1.0, 1.0),
+            (2.0, 2.0),
+            (3.0, 1.0),
+            (2.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 4.0),
+            (0.0, 4.0),
+        ]);
+        let rings = finish_ring(pinched, eps);
+        assert_eq!(rings.len(), 1);
+        let (r, outer) = &rings[0];
+        assert!(outer);
+        assert!(is_valid(r), "{:?}", r.points);
+        assert!((ring_area(r) - 14.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn a_spike_out_and_back_is_dropped() {
+        let eps = 1e-9;
+        let spiked = ring(&[
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 4.0),
+            (2.0, 4.0),
+            (2.0, 6.0),
+            (2.0, 4.0),
+            (0.0, 4.0),
+        ]);
+        let rings = finish_ring(spiked, eps);
+        assert_eq!(rings.len(), 1);
+        let r = &rings[0].0;
+        assert!(is_valid(r));
+        // The square, with the spike's foot left as a straight vertex.
+        assert_eq!(r.points.len(), 5);
+        assert!(!r.points.contains(&DVec2::new(2.0, 6.0)));
+        assert_eq!(ring_area(r), 16.0);
+    }
+
+    fn ring_area(r: &InsetRing) -> f64 {
+        polis_geom::polygon::ring_signed_area(&r.points)
     }
 
     #[test]

@@ -215,3 +215,86 @@ fn thin_quad_inset_by_zero_stays_within_the_tolerance() {
         assert!(area <= a + slack, "d = {d}: {area} > {a}");
     }
 }
+
+/// Fuzz finding (`skeleton_inset`, session 14): an integer star nudged by 5e-10, with
+/// two pairs of collinear edges of different weights (steps, top and bottom). From
+/// t ≈ 2.14 to 4.24 the wavefront touches itself at (0, 1), where two vertices between
+/// steps stand still: two lobes side by side. Separating the two visits "into their own
+/// corners" moved them past each other (each corner was reflex), and the inset ring
+/// crossed itself by 2e-8 m. The lobes are now two shapes touching at that point.
+#[test]
+fn weighted_star_whose_wavefront_touches_itself_between_two_steps() {
+    let pts = [
+        (5.0000000005, -5.860227359426263e-11),
+        (5.0000000005, 2.0000000005),
+        (3.9999999995351416, 3.0000000005),
+        (2.9999999995234226, 4.0000000005),
+        (2.0000000005, 5.0000000005),
+        (5e-10, 5.0000000005),
+        (-1.9999999995, 5.0000000005),
+        (-2.9999999995, 4.0000000005),
+        (-3.9999999995, 3.0000000005),
+        (-4.9999999995, 2.0000000005),
+        (-4.9999999995, 5e-10),
+        (-4.9999999995, -1.9999999995),
+        (-3.9999999995, -2.9999999995),
+        (-2.9999999995000612, -3.9999999995),
+        (-1.9999999995, -4.9999999995),
+        (5e-10, -4.9999999995),
+        (2.0000000005, -4.9999999995),
+        (3.0000000005, -3.9999999995),
+        (4.0000000005, -2.9999999995),
+        (5.0000000005, -1.9999999995),
+    ];
+    let weights = [
+        0.5,
+        0.252300297550927,
+        1.0,
+        3.1,
+        3.0939116502632182,
+        3.1,
+        3.1,
+        0.5,
+        1.0,
+        1.0,
+        2.0,
+        2.996452277409018,
+        0.8499656672007324,
+        2.0,
+        0.5,
+        2.8025406271458,
+        0.427672236209659,
+        2.0,
+        1.0,
+        1.0,
+    ];
+    let p: PolygonWithHoles = poly(&pts).into();
+    let area = p.area();
+    let pinch = v(0.0, 1.0);
+    for d in [2.2, 3.0, 3.764705882352941, 4.0, 4.2] {
+        let shapes = inset_shapes(&p, Some(&weights), d).unwrap();
+        assert_eq!(shapes.len(), 2, "d = {d}: two lobes");
+        let mut total = 0.0;
+        for s in &shapes {
+            let s = s.to_polygon();
+            assert_eq!(s.validate(), Ok(()), "d = {d}");
+            assert!(s.area() > 0.1, "d = {d}: a lobe of {}", s.area());
+            total += s.area();
+            // Both lobes reach the point where they touch.
+            let nearest = s
+                .outer
+                .points()
+                .iter()
+                .map(|q| q.distance(pinch))
+                .fold(f64::INFINITY, f64::min);
+            assert!(nearest < 1e-8, "d = {d}: {nearest}");
+        }
+        assert!(total < area, "d = {d}");
+        let plain: f64 = inset_weighted(&p, &weights, d)
+            .unwrap()
+            .iter()
+            .map(PolygonWithHoles::area)
+            .sum();
+        assert_eq!(plain, total);
+    }
+}
