@@ -102,12 +102,12 @@ fn moved_box(b: Aabb3, t: DVec3) -> Aabb3 {
     }
 }
 
-/// A merged geometry: the mesh and, when any piece has a feature, the feature id of
-/// every vertex.
-type Merged = (Mesh, Option<Vec<u32>>);
+/// A merged geometry: the mesh (the scene's own when it is the geometry's only piece,
+/// unmoved) and, when any piece has a feature, the feature id of every vertex.
+type Merged<'a> = (Cow<'a, Mesh>, Option<Vec<u32>>);
 
 /// The merged geometries of one group: (material, geometry, bounds) per material.
-type GroupGeometries = Vec<(Option<MaterialId>, Merged, Aabb3)>;
+type GroupGeometries<'a> = Vec<(Option<MaterialId>, Merged<'a>, Aabb3)>;
 
 impl<'a> Merge<'a> {
     /// Records `source`, a mesh `m` (bounds `bounds`, feature `feature`), as the next
@@ -158,14 +158,14 @@ impl<'a> Merge<'a> {
 
     /// The merged geometries, per group in key order and per material in order, with
     /// their bounds; a piece without a feature gets `null_id`.
-    fn fill(self, null_id: u32) -> Vec<(GroupKey, GroupGeometries)> {
+    fn fill(self, null_id: u32) -> Vec<(GroupKey, GroupGeometries<'a>)> {
         let Merge {
             groups,
             targets,
             pieces,
             mut owned,
         } = self;
-        let mut merged: Vec<Option<Merged>> = targets.iter().map(|_| None).collect();
+        let mut merged: Vec<Option<Merged<'a>>> = targets.iter().map(|_| None).collect();
         for piece in pieces {
             let spec = &targets[piece.target];
             let feature = if piece.feature == NO_FEATURE {
@@ -174,13 +174,20 @@ impl<'a> Merge<'a> {
                 piece.feature
             };
             let slot = &mut merged[piece.target];
-            if let Source::Owned(k) = piece.source
-                && spec.pieces == 1
-                && let Some(m) = owned[k].take()
-            {
-                let ids = spec.featured.then(|| vec![feature; m.positions.len()]);
-                *slot = Some((m, ids));
-                continue;
+            // A geometry of one piece is that piece: a mesh the walk made is moved in, a
+            // scene mesh that is not moved is borrowed (copying it would give the same
+            // arrays: its material is the geometry's, its indices start at 0).
+            if spec.pieces == 1 {
+                let whole = match piece.source {
+                    Source::Owned(k) => owned[k].take().map(Cow::Owned),
+                    Source::Scene(m, t) if t == DVec3::ZERO => Some(Cow::Borrowed(m)),
+                    Source::Scene(..) => None,
+                };
+                if let Some(m) = whole {
+                    let ids = spec.featured.then(|| vec![feature; m.positions.len()]);
+                    *slot = Some((m, ids));
+                    continue;
+                }
             }
             let (out, ids) = slot.get_or_insert_with(|| {
                 let mut m = Mesh::new(spec.material);
@@ -188,8 +195,12 @@ impl<'a> Merge<'a> {
                 m.normals.reserve_exact(spec.vertices);
                 m.uvs.reserve_exact(spec.vertices);
                 m.indices.reserve_exact(spec.indices);
-                (m, spec.featured.then(|| Vec::with_capacity(spec.vertices)))
+                (
+                    Cow::Owned(m),
+                    spec.featured.then(|| Vec::with_capacity(spec.vertices)),
+                )
             });
+            let out = out.to_mut();
             let (m, t) = match piece.source {
                 Source::Scene(m, t) => (m, t),
                 Source::Owned(k) => match &owned[k] {
@@ -492,7 +503,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             for (material, (mesh, features), bounds) in group {
                 primitives.push((plan.geometries.len(), material));
                 plan.geometries.push(Geometry {
-                    mesh: Cow::Owned(mesh),
+                    mesh,
                     features,
                     bounds: Some(bounds),
                 });
@@ -694,7 +705,7 @@ mod tests {
             prop_assert_eq!(got.len(), expect.len());
             for (k, (mesh, ids, bounds, count)) in expect {
                 let (g_mesh, g_ids, g_bounds) = &got[&k];
-                prop_assert_eq!(g_mesh, &mesh);
+                prop_assert_eq!(&**g_mesh, &mesh);
                 prop_assert_eq!(g_bounds, &bounds);
                 match g_ids {
                     Some(g) => prop_assert_eq!(g, &ids),

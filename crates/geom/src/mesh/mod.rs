@@ -54,7 +54,7 @@
 //! [`Polygon::translated`]: crate::Polygon::translated
 //! [`PolygonWithHoles`]: crate::PolygonWithHoles
 
-use glam::{DMat3, DMat4, DVec2, DVec3, Vec2, Vec3};
+use glam::{DMat3, DMat4, DVec2, DVec3, Vec2, Vec3, Vec3A};
 
 use crate::GeomError;
 use crate::scene::MaterialId;
@@ -458,12 +458,21 @@ impl Mesh {
     }
 
     /// The bounding box of the positions (empty for no vertices).
+    ///
+    /// The same box, to the bit, as extending [`Aabb3::EMPTY`] by every position in
+    /// order (glam's `min`/`max`, `if a < b { a } else { b }` per coordinate), on the
+    /// four lanes of a `Vec3A` at once.
     pub fn bbox(&self) -> Aabb3 {
-        let mut b = Aabb3::EMPTY;
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for &p in &self.positions {
-            b.extend(p);
+            let p = Vec3A::from(p);
+            lo = lo.min(p);
+            hi = hi.max(p);
         }
-        b
+        Aabb3 {
+            min: lo.into(),
+            max: hi.into(),
+        }
     }
 
     /// Signed volume in m³ enclosed by the triangles (divergence theorem), computed in
@@ -675,6 +684,47 @@ fn invalid_vertex(attribute: &'static str, vertex: usize, reason: &'static str) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The box of four lanes at once is the box of `Aabb3::extend` in order, to the
+    /// bit, with NaN, −0 and +0 among the coordinates.
+    #[test]
+    fn bbox_is_extending_by_every_position_in_order() {
+        let values = [
+            0.0f32,
+            -0.0,
+            1.5,
+            -2.25,
+            f32::NAN,
+            3.0e7,
+            -1.0e-30,
+            f32::INFINITY,
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            values[(state % values.len() as u64) as usize]
+        };
+        for n in 0..200 {
+            let mut m = Mesh::new(None);
+            m.positions = (0..n % 23)
+                .map(|_| Vec3::new(next(), next(), next()))
+                .collect();
+            let mut expected = Aabb3::EMPTY;
+            for &p in &m.positions {
+                expected.extend(p);
+            }
+            let got = m.bbox();
+            let bits = |b: Aabb3| {
+                (
+                    b.min.to_array().map(f32::to_bits),
+                    b.max.to_array().map(f32::to_bits),
+                )
+            };
+            assert_eq!(bits(got), bits(expected), "{:?}", m.positions);
+        }
+    }
 
     fn unit_cube() -> Mesh {
         // Six flat quads, outward, counter-clockwise from outside.

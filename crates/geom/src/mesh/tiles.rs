@@ -160,46 +160,53 @@ impl Mesh {
     /// itself. `None` otherwise, without triangles, with a centroid that is not finite
     /// or a side that is not positive.
     ///
-    /// One pass over the indices and one over the triangles, without allocating or
-    /// dividing per triangle (a writer checks a ground tile cut in advance this way
-    /// instead of cutting it again): the tile of a point is monotone in each coordinate
-    /// (a correctly rounded division by a positive side, then the floor), so when the
-    /// centroids' smallest and largest coordinates share a tile, every centroid does.
+    /// One pass over the triangles, without allocating or dividing per triangle (a
+    /// writer checks a ground tile cut in advance this way instead of cutting it
+    /// again): the tile of a point is monotone in each coordinate (a correctly rounded
+    /// division by a positive side, then the floor), so when the centroids' smallest and
+    /// largest coordinates share a tile, every centroid does.
     pub fn whole_tile(&self, size: f64) -> Option<TileIndex> {
         if size.is_nan() || size <= 0.0 {
             return None;
         }
-        let mut next = 0u32;
-        for &i in &self.indices {
-            if i == next {
-                next += 1;
-            } else if i > next {
-                return None;
-            }
-        }
-        if next as usize != self.positions.len()
-            || self.normals.len() != self.positions.len()
-            || !(self.uvs.is_empty() || self.uvs.len() == self.positions.len())
+        let n = self.positions.len();
+        if self.indices.len() < 3
+            || !self.indices.len().is_multiple_of(3)
+            || self.normals.len() != n
+            || !(self.uvs.is_empty() || self.uvs.len() == n)
         {
             return None;
         }
-        if self.indices.len() < 3 {
-            return None;
-        }
+        // One pass over the triangles: the first-use numbering, and the extremes of
+        // the corner sums `a + b + c` in x and z. Dividing by 3 (correctly rounded, by a
+        // positive number) is monotone, so the extreme centroids are the extreme sums
+        // divided once; a sum is finite exactly when its centroid is.
+        let mut next = 0usize;
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         let mut finite = true;
         for tri in self.indices.chunks_exact(3) {
-            let c = (self.positions[tri[0] as usize]
-                + self.positions[tri[1] as usize]
-                + self.positions[tri[2] as usize])
-                / 3.0;
-            finite &= c.is_finite();
-            lo = lo.min(c);
-            hi = hi.max(c);
+            let mut sum = Vec3::ZERO;
+            for (k, &i) in tri.iter().enumerate() {
+                let i = i as usize;
+                if i == next {
+                    next += 1;
+                } else if i > next {
+                    return None;
+                }
+                let p = *self.positions.get(i)?;
+                // `a + b + c` as `triangle_tile` adds them (the first corner not added
+                // to zero: a −0 stays −0).
+                sum = if k == 0 { p } else { sum + p };
+            }
+            finite &= sum.is_finite();
+            lo = lo.min(sum);
+            hi = hi.max(sum);
         }
-        // A centroid that is not finite (an invalid mesh) has no tile to compare.
-        let tile = tile_of(lo.x, lo.z, size);
-        (finite && tile_of(hi.x, hi.z, size) == tile).then_some(tile)
+        if next != n || !finite {
+            return None;
+        }
+        let tile = tile_of(lo.x / 3.0, lo.z / 3.0, size);
+        (tile_of(hi.x / 3.0, hi.z / 3.0, size) == tile).then_some(tile)
     }
 }
 
@@ -245,5 +252,31 @@ mod tests {
         assert_eq!(cut.len(), 1);
         assert_eq!(cut[0].1, m);
         assert_eq!(cut[0].2, m.bbox());
+    }
+
+    proptest::proptest! {
+        /// `whole_tile` answers `Some(t)` exactly when cutting the mesh gives back the
+        /// mesh itself as tile `t`: meshes on a grid that straddles tile lines (−0 and
+        /// +0 among the coordinates), triangles in any vertex order.
+        #[test]
+        fn whole_tile_is_a_cut_that_gives_the_mesh_back(
+            corners in proptest::collection::vec((-6i32..6, -6i32..6, proptest::bool::ANY), 3..12),
+            triangles in proptest::collection::vec((0usize..12, 0usize..12, 0usize..12), 1..8),
+            size in proptest::sample::select(vec![1.0, 2.5, 3.0, 100.0]),
+        ) {
+            let mut m = Mesh::new(None);
+            for &(x, z, negative_zero) in &corners {
+                let z = if z == 0 && negative_zero { -0.0 } else { f64::from(z) * 0.75 };
+                m.add_vertex(DVec3::new(f64::from(x) * 0.5, 0.0, z), DVec3::Y, DVec2::ZERO);
+            }
+            let n = corners.len();
+            for &(a, b, c) in &triangles {
+                m.indices.extend([a % n, b % n, c % n].map(|i| i as u32));
+            }
+            let cut = m.cut_into_tiles(size);
+            let is_own_cut = cut.len() == 1 && cut[0].1 == m;
+            let expected = is_own_cut.then(|| cut[0].0);
+            proptest::prop_assert_eq!(m.whole_tile(size), expected);
+        }
     }
 }
