@@ -275,6 +275,7 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
 /// whether it is an outer ring (`true`) or a hole (`false`); rings of no area are dropped.
 fn finish_ring(mut ring: InsetRing, eps: f64) -> Vec<(InsetRing, bool)> {
     clean_ring(&mut ring, eps);
+    add_touch_points(&mut ring, eps);
     let mut finished = Vec::new();
     let mut pending = vec![ring];
     while let Some(mut ring) = pending.pop() {
@@ -294,6 +295,67 @@ fn finish_ring(mut ring: InsetRing, eps: f64) -> Vec<(InsetRing, bool)> {
         }
     }
     finished
+}
+
+/// A ring can also touch itself where one of its vertices lies on another of its edges
+/// (within `eps` of the edge, not of its ends): that edge gets a copy of the vertex, so
+/// the touch is a point the ring visits twice, which [`split_lobes`] and
+/// [`separate_pinches`] then treat as any other. Both halves of the edge keep its source.
+/// A sweep over `x` with the edges whose extent covers the vertex: about `n log n` for
+/// a ring of `n` vertices.
+fn add_touch_points(ring: &mut InsetRing, eps: f64) {
+    let n = ring.points.len();
+    if n < 4 {
+        return;
+    }
+    let pts = &ring.points;
+    let end = |e: usize| pts[if e + 1 < n { e + 1 } else { 0 }];
+    let lo_x = |e: usize| pts[e].x.min(end(e).x);
+    let mut edges: Vec<usize> = (0..n).collect();
+    edges.sort_by(|&a, &b| lo_x(a).total_cmp(&lo_x(b)).then(a.cmp(&b)));
+    let mut vertices: Vec<usize> = (0..n).collect();
+    vertices.sort_by(|&a, &b| pts[a].x.total_cmp(&pts[b].x).then(a.cmp(&b)));
+    let mut active: Vec<usize> = Vec::new();
+    let mut next = 0;
+    // (edge, position along it, vertex)
+    let mut touches: Vec<(usize, f64, usize)> = Vec::new();
+    for &v in &vertices {
+        let p = pts[v];
+        while next < n && lo_x(edges[next]) <= p.x + eps {
+            active.push(edges[next]);
+            next += 1;
+        }
+        active.retain(|&e| pts[e].x.max(end(e).x) >= p.x - eps);
+        for &e in &active {
+            let (a, b) = (pts[e], end(e));
+            if e == v
+                || (e + 1) % n == v
+                || a.distance(p) <= eps
+                || b.distance(p) <= eps
+                || polis_geom::predicates::distance_to_segment(p, a, b) > eps
+            {
+                continue;
+            }
+            touches.push((e, (p - a).dot(b - a), v));
+        }
+    }
+    if touches.is_empty() {
+        return;
+    }
+    touches.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut points = Vec::with_capacity(n + touches.len());
+    let mut sources = Vec::with_capacity(n + touches.len());
+    let mut t = touches.iter().peekable();
+    for e in 0..n {
+        points.push(ring.points[e]);
+        sources.push(ring.sources[e]);
+        while let Some(&(_, _, v)) = t.next_if(|x| x.0 == e) {
+            points.push(ring.points[v]);
+            sources.push(ring.sources[e]);
+        }
+    }
+    ring.points = points;
+    ring.sources = sources;
 }
 
 /// Points of `ring` within `eps` of another point of it (each pair once, `i < j`), in
@@ -511,6 +573,38 @@ mod tests {
             assert!(is_valid(r));
             assert!(r.points.iter().all(|p| before.contains(p)));
         }
+    }
+
+    #[test]
+    fn a_vertex_touching_another_edge_splits_the_ring_there() {
+        // A 2 × 1 rectangle above the x axis and a triangle below it, one ring: the
+        // ring leaves the origin along the rectangle and comes back down its left side
+        // through the origin (an edge from (0, 1) to (0, −1)), then round the triangle
+        // to the origin, a vertex on that edge.
+        let eps = 1e-9;
+        let touching = ring(&[
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (0.0, 1.0),
+            (0.0, -1.0),
+            (2.0, -1.0),
+        ]);
+        assert!(!is_valid(&touching));
+        let rings = finish_ring(touching, eps);
+        assert_eq!(rings.len(), 2);
+        let mut areas: Vec<f64> = rings.iter().map(|(r, _)| ring_area(r)).collect();
+        areas.sort_by(f64::total_cmp);
+        assert_eq!(areas, [1.0, 2.0]);
+        for (r, outer) in &rings {
+            assert!(outer);
+            assert!(is_valid(r), "{:?}", r.points);
+            assert!(r.points.contains(&DVec2::ZERO));
+        }
+        // The split edge's two halves keep its source (edge 3).
+        let sources: Vec<Option<usize>> =
+            rings.iter().flat_map(|(r, _)| r.sources.clone()).collect();
+        assert_eq!(sources.iter().filter(|&&s| s == Some(3)).count(), 2);
     }
 
     #[test]

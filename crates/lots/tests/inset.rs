@@ -298,3 +298,75 @@ fn weighted_star_whose_wavefront_touches_itself_between_two_steps() {
         assert_eq!(plain, total);
     }
 }
+
+/// Fuzz finding (`skeleton_inset`, session 15, after 7.26 million executions): the same
+/// family as the one above, other weights. At d ≈ 3.22 a wavefront vertex between two
+/// steps, at (0, −1), lies on the step edge of another part of the wavefront: the ring
+/// touches itself in a vertex on an edge, not in two vertices, and validation refused
+/// it. The edge now gets a copy of the vertex, and the lobes are split there.
+#[test]
+fn weighted_star_whose_wavefront_vertex_touches_its_own_step_edge() {
+    let pts = [
+        (5.0000000005, 5e-10),
+        (4.999999999980461, 2.0000000005),
+        (3.999999999500122, 3.0000000005),
+        (3.0000000005, 4.0000000005),
+        (2.0000000005, 5.0000000005),
+        (5e-10, 5.0000000005),
+        (-1.9999999995, 5.0000000005),
+        (-2.9999999995, 4.0000000005),
+        (-3.9999999995, 3.0000000005),
+        (-4.9999999995, 2.0000000005),
+        (-4.9999999995, 5e-10),
+        (-4.9999999995, -1.9999999995),
+        (-3.9999999995, -2.9999999995),
+        (-2.9999999995, -3.9999999995),
+        (-1.9999999995, -4.9999999995),
+        (5e-10, -4.9999999995),
+        (2.0000000005, -4.9999999995),
+        (3.0000000005, -3.9999999995),
+        (4.0000000005, -2.9999999995),
+        (5.0000000005, -2.000000000019539),
+    ];
+    let weights = [
+        2.303112840466926,
+        2.3,
+        2.3,
+        0.9054474708171206,
+        1.0,
+        0.5,
+        3.1,
+        0.5,
+        1.0,
+        1.0,
+        2.0,
+        2.996452277409018,
+        0.8499656672007324,
+        2.0,
+        1.9420233463035022,
+        0.5,
+        0.427672236209659,
+        2.0,
+        2.0,
+        3.094323643854429,
+    ];
+    let p: PolygonWithHoles = poly(&pts).into();
+    let area = p.area();
+    let d = 3.2224002441443504;
+    let shapes = inset_weighted(&p, &weights, d).unwrap();
+    assert_eq!(shapes.len(), 3);
+    let mut total = 0.0;
+    for s in &shapes {
+        assert_eq!(s.validate(), Ok(()));
+        assert!(s.area() > 0.1, "a piece of {}", s.area());
+        total += s.area();
+    }
+    assert!(total < area);
+    // Two of the pieces meet at the touch point.
+    let touch = v(5e-10, -0.9999999995);
+    let at_touch = shapes
+        .iter()
+        .filter(|s| s.outer.points().contains(&touch))
+        .count();
+    assert_eq!(at_touch, 2);
+}
