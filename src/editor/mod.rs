@@ -29,7 +29,11 @@
 //! city is then made by the pipeline with each per-item stage wrapped in a memo (see
 //! `memo.rs`): a city cell's secondary growth, a road-graph cell's blocks and lots, a
 //! lot's building and a building's skin are keyed by a 128-bit digest of the exact bits
-//! of everything they read, and redone only when that digest is new. The dirty set of an
+//! of everything they read, and redone only when that digest is new. A road-graph
+//! cell's buildings and skins are also kept whole, keyed by its lot stage's input, the
+//! city cells its lots can lie in, the lot overrides that can reach them and the rest of
+//! the configuration: a cell an edit leaves alone costs one look-up, not one per lot.
+//! The dirty set of an
 //! edit is therefore exactly the work whose inputs it changed: cells whose boundary,
 //! parameters, seed or maps changed, cells created, split or merged, and, downstream,
 //! road-graph cells whose ring or nearby roads changed.
