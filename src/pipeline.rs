@@ -54,6 +54,8 @@ pub struct Pipeline {
     reuse: Option<Arc<dyn crate::scene::SceneReuse + Send>>,
     /// Whole road-graph cells' buildings and skins of earlier runs (the editor's memo).
     cell_reuse: Option<Arc<dyn CellReuse>>,
+    /// Terrains of earlier runs (the editor's memo).
+    terrains: Option<Arc<dyn crate::scene::GroundReuse + Send>>,
 }
 
 impl Default for Pipeline {
@@ -68,6 +70,7 @@ impl Default for Pipeline {
             scene: true,
             reuse: None,
             cell_reuse: None,
+            terrains: None,
         }
     }
 }
@@ -160,6 +163,16 @@ impl Pipeline {
     /// memo of whole cells).
     pub(crate) fn with_cell_reuse(mut self, reuse: Arc<dyn CellReuse>) -> Self {
         self.cell_reuse = Some(reuse);
+        self
+    }
+
+    /// Takes the terrain from `terrains` where it holds one made on the same ground, and
+    /// gives it the terrains made (the editor's memo).
+    pub(crate) fn with_terrain_reuse(
+        mut self,
+        terrains: Arc<dyn crate::scene::GroundReuse + Send>,
+    ) -> Self {
+        self.terrains = Some(terrains);
         self
     }
 
@@ -428,6 +441,12 @@ impl Pipeline {
                     .reuse
                     .as_deref()
                     .map(|r| r as &dyn crate::scene::SceneReuse),
+                // The ground depends on the road graph where roads are graded into it.
+                terrains: self
+                    .terrains
+                    .as_deref()
+                    .filter(|_| !graded.as_ref().is_some_and(|g| g.moves_ground()))
+                    .map(|t| t as &dyn crate::scene::GroundReuse),
             })?
         } else {
             polis_geom::Scene::new()

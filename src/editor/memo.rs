@@ -22,7 +22,9 @@ use polis_roads::secondary::SecondaryRoads;
 use super::key::Key;
 use crate::citygen::{ConfiguredRoads, GrowthMemo, RoadMode, citygen_network_with};
 use crate::error::Result;
+use crate::ground::TerrainTiles;
 use crate::pipeline::{CellBuilt, CellReuse};
+use crate::scene::GroundReuse;
 use crate::stages::{
     BuildLot, BuildingStage, CellInput, CellLots, CellStage, Dress, DressBuilding, EberlyCells,
     FacadeStage, KellyLots, LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
@@ -184,6 +186,9 @@ struct Fingerprints {
     /// configuration but for the primary network, the per-cell settings and the lot
     /// overrides (which reach them only through those), with the pinned styles.
     plan: Key,
+    /// What the terrain reads of the configuration: all of it but the Citygen settings
+    /// (none of which reaches the elevation or water maps).
+    ground: Key,
 }
 
 /// The memo shared by the wrapped stages of one editor.
@@ -193,6 +198,8 @@ pub(crate) struct Memo {
     lots: Mutex<Store<CellLots>>,
     buildings: Mutex<Store<Option<Arc<Building>>>>,
     dresses: Mutex<Store<Option<Arc<Dress>>>>,
+    /// The last terrain made, by [`Fingerprints::ground`] and the water bed's digest.
+    terrain: Mutex<Option<(Key, TerrainTiles)>>,
     /// Road-graph cells' buildings and skins, whole (see [`WholeCell`]).
     whole: Mutex<Store<WholeCell>>,
     /// The number of the current run.
@@ -335,6 +342,7 @@ impl Memo {
             facades: facades_key(config),
             // Not serialisable: a key of this run alone (no cell is taken whole).
             plan: plan_key(config).unwrap_or(Key::new(0x706C_616E).u64(run)),
+            ground: ground_key(config).unwrap_or(Key::new(0x6772_6F75).u64(run)),
         });
         *lock(&self.redone) = Redone::default();
         self.touched.store(false, Ordering::Relaxed);
@@ -376,6 +384,7 @@ impl Memo {
             buildings: Key::new(2),
             facades: Key::new(3),
             plan: Key::new(4),
+            ground: Key::new(5),
         })
     }
 
@@ -388,6 +397,7 @@ impl Memo {
             .with_buildings(MemoBuildings(Arc::clone(self)))
             .with_facades(MemoFacades(Arc::clone(self)))
             .with_cell_reuse(Arc::clone(self) as Arc<dyn CellReuse>)
+            .with_terrain_reuse(Arc::clone(self) as Arc<dyn GroundReuse + Send>)
     }
 }
 
@@ -550,6 +560,46 @@ fn plan_key(config: &crate::CityConfig) -> Option<Key> {
     let mut w = KeyWriter(Key::new(0x706C_616E).key(facades_key(config)));
     serde_json::to_writer(&mut w, &c).ok()?;
     Some(w.0)
+}
+
+/// The digest of what the terrain reads of `config` ([`Fingerprints::ground`]); `None`
+/// if it cannot be serialised.
+fn ground_key(config: &crate::CityConfig) -> Option<Key> {
+    let mut c = config.clone();
+    c.citygen = Default::default();
+    let mut w = KeyWriter(Key::new(0x6772_6F75));
+    serde_json::to_writer(&mut w, &c).ok()?;
+    Some(w.0)
+}
+
+impl GroundReuse for Memo {
+    fn terrain(&self, bed: Option<Key>) -> Option<TerrainTiles> {
+        let key = terrain_key(self.fingerprints().ground, bed);
+        match &*lock(&self.terrain) {
+            Some((k, (report, tiles))) if *k == key => Some((*report, tiles.clone())),
+            _ => None,
+        }
+    }
+
+    fn keep_terrain(
+        &self,
+        bed: Option<Key>,
+        report: polis_geom::mesh::TerrainReport,
+        tiles: &[polis_geom::Mesh],
+    ) {
+        let key = terrain_key(self.fingerprints().ground, bed);
+        *lock(&self.terrain) = Some((key, (report, tiles.to_vec())));
+    }
+}
+
+/// The key of a terrain on the ground of configuration digest `ground` with the water
+/// bed of digest `bed`.
+fn terrain_key(ground: Key, bed: Option<Key>) -> Key {
+    let k = Key::new(0x7465_7272).key(ground);
+    match bed {
+        Some(b) => k.u64(1).key(b),
+        None => k.u64(0),
+    }
 }
 
 struct MemoLots(Arc<Memo>);
