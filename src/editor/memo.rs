@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use polis_buildings::Building;
 use polis_roads::secondary::SecondaryRoads;
 
-use super::key::Key;
+use super::key::{IdMap, Key};
 use crate::citygen::{ConfiguredRoads, GrowthMemo, RoadMode, citygen_network_with};
 use crate::error::Result;
 use crate::ground::TerrainTiles;
@@ -165,10 +165,10 @@ pub(crate) struct Redone {
 /// about n / 2⁶⁴), and is compared in full.
 #[derive(Default)]
 struct IdKeys {
-    last_built: HashMap<u64, Key>,
-    this_built: HashMap<u64, Key>,
-    last_dressed: HashMap<u64, Key>,
-    this_dressed: HashMap<u64, Key>,
+    last_built: IdMap<Key>,
+    this_built: IdMap<Key>,
+    last_dressed: IdMap<Key>,
+    this_dressed: IdMap<Key>,
 }
 
 /// Fingerprints of the configuration parts each stage reads besides its item.
