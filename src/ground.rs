@@ -24,7 +24,7 @@
 //! References: Kelly 2008 §4.2, §6.2 (the city on its terrain); Parish & Müller 2001 §3
 //! (elevation, water and parks as input maps).
 
-use polis_geom::mesh::Terrain;
+use polis_geom::mesh::{Terrain, TerrainReport};
 use polis_geom::paint::ClassGrid;
 use polis_geom::scene::{Image, ImageData, Texture, Wrap};
 use polis_geom::{Aabb2, DVec2, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene};
@@ -69,13 +69,16 @@ impl LandUse {
 
 /// What the ground layer is made of, before it joins the scene.
 pub(crate) struct Ground {
-    /// The terrain, its mesh taken into `tiles`.
-    pub terrain: Terrain,
+    /// The terrain's sizes and error.
+    pub report: TerrainReport,
     /// The terrain's mesh cut into the scene's tiles ([`SceneConfig::tile_size_m`],
     /// [`Mesh::cut_into_tiles`]), in tile order.
     pub tiles: Vec<Mesh>,
     pub land_use: ClassGrid,
 }
+
+/// A terrain made earlier for the same ground, options and map: its report and tiles.
+pub(crate) type TerrainTiles = (TerrainReport, Vec<Mesh>);
 
 /// The map's square.
 pub(crate) fn map_bounds(config: &CityConfig) -> Aabb2 {
@@ -90,6 +93,7 @@ pub(crate) fn build_ground<'a>(
     water: &[PolygonWithHoles],
     parks: &[PolygonWithHoles],
     blocks: impl Iterator<Item = &'a PolygonWithHoles> + Send,
+    made: Option<TerrainTiles>,
 ) -> Result<Ground> {
     let bounds = map_bounds(config);
     let scene = &config.scene;
@@ -107,20 +111,25 @@ pub(crate) fn build_ground<'a>(
         }
         grid
     };
-    let (terrain, land_use) = polis_geom::par::join(
-        || Terrain::build(elevation, bounds, &scene.terrain_mesh, None),
-        paint,
-    );
-    let mut terrain = terrain?;
-    // Cut here, once, rather than by every tiled glb written: the writer appends a
-    // mesh that is already one tile's cut whole.
-    let tiles = std::mem::take(&mut terrain.mesh)
-        .cut_into_tiles(scene.tile_size_m)
-        .into_iter()
-        .map(|(_, mesh, _)| mesh)
-        .collect();
+    let terrain = || -> Result<TerrainTiles> {
+        if let Some(made) = made {
+            return Ok(made);
+        }
+        let terrain = Terrain::build(elevation, bounds, &scene.terrain_mesh, None)?;
+        // Cut here, once, rather than by every tiled glb written: the writer appends a
+        // mesh that is already one tile's cut whole.
+        let tiles = terrain
+            .mesh
+            .cut_into_tiles(scene.tile_size_m)
+            .into_iter()
+            .map(|(_, mesh, _)| mesh)
+            .collect();
+        Ok((terrain.report, tiles))
+    };
+    let (terrain, land_use) = polis_geom::par::join(terrain, paint);
+    let (report, tiles) = terrain?;
     Ok(Ground {
-        terrain,
+        report,
         tiles,
         land_use,
     })
@@ -134,7 +143,7 @@ pub(crate) fn add_ground(
     ground: Ground,
 ) -> Result<()> {
     let Ground {
-        terrain,
+        report,
         tiles,
         land_use,
     } = ground;
@@ -166,7 +175,7 @@ pub(crate) fn add_ground(
         ..Material::new("ground", [1.0, 1.0, 1.0, 1.0])
     });
     let node = scene.add_node(root, "ground")?;
-    scene.set_metadata(node, "max_error_m", terrain.report.max_error_m)?;
+    scene.set_metadata(node, "max_error_m", report.max_error_m)?;
     for mut tile in tiles {
         tile.material = Some(material);
         let mesh = scene.add_mesh(tile);

@@ -10,11 +10,12 @@ use polis_geom::par::{self, prelude::*};
 
 use polis_buildings::Building;
 use polis_cells::Cell;
-use polis_geom::PolygonWithHoles;
+use polis_geom::{Aabb2, PolygonWithHoles};
 use polis_lots::Block;
 use polis_roads::RoadNetwork;
 
 use crate::city::{City, CityLot, CityStats, SkipReport, StageTiming};
+use crate::editor::key::Key;
 use crate::error::{Error, Result};
 use crate::scene::{SceneInputs, assemble};
 use crate::stages::{
@@ -51,6 +52,10 @@ pub struct Pipeline {
     scene: bool,
     /// Scene parts of an earlier city to reuse (the editor's).
     reuse: Option<Arc<dyn crate::scene::SceneReuse + Send>>,
+    /// Whole road-graph cells' buildings and skins of earlier runs (the editor's memo).
+    cell_reuse: Option<Arc<dyn CellReuse>>,
+    /// Terrains of earlier runs (the editor's memo).
+    terrains: Option<Arc<dyn crate::scene::GroundReuse + Send>>,
 }
 
 impl Default for Pipeline {
@@ -64,6 +69,8 @@ impl Default for Pipeline {
             progress: None,
             scene: true,
             reuse: None,
+            cell_reuse: None,
+            terrains: None,
         }
     }
 }
@@ -148,6 +155,24 @@ impl Pipeline {
         reuse: Arc<dyn crate::scene::SceneReuse + Send>,
     ) -> Self {
         self.reuse = Some(reuse);
+        self
+    }
+
+    /// Takes the buildings and skins of a road-graph cell from `reuse` where it holds
+    /// them for the cell's inputs, and gives it those of the cells made (the editor's
+    /// memo of whole cells).
+    pub(crate) fn with_cell_reuse(mut self, reuse: Arc<dyn CellReuse>) -> Self {
+        self.cell_reuse = Some(reuse);
+        self
+    }
+
+    /// Takes the terrain from `terrains` where it holds one made on the same ground, and
+    /// gives it the terrains made (the editor's memo).
+    pub(crate) fn with_terrain_reuse(
+        mut self,
+        terrains: Arc<dyn crate::scene::GroundReuse + Send>,
+    ) -> Self {
+        self.terrains = Some(terrains);
         self
     }
 
@@ -318,6 +343,14 @@ impl Pipeline {
         let mut kept = CityChunk::default();
         let ids = crate::citygen::block_ids(config, &cells);
         let districts = &roads.districts;
+        // With a memo of whole cells: each city cell's box and digest, for the keys.
+        let cell_memo = self.cell_reuse.as_deref().map(|reuse| CellMemoRun {
+            reuse,
+            districts: districts
+                .iter()
+                .map(|d| (d.region.outer.bbox(), reuse.district_key(d)))
+                .collect(),
+        });
         for (k, chunk) in cells.cells.chunks(cells_per_chunk).enumerate() {
             let span = Span {
                 first: k * cells_per_chunk,
@@ -334,6 +367,7 @@ impl Pipeline {
                 &cx,
                 builder.as_ref(),
                 dresser.as_ref(),
+                cell_memo.as_ref(),
                 &mut report,
             )?;
             timings.extend(chunk_timings);
@@ -407,6 +441,12 @@ impl Pipeline {
                     .reuse
                     .as_deref()
                     .map(|r| r as &dyn crate::scene::SceneReuse),
+                // The ground depends on the road graph where roads are graded into it.
+                terrains: self
+                    .terrains
+                    .as_deref()
+                    .filter(|_| !graded.as_ref().is_some_and(|g| g.moves_ground()))
+                    .map(|t| t as &dyn crate::scene::GroundReuse),
             })?
         } else {
             polis_geom::Scene::new()
@@ -460,6 +500,7 @@ impl Pipeline {
         cx: &StageContext<'_>,
         builder: &dyn BuildLot,
         dresser: &dyn DressBuilding,
+        cell_memo: Option<&CellMemoRun<'_>>,
         report: &mut SkipReport,
     ) -> Result<(CityChunk, [StageTiming; 3])> {
         let mut clock = Instant::now();
@@ -479,7 +520,8 @@ impl Pipeline {
             .edges()
             .map(|(_, _, _, r)| r.width)
             .fold(0.0, f64::max);
-        let per_cell: Vec<Result<std::result::Result<(u64, CellLots), Skip>>> = cells
+        type Made = (u64, CellLots, Option<(Key, Aabb2)>);
+        let per_cell: Vec<Result<std::result::Result<Made, Skip>>> = cells
             .par_iter()
             .zip(ids)
             .map(|(cell, &id)| {
@@ -532,9 +574,10 @@ impl Pipeline {
                     nearby_roads,
                     lot_params: crate::citygen::lot_params_of(cx.config, districts, cell),
                 };
-                let lots = self.lots.lots(&input, cx);
+                let lots = self.lots.lots(&input, cx)?;
                 ticker.tick();
-                Ok(Ok((id, lots?)))
+                let key = cell_memo.map(|m| m.key(&input, &lots));
+                Ok(Ok((id, lots, key)))
             })
             .collect();
         // Exact room for what the cells made (growing by doubling would leave up to half
@@ -543,7 +586,7 @@ impl Pipeline {
             .iter()
             .filter_map(|r| r.as_ref().ok()?.as_ref().ok());
         let (mut n_blocks, mut n_green, mut n_lots) = (0, 0, 0);
-        for (_, lots) in made {
+        for (_, lots, _) in made {
             n_blocks += lots.blocks.len();
             n_green += lots.green_spaces.len();
             n_lots += lots.lots.len();
@@ -551,8 +594,12 @@ impl Pipeline {
         out.blocks.reserve_exact(n_blocks);
         out.green_spaces.reserve_exact(n_green);
         out.lots.reserve_exact(n_lots);
+        // Per cell with lots: its id, its lots' range in `out.lots`, and its key and box
+        // for the memo of whole cells.
+        type Run = (u64, std::ops::Range<usize>, Option<(Key, Aabb2)>);
+        let mut runs: Vec<Run> = Vec::new();
         for result in per_cell {
-            let (cell, lots) = match result? {
+            let (cell, lots, key) = match result? {
                 Ok(done) => done,
                 Err(skip) => {
                     report.skipped.push(skip);
@@ -563,6 +610,7 @@ impl Pipeline {
             out.blocks.extend(lots.blocks);
             out.green_spaces.extend(lots.green_spaces);
             out.lot_splits.extend(lots.splits);
+            let first = out.lots.len();
             for (i, lot) in lots.lots.into_iter().enumerate() {
                 if i >= 1 << 24 || cell >= 1 << 40 {
                     report.skipped.push(Skip {
@@ -578,22 +626,54 @@ impl Pipeline {
                     lot,
                 });
             }
+            runs.push((cell, first..out.lots.len(), key));
         }
         let lots_time = lap(Stage::Lots);
         self.report(Stage::Lots, span.done());
 
-        // Buildings, lot by lot in parallel.
+        // Buildings, lot by lot in parallel, but for the cells whose buildings and skins
+        // the memo of whole cells holds for their inputs.
         let lod = cx.config.effective_lod();
-        let ticker = self.ticker(Stage::Buildings, out.lots.len(), span);
         let lot_ids: std::collections::BTreeSet<u64> = out.lots.iter().map(|l| l.id).collect();
-        let built: Vec<Result<Option<_>>> = out
-            .lots
+        let overrides = &cx.config.citygen.lots;
+        let gone: Vec<bool> = match cell_memo {
+            Some(_) => overrides
+                .iter()
+                .map(|o| !lot_ids.contains(&o.lot))
+                .collect(),
+            None => Vec::new(),
+        };
+        let keys: Vec<Option<Key>> = runs
+            .iter()
+            .map(|(cell, _, key)| {
+                let (m, (key, bbox)) = (cell_memo?, (*key)?);
+                Some(m.with_overrides(key, *cell, bbox, overrides, &gone))
+            })
+            .collect();
+        let hits: Vec<Option<Arc<CellBuilt>>> = keys
+            .iter()
+            .map(|k| cell_memo.zip(*k).and_then(|(m, k)| m.reuse.get(k)))
+            .collect();
+        let todo: Vec<usize> = runs
+            .iter()
+            .zip(&hits)
+            .filter(|(_, hit)| hit.is_none())
+            .flat_map(|((_, range, _), _)| range.clone())
+            .collect();
+        let ticker = self.ticker(Stage::Buildings, todo.len(), span);
+        // Per lot to build: the id its building was drawn under (none for a lot left
+        // empty) and the building with its pinned style.
+        type Built = (Option<u64>, Result<Option<(Arc<Building>, Option<String>)>>);
+        let built: Vec<Built> = todo
             .par_iter()
-            .map(|l| {
+            .map(|&i| {
+                let Some(l) = out.lots.get(i) else {
+                    return (None, Ok(None));
+                };
                 // Zoning, the cell's traits, the height map and the lot's overrides.
                 let Some(plan) = crate::citygen::lot_plan(cx, districts, l, &lot_ids) else {
                     ticker.tick();
-                    return Ok(None);
+                    return (None, Ok(None));
                 };
                 let r = builder.build_shared(&LotInput {
                     id: plan.build_id,
@@ -604,7 +684,7 @@ impl Pipeline {
                 });
                 ticker.tick();
                 // A reseeded lot's building was drawn under another id: give it its own.
-                r.map(|b| {
+                let r = r.map(|b| {
                     b.map(|mut b| {
                         if b.id != l.id || b.lot_id != l.id {
                             let own = Arc::make_mut(&mut b);
@@ -613,56 +693,117 @@ impl Pipeline {
                         }
                         (b, plan.style)
                     })
-                })
+                });
+                (Some(plan.build_id), r)
             })
             .collect();
-        let n_built = built.iter().filter(|b| matches!(b, Ok(Some(_)))).count();
+        let n_built = built.iter().filter(|b| matches!(b.1, Ok(Some(_)))).count()
+            + hits
+                .iter()
+                .flatten()
+                .map(|h| h.buildings.len())
+                .sum::<usize>();
         out.buildings.reserve_exact(n_built);
         out.building_cells.reserve_exact(n_built);
-        let mut styles = Vec::with_capacity(n_built);
-        for (l, b) in out.lots.iter().zip(built) {
-            match b {
-                Ok(Some((b, style))) => {
-                    out.buildings.push(b);
-                    out.building_cells.push(l.cell);
-                    styles.push(style);
-                }
-                Ok(None) => {}
-                Err(e) => report.skipped.push(Skip {
-                    stage: Stage::Buildings,
-                    id: l.id,
-                    reason: e.to_string(),
-                }),
+        // Per cell made here: the ids its buildings were drawn under, its skips.
+        let mut made: Vec<(Vec<u64>, Vec<Skip>)> = Vec::new();
+        // Per building made here: its index in `out.buildings` and its pinned style.
+        let mut fresh = Vec::new();
+        let mut styles = Vec::new();
+        // Per cell: its buildings' range in `out.buildings`.
+        let mut spans = Vec::with_capacity(runs.len());
+        let mut built = built.into_iter();
+        for ((cell, range, _), hit) in runs.iter().zip(&hits) {
+            let first = out.buildings.len();
+            if let Some(h) = hit {
+                out.buildings.extend(h.buildings.iter().cloned());
+                out.building_cells
+                    .extend(std::iter::repeat_n(*cell, h.buildings.len()));
+                report.skipped.extend(h.building_skips.iter().cloned());
+                spans.push(first..out.buildings.len());
+                continue;
             }
+            let (mut ids, mut skips) = (Vec::new(), Vec::new());
+            for l in out.lots.get(range.clone()).unwrap_or_default() {
+                let Some((build_id, b)) = built.next() else {
+                    break;
+                };
+                ids.extend(build_id);
+                match b {
+                    Ok(Some((b, style))) => {
+                        fresh.push(out.buildings.len());
+                        out.buildings.push(b);
+                        out.building_cells.push(l.cell);
+                        styles.push(style);
+                    }
+                    Ok(None) => {}
+                    Err(e) => skips.push(Skip {
+                        stage: Stage::Buildings,
+                        id: l.id,
+                        reason: e.to_string(),
+                    }),
+                }
+            }
+            report.skipped.extend(skips.iter().cloned());
+            made.push((ids, skips));
+            spans.push(first..out.buildings.len());
         }
         let buildings_time = lap(Stage::Buildings);
         self.report(Stage::Buildings, span.done());
 
-        // Facade skins, building by building.
-        let ticker = self.ticker(Stage::Facades, out.buildings.len(), span);
-        let dressed: Vec<Result<Option<_>>> = out
-            .buildings
+        // Facade skins, building by building (those of the cells made here).
+        let ticker = self.ticker(Stage::Facades, fresh.len(), span);
+        let dressed: Vec<Result<Option<_>>> = fresh
             .par_iter()
             .zip(&styles)
-            .map(|(b, style)| {
+            .map(|(&i, style)| {
+                let Some(b) = out.buildings.get(i) else {
+                    return Ok(None);
+                };
                 let r = dresser.dress_shared(b, cx.seed(Stage::Facades, b.id), style.as_deref());
                 ticker.tick();
                 r
             })
             .collect();
         out.dresses.reserve_exact(out.buildings.len());
-        for (b, d) in out.buildings.iter().zip(dressed) {
-            out.dresses.push(match d {
-                Ok(d) => d,
-                Err(e) => {
-                    report.skipped.push(Skip {
-                        stage: Stage::Facades,
-                        id: b.id,
-                        reason: e.to_string(),
-                    });
-                    None
-                }
-            });
+        let mut dressed = dressed.into_iter();
+        let mut made = made.into_iter();
+        for ((range, hit), key) in spans.into_iter().zip(&hits).zip(&keys) {
+            if let Some(h) = hit {
+                out.dresses.extend(h.dresses.iter().cloned());
+                report.skipped.extend(h.facade_skips.iter().cloned());
+                continue;
+            }
+            let mut skips = Vec::new();
+            for b in out.buildings.get(range.clone()).unwrap_or_default() {
+                out.dresses.push(match dressed.next() {
+                    Some(Ok(d)) => d,
+                    Some(Err(e)) => {
+                        skips.push(Skip {
+                            stage: Stage::Facades,
+                            id: b.id,
+                            reason: e.to_string(),
+                        });
+                        None
+                    }
+                    None => None,
+                });
+            }
+            report.skipped.extend(skips.iter().cloned());
+            let (ids, building_skips) = made.next().unwrap_or_default();
+            if let (Some(m), Some(key)) = (cell_memo, key) {
+                let cell = CellBuilt {
+                    buildings: out
+                        .buildings
+                        .get(range.clone())
+                        .unwrap_or_default()
+                        .to_vec(),
+                    dresses: out.dresses.get(range).unwrap_or_default().to_vec(),
+                    building_skips,
+                    facade_skips: skips,
+                };
+                m.reuse.put(*key, cell, &ids);
+            }
         }
         let facades_time = lap(Stage::Facades);
         self.report(Stage::Facades, span.done());
@@ -733,6 +874,92 @@ impl Span {
         } else {
             (self.first + self.len) as f64 / self.total.max(1) as f64
         }
+    }
+}
+
+/// The buildings and skins of one road-graph cell's lots, with what their stages
+/// skipped: what the memo of whole cells ([`CellReuse`]) keeps.
+#[derive(Debug, Default)]
+pub(crate) struct CellBuilt {
+    /// Its buildings, in lot order.
+    pub buildings: Vec<Arc<Building>>,
+    /// Their skins.
+    pub dresses: Vec<Option<Arc<Dress>>>,
+    /// Lots whose building failed, in lot order.
+    pub building_skips: Vec<Skip>,
+    /// Buildings whose skin failed, in building order.
+    pub facade_skips: Vec<Skip>,
+}
+
+/// Whole road-graph cells of earlier runs (the editor's memo): a cell whose key is known
+/// takes its buildings and skins from there instead of planning, building and dressing
+/// each lot. The key must be a digest of everything they read, so a reused cell is bit
+/// for bit what the stages would make again.
+pub(crate) trait CellReuse: Send + Sync {
+    /// The digest of city cell `d` as the lot plans read it (id, region, traits).
+    fn district_key(&self, d: &crate::citygen::District) -> Key;
+    /// The digest of what a cell's buildings and skins read of its input and of the
+    /// configuration (the lot stage's input, the configuration but for the primary
+    /// network, the per-cell settings and the lot overrides).
+    fn cell_key(&self, input: &CellInput<'_>) -> Key;
+    /// The cell made for `key` by an earlier run, if kept.
+    fn get(&self, key: Key) -> Option<Arc<CellBuilt>>;
+    /// Keeps `cell`, made for `key`; `build_ids` are the ids its lots' buildings were
+    /// drawn under (lots left empty by their plan have none).
+    fn put(&self, key: Key, cell: CellBuilt, build_ids: &[u64]);
+}
+
+/// A run's memo of whole cells with each city cell's box and digest.
+struct CellMemoRun<'a> {
+    reuse: &'a dyn CellReuse,
+    districts: Vec<(Aabb2, Key)>,
+}
+
+impl CellMemoRun<'_> {
+    /// The key of a cell's buildings and skins but for the lot overrides, and the box of
+    /// its lots' corners and centroids: the cell's input with every city cell a lot plan
+    /// could find one of its lots' centroids in (those whose box meets the box).
+    fn key(&self, input: &CellInput<'_>, lots: &CellLots) -> (Key, Aabb2) {
+        let mut bbox = Aabb2::EMPTY;
+        for l in &lots.lots {
+            for &p in l.polygon.points() {
+                bbox.extend(p);
+            }
+            bbox.extend(l.polygon.centroid());
+        }
+        let mut key = self.reuse.cell_key(input);
+        for (i, (b, k)) in self.districts.iter().enumerate() {
+            if b.intersects(&bbox) {
+                key = key.u64(i as u64).key(*k);
+            }
+        }
+        (key, bbox)
+    }
+
+    /// `key` with the overrides a lot of cell `cell` (lots within `bbox`) can find: its
+    /// lots' by id, and those whose lot is gone (`gone`, per override: no lot of the run
+    /// has its id) anchored in the box; in configuration order, as the lot plans search
+    /// them.
+    fn with_overrides(
+        &self,
+        key: Key,
+        cell: u64,
+        bbox: Aabb2,
+        overrides: &[crate::citygen::LotOverride],
+        gone: &[bool],
+    ) -> Key {
+        let mut key = key.u64(overrides.len() as u64);
+        for (i, (o, &gone)) in overrides.iter().zip(gone).enumerate() {
+            let mine = if gone {
+                bbox.contains(polis_geom::DVec2::new(o.at[0], o.at[1]))
+            } else {
+                o.lot >> 24 == cell
+            };
+            if mine {
+                key = key.u64(i as u64).bytes(format!("{o:?}").as_bytes());
+            }
+        }
+        key
     }
 }
 

@@ -26,7 +26,7 @@ use polis_lots::Block;
 use polis_roads::{RoadClass, RoadNetwork};
 
 use crate::error::Result;
-use crate::ground::{Ground, add_ground, build_ground};
+use crate::ground::{Ground, TerrainTiles, add_ground, build_ground};
 use crate::stages::{Dress, SkinQuad};
 use crate::{CityConfig, CityMaps, Foundation};
 
@@ -423,6 +423,26 @@ pub(crate) struct SceneInputs<'a> {
     pub green_spaces: &'a [PolygonWithHoles],
     /// Leaves of an earlier scene of the same city to reuse (the editor's splice).
     pub reuse: Option<&'a dyn SceneReuse>,
+    /// Terrains of earlier runs to reuse (the editor's memo); only where `ground` does
+    /// not depend on the road graph (no roads graded into it).
+    pub terrains: Option<&'a dyn GroundReuse>,
+}
+
+/// Terrains an editor keeps between runs. A terrain is a function of the ground it
+/// follows, the map and the terrain options: a memo keyed by the configuration's digest
+/// (which fixes the map, the options and the elevation map) and the water bed's
+/// ([`Water::bed_key`](crate::water::Water)) hands back the terrain made before.
+pub(crate) trait GroundReuse: Sync {
+    /// The terrain made earlier on the ground with the water bed of digest `bed` (none:
+    /// no water), if kept.
+    fn terrain(&self, bed: Option<crate::editor::key::Key>) -> Option<TerrainTiles>;
+    /// Keeps the terrain made on the ground with the water bed of digest `bed`.
+    fn keep_terrain(
+        &self,
+        bed: Option<crate::editor::key::Key>,
+        report: polis_geom::mesh::TerrainReport,
+        tiles: &[Mesh],
+    );
 }
 
 /// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
@@ -786,13 +806,17 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
                 (None, Some(c)) => c,
                 (None, None) => elevation,
             };
-            Some(build_ground(
-                inp.config,
-                terrain_field,
-                &water,
-                &parks,
-                blocks,
-            )?)
+            // A terrain on the same ground (no graded roads in it) and water bed as an
+            // earlier run's is that terrain.
+            let bed = inp.water.map(crate::water::Water::bed_key);
+            let memo = inp.terrains.filter(|_| inp.cut_in.is_none());
+            let made = memo.and_then(|m| m.terrain(bed));
+            let fresh = made.is_none();
+            let ground = build_ground(inp.config, terrain_field, &water, &parks, blocks, made)?;
+            if let Some(m) = memo.filter(|_| fresh) {
+                m.keep_terrain(bed, ground.report, &ground.tiles);
+            }
+            Some(ground)
         } else {
             None
         };

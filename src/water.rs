@@ -173,6 +173,9 @@ pub(crate) struct Water {
     roads: Vec<(DVec2, DVec2, f64)>,
     road_index: SegmentIndex<u32>,
     widest_road: f64,
+    /// A digest of everything the bed reads besides the ground under it
+    /// ([`bed_key`](Self::bed_key)).
+    bed_key: crate::editor::key::Key,
 }
 
 impl Water {
@@ -253,6 +256,37 @@ impl Water {
             roads.push((a, b, 0.5 * road.width.max(0.0)));
         }
         let widest_road = roads.iter().map(|r| r.2).fold(0.0, f64::max);
+        // The bed's digest: the bodies, the blocks that reach into them, and the roads
+        // within reach of one. A depth is read inside a body, within a bank's reach
+        // (`WATER_BANK_M + WATER_BANK_WALL_M`) of its shore, from roads whose corridor
+        // with its margin comes closer than that: no road farther from a body's box
+        // can change it.
+        let reach = WATER_BANK_M + WATER_BANK_WALL_M + widest_road + WATER_LAND_MARGIN_M;
+        let boxes: Vec<Aabb2> = bodies
+            .iter()
+            .map(|b| b.polygon.bbox().expanded(reach))
+            .collect();
+        // The blocks and roads in any order (the bed reads them as sets: whether a
+        // point lies in a block, the nearest distances), so an edit elsewhere that
+        // renumbers them keeps the digest.
+        use crate::editor::key::Key;
+        let mut bed_key = Key::new(0x7761_7465).u64(bodies.len() as u64);
+        for b in &bodies {
+            bed_key = bed_key.region(&b.polygon).f64(b.level);
+        }
+        let mut land: Vec<Key> = wet.iter().map(|b| Key::new(1).region(b)).collect();
+        land.extend(roads.iter().filter_map(|&(a, b, half)| {
+            let seg = Aabb2::new(a.min(b), a.max(b));
+            boxes
+                .iter()
+                .any(|x| x.intersects(&seg))
+                .then(|| Key::new(2).point(a).point(b).f64(half))
+        }));
+        land.sort_unstable();
+        bed_key = bed_key.u64(land.len() as u64);
+        for k in land {
+            bed_key = bed_key.key(k);
+        }
         Ok(Some(Water {
             bodies,
             shore,
@@ -260,6 +294,7 @@ impl Water {
             roads,
             road_index,
             widest_road,
+            bed_key,
         }))
     }
 
@@ -326,6 +361,13 @@ impl Water {
             return excess; // past the bank (exactly: what a batch far from shores gives)
         }
         excess.min(bank(d))
+    }
+
+    /// A digest of everything the bed reads besides the ground it is cut into: the
+    /// bodies, the blocks reaching into them and the roads near enough to one to bound
+    /// a bank. Two waters with the same digest cut the same bed into the same ground.
+    pub(crate) fn bed_key(&self) -> crate::editor::key::Key {
+        self.bed_key
     }
 
     /// The bed under the bodies, on top of `base` (the ground elsewhere).

@@ -809,3 +809,49 @@ fn a_cell_whose_growth_is_skipped_stays_an_editable_cell() {
     assert!(back.skipped.is_none(), "{back:?}");
     assert_same_as_generate(&ed);
 }
+
+/// Edits of a city on a coast equal `generate`: the terrain an edit takes from the run
+/// before (its water bed's inputs unchanged: no block or road near the water moved) and
+/// the one it makes again (a node by the shore moved) are both the terrain `generate`
+/// makes, and so is the one undo brings back.
+#[test]
+fn edits_on_a_coast_keep_the_terrain_generate_makes() {
+    let mut c = small();
+    c.maps.water = Some(
+        serde_json::from_str(
+            r#"{ "kind": "coast", "toward_deg": 0, "distance_m": 560, "roughness_m": 25,
+                 "wavelength_m": 300 }"#,
+        )
+        .unwrap(),
+    );
+    let mut ed = CityEditor::new(c).unwrap();
+    assert!(ed.city().maps.has_water, "the coast gives the city water");
+    // A move by the shore (the easternmost node that can move), then one far from it.
+    let mut nodes: Vec<_> = ed.network().nodes().map(|(id, n)| (id.0, n.pos)).collect();
+    nodes.sort_by(|a, b| b.1.x.total_cmp(&a.1.x).then(a.0.cmp(&b.0)));
+    let valid = |ed: &CityEditor, (node, p): (u64, polis::geom::DVec2)| {
+        let mv = Edit::MoveNode {
+            node,
+            to: [p.x - 3.0, p.y + 2.5],
+        };
+        ed.propose(&mv).valid.then_some(mv)
+    };
+    let east = nodes
+        .iter()
+        .find_map(|&n| valid(&ed, n))
+        .expect("a node by the sea");
+    ed.apply(east).unwrap();
+    assert_same_as_generate(&ed);
+    // The outer ring's nodes all bound the cell between it and the map's edge, which
+    // reaches the shore: a node of the inner ring, nearest the centre.
+    nodes.sort_by(|a, b| a.1.length().total_cmp(&b.1.length()).then(a.0.cmp(&b.0)));
+    let inner = nodes
+        .iter()
+        .find_map(|&n| valid(&ed, n))
+        .expect("a node far from the sea");
+    ed.apply(inner).unwrap();
+    assert_same_as_generate(&ed);
+    ed.undo().unwrap();
+    ed.undo().unwrap();
+    assert_same_as_generate(&ed);
+}

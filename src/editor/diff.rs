@@ -1,7 +1,7 @@
 //! What changed between two states of an edited city, by stable id: the
 //! [`ChangeEvents`] a host applies to its meshes.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 use std::sync::Arc;
 
 use polis_geom::DVec2;
@@ -14,16 +14,33 @@ use crate::City;
 use crate::CityConfig;
 use crate::citygen::{District, LotOverride};
 
-/// Removed, added and changed keys between two maps (values compared with `==`).
-fn delta<K: Ord + Clone, V: PartialEq>(old: &BTreeMap<K, V>, new: &BTreeMap<K, V>) -> Delta<K> {
+/// Pairs sorted by key, of equal keys the last kept (as collecting them into a
+/// `BTreeMap` would): the maps the deltas compare, as sorted vectors (one sort instead of
+/// a tree insertion per item).
+fn by_key<K: Ord, V>(mut v: Vec<(K, V)>) -> Vec<(K, V)> {
+    // Stable: of equal keys the last stays last.
+    v.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out: Vec<(K, V)> = Vec::with_capacity(v.len());
+    for (k, x) in v {
+        match out.last_mut() {
+            Some(last) if last.0 == k => *last = (k, x),
+            _ => out.push((k, x)),
+        }
+    }
+    out
+}
+
+/// Removed, added and changed keys between two maps sorted by key ([`by_key`]; values
+/// compared with `==`).
+fn delta<K: Ord + Clone, V: PartialEq>(old: &[(K, V)], new: &[(K, V)]) -> Delta<K> {
     delta_by(old, new, |v, w| v != w)
 }
 
-/// Removed, added and changed keys between two maps, `changed` telling whether an old
-/// value and the new one differ.
+/// Removed, added and changed keys between two maps sorted by key ([`by_key`]),
+/// `changed` telling whether an old value and the new one differ; each list ascending.
 fn delta_by<K: Ord + Clone, V, W>(
-    old: &BTreeMap<K, V>,
-    new: &BTreeMap<K, W>,
+    old: &[(K, V)],
+    new: &[(K, W)],
     changed: impl Fn(&V, &W) -> bool,
 ) -> Delta<K> {
     let mut d = Delta {
@@ -31,18 +48,37 @@ fn delta_by<K: Ord + Clone, V, W>(
         added: Vec::new(),
         changed: Vec::new(),
     };
-    for (k, v) in old {
-        match new.get(k) {
-            None => d.removed.push(k.clone()),
-            Some(w) if changed(v, w) => d.changed.push(k.clone()),
-            Some(_) => {}
+    let (mut i, mut j) = (0, 0);
+    loop {
+        match (old.get(i), new.get(j)) {
+            (Some((k, v)), Some((l, w))) => match k.cmp(l) {
+                std::cmp::Ordering::Less => {
+                    d.removed.push(k.clone());
+                    i += 1;
+                }
+                std::cmp::Ordering::Greater => {
+                    d.added.push(l.clone());
+                    j += 1;
+                }
+                std::cmp::Ordering::Equal => {
+                    if changed(v, w) {
+                        d.changed.push(k.clone());
+                    }
+                    i += 1;
+                    j += 1;
+                }
+            },
+            (Some((k, _)), None) => {
+                d.removed.push(k.clone());
+                i += 1;
+            }
+            (None, Some((l, _))) => {
+                d.added.push(l.clone());
+                j += 1;
+            }
+            (None, None) => break,
         }
     }
-    d.added = new
-        .keys()
-        .filter(|k| !old.contains_key(*k))
-        .cloned()
-        .collect();
     d
 }
 
@@ -120,13 +156,15 @@ fn differ(a: &Dressed<'_>, b: &Dressed<'_>) -> bool {
     !(same_skin && (Arc::ptr_eq(a.0, b.0) || a.0 == b.0))
 }
 
-/// A city's buildings with their index and skin, by id.
-fn buildings_of(c: &City) -> BTreeMap<u64, (usize, Dressed<'_>)> {
-    c.buildings
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (b.id, (i, (b, c.dresses.get(i).and_then(Option::as_ref)))))
-        .collect()
+/// A city's buildings with their index and skin, by id ([`by_key`]).
+fn buildings_of(c: &City) -> Vec<(u64, (usize, Dressed<'_>))> {
+    by_key(
+        c.buildings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.id, (i, (b, c.dresses.get(i).and_then(Option::as_ref)))))
+            .collect(),
+    )
 }
 
 /// The change events from `old` to `new`. `spliced` is the scene splice of the edit, if
@@ -161,16 +199,12 @@ pub(super) fn changes(
             par::join(
                 || {
                     delta(
-                        &old.lots.iter().map(|l| (l.id, l)).collect(),
-                        &new.lots.iter().map(|l| (l.id, l)).collect(),
+                        &by_key(old.lots.iter().map(|l| (l.id, l)).collect()),
+                        &by_key(new.lots.iter().map(|l| (l.id, l)).collect()),
                     )
                 },
                 || {
-                    let new_b: BTreeMap<u64, Dressed<'_>> = buildings_of(new)
-                        .into_iter()
-                        .map(|(k, (_, v))| (k, v))
-                        .collect();
-                    delta_by(&buildings_of(old), &new_b, |(i, v), w| {
+                    delta_by(&buildings_of(old), &buildings_of(new), |(i, v), (_, w)| {
                         !same_building(*i) && differ(v, w)
                     })
                 },
@@ -178,12 +212,14 @@ pub(super) fn changes(
         },
         || {
             delta_by(
-                &old.blocks
-                    .iter()
-                    .enumerate()
-                    .map(|(i, b)| (b.id(), (i, b)))
-                    .collect(),
-                &new.blocks.iter().map(|b| (b.id(), b)).collect(),
+                &by_key(
+                    old.blocks
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| (b.id(), (i, b)))
+                        .collect(),
+                ),
+                &by_key(new.blocks.iter().map(|b| (b.id(), b)).collect()),
                 |(i, v), w| !same_block(*i) && v != w,
             )
         },
@@ -199,19 +235,28 @@ pub(super) fn changes(
         .added
         .extend(blocks.added.iter().map(|c| name("cell", c)));
     let mut touched: BTreeSet<u64> = blocks.changed.iter().copied().collect();
-    let cells_of = |c: &City| -> BTreeMap<u64, u64> {
-        c.buildings
-            .iter()
-            .zip(&c.building_cells)
-            .map(|(b, &cell)| (b.id, cell))
-            .collect()
+    // The cell of each building the events name, looked up by id.
+    let cells_of = |c: &City| -> Vec<(u64, u64)> {
+        by_key(
+            c.buildings
+                .iter()
+                .zip(&c.building_cells)
+                .map(|(b, &cell)| (b.id, cell))
+                .collect(),
+        )
+    };
+    let find = |of: &[(u64, u64)], id: u64| {
+        of.binary_search_by_key(&id, |p| p.0)
+            .ok()
+            .and_then(|k| of.get(k))
+            .map(|p| p.1)
     };
     let (old_of, new_of) = (cells_of(old), cells_of(new));
-    for id in buildings.changed.iter().chain(&buildings.added) {
-        touched.extend(new_of.get(id).copied());
+    for &id in buildings.changed.iter().chain(&buildings.added) {
+        touched.extend(find(&new_of, id));
     }
-    for id in &buildings.removed {
-        touched.extend(old_of.get(id).copied());
+    for &id in &buildings.removed {
+        touched.extend(find(&old_of, id));
     }
     let gone: BTreeSet<u64> = blocks
         .removed
@@ -267,6 +312,9 @@ pub(super) fn changes(
 
 /// The lot overrides of `config` that find no lot of `city`, by id or anchor.
 pub(super) fn orphans(config: &CityConfig, city: &City) -> Vec<LotOverride> {
+    if config.citygen.lots.is_empty() {
+        return Vec::new();
+    }
     let ids: BTreeSet<u64> = city.lots.iter().map(|l| l.id).collect();
     config
         .citygen

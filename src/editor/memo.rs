@@ -1,7 +1,9 @@
 //! The editor's memo: the pipeline's own stages wrapped so that each piece of per-item
 //! work (a city cell's secondary growth, a road-graph cell's blocks and lots, a lot's
 //! building, a building's skin) is looked up by the exact digest of everything it reads
-//! ([`Key`]) and done only when that digest is new.
+//! ([`Key`]) and done only when that digest is new. A road-graph cell's buildings and
+//! skins are kept whole as well ([`CellReuse`]): a cell whose key is known takes them in
+//! one look-up, without planning, keying or looking up each lot.
 //!
 //! Because every stage is a deterministic function of those inputs, a reused result is
 //! bit for bit what the stage would make again: the edited city is the city
@@ -11,36 +13,59 @@
 
 use std::collections::{BTreeSet, HashMap};
 use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use polis_buildings::Building;
 use polis_roads::secondary::SecondaryRoads;
 
-use super::key::Key;
+use super::key::{IdMap, Key};
 use crate::citygen::{ConfiguredRoads, GrowthMemo, RoadMode, citygen_network_with};
 use crate::error::Result;
+use crate::ground::TerrainTiles;
+use crate::pipeline::{CellBuilt, CellReuse};
+use crate::scene::GroundReuse;
 use crate::stages::{
     BuildLot, BuildingStage, CellInput, CellLots, CellStage, Dress, DressBuilding, EberlyCells,
     FacadeStage, KellyLots, LotInput, LotStage, RoadStage, RoadsOutput, Skip, StageContext,
 };
 
-/// Results of one kind: those the last run used, and those this run used so far. Each
-/// is behind an `Arc`, so a look-up holds the lock for a pointer copy only and the
-/// caller copies the result out of it with the lock released (the per-item stages look
-/// up from both threads).
+/// Results of one kind, each behind an `Arc` with the number of the last run that used
+/// it: a look-up holds the lock for a pointer copy only and the caller copies the result
+/// out of it with the lock released (the per-item stages look up from both threads).
+/// After a successful run the store keeps what that run used (looked up, made, or
+/// touched through a road-graph cell's whole result: [`Memo::touch_cell`]), so memory
+/// stays one city's worth of results.
 ///
-/// The maps are hash maps on the keys' own bits (keys are digests already); they are
-/// looked up and moved whole, never iterated into an output.
+/// The map is a hash map on the keys' own bits (keys are digests already); it is
+/// looked up and pruned, never iterated into an output.
 struct Store<T> {
-    last: HashMap<Key, Arc<T>, KeyBits>,
-    this: HashMap<Key, Arc<T>, KeyBits>,
+    map: HashMap<Key, Arc<Entry<T>>, KeyBits>,
+    /// The number of the current run.
+    run: u64,
+    /// Whether this run looked anything up or made anything.
+    used: bool,
+}
+
+/// A result in a [`Store`] and the number of the last run that used it.
+pub(crate) struct Entry<T> {
+    value: T,
+    used: AtomicU64,
+}
+
+impl<T> Entry<T> {
+    /// Marks the entry used by run `run`.
+    fn touch(&self, run: u64) {
+        self.used.store(run, Ordering::Relaxed);
+    }
 }
 
 impl<T> Default for Store<T> {
     fn default() -> Self {
         Store {
-            last: HashMap::default(),
-            this: HashMap::default(),
+            map: HashMap::default(),
+            run: 0,
+            used: false,
         }
     }
 }
@@ -74,28 +99,46 @@ impl Hasher for KeyBitsHasher {
 }
 
 impl<T> Store<T> {
-    /// The result for `key`, if any run kept it (moved into this run's set).
-    fn get(&mut self, key: Key) -> Option<Arc<T>> {
-        if let Some(v) = self.this.get(&key) {
-            return Some(Arc::clone(v));
-        }
-        let v = self.last.remove(&key)?;
-        self.this.insert(key, Arc::clone(&v));
-        Some(v)
+    /// Starts run `run`.
+    fn begin(&mut self, run: u64) {
+        self.run = run;
+        self.used = false;
     }
 
-    fn put(&mut self, key: Key, v: Arc<T>) {
-        self.this.insert(key, v);
+    /// The result for `key`, if a run kept it (marked used by this one).
+    fn get(&mut self, key: Key) -> Option<Arc<Entry<T>>> {
+        let e = self.map.get(&key)?;
+        e.touch(self.run);
+        self.used = true;
+        Some(Arc::clone(e))
     }
 
-    /// Ends a run: keep what it used (or, after a failed run or one that skipped this
-    /// kind of work, such as growth when the road stage was reused whole, everything).
-    fn finish(&mut self, ok: bool) {
-        if ok && !self.this.is_empty() {
-            self.last = std::mem::take(&mut self.this);
-        } else {
-            let this = std::mem::take(&mut self.this);
-            self.last.extend(this);
+    /// Keeps `value` for `key` (used by this run).
+    fn put(&mut self, key: Key, value: T) -> Arc<Entry<T>> {
+        let e = Arc::new(Entry {
+            value,
+            used: AtomicU64::new(self.run),
+        });
+        self.map.insert(key, Arc::clone(&e));
+        self.used = true;
+        e
+    }
+
+    /// The entries of `keys` that the store holds, in order (none marked used).
+    fn entries(&self, keys: &[Key]) -> Vec<Arc<Entry<T>>> {
+        keys.iter()
+            .filter_map(|k| self.map.get(k).cloned())
+            .collect()
+    }
+
+    /// Ends a run: keep what it used (`touched`: some entries were marked used through
+    /// a cell's whole result), or, after a failed run or one that skipped this kind of
+    /// work (such as growth when the road stage was reused whole), everything.
+    fn finish(&mut self, ok: bool, touched: bool) {
+        if ok && (self.used || touched) {
+            let run = self.run;
+            self.map
+                .retain(|_, e| e.used.load(Ordering::Relaxed) == run);
         }
     }
 }
@@ -122,10 +165,10 @@ pub(crate) struct Redone {
 /// about n / 2⁶⁴), and is compared in full.
 #[derive(Default)]
 struct IdKeys {
-    last_built: HashMap<u64, Key>,
-    this_built: HashMap<u64, Key>,
-    last_dressed: HashMap<u64, Key>,
-    this_dressed: HashMap<u64, Key>,
+    last_built: IdMap<Key>,
+    this_built: IdMap<Key>,
+    last_dressed: IdMap<Key>,
+    this_dressed: IdMap<Key>,
 }
 
 /// Fingerprints of the configuration parts each stage reads besides its item.
@@ -138,6 +181,14 @@ struct Fingerprints {
     lots: Key,
     buildings: Key,
     facades: Key,
+    /// Everything a road-graph cell's buildings and skins read of the configuration
+    /// besides the cell's input, its city cells and its lot overrides: the
+    /// configuration but for the primary network, the per-cell settings and the lot
+    /// overrides (which reach them only through those), with the pinned styles.
+    plan: Key,
+    /// What the terrain reads of the configuration: all of it but the Citygen settings
+    /// (none of which reaches the elevation or water maps).
+    ground: Key,
 }
 
 /// The memo shared by the wrapped stages of one editor.
@@ -147,6 +198,14 @@ pub(crate) struct Memo {
     lots: Mutex<Store<CellLots>>,
     buildings: Mutex<Store<Option<Arc<Building>>>>,
     dresses: Mutex<Store<Option<Arc<Dress>>>>,
+    /// The last terrain made, by [`Fingerprints::ground`] and the water bed's digest.
+    terrain: Mutex<Option<(Key, TerrainTiles)>>,
+    /// Road-graph cells' buildings and skins, whole (see [`WholeCell`]).
+    whole: Mutex<Store<WholeCell>>,
+    /// The number of the current run.
+    run: AtomicU64,
+    /// Whether this run took a cell whole (and so marked its buildings and skins used).
+    touched: AtomicBool,
     dresser: Mutex<Option<(Key, Arc<dyn DressBuilding>)>>,
     /// The building generator of the last run (its grammars parsed), by
     /// [`Fingerprints::buildings`].
@@ -161,6 +220,15 @@ pub(crate) struct Memo {
     /// With the output, every city cell (grown, then ungrown) for the editor.
     roads: Mutex<Option<(Key, RoadsOutput, Vec<crate::citygen::District>)>>,
     cells: Mutex<Option<(Key, polis_cells::CellDecomposition)>>,
+}
+
+/// A road-graph cell's buildings and skins, with the memo's entries of each (so a run
+/// that takes the cell whole marks them used, and the stores keep them for a later run
+/// that makes the cell again from some of the same lots).
+struct WholeCell {
+    built: Arc<CellBuilt>,
+    buildings: Vec<Arc<Entry<Option<Arc<Building>>>>>,
+    dresses: Vec<Arc<Entry<Option<Arc<Dress>>>>>,
 }
 
 /// Writes serialised bytes into a [`Key`].
@@ -259,6 +327,7 @@ impl Memo {
 
     /// Starts a run on `config`: fingerprints of what the stages read globally.
     pub(crate) fn begin(&self, config: &crate::CityConfig) {
+        let run = self.run.fetch_add(1, Ordering::Relaxed) + 1;
         let text = |salt: u64, s: String| Key::new(salt).bytes(s.as_bytes());
         *lock(&self.fingerprints) = Some(Fingerprints {
             roads: roads_key(config).unwrap_or(Key::new(config.seed)),
@@ -271,8 +340,17 @@ impl Memo {
                 format!("{:?}|{}", config.effective_building_params(), config.seed),
             ),
             facades: facades_key(config),
+            // Not serialisable: a key of this run alone (no cell is taken whole).
+            plan: plan_key(config).unwrap_or(Key::new(0x706C_616E).u64(run)),
+            ground: ground_key(config).unwrap_or(Key::new(0x6772_6F75).u64(run)),
         });
         *lock(&self.redone) = Redone::default();
+        self.touched.store(false, Ordering::Relaxed);
+        lock(&self.growth).begin(run);
+        lock(&self.lots).begin(run);
+        lock(&self.buildings).begin(run);
+        lock(&self.dresses).begin(run);
+        lock(&self.whole).begin(run);
     }
 
     /// Ends a run (see [`Store::finish`]) and returns what it redid and the city cells
@@ -287,10 +365,12 @@ impl Memo {
                 ids.last_dressed = this_dressed;
             }
         }
-        lock(&self.growth).finish(ok);
-        lock(&self.lots).finish(ok);
-        lock(&self.buildings).finish(ok);
-        lock(&self.dresses).finish(ok);
+        let touched = self.touched.load(Ordering::Relaxed);
+        lock(&self.growth).finish(ok, false);
+        lock(&self.lots).finish(ok, false);
+        lock(&self.buildings).finish(ok, touched);
+        lock(&self.dresses).finish(ok, touched);
+        lock(&self.whole).finish(ok, false);
         (
             std::mem::take(&mut *lock(&self.redone)),
             std::mem::take(&mut *lock(&self.districts)),
@@ -303,6 +383,8 @@ impl Memo {
             lots: Key::new(1),
             buildings: Key::new(2),
             facades: Key::new(3),
+            plan: Key::new(4),
+            ground: Key::new(5),
         })
     }
 
@@ -314,6 +396,8 @@ impl Memo {
             .with_lots(MemoLots(Arc::clone(self)))
             .with_buildings(MemoBuildings(Arc::clone(self)))
             .with_facades(MemoFacades(Arc::clone(self)))
+            .with_cell_reuse(Arc::clone(self) as Arc<dyn CellReuse>)
+            .with_terrain_reuse(Arc::clone(self) as Arc<dyn GroundReuse + Send>)
     }
 }
 
@@ -326,12 +410,68 @@ impl GrowthMemo for Memo {
     ) -> Result<std::result::Result<SecondaryRoads, Skip>> {
         let hit = lock(&self.growth).get(key);
         if let Some(v) = hit {
-            return Ok((*v).clone());
+            return Ok(v.value.clone());
         }
         let v = grow()?;
-        lock(&self.growth).put(key, Arc::new(v.clone()));
+        lock(&self.growth).put(key, v.clone());
         lock(&self.redone).cells.insert(id);
         Ok(v)
+    }
+}
+
+impl CellReuse for Memo {
+    fn district_key(&self, d: &crate::citygen::District) -> Key {
+        Key::new(0x6469_7374)
+            .u64(d.id)
+            .u64(u64::from(d.traits_apply))
+            .bytes(format!("{:?}", d.traits).as_bytes())
+            .region(&d.region)
+    }
+
+    fn cell_key(&self, input: &CellInput<'_>) -> Key {
+        let fp = self.fingerprints();
+        Key::new(0x6365_6C6C)
+            .key(lots_key(fp.lots, input))
+            .key(fp.plan)
+    }
+
+    fn get(&self, key: Key) -> Option<Arc<CellBuilt>> {
+        let cell = lock(&self.whole).get(key)?;
+        let run = self.run.load(Ordering::Relaxed);
+        for e in &cell.value.buildings {
+            e.touch(run);
+        }
+        for e in &cell.value.dresses {
+            e.touch(run);
+        }
+        self.touched.store(true, Ordering::Relaxed);
+        Some(Arc::clone(&cell.value.built))
+    }
+
+    fn put(&self, key: Key, cell: CellBuilt, build_ids: &[u64]) {
+        let (built, dressed): (Vec<Key>, Vec<Key>) = {
+            let ids = lock(&self.ids);
+            (
+                build_ids
+                    .iter()
+                    .filter_map(|id| ids.this_built.get(id).copied())
+                    .collect(),
+                cell.buildings
+                    .iter()
+                    .filter_map(|b| ids.this_dressed.get(&b.id).copied())
+                    .collect(),
+            )
+        };
+        let buildings = lock(&self.buildings).entries(&built);
+        let dresses = lock(&self.dresses).entries(&dressed);
+        lock(&self.whole).put(
+            key,
+            WholeCell {
+                built: Arc::new(cell),
+                buildings,
+                dresses,
+            },
+        );
     }
 }
 
@@ -387,33 +527,93 @@ impl CellStage for MemoCells {
     }
 }
 
+/// The input key of a cell's blocks and lots (`lots`: the lot stage's fingerprint).
+fn lots_key(lots: Key, input: &CellInput<'_>) -> Key {
+    let r = &input.region;
+    let mut key = Key::new(0x6C6F_7473)
+        .key(lots)
+        .u64(r.id)
+        .u64(input.seed)
+        .region(&r.polygon)
+        .u64(r.road_widths.len() as u64);
+    for &w in &r.road_widths {
+        key = key.f64(w);
+    }
+    key = key.u64(input.nearby_roads.len() as u64);
+    for &(a, b, w) in &input.nearby_roads {
+        key = key.point(a).point(b).f64(w);
+    }
+    if let Some(p) = &input.lot_params {
+        key = key.bytes(format!("{p:?}").as_bytes());
+    }
+    key
+}
+
+/// The digest of what a road-graph cell's buildings and skins read of `config` besides
+/// the cell ([`Fingerprints::plan`]).
+/// `None` if it cannot be serialised.
+fn plan_key(config: &crate::CityConfig) -> Option<Key> {
+    let mut c = config.clone();
+    c.citygen.primary = Default::default();
+    c.citygen.cells.clear();
+    c.citygen.lots.clear();
+    let mut w = KeyWriter(Key::new(0x706C_616E).key(facades_key(config)));
+    serde_json::to_writer(&mut w, &c).ok()?;
+    Some(w.0)
+}
+
+/// The digest of what the terrain reads of `config` ([`Fingerprints::ground`]); `None`
+/// if it cannot be serialised.
+fn ground_key(config: &crate::CityConfig) -> Option<Key> {
+    let mut c = config.clone();
+    c.citygen = Default::default();
+    let mut w = KeyWriter(Key::new(0x6772_6F75));
+    serde_json::to_writer(&mut w, &c).ok()?;
+    Some(w.0)
+}
+
+impl GroundReuse for Memo {
+    fn terrain(&self, bed: Option<Key>) -> Option<TerrainTiles> {
+        let key = terrain_key(self.fingerprints().ground, bed);
+        match &*lock(&self.terrain) {
+            Some((k, (report, tiles))) if *k == key => Some((*report, tiles.clone())),
+            _ => None,
+        }
+    }
+
+    fn keep_terrain(
+        &self,
+        bed: Option<Key>,
+        report: polis_geom::mesh::TerrainReport,
+        tiles: &[polis_geom::Mesh],
+    ) {
+        let key = terrain_key(self.fingerprints().ground, bed);
+        *lock(&self.terrain) = Some((key, (report, tiles.to_vec())));
+    }
+}
+
+/// The key of a terrain on the ground of configuration digest `ground` with the water
+/// bed of digest `bed`.
+fn terrain_key(ground: Key, bed: Option<Key>) -> Key {
+    let k = Key::new(0x7465_7272).key(ground);
+    match bed {
+        Some(b) => k.u64(1).key(b),
+        None => k.u64(0),
+    }
+}
+
 struct MemoLots(Arc<Memo>);
 
 impl LotStage for MemoLots {
     fn lots(&self, input: &CellInput<'_>, cx: &StageContext<'_>) -> Result<CellLots> {
         let r = &input.region;
-        let mut key = Key::new(0x6C6F_7473)
-            .key(self.0.fingerprints().lots)
-            .u64(r.id)
-            .u64(input.seed)
-            .region(&r.polygon)
-            .u64(r.road_widths.len() as u64);
-        for &w in &r.road_widths {
-            key = key.f64(w);
-        }
-        key = key.u64(input.nearby_roads.len() as u64);
-        for &(a, b, w) in &input.nearby_roads {
-            key = key.point(a).point(b).f64(w);
-        }
-        if let Some(p) = &input.lot_params {
-            key = key.bytes(format!("{p:?}").as_bytes());
-        }
+        let key = lots_key(self.0.fingerprints().lots, input);
         let hit = lock(&self.0.lots).get(key);
         if let Some(v) = hit {
-            return Ok((*v).clone());
+            return Ok(v.value.clone());
         }
         let v = KellyLots.lots(input, cx)?;
-        lock(&self.0.lots).put(key, Arc::new(v.clone()));
+        lock(&self.0.lots).put(key, v.clone());
         lock(&self.0.redone).blocks.insert(r.id);
         Ok(v)
     }
@@ -473,10 +673,10 @@ impl BuildLot for MemoBuild<'_> {
         lock(&self.memo.ids).this_built.insert(lot.id, key);
         let hit = lock(&self.memo.buildings).get(key);
         if let Some(v) = hit {
-            return Ok((*v).clone());
+            return Ok(v.value.clone());
         }
         let v = self.inner.build(lot)?.map(Arc::new);
-        lock(&self.memo.buildings).put(key, Arc::new(v.clone()));
+        lock(&self.memo.buildings).put(key, v.clone());
         lock(&self.memo.redone).buildings += 1;
         Ok(v)
     }
@@ -538,10 +738,10 @@ impl DressBuilding for MemoDress<'_> {
         lock(&self.memo.ids).this_dressed.insert(b.id, key);
         let hit = lock(&self.memo.dresses).get(key);
         if let Some(v) = hit {
-            return Ok((*v).clone());
+            return Ok(v.value.clone());
         }
         let v = self.inner.dress_styled(b, seed, style)?.map(Arc::new);
-        lock(&self.memo.dresses).put(key, Arc::new(v.clone()));
+        lock(&self.memo.dresses).put(key, v.clone());
         lock(&self.memo.redone).dresses += 1;
         Ok(v)
     }

@@ -29,7 +29,11 @@
 //! city is then made by the pipeline with each per-item stage wrapped in a memo (see
 //! `memo.rs`): a city cell's secondary growth, a road-graph cell's blocks and lots, a
 //! lot's building and a building's skin are keyed by a 128-bit digest of the exact bits
-//! of everything they read, and redone only when that digest is new. The dirty set of an
+//! of everything they read, and redone only when that digest is new. A road-graph
+//! cell's buildings and skins are also kept whole, keyed by its lot stage's input, the
+//! city cells its lots can lie in, the lot overrides that can reach them and the rest of
+//! the configuration: a cell an edit leaves alone costs one look-up, not one per lot.
+//! The dirty set of an
 //! edit is therefore exactly the work whose inputs it changed: cells whose boundary,
 //! parameters, seed or maps changed, cells created, split or merged, and, downstream,
 //! road-graph cells whose ring or nearby roads changed.
@@ -73,17 +77,18 @@
 //! # Limitations
 //!
 //! * A lot edit made in place costs what it touches: about 10 ms of CPU on the full
-//!   `citygen` preset (72,442 buildings). An edit of the primary network or of a cell
+//!   `citygen` preset (64,000 buildings). An edit of the primary network or of a cell
 //!   still runs the pipeline: it builds the union graph and its cell decomposition whole
-//!   (their inputs are the whole city), looks up every lot, building and skin in the
-//!   memo by a key hashed from its inputs (reused buildings and skins are shared
-//!   `Arc`s, a pointer copy; lots and blocks are copied), assembles the scene again
-//!   (reused leaves take their meshes, names and metadata from the old scene without
-//!   copying them; the road surfaces and the ground are meshed again) and the change
-//!   events compare the lots and blocks of the two cities. Its cost is therefore
-//!   proportional to the city's size, not to the dirty set: about 0.7 s of CPU per edit
-//!   on that preset, far from Kelly's 60 ms per cell; BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene is not spliced (the
-//!   ground depends on every road).
+//!   (their inputs are the whole city), looks up every road-graph cell's lots in the
+//!   memo and copies them out (a cell whose inputs are unchanged then takes its
+//!   buildings and skins whole, in one look-up), meshes the road surfaces again, assembles
+//!   the scene again (reused leaves take their meshes, names and metadata from the old
+//!   scene without copying them; the terrain is reused while the water bed under it is
+//!   unchanged) and the change events compare the lots and blocks of the two cities. Its
+//!   cost is therefore still proportional to the city's size, not to the dirty set:
+//!   about 0.7 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
+//!   BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene
+//!   is not spliced and the terrain not reused (the ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it
 //!   changes where later road edits are legal.
 //! * Only Citygen-mode cities are editable ([`RoadMode::Citygen`](crate::RoadMode)).

@@ -11,7 +11,6 @@
 //! grading on nothing is reused. The scene so made is the scene `assemble` would make:
 //! reuse only skips recomputing identical parts.
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
@@ -21,7 +20,7 @@ use polis_geom::scene::NodeId;
 use polis_geom::{Mesh, Transform};
 use polis_lots::Block;
 
-use super::key::Key;
+use super::key::{IdBits, IdMap, Key};
 use super::memo::Memo;
 use crate::City;
 use crate::CityConfig;
@@ -64,9 +63,9 @@ pub(super) struct OldScene {
     /// the old city's (equal without comparing them).
     memo: Arc<Memo>,
     /// Building id → (index in the city's buildings, node, slot in `names`).
-    buildings: HashMap<u64, (usize, NodeId, usize)>,
+    buildings: IdMap<(usize, NodeId, usize)>,
     /// Block id → (index in the city's blocks, node, slot in `names`).
-    blocks: HashMap<u64, (usize, NodeId, usize)>,
+    blocks: IdMap<(usize, NodeId, usize)>,
     /// Per old building (by index): found equal to the new one (building, skin and cell)
     /// and reused; the change events then need not compare it again.
     same_buildings: Vec<AtomicBool>,
@@ -80,8 +79,8 @@ pub(super) struct Lent {
     meshes: Vec<Mesh>,
     names: Vec<(String, Metadata)>,
     named: Vec<NodeId>,
-    buildings: HashMap<u64, (usize, NodeId, usize)>,
-    blocks: HashMap<u64, (usize, NodeId, usize)>,
+    buildings: IdMap<(usize, NodeId, usize)>,
+    blocks: IdMap<(usize, NodeId, usize)>,
 }
 
 /// Values in slots of their own, to be taken once each.
@@ -101,20 +100,20 @@ impl OldScene {
     /// Indexes `city`'s scene leaves by the ids in their names and moves out of it its
     /// scene's meshes and its leaves' names and metadata.
     pub(super) fn lend(city: &mut City) -> Lent {
-        let building_at: HashMap<u64, usize> = city
+        let building_at: IdMap<usize> = city
             .buildings
             .iter()
             .enumerate()
             .map(|(i, b)| (b.id, i))
             .collect();
-        let block_at: HashMap<u64, usize> = city
+        let block_at: IdMap<usize> = city
             .blocks
             .iter()
             .enumerate()
             .map(|(i, b)| (b.id(), i))
             .collect();
-        let mut buildings = HashMap::with_capacity(building_at.len());
-        let mut blocks = HashMap::with_capacity(block_at.len());
+        let mut buildings = IdMap::with_capacity_and_hasher(building_at.len(), IdBits);
+        let mut blocks = IdMap::with_capacity_and_hasher(block_at.len(), IdBits);
         let mut names = Vec::with_capacity(building_at.len() + block_at.len());
         let mut named = Vec::with_capacity(names.capacity());
         for (n, node) in city.scene.nodes.iter_mut().enumerate() {
