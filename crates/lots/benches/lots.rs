@@ -1,5 +1,5 @@
-//! Benchmarks: straight skeletons of random convex, star-shaped and concave polygons, and
-//! lot subdivision of Manhattan-size blocks.
+//! Benchmarks: straight skeletons and insets of random convex, star-shaped and concave
+//! polygons, and lot subdivision of Manhattan-size blocks.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
@@ -86,6 +86,20 @@ fn skeleton_star(bencher: divan::Bencher<'_, '_>, n: usize) {
 fn skeleton_concave(bencher: divan::Bencher<'_, '_>, n: usize) {
     let p = concave(n);
     bencher.bench(|| StraightSkeleton::new(divan::black_box(&p)).unwrap());
+}
+
+/// Insets of the star (10 m: reflex vertices meeting, the wavefront in pieces) and of the
+/// comb (0.3 m: every tooth still there), each ring cleaned of pinches and touches.
+#[divan::bench(args = sizes())]
+fn inset_star(bencher: divan::Bencher<'_, '_>, n: usize) {
+    let p = star(n);
+    bencher.bench(|| polis_lots::inset(divan::black_box(&p), 10.0).unwrap());
+}
+
+#[divan::bench(args = sizes())]
+fn inset_concave(bencher: divan::Bencher<'_, '_>, n: usize) {
+    let p = concave(n);
+    bencher.bench(|| polis_lots::inset(divan::black_box(&p), 0.3).unwrap());
 }
 
 /// 10,000 Manhattan-size blocks (about 60 × 240 m, sizes and angles jittered).

@@ -20,6 +20,12 @@
 //! than the time the fastest edge needs to move `1e-9` of the polygon's size) counts as
 //! happening at `d`, so that two pieces meeting exactly at `d` come out separated, not
 //! lying on each other.
+//!
+//! Where the wavefront touches itself at `d` (within `1e-9` of the polygon's size: two
+//! vertices, or a vertex on an edge — weighted steps can hold such a contact over a
+//! whole range of distances), pieces side by side come out as separate polygons sharing
+//! that point, and a hole touching the ring around it is opened by moving each visit of
+//! the point `2e-9` of the size into its own corner.
 
 use polis_geom::lines::innermost_ring_containing;
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
