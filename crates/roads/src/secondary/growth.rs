@@ -11,6 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::cell::{CellMaps, SecondaryCell};
 use super::error::SecondaryError;
+use super::grid::GridRoad;
+use super::join::{self, Join};
 use super::params::{BuildingHint, Deviated, SecondaryParams};
 use super::snap::{SnapEvent, Snapper};
 use crate::network::{Junction, Road, RoadClass, RoadNetwork};
@@ -106,9 +108,12 @@ impl SecondaryRoads {
 ///
 /// # Guarantees
 ///
-/// * The cell's graph stays planar (every road goes in through
-///   [`PlanarGraph::insert_segment`](polis_geom::PlanarGraph::insert_segment) after the
-///   exact checks below) and every secondary road lies inside the cell region: a
+/// * The cell's graph stays planar (every road goes in after the exact checks below: a
+///   free end or a joined node as it is, a join onto a road as the split and the edge
+///   that [`PlanarGraph::insert_segment`](polis_geom::PlanarGraph::insert_segment)
+///   would make — checked by the insertion's rules, and left to the insertion itself
+///   where one of them could do more) and every secondary road lies inside the cell
+///   region: a
 ///   proposal that touches or crosses anything other than its own two ends, or whose
 ///   midpoint is not strictly inside the region (exact point location), is dropped.
 /// * Every secondary road is connected to the boundary: growth starts from boundary
@@ -137,6 +142,8 @@ impl SecondaryRoads {
 pub struct SecondaryGrowth {
     params: SecondaryParams,
     snapper: Snapper,
+    scratch: Vec<GridRoad>,
+    joins: (u64, u64),
 }
 
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
@@ -170,6 +177,8 @@ impl SecondaryGrowth {
         Ok(SecondaryGrowth {
             params,
             snapper: Snapper::default(),
+            scratch: Vec::new(),
+            joins: (0, 0),
         })
     }
 
@@ -182,6 +191,12 @@ impl SecondaryGrowth {
     /// bounding box (Kelly's measure of the `r`/`s` optimisation).
     pub fn snap_counters(&self) -> (u64, u64) {
         (self.snapper.exact_tests, self.snapper.box_hits)
+    }
+
+    /// Joins onto a road so far: made directly (a split and an edge) and left to planar
+    /// insertion (see [`SecondaryGrowth::grow`]'s guarantees).
+    pub fn join_counters(&self) -> (u64, u64) {
+        self.joins
     }
 
     /// Grows the secondary roads of `cell`. `seed` is mixed with the cell's id.
@@ -243,6 +258,10 @@ impl SecondaryGrowth {
                 Err(e) => return Err(e.into()),
             }
         }
+        // Growth asks the graph no spatial question (the snap grid below answers them):
+        // the graph's own spatial index, which the filaments' insertion built, is freed
+        // and not kept up to date on every change.
+        g.release_spatial_index();
         // The snap search's flat grid over the cell, in squares of the segment size.
         self.snapper
             .begin_cell(g.bbox(), p.segment_size_m.value.max(1.0));
@@ -282,6 +301,8 @@ impl SecondaryGrowth {
             guard,
             tolerance: (p.segment_size_m.value * INSERT_TOLERANCE).max(1e-3),
             decided: Vec::new(),
+            scratch: std::mem::take(&mut self.scratch),
+            joins: (0, 0),
         };
         let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
         // Initial segments from deviated midpoints of the longest sides: the first
@@ -379,6 +400,9 @@ impl SecondaryGrowth {
             }
         }
         let report = run.report;
+        self.joins.0 += run.joins.0;
+        self.joins.1 += run.joins.1;
+        self.scratch = run.scratch;
         let network = run.g;
         Ok(SecondaryRoads {
             cell: cell.id,
@@ -427,6 +451,10 @@ struct Run<'a> {
     tolerance: f64,
     /// The connectivity decisions of the node being expanded, per road or junction met.
     decided: Vec<(JoinKey, bool)>,
+    /// Scratch of [`join::plan`].
+    scratch: Vec<GridRoad>,
+    /// Joins onto a road made directly and by planar insertion.
+    joins: (u64, u64),
 }
 
 /// What a snap event would join: the connectivity draw is made once per pair of the
@@ -554,36 +582,38 @@ impl Run<'_> {
                 }
                 Err(e) => return Err(e.into()),
             },
-            Target::OnEdge(..) => {
-                let ins = self.g.insert_segment_with(
-                    a,
-                    t,
-                    road,
-                    &SnapOptions {
-                        snap_distance: self.tolerance,
-                    },
-                    |_| Junction { step },
+            Target::OnEdge(e, _) => {
+                let plan = join::plan(
+                    &self.g,
+                    self.snapper,
+                    &mut self.scratch,
+                    source,
+                    (a, t),
+                    e,
+                    self.tolerance,
                 );
-                let ins = match ins {
-                    Ok(ins) => ins,
-                    Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {
+                match plan {
+                    Join::Split { edge, point } => {
+                        self.joins.0 += 1;
+                        let (m, _) = self.g.split_edge(edge, point, Junction { step })?;
+                        self.snapper.touched(&self.g, edge);
+                        self.g.add_edge(source, m, road)?;
+                        m
+                    }
+                    Join::ZeroLength => {
                         self.report.refused_blocked += 1;
                         return Ok(None);
                     }
-                    Err(e) => return Err(e.into()),
-                };
-                for &(split, _) in &ins.split {
-                    self.snapper.touched(&self.g, split);
-                }
-                if ins.created.is_empty() {
-                    // The road exists already (the insertion followed existing roads).
-                    self.report.refused_blocked += 1;
-                    return Ok(None);
-                }
-                self.edges += ins.created.len() as u32 - 1;
-                match ins.nodes.last() {
-                    Some(&n) => n,
-                    None => return Ok(None),
+                    Join::General => {
+                        self.joins.1 += 1;
+                        match self.insert(a, t, road)? {
+                            Some(n) => n,
+                            None => {
+                                self.report.refused_blocked += 1;
+                                return Ok(None);
+                            }
+                        }
+                    }
                 }
             }
         };
@@ -594,6 +624,38 @@ impl Run<'_> {
             Target::OnEdge(..) => self.report.placed_road += 1,
         }
         Ok(Some(Placed { node: end }))
+    }
+
+    /// Adds the road `a–t` by planar insertion (a join onto a road that
+    /// [`join::plan`] leaves to it): returns its last node, or `None` when the
+    /// insertion refuses it or only follows existing roads. The graph's spatial index,
+    /// which the insertion builds, is freed again: nothing else in growth reads it.
+    fn insert(&mut self, a: DVec2, t: DVec2, road: Road) -> Result<Option<NodeId>, SecondaryError> {
+        let step = road.step;
+        let ins = self.g.insert_segment_with(
+            a,
+            t,
+            road,
+            &SnapOptions {
+                snap_distance: self.tolerance,
+            },
+            |_| Junction { step },
+        );
+        self.g.release_spatial_index();
+        let ins = match ins {
+            Ok(ins) => ins,
+            Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => return Ok(None),
+            Err(e) => return Err(e.into()),
+        };
+        for &(split, _) in &ins.split {
+            self.snapper.touched(&self.g, split);
+        }
+        if ins.created.is_empty() {
+            // The road exists already (the insertion followed existing roads).
+            return Ok(None);
+        }
+        self.edges += ins.created.len() as u32 - 1;
+        Ok(ins.nodes.last().copied())
     }
 
     /// Whether the road `a–t` from `source` would make an angle sharper than

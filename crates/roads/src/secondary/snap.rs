@@ -127,6 +127,17 @@ impl Snapper {
         &self.roads
     }
 
+    /// Appends to `out` every road of `g` whose box meets `b`, with its ends, as the
+    /// snap grid lists it (each once; the last query's candidates stay as they were).
+    pub(crate) fn roads_in(&mut self, g: &RoadNetwork, b: &Aabb2, out: &mut Vec<GridRoad>) {
+        self.grid.sync(g);
+        self.grid.for_each_in(b, |r| {
+            if Aabb2::new(r.pu, r.pv).intersects(b) {
+                out.push(*r);
+            }
+        });
+    }
+
     /// Road `e` of `g` was split or removed since the last query (see
     /// [`begin_cell`](Self::begin_cell)).
     pub fn touched(&mut self, g: &RoadNetwork, e: EdgeId) {
