@@ -219,21 +219,26 @@ fn growth_bench(
         let (t, c) = (Instant::now(), thread_cpu_ns());
         let mut roads = 0;
         let mut digest = 0u64;
+        let mut joins = (0, 0);
         for (cell, p) in &inputs {
             let mut growth = SecondaryGrowth::new(p.clone())?;
             if let Ok(r) = growth.grow(cell, &maps, seed) {
                 roads += r.segments().count();
                 digest = polis::geom::hash::splitmix64(digest ^ graph_digest(&r.network));
             }
+            let (direct, general) = growth.join_counters();
+            joins = (joins.0 + direct, joins.1 + general);
         }
         let (wall, cpu) = (
             t.elapsed().as_secs_f64() * 1e3,
             (thread_cpu_ns() - c) as f64 / 1e6,
         );
         println!(
-            "run {run}: {} cells, {roads} secondary roads (digest {digest:016x}), serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell",
+            "run {run}: {} cells, {roads} secondary roads (digest {digest:016x}), serial wall {wall:.2} ms, CPU {cpu:.2} ms, {:.3} ms CPU per cell; joins onto a road {} direct, {} by planar insertion",
             inputs.len(),
-            cpu / inputs.len().max(1) as f64
+            cpu / inputs.len().max(1) as f64,
+            joins.0,
+            joins.1
         );
     }
     // The same growth with the cells spread over the pool's threads (as the pipeline

@@ -301,7 +301,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         }
         // Exactly on an edge (exact test, independent of the distance rounding).
         let on: Option<EdgeId> = self
-            .edge_index
+            .edge_index()
             .first_crossing(p, p, |_| true)
             .map(|h| h.key);
         if let Some(e) = on {
@@ -505,7 +505,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         // Candidates come in no particular order: `offer` keeps the least event by
         // (t, rank, id), so the answer does not depend on it.
         let bx = crate::Aabb2::new(pc, pt).expanded(snap);
-        self.node_index.for_each_candidate(&bx, |n, shape| {
+        self.node_index().for_each_candidate(&bx, |n, shape| {
             let Shape::Point(pn) = *shape else { return };
             if !bx.contains(pn) || !fresh(n) {
                 return;
@@ -572,15 +572,16 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             }
             Ok(())
         };
-        self.edge_index.for_each_candidate_along(pc, pt, |key, s| {
-            if failure.is_none()
-                && let Shape::Segment(s0, s1) = *s
-                && let Some(hit) = classify_hit(key, pc, pt, s0, s1)
-                && let Err(e) = visit(hit)
-            {
-                failure = Some(e);
-            }
-        });
+        self.edge_index()
+            .for_each_candidate_along(pc, pt, |key, s| {
+                if failure.is_none()
+                    && let Shape::Segment(s0, s1) = *s
+                    && let Some(hit) = classify_hit(key, pc, pt, s0, s1)
+                    && let Err(e) = visit(hit)
+                {
+                    failure = Some(e);
+                }
+            });
         if let Some(e) = failure {
             return Err(e);
         }
@@ -611,7 +612,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let pm = self.position(m)?;
         let eps = rounding_eps(pm);
         let mut near: Vec<EdgeId> = also.into_iter().collect();
-        for hit in self.edge_index.segments_within(pm, eps) {
+        for hit in self.edge_index().segments_within(pm, eps) {
             if near.contains(&hit.key) || !self.contains_edge(hit.key) {
                 continue;
             }
@@ -656,7 +657,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             let bx = crate::Aabb2::new(pa, pb).expanded(eps);
             // The least (t, id): independent of the index's candidate order.
             let mut best: Option<(f64, NodeId)> = None;
-            self.node_index.for_each_candidate(&bx, |n, shape| {
+            self.node_index().for_each_candidate(&bx, |n, shape| {
                 let Shape::Point(pn) = *shape else { return };
                 if n == a || n == b || !bx.contains(pn) {
                     return;
@@ -805,26 +806,28 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         skip: Option<EdgeId>,
     ) -> Option<SegmentHit<EdgeId>> {
         let mut bad: Option<SegmentHit<EdgeId>> = None;
-        self.edge_index.for_each_candidate_along(pa, pb, |key, s| {
-            if bad.is_some() || Some(key) == skip {
-                return;
-            }
-            let Shape::Segment(s0, s1) = *s else { return };
-            let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
-                return;
-            };
-            let ok = match hit.kind {
-                SegmentIntersection::Touching { point, .. } => {
-                    self.endpoints(key).is_ok_and(|(c, d)| {
-                        (point == pa && (c == a || d == a)) || (point == pb && (c == b || d == b))
-                    })
+        self.edge_index()
+            .for_each_candidate_along(pa, pb, |key, s| {
+                if bad.is_some() || Some(key) == skip {
+                    return;
                 }
-                _ => false,
-            };
-            if !ok {
-                bad = Some(hit);
-            }
-        });
+                let Shape::Segment(s0, s1) = *s else { return };
+                let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
+                    return;
+                };
+                let ok = match hit.kind {
+                    SegmentIntersection::Touching { point, .. } => {
+                        self.endpoints(key).is_ok_and(|(c, d)| {
+                            (point == pa && (c == a || d == a))
+                                || (point == pb && (c == b || d == b))
+                        })
+                    }
+                    _ => false,
+                };
+                if !ok {
+                    bad = Some(hit);
+                }
+            });
         bad
     }
 }

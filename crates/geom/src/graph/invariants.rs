@@ -96,18 +96,19 @@ impl<N, E> PlanarGraph<N, E> {
 
     /// The spatial indexes hold exactly the live nodes and edges, with their geometry.
     fn check_index(&self) -> Result<(), GeomError> {
-        if self.node_index.len() != self.node_count() || self.edge_index.len() != self.edge_count()
+        if self.node_index().len() != self.node_count()
+            || self.edge_index().len() != self.edge_count()
         {
             return Err(corrupt(format!(
                 "the spatial indexes hold {} nodes / {} edges, the graph {} / {}",
-                self.node_index.len(),
-                self.edge_index.len(),
+                self.node_index().len(),
+                self.edge_index().len(),
                 self.node_count(),
                 self.edge_count()
             )));
         }
         for (n, p, _) in self.nodes() {
-            if self.node_index.get(n) != Some(Shape::Point(p)) {
+            if self.node_index().get(n) != Some(Shape::Point(p)) {
                 return Err(corrupt(format!(
                     "node {n} is missing or misplaced in the index"
                 )));
@@ -115,7 +116,7 @@ impl<N, E> PlanarGraph<N, E> {
         }
         for (e, a, b, _) in self.edges() {
             let s = Shape::Segment(self.position(a)?, self.position(b)?);
-            if self.edge_index.get(e) != Some(s) {
+            if self.edge_index().get(e) != Some(s) {
                 return Err(corrupt(format!(
                     "edge {e} is missing or misplaced in the index"
                 )));
@@ -169,12 +170,12 @@ impl<N, E> PlanarGraph<N, E> {
         // verified); every decision is made by `check_pair` with exact predicates.
         for (n, p, _) in self.nodes() {
             let item = Item::Node(n, p);
-            for near in self.node_index.points_within(p, 0.0) {
+            for near in self.node_index().points_within(p, 0.0) {
                 if near.key > n {
                     check_pair(&item, &Item::Node(near.key, near.point))?;
                 }
             }
-            for hit in self.edge_index.segments_crossing(p, p) {
+            for hit in self.edge_index().segments_crossing(p, p) {
                 check_pair(&item, &edge_item(hit.key)?)?;
             }
         }
@@ -183,7 +184,7 @@ impl<N, E> PlanarGraph<N, E> {
             let Item::Edge(_, _, a, b) = item else {
                 continue;
             };
-            for hit in self.edge_index.segments_crossing(a, b) {
+            for hit in self.edge_index().segments_crossing(a, b) {
                 if hit.key > e {
                     check_pair(&item, &edge_item(hit.key)?)?;
                 }

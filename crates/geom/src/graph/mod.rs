@@ -31,11 +31,15 @@
 //! guarantees and limitations: [`insert`]).
 //! [`check_invariants`](PlanarGraph::check_invariants) verifies everything.
 //!
-//! The graph keeps spatial indexes ([`SegmentIndex`]) of its nodes and edges, updated
-//! on every change: [`nearest_node`](PlanarGraph::nearest_node),
+//! The graph keeps spatial indexes ([`SegmentIndex`]) of its nodes and edges:
+//! [`nearest_node`](PlanarGraph::nearest_node),
 //! [`nearest_edge`](PlanarGraph::nearest_edge), [`edges_crossing`](PlanarGraph::edges_crossing),
-//! [`nodes_in_box`](PlanarGraph::nodes_in_box) and [`edges_in_box`](PlanarGraph::edges_in_box)
-//! use them.
+//! [`nodes_in_box`](PlanarGraph::nodes_in_box), [`edges_in_box`](PlanarGraph::edges_in_box)
+//! and planar insertion use them. They are built from the graph by the first call that
+//! needs them and updated on every change from then on; a graph made only of raw
+//! changes and never asked a spatial question never builds them, and
+//! [`release_spatial_index`](PlanarGraph::release_spatial_index) frees them until the
+//! next such call. Answers do not depend on when the indexes were built.
 //!
 //! # Example
 //!
@@ -79,6 +83,8 @@ mod insert_tests;
 mod invariants;
 #[cfg(feature = "serde")]
 mod serde_impl;
+
+use std::sync::OnceLock;
 
 use glam::DVec2;
 
@@ -154,13 +160,22 @@ pub struct PlanarGraph<N, E> {
     pub(crate) edges: Vec<Option<Edge<E>>>,
     node_count: usize,
     edge_count: usize,
-    /// Every live node as a point.
-    pub(crate) node_index: SegmentIndex<NodeId>,
-    /// Every live edge as a segment.
-    pub(crate) edge_index: SegmentIndex<EdgeId>,
+    /// The options of the spatial indexes.
+    index_options: GridOptions,
+    /// The spatial indexes, once built (see the [module docs](self)).
+    index: OnceLock<Indexes>,
     /// Every change so far kept the graph planar by construction (see
     /// [`PlanarGraph::is_planar_by_construction`]).
     pub(crate) planar_by_construction: bool,
+}
+
+/// The spatial indexes of a [`PlanarGraph`].
+#[derive(Debug, Clone)]
+pub(crate) struct Indexes {
+    /// Every live node as a point.
+    pub(crate) nodes: SegmentIndex<NodeId>,
+    /// Every live edge as a segment.
+    pub(crate) edges: SegmentIndex<EdgeId>,
 }
 
 impl<N, E> Default for PlanarGraph<N, E> {
@@ -191,8 +206,8 @@ impl<N, E> PlanarGraph<N, E> {
             edges: Vec::new(),
             node_count: 0,
             edge_count: 0,
-            node_index: SegmentIndex::default(),
-            edge_index: SegmentIndex::default(),
+            index_options: GridOptions::default(),
+            index: OnceLock::new(),
             planar_by_construction: true,
         }
     }
@@ -216,52 +231,96 @@ impl<N, E> PlanarGraph<N, E> {
     /// # Errors
     /// [`GeomError::InvalidParameter`] for a bad cell size.
     pub fn with_index_options(options: GridOptions) -> Result<Self, GeomError> {
+        // Checks the options now; the indexes themselves are built when first needed.
+        SegmentIndex::<NodeId>::new(options)?;
         Ok(PlanarGraph {
-            node_index: SegmentIndex::new(options)?,
-            edge_index: SegmentIndex::new(options)?,
+            index_options: options,
             ..Self::new()
         })
     }
 
     // ----- spatial queries -------------------------------------------------------------
 
+    /// The spatial indexes, built from the graph if they are not yet.
+    fn indexes(&self) -> &Indexes {
+        self.index.get_or_init(|| {
+            // The options were checked when the graph was made (`with_index_options`).
+            let mut ix = Indexes {
+                nodes: SegmentIndex::new(self.index_options).unwrap_or_default(),
+                edges: SegmentIndex::new(self.index_options).unwrap_or_default(),
+            };
+            // Every position was checked on entry (`add_node`, `split_edge`), so no
+            // insertion below can fail.
+            for (n, p, _) in self.nodes() {
+                let _ = ix.nodes.insert_point(n, p);
+            }
+            for (e, a, b, _) in self.edges() {
+                if let (Ok(pa), Ok(pb)) = (self.position(a), self.position(b)) {
+                    let _ = ix.edges.insert_segment(e, pa, pb);
+                }
+            }
+            ix
+        })
+    }
+
+    /// The spatial indexes if they are built, for updating them.
+    fn indexes_mut(&mut self) -> Option<&mut Indexes> {
+        self.index.get_mut()
+    }
+
+    /// Frees the spatial indexes. Nothing else changes: the next spatial query or planar
+    /// insertion builds them again from the graph, and answers do not depend on when
+    /// they were built. For a caller about to make many raw changes
+    /// ([`add_node`](Self::add_node), [`add_edge`](Self::add_edge),
+    /// [`split_edge`](Self::split_edge), removals) with no spatial question between them:
+    /// those changes then skip the indexes' upkeep.
+    pub fn release_spatial_index(&mut self) {
+        self.index.take();
+    }
+
+    /// Whether the spatial indexes are built now (see
+    /// [`release_spatial_index`](Self::release_spatial_index)).
+    pub fn has_spatial_index(&self) -> bool {
+        self.index.get().is_some()
+    }
+
     /// The spatial index of the live nodes (as points), for queries beyond the ones below.
     pub fn node_index(&self) -> &SegmentIndex<NodeId> {
-        &self.node_index
+        &self.indexes().nodes
     }
 
     /// The spatial index of the live edges (as segments).
     pub fn edge_index(&self) -> &SegmentIndex<EdgeId> {
-        &self.edge_index
+        &self.indexes().edges
     }
 
     /// The node nearest to `p` within `radius` metres (inclusive; ties by smaller id),
     /// with its distance.
     pub fn nearest_node(&self, p: DVec2, radius: f64) -> Option<(NodeId, f64)> {
-        self.node_index
+        self.node_index()
             .nearest_point(p, radius)
             .map(|n| (n.key, n.distance))
     }
 
     /// The edge nearest to `p` within `radius` metres (inclusive; ties by smaller id).
     pub fn nearest_edge(&self, p: DVec2, radius: f64) -> Option<SegmentNear<EdgeId>> {
-        self.edge_index.nearest_segment(p, radius)
+        self.edge_index().nearest_segment(p, radius)
     }
 
     /// Nodes inside the closed box `b`, in id order.
     pub fn nodes_in_box(&self, b: &Aabb2) -> Vec<NodeId> {
-        self.node_index.query_box(b)
+        self.node_index().query_box(b)
     }
 
     /// Edges sharing a point with the closed box `b`, in id order.
     pub fn edges_in_box(&self, b: &Aabb2) -> Vec<EdgeId> {
-        self.edge_index.query_box(b)
+        self.edge_index().query_box(b)
     }
 
     /// Edges that cross, touch or overlap the segment `a–b`, ordered along it (see
     /// [`SpatialIndex::segments_crossing`]).
     pub fn edges_crossing(&self, a: DVec2, b: DVec2) -> Vec<SegmentHit<EdgeId>> {
-        self.edge_index.segments_crossing(a, b)
+        self.edge_index().segments_crossing(a, b)
     }
 
     // ----- sizes and iteration -------------------------------------------------------
@@ -507,7 +566,9 @@ impl<N, E> PlanarGraph<N, E> {
     pub fn add_node(&mut self, pos: DVec2, payload: N) -> Result<NodeId, GeomError> {
         validate_point(self.nodes.len(), pos)?;
         let id = next_id(self.nodes.len(), "node")?;
-        self.node_index.insert_point(NodeId(id), pos)?;
+        if let Some(ix) = self.indexes_mut() {
+            ix.nodes.insert_point(NodeId(id), pos)?;
+        }
         self.planar_by_construction = false;
         self.nodes.push(Some(Node {
             pos,
@@ -539,7 +600,9 @@ impl<N, E> PlanarGraph<N, E> {
             });
         }
         let id = EdgeId(next_id(self.edges.len(), "edge")?);
-        self.edge_index.insert_segment(id, pa, pb)?;
+        if let Some(ix) = self.indexes_mut() {
+            ix.edges.insert_segment(id, pa, pb)?;
+        }
         self.planar_by_construction = false;
         self.edges.push(Some(Edge {
             ends: [a, b],
@@ -596,7 +659,9 @@ impl<N, E> PlanarGraph<N, E> {
             .get_mut(e.index())
             .and_then(Option::take)
             .ok_or_else(|| bad_edge(e))?;
-        self.edge_index.remove(e);
+        if let Some(ix) = self.indexes_mut() {
+            ix.edges.remove(e);
+        }
         self.edge_count -= 1;
         Ok(ed.payload)
     }
@@ -612,7 +677,9 @@ impl<N, E> PlanarGraph<N, E> {
             .get_mut(n.index())
             .and_then(Option::take)
             .ok_or_else(|| bad_node(n))?;
-        self.node_index.remove(n);
+        if let Some(ix) = self.indexes_mut() {
+            ix.nodes.remove(n);
+        }
         self.node_count -= 1;
         Ok(node.payload)
     }
@@ -695,8 +762,10 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let new_edge = EdgeId(self.edges.len() as u32);
         self.planar_by_construction = false;
         let m = self.add_node(point, node_payload)?;
-        self.edge_index.insert_segment(e, pa, point)?;
-        self.edge_index.insert_segment(new_edge, point, pb)?;
+        if let Some(ix) = self.indexes_mut() {
+            ix.edges.insert_segment(e, pa, point)?;
+            ix.edges.insert_segment(new_edge, point, pb)?;
+        }
         // Re-wire: e becomes a–m, new edge m–b.
         self.detach(b, e);
         if let Some(Some(ed)) = self.edges.get_mut(e.index()) {
@@ -903,6 +972,57 @@ mod tests {
         let (pa, pb) = raw.segment(e).unwrap();
         raw.split_edge(e, pa.lerp(pb, 0.5), ()).unwrap();
         assert!(!raw.is_planar_by_construction());
+    }
+
+    /// The spatial indexes are built by the first question, skipped by raw changes while
+    /// released, and give the same answers and insertions whenever they were built.
+    #[test]
+    fn a_released_index_is_rebuilt_with_the_same_answers() {
+        let opts = SnapOptions::default();
+        let mut kept: PlanarGraph<(), u8> = PlanarGraph::new();
+        assert!(!kept.has_spatial_index());
+        kept.insert_segment(v(0.0, 0.0), v(10.0, 10.0), 1, &opts)
+            .unwrap();
+        assert!(kept.has_spatial_index());
+        let mut released = kept.clone();
+        released.release_spatial_index();
+        assert!(!released.has_spatial_index());
+        // The same raw changes to both: a split, an edge, a removal.
+        for g in [&mut kept, &mut released] {
+            let e = g.edge_ids().next().unwrap();
+            let (m, _) = g.split_edge(e, v(4.0, 4.0), ()).unwrap();
+            let n = g.add_node(v(4.0, -6.0), ()).unwrap();
+            let f = g.add_edge(m, n, 2).unwrap();
+            let far = g.add_node(v(30.0, 30.0), ()).unwrap();
+            g.remove_node(far).unwrap();
+            g.remove_edge(f).unwrap();
+            g.add_edge(m, n, 3).unwrap();
+        }
+        assert!(kept.has_spatial_index() && !released.has_spatial_index());
+        assert_eq!(
+            kept.nearest_edge(v(5.0, -1.0), 3.0),
+            released.nearest_edge(v(5.0, -1.0), 3.0)
+        );
+        assert!(released.has_spatial_index());
+        let b = Aabb2::new(v(-1.0, -7.0), v(6.0, 5.0));
+        assert_eq!(kept.nodes_in_box(&b), released.nodes_in_box(&b));
+        assert_eq!(kept.edges_in_box(&b), released.edges_in_box(&b));
+        // Planar insertion gives the same graph either way.
+        released.release_spatial_index();
+        let a = kept.insert_segment(v(0.0, 8.0), v(9.0, -3.0), 4, &opts);
+        let b = released.insert_segment(v(0.0, 8.0), v(9.0, -3.0), 4, &opts);
+        assert_eq!(a.unwrap(), b.unwrap());
+        assert_eq!(
+            kept.edges()
+                .map(|(e, u, w, p)| (e, u, w, *p))
+                .collect::<Vec<_>>(),
+            released
+                .edges()
+                .map(|(e, u, w, p)| (e, u, w, *p))
+                .collect::<Vec<_>>()
+        );
+        kept.check_invariants().unwrap();
+        released.check_invariants().unwrap();
     }
 
     #[test]

@@ -5,12 +5,14 @@ use std::collections::VecDeque;
 use polis_geom::graph::SnapOptions;
 use polis_geom::hash::splitmix64;
 use polis_geom::{DVec2, EdgeId, NodeId, PointLocation, PolygonWithHoles};
-use rand::{RngExt, SeedableRng};
+use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
 use super::cell::{CellMaps, SecondaryCell};
 use super::error::SecondaryError;
+use super::grid::GridRoad;
+use super::join::{self, Join};
 use super::params::{BuildingHint, Deviated, SecondaryParams};
 use super::snap::{SnapEvent, Snapper};
 use crate::network::{Junction, Road, RoadClass, RoadNetwork};
@@ -106,9 +108,12 @@ impl SecondaryRoads {
 ///
 /// # Guarantees
 ///
-/// * The cell's graph stays planar (every road goes in through
-///   [`PlanarGraph::insert_segment`](polis_geom::PlanarGraph::insert_segment) after the
-///   exact checks below) and every secondary road lies inside the cell region: a
+/// * The cell's graph stays planar (every road goes in after the exact checks below: a
+///   free end or a joined node as it is, a join onto a road as the split and the edge
+///   that [`PlanarGraph::insert_segment`](polis_geom::PlanarGraph::insert_segment)
+///   would make — checked by the insertion's rules, and left to the insertion itself
+///   where one of them could do more) and every secondary road lies inside the cell
+///   region: a
 ///   proposal that touches or crosses anything other than its own two ends, or whose
 ///   midpoint is not strictly inside the region (exact point location), is dropped.
 /// * Every secondary road is connected to the boundary: growth starts from boundary
@@ -137,6 +142,8 @@ impl SecondaryRoads {
 pub struct SecondaryGrowth {
     params: SecondaryParams,
     snapper: Snapper,
+    scratch: Vec<GridRoad>,
+    joins: (u64, u64),
 }
 
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
@@ -170,6 +177,8 @@ impl SecondaryGrowth {
         Ok(SecondaryGrowth {
             params,
             snapper: Snapper::default(),
+            scratch: Vec::new(),
+            joins: (0, 0),
         })
     }
 
@@ -182,6 +191,12 @@ impl SecondaryGrowth {
     /// bounding box (Kelly's measure of the `r`/`s` optimisation).
     pub fn snap_counters(&self) -> (u64, u64) {
         (self.snapper.exact_tests, self.snapper.box_hits)
+    }
+
+    /// Joins onto a road so far: made directly (a split and an edge) and left to planar
+    /// insertion (see [`SecondaryGrowth::grow`]'s guarantees).
+    pub fn join_counters(&self) -> (u64, u64) {
+        self.joins
     }
 
     /// Grows the secondary roads of `cell`. `seed` is mixed with the cell's id.
@@ -243,6 +258,10 @@ impl SecondaryGrowth {
                 Err(e) => return Err(e.into()),
             }
         }
+        // Growth asks the graph no spatial question (the snap grid below answers them):
+        // the graph's own spatial index, which the filaments' insertion built, is freed
+        // and not kept up to date on every change.
+        g.release_spatial_index();
         // The snap search's flat grid over the cell, in squares of the segment size.
         self.snapper
             .begin_cell(g.bbox(), p.segment_size_m.value.max(1.0));
@@ -282,6 +301,10 @@ impl SecondaryGrowth {
             guard,
             tolerance: (p.segment_size_m.value * INSERT_TOLERANCE).max(1e-3),
             decided: Vec::new(),
+            scratch: std::mem::take(&mut self.scratch),
+            root_roads: Vec::new(),
+            root: (None, 0),
+            joins: (0, 0),
         };
         let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
         // Initial segments from deviated midpoints of the longest sides: the first
@@ -366,19 +389,36 @@ impl SecondaryGrowth {
             run.decided.clear();
             // Direction i is `dir` turned by i steps: one rotation applied i times.
             let (sin, cos) = step.sin_cos();
+            let certain = FoldBound::new(&p, step);
             let mut turned = dir;
             for _ in 0..degree {
-                let new_dir = run.deviate(turned, step);
+                // A direction that folds onto a road at the node whatever its draws is
+                // refused without them (test 0's answer; the generator steps past them).
+                let folds = match &certain {
+                    Some(bound) => run.folds_for_sure(source, turned, bound)?,
+                    None => false,
+                };
+                let new_dir = if folds {
+                    run.skip_fold();
+                    None
+                } else {
+                    Some(run.deviate(turned, step))
+                };
                 turned = DVec2::new(
                     turned.x * cos - turned.y * sin,
                     turned.x * sin + turned.y * cos,
                 );
-                if let Some(placed) = run.place_segment(source, new_dir)? {
+                if let Some(new_dir) = new_dir
+                    && let Some(placed) = run.place_segment(source, new_dir)?
+                {
                     queue.push_back((placed.node, new_dir));
                 }
             }
         }
         let report = run.report;
+        self.joins.0 += run.joins.0;
+        self.joins.1 += run.joins.1;
+        self.scratch = run.scratch;
         let network = run.g;
         Ok(SecondaryRoads {
             cell: cell.id,
@@ -412,6 +452,59 @@ fn rotate(v: DVec2, angle: f64) -> DVec2 {
     DVec2::new(v.x * c - v.y * s, v.x * s + v.y * c)
 }
 
+/// What every proposal of one expanded node can be, for test 0 before the draws: the
+/// longest segment (the deviated size at its largest, on the aspect ellipse), the
+/// smallest snap size, and the widest deviation of a direction, each widened by a
+/// relative margin of 10⁻⁹ (far above the rounding of the test's arithmetic).
+///
+/// A proposal in direction `d` (unit) and of length `l` from node `a` folds onto the
+/// node's road `a–p` (test 0, [`snap`](super::snap)) when the angle `θ` between `d` and
+/// `p − a` is below 90° and `min(l, |p − a|) · sin θ` is at most the snap size: shorter
+/// than the road, its end is within `l · sin θ` of it; longer, `p` is within
+/// `|p − a| · sin θ` of the segment, before its end. With `|θ|` at most the angle of the
+/// undeviated direction plus the widest deviation, this holds for every draw when it
+/// holds for the bounds.
+struct FoldBound {
+    len_max: f64,
+    radius_min: f64,
+    sin_dev: f64,
+    cos_dev: f64,
+}
+
+impl FoldBound {
+    /// The bounds for a node whose directions are `step` radians apart, or `None` when
+    /// a draw could give a zero-length segment or snap size (no proposal is certain).
+    fn new(p: &SecondaryParams, step: f64) -> Option<FoldBound> {
+        const MARGIN: f64 = 1e-9;
+        let size = p.segment_size_m;
+        let len_min = size.value * (1.0 - size.deviance) * p.aspect.min(1.0);
+        let len_max = size.value * (1.0 + size.deviance) * p.aspect.max(1.0) * (1.0 + MARGIN);
+        let radius_min = p.snap_size_m.value * (1.0 - p.snap_size_m.deviance) * (1.0 - MARGIN);
+        let dev = p.degree_deviance * 0.5 * step * (1.0 + MARGIN) + MARGIN;
+        let ok = len_min > 0.0
+            && len_max.is_finite()
+            && radius_min > 0.0
+            && dev < std::f64::consts::FRAC_PI_2;
+        let (sin_dev, cos_dev) = dev.sin_cos();
+        ok.then_some(FoldBound {
+            len_max,
+            radius_min,
+            sin_dev,
+            cos_dev,
+        })
+    }
+
+    /// Whether every proposal deviated from `turned` folds onto the road of unit
+    /// direction `w` and length `len`.
+    fn folds(&self, turned: DVec2, w: DVec2, len: f64) -> bool {
+        let (cos, sin) = (turned.dot(w), turned.perp_dot(w).abs());
+        // sin and cos of the angle plus the widest deviation.
+        let sin_max = sin * self.cos_dev + cos * self.sin_dev;
+        let cos_min = cos * self.cos_dev - sin * self.sin_dev;
+        cos_min > 1e-9 && self.len_max.min(len) * sin_max <= self.radius_min
+    }
+}
+
 /// One growth run's state.
 struct Run<'a> {
     p: &'a SecondaryParams,
@@ -427,6 +520,15 @@ struct Run<'a> {
     tolerance: f64,
     /// The connectivity decisions of the node being expanded, per road or junction met.
     decided: Vec<(JoinKey, bool)>,
+    /// Scratch of [`join::plan`].
+    scratch: Vec<GridRoad>,
+    /// The roads of a node as (unit direction, length), for
+    /// [`folds_for_sure`](Self::folds_for_sure), and the node and the graph's edge
+    /// bound they were read at.
+    root_roads: Vec<(DVec2, f64)>,
+    root: (Option<NodeId>, usize),
+    /// Joins onto a road made directly and by planar insertion.
+    joins: (u64, u64),
 }
 
 /// What a snap event would join: the connectivity draw is made once per pair of the
@@ -438,6 +540,46 @@ enum JoinKey {
 }
 
 impl Run<'_> {
+    /// Whether every proposal from `source` in a direction deviated from `turned` (as
+    /// [`deviate`](Self::deviate) draws it) folds onto a road at `source` by test 0,
+    /// whatever its length and snap size draws (see [`FoldBound`]).
+    fn folds_for_sure(
+        &mut self,
+        source: NodeId,
+        turned: DVec2,
+        bound: &FoldBound,
+    ) -> Result<bool, SecondaryError> {
+        // The node's roads as (unit direction, length), read again after any change.
+        if self.root.0 != Some(source) || self.root.1 != self.g.edge_bound() {
+            self.root_roads.clear();
+            let a = self.g.position(source)?;
+            for &e in self.g.edges_at(source)? {
+                let ap = self.g.position(self.g.other_end(e, source)?)? - a;
+                let len = ap.length();
+                if len > 0.0 {
+                    self.root_roads.push((ap / len, len));
+                }
+            }
+            self.root = (Some(source), self.g.edge_bound());
+        }
+        Ok(self
+            .root_roads
+            .iter()
+            .any(|&(w, len)| bound.folds(turned, w, len)))
+    }
+
+    /// A proposal [`folds_for_sure`](Self::folds_for_sure): counted as test 0 counts it,
+    /// and the generator stepped past its four draws (direction, length, snap size,
+    /// width), so that every later draw is the one it would have been.
+    fn skip_fold(&mut self) {
+        self.report.proposals += 1;
+        self.report.refused_blocked += 1;
+        self.snapper.count_fold();
+        for _ in 0..4 {
+            self.rng.next_u64();
+        }
+    }
+
     /// `dir` turned by up to ± degree deviance × half of `step` (radians).
     fn deviate(&mut self, dir: DVec2, step: f64) -> DVec2 {
         let u: f64 = self.rng.random::<f64>();
@@ -554,36 +696,38 @@ impl Run<'_> {
                 }
                 Err(e) => return Err(e.into()),
             },
-            Target::OnEdge(..) => {
-                let ins = self.g.insert_segment_with(
-                    a,
-                    t,
-                    road,
-                    &SnapOptions {
-                        snap_distance: self.tolerance,
-                    },
-                    |_| Junction { step },
+            Target::OnEdge(e, _) => {
+                let plan = join::plan(
+                    &self.g,
+                    self.snapper,
+                    &mut self.scratch,
+                    source,
+                    (a, t),
+                    e,
+                    self.tolerance,
                 );
-                let ins = match ins {
-                    Ok(ins) => ins,
-                    Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => {
+                match plan {
+                    Join::Split { edge, point } => {
+                        self.joins.0 += 1;
+                        let (m, _) = self.g.split_edge(edge, point, Junction { step })?;
+                        self.snapper.touched(&self.g, edge);
+                        self.g.add_edge(source, m, road)?;
+                        m
+                    }
+                    Join::ZeroLength => {
                         self.report.refused_blocked += 1;
                         return Ok(None);
                     }
-                    Err(e) => return Err(e.into()),
-                };
-                for &(split, _) in &ins.split {
-                    self.snapper.touched(&self.g, split);
-                }
-                if ins.created.is_empty() {
-                    // The road exists already (the insertion followed existing roads).
-                    self.report.refused_blocked += 1;
-                    return Ok(None);
-                }
-                self.edges += ins.created.len() as u32 - 1;
-                match ins.nodes.last() {
-                    Some(&n) => n,
-                    None => return Ok(None),
+                    Join::General => {
+                        self.joins.1 += 1;
+                        match self.insert(a, t, road)? {
+                            Some(n) => n,
+                            None => {
+                                self.report.refused_blocked += 1;
+                                return Ok(None);
+                            }
+                        }
+                    }
                 }
             }
         };
@@ -594,6 +738,38 @@ impl Run<'_> {
             Target::OnEdge(..) => self.report.placed_road += 1,
         }
         Ok(Some(Placed { node: end }))
+    }
+
+    /// Adds the road `a–t` by planar insertion (a join onto a road that
+    /// [`join::plan`] leaves to it): returns its last node, or `None` when the
+    /// insertion refuses it or only follows existing roads. The graph's spatial index,
+    /// which the insertion builds, is freed again: nothing else in growth reads it.
+    fn insert(&mut self, a: DVec2, t: DVec2, road: Road) -> Result<Option<NodeId>, SecondaryError> {
+        let step = road.step;
+        let ins = self.g.insert_segment_with(
+            a,
+            t,
+            road,
+            &SnapOptions {
+                snap_distance: self.tolerance,
+            },
+            |_| Junction { step },
+        );
+        self.g.release_spatial_index();
+        let ins = match ins {
+            Ok(ins) => ins,
+            Err(polis_geom::GeomError::ZeroLengthEdge { .. }) => return Ok(None),
+            Err(e) => return Err(e.into()),
+        };
+        for &(split, _) in &ins.split {
+            self.snapper.touched(&self.g, split);
+        }
+        if ins.created.is_empty() {
+            // The road exists already (the insertion followed existing roads).
+            return Ok(None);
+        }
+        self.edges += ins.created.len() as u32 - 1;
+        Ok(ins.nodes.last().copied())
     }
 
     /// Whether the road `a–t` from `source` would make an angle sharper than
@@ -696,5 +872,75 @@ impl Run<'_> {
             }
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::secondary::Neighbourhood;
+    use crate::secondary::snap::folds_onto_root;
+
+    /// Where [`FoldBound`] says a direction folds for every draw, test 0 folds every
+    /// proposal drawn in it (directions deviated, lengths on the aspect ellipse and snap
+    /// sizes, all at random and at their extremes), on random roads at the root; and the
+    /// bound is not empty.
+    #[test]
+    fn a_certain_fold_folds_for_every_draw() {
+        let mut rng = Pcg64Mcg::seed_from_u64(15);
+        let mut certain = 0;
+        for n in Neighbourhood::ALL {
+            let mut p = n.params().unwrap();
+            p.aspect = [1.0, 0.4, 2.5][rng.random_range(0..3)];
+            let axis = DVec2::from_angle(rng.random::<f64>() * 6.0);
+            for degree in [3u32, 4, 6, 18] {
+                let step = std::f64::consts::TAU / f64::from(degree);
+                let Some(bound) = FoldBound::new(&p, step) else {
+                    continue;
+                };
+                for _ in 0..400 {
+                    let mut g = RoadNetwork::new();
+                    let a = DVec2::new(rng.random::<f64>() * 100.0, rng.random::<f64>() * 100.0);
+                    let root = g.add_node(a, Junction::default()).unwrap();
+                    let dir = DVec2::from_angle(rng.random::<f64>() * 6.3);
+                    // A road near the direction, of a length around the segment size.
+                    let off = (rng.random::<f64>() - 0.5) * 1.2;
+                    let len = p.segment_size_m.value * (0.05 + 2.0 * rng.random::<f64>());
+                    let w = DVec2::from_angle(off).rotate(dir);
+                    let far = g.add_node(a + w * len, Junction::default()).unwrap();
+                    g.add_edge(root, far, crate::secondary::snap::tests::street())
+                        .unwrap();
+                    if !bound.folds(dir, w, len) {
+                        continue;
+                    }
+                    certain += 1;
+                    for k in 0..40 {
+                        // Extremes first, then random draws.
+                        let (u, s, r) = match k {
+                            0 => (0.0, 1.0, 0.0),
+                            1 => (1.0 - 1e-16, 1.0, 0.0),
+                            2 => (0.0, 1.0 - 1e-16, 0.0),
+                            3 => (1.0 - 1e-16, 1.0 - 1e-16, 0.0),
+                            _ => (rng.random(), rng.random(), rng.random()),
+                        };
+                        let angle = p.degree_deviance * (2.0 * u - 1.0) * 0.5 * step;
+                        let d = rotate(dir, angle);
+                        let size = p.segment_size_m.value
+                            * (1.0 + p.segment_size_m.deviance * (2.0 * s - 1.0));
+                        let along = size * p.aspect;
+                        let (c, sn) = (d.dot(axis), d.perp_dot(axis));
+                        let l = along * size / ((size * c).powi(2) + (along * sn).powi(2)).sqrt();
+                        let radius =
+                            p.snap_size_m.value * (1.0 + p.snap_size_m.deviance * (2.0 * r - 1.0));
+                        assert!(
+                            folds_onto_root(&g, root, a, a + d * l, radius),
+                            "{n:?} degree {degree}: {dir} {w} {len} {l} {radius}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(certain > 500, "{certain}");
     }
 }

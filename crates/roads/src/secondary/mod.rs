@@ -34,6 +34,7 @@ pub mod cell;
 pub mod error;
 mod grid;
 pub mod growth;
+mod join;
 pub mod params;
 pub mod pattern;
 pub mod presets;

@@ -29,7 +29,9 @@
 //! directions of a suburban node are such folds; answering them without the grid
 //! search roughly halves the growth's time. It differs from the full search only when a
 //! non-adjacent node or road lies in the snap area nearer to the root than the fold,
-//! which the full search would have joined instead.
+//! which the full search would have joined instead. Growth answers test 0 before the
+//! proposal's draws where the fold holds for every draw the proposal could make (its
+//! `FoldBound`), stepping the generator past them, so the roads are the same.
 
 use polis_geom::predicates::{Orientation, lerp_stable, orient2d};
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
@@ -125,6 +127,24 @@ impl Snapper {
     /// their ends; empty after a query answered by test 0.
     pub(crate) fn candidates(&self) -> &[GridRoad] {
         &self.roads
+    }
+
+    /// Counts a proposal that growth found folding onto a road at its root (test 0)
+    /// without asking: as [`snap`](Self::snap) counts one it answers by test 0.
+    pub(crate) fn count_fold(&mut self) {
+        self.folded += 1;
+        self.roads.clear();
+    }
+
+    /// Appends to `out` every road of `g` whose box meets `b`, with its ends, as the
+    /// snap grid lists it (each once; the last query's candidates stay as they were).
+    pub(crate) fn roads_in(&mut self, g: &RoadNetwork, b: &Aabb2, out: &mut Vec<GridRoad>) {
+        self.grid.sync(g);
+        self.grid.for_each_in(b, |r| {
+            if Aabb2::new(r.pu, r.pv).intersects(b) {
+                out.push(*r);
+            }
+        });
     }
 
     /// Road `e` of `g` was split or removed since the last query (see
@@ -346,7 +366,13 @@ fn closest_point(p: DVec2, u: DVec2, v: DVec2) -> DVec2 {
 /// root's own roads: that road's other end is in the snap area (test 1's condition), or
 /// `b` is within `radius` of the road (test 3's). Such a proposal can only fold onto the
 /// road it starts beside, so it is answered before the grid is searched.
-fn folds_onto_root(g: &RoadNetwork, root: NodeId, a: DVec2, b: DVec2, radius: f64) -> bool {
+pub(super) fn folds_onto_root(
+    g: &RoadNetwork,
+    root: NodeId,
+    a: DVec2,
+    b: DVec2,
+    radius: f64,
+) -> bool {
     let Ok(edges) = g.edges_at(root) else {
         return false;
     };
