@@ -370,3 +370,65 @@ fn weighted_star_whose_wavefront_vertex_touches_its_own_step_edge() {
         .count();
     assert_eq!(at_touch, 2);
 }
+
+/// Fuzz finding (`skeleton_inset`, session 15, after about 6.4 million executions of the
+/// run after the two fixes above), **open**: an integer star nudged by 5e-10 with weights
+/// from 0.1 to 3.1. The weighted skeleton fails ("part of the wavefront never
+/// collapsed"), and the inset at d ≈ 2.18 returns a ring whose edge from input edge 14
+/// crosses a step edge at (0, 1.08): the event loop loses the wavefront's consistency
+/// before `d`, a defect of the engine, not of the ring clean-up. The inset must give a
+/// valid result or an error.
+#[test]
+#[ignore = "open finding: the weighted engine loses the wavefront on a nudged star with steps"]
+fn weighted_star_whose_skeleton_fails_open_finding() {
+    let pts = [
+        (5.0000000005, 5e-10),
+        (4.999999999789051, 2.0000000005),
+        (3.9999999995351416, 3.000000000496109),
+        (3.0000000005, 4.0000000005),
+        (2.0000000005, 5.0000000005),
+        (-4.687495231555657e-10, 5.000000000496109),
+        (-1.9999999995, 5.0000000005),
+        (-2.9999999995, 4.0000000005),
+        (-3.9999999995, 3.0000000005),
+        (-4.9999999995, 2.0000000005),
+        (-4.9999999995, 5e-10),
+        (-4.9999999995, -1.9999999995009765),
+        (-3.9999999995, -2.999999999750004),
+        (-2.9999999995, -3.9999999995),
+        (-1.0000000005, -3.0000000005),
+        (-4.882810711833372e-10, -1.9999999998828184),
+        (2.0000000005, -4.9999999995),
+        (3.0000000005, -3.999999999964851),
+        (5.0000000005, -3.9999999996250017),
+        (5.0000000005, -2.000000000457046),
+    ];
+    let weights = [
+        3.01796749828336,
+        3.1,
+        2.8025406271458,
+        0.1000457770656901,
+        1.0,
+        2.2371023117418174,
+        1.0,
+        0.6563744563973449,
+        0.5,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+        2.0,
+        2.0,
+        0.6624628061341268,
+        2.0,
+    ];
+    let p: PolygonWithHoles = poly(&pts).into();
+    if let Ok(shapes) = inset_weighted(&p, &weights, 2.179598687724117) {
+        for s in &shapes {
+            assert_eq!(s.validate(), Ok(()));
+        }
+    }
+}
