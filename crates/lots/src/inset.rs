@@ -281,17 +281,24 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
 /// whether it is an outer ring (`true`) or a hole (`false`); rings of no area are dropped.
 fn finish_ring(mut ring: InsetRing, eps: f64) -> Vec<(InsetRing, bool)> {
     clean_ring(&mut ring, eps);
-    add_touch_points(&mut ring, eps);
+    // One sort by x serves the touch sweep and the pinch search (made again only when
+    // the ring changes).
+    let mut order = x_order(&ring.points);
+    if add_touch_points(&mut ring, &order, eps) {
+        order = x_order(&ring.points);
+    }
     let mut finished = Vec::new();
-    let mut pending = vec![ring];
-    while let Some(mut ring) = pending.pop() {
-        if let Some((a, b)) = split_lobes(&ring, eps) {
+    let mut pending = vec![(ring, Some(order))];
+    while let Some((mut ring, order)) = pending.pop() {
+        let order = order.unwrap_or_else(|| x_order(&ring.points));
+        let pairs = pinch_pairs(&ring, &order, eps);
+        if let Some((a, b)) = split_lobes(&ring, &pairs, eps) {
             // Depth first, the first piece next: the order follows the ring's.
-            pending.push(b);
-            pending.push(a);
+            pending.push((b, None));
+            pending.push((a, None));
             continue;
         }
-        separate_pinches(&mut ring, eps);
+        separate_pinches(&mut ring, &pairs, eps);
         if ring.points.len() < 3 {
             continue;
         }
@@ -307,25 +314,24 @@ fn finish_ring(mut ring: InsetRing, eps: f64) -> Vec<(InsetRing, bool)> {
 /// (within `eps` of the edge, not of its ends): that edge gets a copy of the vertex, so
 /// the touch is a point the ring visits twice, which [`split_lobes`] and
 /// [`separate_pinches`] then treat as any other. Both halves of the edge keep its source.
-/// A sweep over `x` with the edges whose extent covers the vertex: about `n log n` for
-/// a ring of `n` vertices.
-fn add_touch_points(ring: &mut InsetRing, eps: f64) {
+/// A sweep over `x` (the vertices in `order`, [`x_order`]) with the edges whose extent
+/// covers the vertex: about `n log n` for a ring of `n` vertices. Whether any edge got a
+/// vertex.
+fn add_touch_points(ring: &mut InsetRing, order: &[usize], eps: f64) -> bool {
     let n = ring.points.len();
     if n < 4 {
-        return;
+        return false;
     }
     let pts = &ring.points;
     let end = |e: usize| pts[if e + 1 < n { e + 1 } else { 0 }];
     let lo_x = |e: usize| pts[e].x.min(end(e).x);
     let mut edges: Vec<usize> = (0..n).collect();
     edges.sort_by(|&a, &b| lo_x(a).total_cmp(&lo_x(b)).then(a.cmp(&b)));
-    let mut vertices: Vec<usize> = (0..n).collect();
-    vertices.sort_by(|&a, &b| pts[a].x.total_cmp(&pts[b].x).then(a.cmp(&b)));
     let mut active: Vec<usize> = Vec::new();
     let mut next = 0;
     // (edge, position along it, vertex)
     let mut touches: Vec<(usize, f64, usize)> = Vec::new();
-    for &v in &vertices {
+    for &v in order {
         let p = pts[v];
         while next < n && lo_x(edges[next]) <= p.x + eps {
             active.push(edges[next]);
@@ -346,7 +352,7 @@ fn add_touch_points(ring: &mut InsetRing, eps: f64) {
         }
     }
     if touches.is_empty() {
-        return;
+        return false;
     }
     touches.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
     let mut points = Vec::with_capacity(n + touches.len());
@@ -362,19 +368,24 @@ fn add_touch_points(ring: &mut InsetRing, eps: f64) {
     }
     ring.points = points;
     ring.sources = sources;
+    true
 }
 
-/// Points of `ring` within `eps` of another point of it (each pair once, `i < j`), in
-/// the order of the sweep by `x`.
-fn pinch_pairs(ring: &InsetRing, eps: f64) -> Vec<(usize, usize)> {
-    let n = ring.points.len();
-    let mut order: Vec<usize> = (0..n).collect();
+/// The indices of `points` sorted by `x`, then `y`, then index.
+fn x_order(points: &[DVec2]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
     order.sort_by(|&a, &b| {
-        let (p, q) = (ring.points[a], ring.points[b]);
+        let (p, q) = (points[a], points[b]);
         p.x.total_cmp(&q.x)
             .then(p.y.total_cmp(&q.y))
             .then(a.cmp(&b))
     });
+    order
+}
+
+/// Points of `ring` within `eps` of another point of it (each pair once, `i < j`), in
+/// the order of the sweep by `x` over `order` ([`x_order`]).
+fn pinch_pairs(ring: &InsetRing, order: &[usize], eps: f64) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for (k, &i) in order.iter().enumerate() {
         let p = ring.points[i];
@@ -397,7 +408,11 @@ fn pinch_pairs(ring: &InsetRing, eps: f64) -> Vec<(usize, usize)> {
 /// rings, returned here: the loop from the first visit to the second, and the rest.
 /// `None` when there is no such point; a hole loop inside an outer loop (or two holes
 /// touching) is left to [`separate_pinches`], which keeps it one ring.
-fn split_lobes(ring: &InsetRing, eps: f64) -> Option<(InsetRing, InsetRing)> {
+fn split_lobes(
+    ring: &InsetRing,
+    pairs: &[(usize, usize)],
+    eps: f64,
+) -> Option<(InsetRing, InsetRing)> {
     let n = ring.points.len();
     if n < 4 {
         return None;
@@ -413,7 +428,7 @@ fn split_lobes(ring: &InsetRing, eps: f64) -> Option<(InsetRing, InsetRing)> {
         }
     };
     let area = polis_geom::polygon::ring_signed_area;
-    for (i, j) in pinch_pairs(ring, eps) {
+    for &(i, j) in pairs {
         if j - i < 2 || n - (j - i) < 2 {
             // Neighbours within `eps` are merged by `clean_ring`; a loop needs two edges.
             continue;
@@ -448,15 +463,12 @@ fn split_lobes(ring: &InsetRing, eps: f64) -> Option<(InsetRing, InsetRing)> {
 /// corner — there the visits' corners are the ring's separate interior wedges — which
 /// makes the ring simple and changes no edge by more than that. (Loops side by side are
 /// split apart first by [`split_lobes`]: their visits' corners overlap.)
-fn separate_pinches(ring: &mut InsetRing, eps: f64) {
+fn separate_pinches(ring: &mut InsetRing, pairs: &[(usize, usize)], eps: f64) {
     let n = ring.points.len();
     if n < 4 {
         return;
     }
-    let mut pinched: Vec<usize> = pinch_pairs(ring, eps)
-        .into_iter()
-        .flat_map(|(i, j)| [i, j])
-        .collect();
+    let mut pinched: Vec<usize> = pairs.iter().flat_map(|&(i, j)| [i, j]).collect();
     pinched.sort_unstable();
     pinched.dedup();
     let moved: Vec<(usize, DVec2)> = pinched

@@ -534,11 +534,16 @@ fn planar_insert_fuzz_findings() {
         "b7a4f4b42f6fcc00692cc2002d6f69ccc22dffff2c0000c22b962c6f240000140bffff0000ffff6c00d3ff004b7ac27f00000000da692c6fff0000ffff00004bc2ca2200defcff00004bc2da2200dffc0700003dffff00c2da69306f2400cb32cb0014cbcc006bc2da2200692c6f00140bfdff5454e454545400001260fff72c",
     ];
     for hex in cases {
-        let bytes: Vec<u8> = (0..hex.len() / 2)
-            .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
-            .collect();
-        planar_insert_case(&bytes).unwrap();
+        replay(hex);
     }
+}
+
+/// Runs a fuzz input given in hex through the fuzz target's checks.
+fn replay(hex: &str) {
+    let bytes: Vec<u8> = (0..hex.len() / 2)
+        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
+        .collect();
+    planar_insert_case(&bytes).unwrap();
 }
 
 /// Fuzzing finding of `planar_insert` (issue 22): with snap 0, a segment inserted a
@@ -551,10 +556,7 @@ fn planar_insert_fuzz_findings() {
 #[test]
 fn planar_insert_open_fuzz_finding() {
     let hex = "fa215b2500004040fae5fa215b25007a00a71e00004040fae55b400025255b00004f12008d0b40ffff40e95d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d5d21fcffff00065b400025255b00004f8d0b40ffff40e9df03dea4daff85fca71e00004040fae55b400025255b00004f8d0b40ffff40ffff0006";
-    let bytes: Vec<u8> = (0..hex.len() / 2)
-        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
-        .collect();
-    planar_insert_case(&bytes).unwrap();
+    replay(hex);
 }
 
 /// Fuzzing finding (9) of `planar_insert` (session 13, after 6.17 million executions;
@@ -569,10 +571,7 @@ fn planar_insert_open_fuzz_finding() {
 #[test]
 fn planar_insert_open_fuzz_finding_9() {
     let hex = "00000018860000002d1100ffffffffffffffffff00fff2ff3f15fdbd0000ffffe437083701250014bf7c3d3d3d002cccff2b143ded000000000020000032090000000000000040000000ff0135090000000000e40100ff240000000c1000003c00ffffe40010002700ff052a000000000000e50100007d00000000213900273d";
-    let bytes: Vec<u8> = (0..hex.len() / 2)
-        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
-        .collect();
-    planar_insert_case(&bytes).unwrap();
+    replay(hex);
 }
 
 /// Fuzzing finding (10) of `planar_insert` (session 14, after 4.69 million executions).
@@ -589,8 +588,5 @@ fn planar_insert_open_fuzz_finding_9() {
 #[test]
 fn planar_insert_open_fuzz_finding_10() {
     let hex = "000000cb0600ffffffff4500d50000233f0000000000370000233f00000000d30000000031000000f7ff0000000000000000000000000034060013000036000000000000006b6b6b6b6b6b6b6bffffff006b6b6b83000034140400";
-    let bytes: Vec<u8> = (0..hex.len() / 2)
-        .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
-        .collect();
-    planar_insert_case(&bytes).unwrap();
+    replay(hex);
 }
