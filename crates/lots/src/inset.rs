@@ -143,6 +143,12 @@ impl Inset {
         }
         reset_checked(&mut self.engine, polygon, weights);
         self.engine.run_through(d)?;
+        // Such a component would come out unchanged at every later distance.
+        if self.engine.steps_enclose_a_region() {
+            return Err(LotsError::SkeletonFailed {
+                reason: crate::skeleton::STEPS_ENCLOSE,
+            });
+        }
         Ok(wavefront_at(&self.engine, d))
     }
 }

@@ -5,7 +5,7 @@
 mod common;
 use common::*;
 use polis_geom::{Polygon, PolygonWithHoles};
-use polis_lots::{inset, inset_shapes, inset_weighted};
+use polis_lots::{StraightSkeleton, inset, inset_shapes, inset_weighted};
 
 #[test]
 fn square_inset_and_vanishing() {
@@ -372,15 +372,18 @@ fn weighted_star_whose_wavefront_vertex_touches_its_own_step_edge() {
 }
 
 /// Fuzz finding (`skeleton_inset`, session 15, after about 6.4 million executions of the
-/// run after the two fixes above), **open**: an integer star nudged by 5e-10 with weights
-/// from 0.1 to 3.1. The weighted skeleton fails ("part of the wavefront never
-/// collapsed"), and the inset at d ≈ 2.18 returns a ring whose edge from input edge 14
-/// crosses a step edge at (0, 1.08): the event loop loses the wavefront's consistency
-/// before `d`, a defect of the engine, not of the ring clean-up. The inset must give a
-/// valid result or an error.
+/// run after the two fixes above): an integer star nudged by 5e-10 with weights from 0.1
+/// to 3.1, whose three weighted steps (at (0, 5), (3, 4) and (−3, 4)) lie on three lines
+/// through (0, 1). At t ≈ 1.788 input edge 5 vanishes at (0, 1), where the step from
+/// (3, 4) lies at that moment: the vertex the edge event leaves there stands still
+/// between two steps, on a step edge that does not move either. Neither closes on the
+/// other, so no split event was ever found, the step's piece stayed whole across the
+/// vertex, and the wavefront lost its consistency (the skeleton failed, "part of the
+/// wavefront never collapsed", and the inset at d ≈ 2.18 returned a crossing ring). A
+/// vertex on a line and moving along with it is now a touch at once
+/// (`candidates::line_hit`): the piece splits there into two stationary vertices.
 #[test]
-#[ignore = "open finding: the weighted engine loses the wavefront on a nudged star with steps"]
-fn weighted_star_whose_skeleton_fails_open_finding() {
+fn weighted_star_whose_three_steps_meet_at_one_point() {
     let pts = [
         (5.0000000005, 5e-10),
         (4.999999999789051, 2.0000000005),
@@ -426,9 +429,13 @@ fn weighted_star_whose_skeleton_fails_open_finding() {
         2.0,
     ];
     let p: PolygonWithHoles = poly(&pts).into();
-    if let Ok(shapes) = inset_weighted(&p, &weights, 2.179598687724117) {
+    let sk = StraightSkeleton::weighted(&p, &weights).unwrap();
+    check_skeleton(&p, &sk, 1e-8).unwrap();
+    for d in [1.0, 1.788, 2.0, 2.179598687724117, 2.5, 3.0] {
+        let shapes = inset_weighted(&p, &weights, d).unwrap();
+        assert!(!shapes.is_empty() || d >= 2.5, "nothing left at {d}");
         for s in &shapes {
-            assert_eq!(s.validate(), Ok(()));
+            assert_eq!(s.validate(), Ok(()), "at {d}");
         }
     }
 }

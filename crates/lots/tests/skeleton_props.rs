@@ -5,7 +5,7 @@
 mod common;
 use common::*;
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
-use polis_lots::{StraightSkeleton, inset_shapes};
+use polis_lots::{LotsError, StraightSkeleton, inset_shapes, skeleton};
 use proptest::prelude::*;
 
 /// Star-shaped polygons; with `grid`, vertices snap to integers (collinear runs, parallel
@@ -181,10 +181,21 @@ fn untangled(points: &[(i32, i32)]) -> Option<Polygon> {
 
 /// The weighted skeleton with weights `ws` repeated over all edges (ring by ring),
 /// checked independently, and its insets.
+///
+/// The one refusal allowed is the documented limitation of weighted steps enclosing a
+/// region (`skeleton::STEPS_ENCLOSE`); its insets must be refused the same way.
 fn check_weighted(p: &PolygonWithHoles, ws: &[f64]) -> Result<(), TestCaseError> {
     let count: usize = p.rings().map(|(_, r)| r.len()).sum();
     let w: Vec<f64> = (0..count).map(|i| ws[i % ws.len()]).collect();
-    let sk = StraightSkeleton::weighted(p, &w).unwrap();
+    let sk = match StraightSkeleton::weighted(p, &w) {
+        Ok(sk) => sk,
+        Err(LotsError::SkeletonFailed { reason }) if reason == skeleton::STEPS_ENCLOSE => {
+            // Insets after the region is enclosed are refused too.
+            prop_assert!(inset_shapes(p, Some(&w), 1e6).is_err());
+            return Ok(());
+        }
+        Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
+    };
     if let Err(e) = check_skeleton(p, &sk, 1e-8) {
         prop_assert!(false, "{}", e);
     }
@@ -538,5 +549,50 @@ fn weighted_wheel_with_14_spokes() {
             let inner = polis_lots::inset_weighted(&p, &w, d).unwrap();
             assert!(!inner.is_empty(), "w0 = {w0}, d = {d}");
         }
+    }
+}
+
+/// The case of `weighted_steps_interacting` (found at 3,000 cases) where steps alone come
+/// to enclose a 1.32 m × 0.5 m rectangle between t = 1.5 and 2: the edges that would have swept it
+/// (31, 11) ran face to face into steps and were zipped away with them, leaving four
+/// stationary vertices between steps. The skeleton is refused with its documented reason,
+/// so are the insets after that moment (they used to return the rectangle at any distance,
+/// even 100 m), and the insets before it are valid.
+#[test]
+fn steps_enclosing_a_region_are_refused() {
+    let top = [3u8, 1, 0, 2, 3, 3, 3, 2, 3, 0, 1];
+    let bottom = [2u8, 2, 0, 1, 0, 2, 0, 1, 0, 1, 0, 0];
+    let mut holes = Vec::new();
+    for (x, wide) in [(8.0, false), (2.0, true)] {
+        let mut r = Polygon::rect(
+            v(x + 0.25, -0.5),
+            v(x + if wide { 1.75 } else { 0.75 }, 0.5),
+        );
+        r.reverse();
+        holes.push(r);
+    }
+    let p = PolygonWithHoles::new(two_sided(&top, &bottom), holes);
+    assert_eq!(p.validate(), Ok(()));
+    let ws = [
+        1.0, 0.5, 0.5, 2.0, 0.25, 3.0, 2.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 3.0, 1.0, 1.0, 0.25,
+        0.25, 3.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 1.0, 0.5,
+    ];
+    let count: usize = p.rings().map(|(_, r)| r.len()).sum();
+    let w: Vec<f64> = (0..count).map(|i| ws[i % ws.len()]).collect();
+    assert_eq!(
+        StraightSkeleton::weighted(&p, &w).err(),
+        Some(LotsError::SkeletonFailed {
+            reason: skeleton::STEPS_ENCLOSE
+        })
+    );
+    for d in [0.5, 1.0, 1.5] {
+        let shapes = inset_shapes(&p, Some(&w), d).unwrap();
+        assert!(!shapes.is_empty());
+        for s in &shapes {
+            assert_eq!(s.to_polygon().validate(), Ok(()), "at {d}");
+        }
+    }
+    for d in [2.0, 3.0, 100.0] {
+        assert!(inset_shapes(&p, Some(&w), d).is_err(), "at {d}");
     }
 }

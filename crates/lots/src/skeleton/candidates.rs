@@ -151,12 +151,13 @@ impl SplitLines {
         let (px, py) = (q.p0.x, q.p0.y);
         let slope = self.nx[i] * q.vel.x + self.ny[i] * q.vel.y - self.w[i];
         let ahead = self.nx[i] * px + self.ny[i] * py - self.c[i] - self.w[i] * q.t0;
-        let t = q.t0 - ahead.max(0.0) / slope;
-        if slope < 0.0 && ahead >= -eps {
-            t
-        } else {
-            f64::INFINITY
-        }
+        line_hit(
+            slope,
+            ahead,
+            q.t0,
+            eps,
+            TOUCH_SLOPE_REL * (q.vel.length() + self.w[i]),
+        )
     }
 
     fn batch_scanned(&mut self, q: &Query, b: &Bounds) -> CandidateBatch {
@@ -169,15 +170,11 @@ impl SplitLines {
         // `hit_time`, written out over the arrays).
         let (nxs, nys, cs, ws) = (&self.nx[..m], &self.ny[..m], &self.c[..m], &self.w[..m]);
         let (px, py, vx, vy, t0, eps) = (q.p0.x, q.p0.y, q.vel.x, q.vel.y, q.t0, b.eps);
+        let speed = q.vel.length();
         for (i, slot) in times.iter_mut().enumerate() {
             let slope = nxs[i] * vx + nys[i] * vy - ws[i];
             let ahead = nxs[i] * px + nys[i] * py - cs[i] - ws[i] * t0;
-            let t = t0 - ahead.max(0.0) / slope;
-            *slot = if slope < 0.0 && ahead >= -eps {
-                t
-            } else {
-                f64::INFINITY
-            };
+            *slot = line_hit(slope, ahead, t0, eps, TOUCH_SLOPE_REL * (speed + ws[i]));
         }
         // Second pass: the few that can enter the batch.
         for (i, &t) in times.iter().enumerate() {
@@ -206,6 +203,33 @@ impl SplitLines {
         self.index = index;
         batch.complete = (batch.len as usize) < CANDIDATE_BATCH;
         batch
+    }
+}
+
+/// A closing speed below this times the vertex's and the line's speeds counts as none:
+/// the vertex moves along with the line (far above the rounding of the slope, about
+/// `1e-16` of the speeds, and far below any real closing speed: closing the coincidence
+/// tolerance at it would take `1e3` times the polygon's size over the speed).
+pub(crate) const TOUCH_SLOPE_REL: f64 = 1e-12;
+
+/// When a vertex, `ahead` in front of a wavefront line at time `t0` (negative: behind
+/// it) and closing on it at `-slope` per unit of time, reaches it: `t0` if it is on
+/// the line (within `eps`) and moving along with it (closing speed within `tol` of 0),
+/// else the time it crosses the line if it closes on it from in front (or from within
+/// `eps` behind), else never (infinity).
+///
+/// The touching case matters when neither moves towards the other: a vertex that stands
+/// still between two weighted steps and a step edge (weight 0) that an event laid over
+/// it, or a vertex gliding along an edge of its own speed. The wavefront touches itself
+/// there, which is an event (the piece it touches splits), and no crossing time exists.
+#[inline(always)]
+pub(crate) fn line_hit(slope: f64, ahead: f64, t0: f64, eps: f64, tol: f64) -> f64 {
+    if ahead.abs() <= eps && slope.abs() <= tol {
+        t0
+    } else if slope < 0.0 && ahead >= -eps {
+        t0 - ahead.max(0.0) / slope
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -32,7 +32,9 @@ use std::collections::{BinaryHeap, HashMap};
 
 use polis_geom::DVec2;
 
-use super::candidates::{Bounds, Candidate, CandidateBatch, Query, SplitLines};
+use super::candidates::{
+    Bounds, Candidate, CandidateBatch, Query, SplitLines, TOUCH_SLOPE_REL, line_hit,
+};
 use super::wavefront::{EdgeLine, Motion, Vertex, angle_cmp, is_reflex, meet, motion};
 use super::{SkeletonArc, SkeletonNode};
 use crate::LotsError;
@@ -112,7 +114,7 @@ pub(crate) struct Engine {
     pub eps: f64,
     /// The time the fastest edge needs to move `eps`: events this close after a time
     /// count as at that time (see [`Engine::run_through`]).
-    time_eps: f64,
+    pub time_eps: f64,
     /// No event can happen after this time (the polygon is gone by then).
     horizon: f64,
     bbox_min: DVec2,
@@ -298,11 +300,10 @@ impl Engine {
             }
             let vel = y.velocity();
             let slope = step_line.normal.dot(vel);
-            let ahead = step_line.ahead(y.p0, y.t0);
-            if slope >= 0.0 || ahead < -self.eps {
-                continue;
-            }
-            let t = y.t0 - ahead.max(0.0) / slope;
+            // The step does not move: measured now, the vertex is where it is now.
+            let ahead = step_line.ahead(y.at(self.now), self.now);
+            let tol = TOUCH_SLOPE_REL * vel.length();
+            let t = line_hit(slope, ahead, self.now, self.eps, tol);
             if t.is_finite() && t >= self.now && t <= self.horizon {
                 self.queue.push(Reverse(Event {
                     t,
@@ -922,6 +923,35 @@ impl Engine {
                 v = self.new_vertex(pb, x.in_edge, vb.out_edge, a, vb.next, qn);
             }
         }
+    }
+
+    /// Whether some wavefront component is bounded by weighted steps alone. Nothing moves
+    /// such a component (a step has weight 0 and only an input edge parallel to it can
+    /// sweep it away), so no event will ever collapse it: the region it encloses is never
+    /// swept under the step convention (see the module docs' limitations).
+    pub fn steps_enclose_a_region(&self) -> bool {
+        let n_in = self.input_edges() as u32;
+        if self.edges.len() == n_in as usize {
+            return false;
+        }
+        let mut seen = vec![false; self.verts.len()];
+        for start in 0..self.verts.len() {
+            if seen[start] || !self.verts[start].alive {
+                continue;
+            }
+            let mut only_steps = true;
+            let mut v = start;
+            while !seen[v] {
+                seen[v] = true;
+                let x = &self.verts[v];
+                only_steps &= x.out_edge >= n_in;
+                v = x.next as usize;
+            }
+            if only_steps {
+                return true;
+            }
+        }
+        false
     }
 
     /// Whether any vertex is still active.
