@@ -224,12 +224,18 @@ pub(crate) const TOUCH_SLOPE_REL: f64 = 1e-12;
 /// there, which is an event (the piece it touches splits), and no crossing time exists.
 #[inline(always)]
 pub(crate) fn line_hit(slope: f64, ahead: f64, t0: f64, eps: f64, tol: f64) -> f64 {
-    if ahead.abs() <= eps && slope.abs() <= tol {
-        t0
-    } else if slope < 0.0 && ahead >= -eps {
-        t0 - ahead.max(0.0) / slope
+    // Both answers computed, then selected: branch-free, so the scan over all lines
+    // vectorises.
+    let crossing = t0 - ahead.max(0.0) / slope;
+    let t = if slope < 0.0 && ahead >= -eps {
+        crossing
     } else {
         f64::INFINITY
+    };
+    if ahead.abs() <= eps && slope.abs() <= tol {
+        t0
+    } else {
+        t
     }
 }
 
