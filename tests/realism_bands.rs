@@ -18,7 +18,10 @@
 //! hundred streets (seed 6 of the held-out set: 26 streets, its start in a corner). Since
 //! session 13 highway rays count no population in water or parks and the axiom's second
 //! highway takes an open ray (`polis_roads::DefaultGoals::ray_open`), so both grow whole
-//! networks; seed 2 keeps one miss, its circuity (1.073 against 1.045 ± 0.02).
+//! networks; seed 2 kept one miss, its circuity (1.073 against 1.045 ± 0.02), until
+//! session 16 retuned `default` on seeds 1–40 and checked it on 41–200 (streets curving
+//! 16° instead of 36°, more dead ends, and smaller grid patches that average out over the
+//! city, so its orientation order no longer swings with the seed): see BENCHMARKS.md.
 //! Tunnels (issue 27) changed `san_francisco` seeds 1–2: highways pass under the hills
 //! they used to stop at. `citygen_us` and `milan` joined the test in session 11 (their
 //! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` keeps
@@ -61,8 +64,7 @@ fn misses(preset: &str, seed: u64) -> Vec<String> {
 }
 
 /// (preset, seed, metric) out of band today; everything else must be in band.
-const KNOWN_MISSES: &[(&str, u64, &str)] =
-    &[("default", 2, "circuity"), ("citygen_us", 2, "circuity")];
+const KNOWN_MISSES: &[(&str, u64, &str)] = &[("citygen_us", 2, "circuity")];
 
 fn check(preset: &str) {
     let mut unexpected = Vec::new();
