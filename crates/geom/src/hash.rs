@@ -1,5 +1,8 @@
 //! [`splitmix64`]: the stateless 64-bit mix that derives seeds from seeds and ids;
-//! [`point_key`]: an exact key of a point for sorting, hashing and matching.
+//! [`point_key`]: an exact key of a point for sorting, hashing and matching;
+//! [`FxHasher`]: a fast deterministic hasher for such keys.
+
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec2;
 
@@ -25,6 +28,55 @@ pub fn splitmix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
 }
+
+/// A small, fast, deterministic hasher for keys polis builds itself (bits of numbers,
+/// ids) (the multiply-rotate scheme of Firefox's "FxHash",
+/// with a final bit mix).
+/// For lookups only: nothing polis writes depends on a hash map's iteration order.
+#[derive(Default, Clone, Copy)]
+pub struct FxHasher(u64);
+
+const SEED: u64 = 0x51_7c_c1_b7_27_22_0a_95;
+
+impl Hasher for FxHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut buf = [0u8; 8];
+            buf[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(buf));
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(SEED);
+    }
+    #[inline]
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(u64::from(i));
+    }
+    #[inline]
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        // A final avalanche (MurmurHash3's fmix64): the multiply above leaves the low bits,
+        // which pick the bucket, depending on the low input bits only.
+        let mut h = self.0;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        h
+    }
+}
+
+/// [`FxHasher`] as a hash map's `BuildHasher` (`HashMap<K, V, FxBuild>`).
+pub type FxBuild = BuildHasherDefault<FxHasher>;
 
 #[cfg(test)]
 mod tests {

@@ -281,11 +281,21 @@ fn textures_in_a_subfolder_are_found_from_the_mtl() {
     }
 }
 
-/// The OBJ text of `scene` as the first writer made it, one `writeln!` at a time with
-/// `core`'s number formatting: the reference the batched, parallel writer must match byte
-/// for byte.
+/// The OBJ text of `scene` written the plain way, one `writeln!` at a time with `core`'s
+/// number formatting and a linear search for each value already written in the node: the
+/// reference the batched, parallel, hashed writer must match byte for byte.
 pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
     use std::io::Write as _;
+    /// The 1-based index of `v` among `vs` from `base` on, adding it if new.
+    fn find<T: Copy>(vs: &mut Vec<T>, v: T, same: impl Fn(&T, &T) -> bool, base: u64) -> u64 {
+        let k = vs.iter().position(|x| same(x, &v)).unwrap_or_else(|| {
+            vs.push(v);
+            vs.len() - 1
+        });
+        base + k as u64
+    }
+    let bits3 = |a: &[f32; 3], b: &[f32; 3]| a.map(f32::to_bits) == b.map(f32::to_bits);
+    let bits2 = |a: &[f32; 2], b: &[f32; 2]| a.map(f32::to_bits) == b.map(f32::to_bits);
     let mut w = Vec::new();
     let _ = writeln!(w, "# polis-export {}", env!("CARGO_PKG_VERSION"));
     let _ = writeln!(
@@ -294,7 +304,7 @@ pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
     );
     let _ = writeln!(w, "mtllib {stem}.mtl");
     let worlds = scene.world_matrices();
-    let mut base: u64 = 1;
+    let (mut vb, mut tb, mut nb) = (1u64, 1u64, 1u64);
     for (i, node) in scene.nodes.iter().enumerate() {
         let meshes: Vec<&Mesh> = node
             .meshes
@@ -305,51 +315,71 @@ pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
         if meshes.is_empty() {
             continue;
         }
-        let _ = writeln!(w, "g {}_{i}", sanitize(&node.name, "node"));
         let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
         let identity = world == DMat4::IDENTITY;
         let linear = DMat3::from_mat4(world);
         let mirror = linear.determinant() < 0.0;
         let normal_matrix = linear.inverse().transpose();
+        let (mut ps, mut ts, mut ns) = (Vec::new(), Vec::new(), Vec::new());
+        let mut faces: Vec<(String, Vec<[[u64; 3]; 3]>)> = Vec::new();
         for m in meshes {
-            match m.material {
-                Some(id) => {
-                    let _ = writeln!(w, "usemtl {}", material_name(id.index(), scene));
-                }
-                None => {
-                    let _ = writeln!(w, "usemtl {DEFAULT_MATERIAL}");
-                }
-            }
-            for p in &m.positions {
+            let mut ids = Vec::new();
+            for k in 0..m.vertex_count() {
+                let p = m.positions[k];
                 let p = if identity {
-                    *p
+                    p
                 } else {
                     world.transform_point3(p.as_dvec3()).as_vec3()
                 };
-                let _ = writeln!(w, "v {} {} {}", p.x, p.y, p.z);
-            }
-            for t in &m.uvs {
-                let _ = writeln!(w, "vt {} {}", t.x, 1.0 - t.y);
-            }
-            for n in &m.normals {
+                let t = m.uvs[k];
+                let n = m.normals[k];
                 let n = if identity {
                     n.normalize_or_zero()
                 } else {
                     (normal_matrix * n.as_dvec3()).normalize_or_zero().as_vec3()
                 };
-                let _ = writeln!(w, "vn {} {} {}", n.x, n.y, n.z);
+                ids.push([
+                    find(&mut ps, p.to_array(), bits3, vb),
+                    find(&mut ts, [t.x, 1.0 - t.y], bits2, tb),
+                    find(&mut ns, n.to_array(), bits3, nb),
+                ]);
             }
-            for [a, b, c] in m.triangles() {
-                let (a, b, c) = (
-                    base + u64::from(a),
-                    base + u64::from(b),
-                    base + u64::from(c),
-                );
-                let (b, c) = if mirror { (c, b) } else { (b, c) };
-                let _ = writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
-            }
-            base += m.vertex_count() as u64;
+            let name = match m.material {
+                Some(id) => material_name(id.index(), scene),
+                None => DEFAULT_MATERIAL.to_string(),
+            };
+            let tris = m
+                .triangles()
+                .map(|[a, b, c]| {
+                    let (b, c) = if mirror { (c, b) } else { (b, c) };
+                    [a, b, c].map(|k| ids[k as usize])
+                })
+                .collect();
+            faces.push((name, tris));
         }
+        let _ = writeln!(w, "g {}_{i}", sanitize(&node.name, "node"));
+        for [x, y, z] in &ps {
+            let _ = writeln!(w, "v {x} {y} {z}");
+        }
+        for [u, v] in &ts {
+            let _ = writeln!(w, "vt {u} {v}");
+        }
+        for [x, y, z] in &ns {
+            let _ = writeln!(w, "vn {x} {y} {z}");
+        }
+        for (name, tris) in faces {
+            let _ = writeln!(w, "usemtl {name}");
+            for [a, b, c] in tris {
+                let _ = writeln!(
+                    w,
+                    "f {}/{}/{} {}/{}/{} {}/{}/{}",
+                    a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]
+                );
+            }
+        }
+        vb += ps.len() as u64;
+        tb += ts.len() as u64;
+        nb += ns.len() as u64;
     }
     w
 }

@@ -1,7 +1,6 @@
 //! [`GridIndex`]: a hashed uniform grid.
 
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec2;
 
@@ -9,52 +8,7 @@ use super::{GridOptions, IndexKey, Shape, SpatialIndex};
 use crate::bbox::Aabb2;
 use crate::error::GeomError;
 
-/// A small, fast, deterministic hasher (the multiply-rotate scheme of Firefox's "FxHash",
-/// with a final bit mix).
-/// Only used for lookups; no output ever depends on hash-map iteration order.
-#[derive(Default, Clone, Copy)]
-pub(crate) struct FxHasher(u64);
-
-const SEED: u64 = 0x51_7c_c1_b7_27_22_0a_95;
-
-impl Hasher for FxHasher {
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut buf = [0u8; 8];
-            buf[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(buf));
-        }
-    }
-    #[inline]
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(SEED);
-    }
-    #[inline]
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(u64::from(i));
-    }
-    #[inline]
-    fn write_i64(&mut self, i: i64) {
-        self.write_u64(i as u64);
-    }
-    #[inline]
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-    #[inline]
-    fn finish(&self) -> u64 {
-        // A final avalanche (MurmurHash3's fmix64): the multiply above leaves the low bits,
-        // which pick the bucket, depending on the low input bits only.
-        let mut h = self.0;
-        h ^= h >> 33;
-        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
-        h ^= h >> 33;
-        h
-    }
-}
-
-pub(crate) type FxBuild = BuildHasherDefault<FxHasher>;
+pub(crate) use crate::hash::FxBuild;
 
 type Cell = (i64, i64);
 
