@@ -179,8 +179,45 @@ fn check_glb_hygiene(name: &str, city: &City, doc: &polis::export::gltf::Gltf) {
         image_used[t.source().index()] = true;
     }
     assert!(image_used.iter().all(|&u| u), "{name}: unused images");
+    // Samplers that suit their images: repeating or mipmapped sampling (what WebGL 1 and
+    // the Khronos validator's IMAGE_NPOT_DIMENSIONS ask of) only on power-of-two images.
+    let blob = doc.blob.as_deref().unwrap_or_default();
+    let mut sampled_as_tiles = 0;
+    for t in doc.textures() {
+        use polis::export::gltf::image::Source;
+        use polis::export::gltf::texture::{MinFilter, WrappingMode};
+        let s = t.sampler();
+        let repeats = [s.wrap_s(), s.wrap_t()]
+            .iter()
+            .any(|w| *w != WrappingMode::ClampToEdge);
+        let mipmaps = !matches!(
+            s.min_filter(),
+            None | Some(MinFilter::Nearest) | Some(MinFilter::Linear)
+        );
+        let Source::View { view, mime_type } = t.source().source() else {
+            panic!("{name}: an image outside the glb");
+        };
+        assert_eq!(mime_type, "image/png", "{name}");
+        let png = &blob[view.offset()..view.offset() + view.length()];
+        let (w, h) = (
+            u32::from_be_bytes(png[16..20].try_into().unwrap()),
+            u32::from_be_bytes(png[20..24].try_into().unwrap()),
+        );
+        if repeats || mipmaps {
+            sampled_as_tiles += 1;
+            assert!(
+                w.is_power_of_two() && h.is_power_of_two(),
+                "{name}: image {} is {w} × {h} under a repeating or mipmapped sampler",
+                t.source().index()
+            );
+        }
+    }
+    assert!(
+        doc.textures().count() == 0 || sampled_as_tiles > 0,
+        "{name}: no texture is sampled as a repeating tile"
+    );
     // One name for building kinds.
-    let (_, json) = map_bytes(city);
+    let (svg, json) = map_bytes(city);
     let json: serde_json::Value = serde_json::from_slice(&json).unwrap();
     let mut map_kinds: Vec<String> = json["features"]
         .as_array()
@@ -226,6 +263,22 @@ fn check_glb_hygiene(name: &str, city: &City, doc: &polis::export::gltf::Gltf) {
         "{name}: no building kinds in the glb"
     );
     assert_eq!(glb_kinds, map_kinds, "{name}: building kinds differ");
+    // The SVG's footprints (the paths with a height) carry the kind as their class.
+    let svg = String::from_utf8(svg).unwrap();
+    let mut svg_kinds: Vec<String> = svg
+        .lines()
+        .filter(|l| l.contains("data-height="))
+        .filter_map(|l| {
+            let rest = &l[l.find("class=\"")? + 7..];
+            Some(rest[..rest.find('"')?].to_string())
+        })
+        .collect();
+    svg_kinds.sort();
+    svg_kinds.dedup();
+    assert_eq!(
+        svg_kinds, map_kinds,
+        "{name}: building kinds differ in the SVG"
+    );
 }
 
 /// A scene node's untextured meshes: a building's mass or a block's plinth (the
