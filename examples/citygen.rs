@@ -8,7 +8,9 @@
 //! ```
 //!
 //! `--bench-growth RUNS` grows every Kelly cell serially on one thread `RUNS` times and
-//! prints CPU time and a digest of the grown graphs, then `RUNS` times on the thread pool
+//! prints CPU time and a digest of the grown graphs; then each cell's least time over
+//! those runs, with what the cells would take on the pool's number of idle cores (handed
+//! out in their order, or largest first); then grows them `RUNS` times on the thread pool
 //! (`--threads`, default all cores) and prints wall time and the digest (the serial one).
 //!
 //! `--city` also generates the whole city (without the 3-D scene) after the road part;
@@ -215,14 +217,20 @@ fn growth_bench(
     }
     let seed = cx.seed(Stage::Roads, 1);
     let maps = CellMaps::none();
+    // Each cell's least wall time over the serial runs (its growth alone, read with the
+    // monotonic clock, which costs far less than the CPU clock's file read).
+    let mut cell_ns = vec![u64::MAX; inputs.len()];
     for run in 0..runs {
         let (t, c) = (Instant::now(), thread_cpu_ns());
         let mut roads = 0;
         let mut digest = 0u64;
         let mut joins = (0, 0);
-        for (cell, p) in &inputs {
+        for ((cell, p), best) in inputs.iter().zip(&mut cell_ns) {
+            let started = Instant::now();
             let mut growth = SecondaryGrowth::new(p.clone())?;
-            if let Ok(r) = growth.grow(cell, &maps, seed) {
+            let grown = growth.grow(cell, &maps, seed);
+            *best = (*best).min(started.elapsed().as_nanos() as u64);
+            if let Ok(r) = grown {
                 roads += r.segments().count();
                 digest = polis::geom::hash::splitmix64(digest ^ graph_digest(&r.network));
             }
@@ -241,6 +249,7 @@ fn growth_bench(
             joins.1
         );
     }
+    schedules(&cell_ns, pool.current_num_threads());
     // The same growth with the cells spread over the pool's threads (as the pipeline
     // grows them): wall time, and the digest, which must be the serial one.
     for run in 0..runs {
@@ -268,6 +277,39 @@ fn growth_bench(
         );
     }
     Ok(())
+}
+
+/// Prints the cells' growth times (each cell's least over the serial runs) and what they
+/// would take on `threads` idle cores: the lower bound (the largest cell, or the sum
+/// shared evenly), cells handed out in their order to whichever core is free first, and
+/// largest first.
+fn schedules(cell_ns: &[u64], threads: usize) {
+    let threads = threads.max(1);
+    let ms = |ns: u64| ns as f64 / 1e6;
+    let sum: u64 = cell_ns.iter().sum();
+    let mut sorted = cell_ns.to_vec();
+    sorted.sort_unstable_by(|a, b| b.cmp(a));
+    let makespan = |order: &[u64]| {
+        let mut free = vec![0u64; threads];
+        for &t in order {
+            if let Some(f) = free.iter_mut().min() {
+                *f += t;
+            }
+        }
+        free.into_iter().max().unwrap_or(0)
+    };
+    let largest = sorted.first().copied().unwrap_or(0);
+    println!(
+        "cells: sum of least times {:.2} ms, largest {:.2} ms, next {:.2} / {:.2} / {:.2} ms; on {threads} idle cores: bound {:.2} ms, in order {:.2} ms, largest first {:.2} ms",
+        ms(sum),
+        ms(largest),
+        ms(sorted.get(1).copied().unwrap_or(0)),
+        ms(sorted.get(2).copied().unwrap_or(0)),
+        ms(sorted.get(3).copied().unwrap_or(0)),
+        ms(largest.max(sum.div_ceil(threads as u64))),
+        ms(makespan(cell_ns)),
+        ms(makespan(&sorted)),
+    );
 }
 
 /// FNV-1a over a graph's nodes and edges in id order (positions to the bit).

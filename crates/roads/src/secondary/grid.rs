@@ -1,18 +1,20 @@
 //! A flat grid of one cell's roads for the snap algorithm's extended-box search: sized to
 //! the cell once, with no hashing, append-only while the cell grows.
 //!
-//! Each road is entered in every grid square its segment passes through (a conservative
-//! cover, column by column), with its end nodes and their positions copied into the
-//! entry, so a search reads no graph at all; coordinates outside the grid clamp to its
-//! border squares, so the cover stays conservative for any road.
+//! Each road is entered, by its id alone, in every grid square its segment passes
+//! through (a conservative cover, column by column); coordinates outside the grid clamp
+//! to its border squares, so the cover stays conservative for any road. A table by road
+//! id holds each road's end nodes and their positions as they are now, so a search reads
+//! no graph at all, and the query stamp that reports each road once per search.
 //!
 //! Growth only adds roads, except where it splits a road (a secondary road joining it)
 //! or removes one (an undone start split). Road ids are never reused by the graph, so
 //! the new roads to enter are exactly the ids above the last one entered
 //! ([`SnapGrid::sync`]); a road that changed is reported with [`SnapGrid::refresh`],
-//! which gives it a new version and enters its current segment under that version. The
-//! entries of older versions stay in their squares and are passed over (each costs one
-//! comparison, never an answer).
+//! which copies its current ends into the table and enters its current segment again
+//! (a removed road is marked dead). Squares the road has left keep its id: a search
+//! that meets it there reads the table's current segment, which the caller's box test
+//! then judges, so such an entry costs a look-up, never a wrong answer.
 
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
 
@@ -21,8 +23,7 @@ use crate::network::RoadNetwork;
 /// The most squares the grid is made of (the square size grows to keep within it).
 const MAX_SQUARES: usize = 1 << 16;
 
-/// A road as the grid lists it: its id, end nodes and their positions (as of the
-/// version `version`).
+/// A road as the grid lists it: its id, end nodes and their positions.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct GridRoad {
     /// The road.
@@ -35,7 +36,6 @@ pub(crate) struct GridRoad {
     pub(crate) pu: DVec2,
     /// The second end's position.
     pub(crate) pv: DVec2,
-    version: u32,
 }
 
 impl GridRoad {
@@ -48,16 +48,33 @@ impl GridRoad {
             v,
             pu: g.position(u).ok()?,
             pv: g.position(v).ok()?,
-            version: 0,
         })
     }
 }
 
-/// Per road id: its current version and the query that last reported it.
-#[derive(Debug, Clone, Copy, Default)]
-struct Mark {
-    version: u32,
+/// Per road id: the road as it is now, whether it is alive, and the query that last
+/// reported it.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    road: GridRoad,
+    alive: bool,
     stamp: u32,
+}
+
+impl Default for Slot {
+    fn default() -> Self {
+        Slot {
+            road: GridRoad {
+                edge: EdgeId::from_raw(0),
+                u: NodeId::from_raw(0),
+                v: NodeId::from_raw(0),
+                pu: DVec2::ZERO,
+                pv: DVec2::ZERO,
+            },
+            alive: false,
+            stamp: 0,
+        }
+    }
 }
 
 /// See the [module docs](self).
@@ -68,10 +85,12 @@ pub(crate) struct SnapGrid {
     inv: f64,
     nx: usize,
     ny: usize,
-    squares: Vec<Vec<GridRoad>>,
+    /// The ids of the roads entered in each square.
+    squares: Vec<Vec<u32>>,
     /// Roads with ids below this are entered.
     entered: usize,
-    marks: Vec<Mark>,
+    /// By road id.
+    slots: Vec<Slot>,
     query: u32,
 }
 
@@ -113,17 +132,18 @@ impl SnapGrid {
             self.squares.resize_with(n, Vec::new);
         }
         self.entered = 0;
-        self.marks.clear();
+        self.slots.clear();
         self.query = 0;
     }
 
     /// The column of `x` (clamped to the grid; `⌊·⌋` by truncation, as the value is not
-    /// negative where it is used).
+    /// negative where it is used; the conversion saturates at `u32::MAX`, far above any
+    /// column count).
     #[inline]
     fn col(&self, x: f64) -> usize {
         let c = (x - self.origin.x) * self.inv;
         if c >= 0.0 {
-            (c as usize).min(self.nx - 1)
+            (c as u32 as usize).min(self.nx - 1)
         } else {
             0
         }
@@ -134,7 +154,7 @@ impl SnapGrid {
     fn row(&self, y: f64) -> usize {
         let c = (y - self.origin.y) * self.inv;
         if c >= 0.0 {
-            (c as usize).min(self.ny - 1)
+            (c as u32 as usize).min(self.ny - 1)
         } else {
             0
         }
@@ -146,8 +166,8 @@ impl SnapGrid {
         if self.nx == 0 {
             self.reset(g.bbox(), 64.0);
         }
-        if self.marks.len() < bound {
-            self.marks.resize(bound, Mark::default());
+        if self.slots.len() < bound {
+            self.slots.resize(bound, Slot::default());
         }
         for i in self.entered..bound {
             self.enter(g, EdgeId::from_raw(i as u32));
@@ -155,33 +175,30 @@ impl SnapGrid {
         self.entered = self.entered.max(bound);
     }
 
-    /// Road `e` (entered before) was split or removed: its entries so far are stale and
-    /// its current segment, if it is still alive, is entered again.
+    /// Road `e` (entered before) was split or removed: its slot takes its current ends
+    /// (or marks it dead) and its current segment, if it is still alive, is entered
+    /// again.
     pub(crate) fn refresh(&mut self, g: &RoadNetwork, e: EdgeId) {
         if e.index() >= self.entered {
             return; // not entered yet: `sync` will read its current segment
         }
-        if let Some(m) = self.marks.get_mut(e.index()) {
-            m.version = m.version.wrapping_add(1);
-        }
         self.enter(g, e);
     }
 
-    /// Enters road `e`'s current segment, under its current version, in every square
-    /// the segment passes through (nothing for a dead id).
+    /// Copies road `e`'s current ends into its slot (marking it dead for a dead id) and
+    /// enters its current segment in every square the segment passes through.
     fn enter(&mut self, g: &RoadNetwork, e: EdgeId) {
-        let (Ok((u, v)), Ok((a, b))) = (g.endpoints(e), g.segment(e)) else {
+        let Some(slot) = self.slots.get_mut(e.index()) else {
             return;
         };
-        let version = self.marks.get(e.index()).map_or(0, |m| m.version);
-        let road = GridRoad {
-            edge: e,
-            u,
-            v,
-            pu: a,
-            pv: b,
-            version,
+        let Some(road) = GridRoad::of(g, e) else {
+            slot.alive = false;
+            return;
         };
+        slot.road = road;
+        slot.alive = true;
+        let id = e.index() as u32;
+        let (a, b) = (road.pu, road.pv);
         let (c0, c1) = (self.col(a.x.min(b.x)), self.col(a.x.max(b.x)));
         let (r0, r1) = (self.row(a.y.min(b.y)), self.row(a.y.max(b.y)));
         let dx = b.x - a.x;
@@ -212,7 +229,7 @@ impl SnapGrid {
             };
             for r in lo..=hi {
                 if let Some(s) = self.squares.get_mut(r * self.nx + c) {
-                    s.push(road);
+                    s.push(id);
                 }
             }
         }
@@ -227,8 +244,8 @@ impl SnapGrid {
         }
         self.query = self.query.wrapping_add(1);
         if self.query == 0 {
-            for m in &mut self.marks {
-                m.stamp = 0;
+            for slot in &mut self.slots {
+                slot.stamp = 0;
             }
             self.query = 1;
         }
@@ -239,13 +256,14 @@ impl SnapGrid {
                 continue;
             };
             for s in row {
-                for road in s {
-                    if let Some(m) = self.marks.get_mut(road.edge.index())
-                        && m.version == road.version
-                        && m.stamp != self.query
+                for &id in s {
+                    if let Some(slot) = self.slots.get_mut(id as usize)
+                        && slot.stamp != self.query
                     {
-                        m.stamp = self.query;
-                        f(road);
+                        slot.stamp = self.query;
+                        if slot.alive {
+                            f(&slot.road);
+                        }
                     }
                 }
             }

@@ -13,9 +13,11 @@
 //!    `s = ap⊥·ab / |ab|²`; a node with `0 < r ≤ 1` and `|s|·|ab| ≤ snap` is an event at
 //!    `r`; one with `1 < r ≤ 1 + snap/|ab|` is an event if it lies within the snap size of
 //!    `b`. The best `r` so far is the benchmark: only smaller `r` are tested further.
-//! 3. **Test 2, segment intersection** (§4.3.3.4): the `r` and `s` of test 1 are reused.
-//!    A road whose end nodes lie strictly on opposite sides of the line `ab` (the sign of
-//!    `s`, decided exactly by `orient2d`) meets the line at
+//! 3. **Test 2, segment intersection** (§4.3.3.4): only roads whose boxes meet the box
+//!    of `a–b` itself (not grown) can cross it, so only their ends get test 1's `r` and
+//!    `s` and an exact side (the other roads' ends, often outside the extended box, are
+//!    never computed). A road whose end nodes lie strictly on opposite sides of the line
+//!    `ab` (the sign of `s`, decided exactly by `orient2d`) meets the line at
 //!    `r = (r_u·|s_v| + r_v·|s_u|) / (|s_u| + |s_v|)`, known without computing the
 //!    intersection; only when that `r` beats the benchmark is the exact crossing test run.
 //! 4. **Test 3, segment proximity** (§4.3.3.5): only if tests 1 and 2 found nothing,
@@ -66,11 +68,9 @@ struct NodeScalars {
 /// The snap algorithm with its per-query scratch (reused between queries).
 #[derive(Debug, Default, Clone)]
 pub struct Snapper {
-    stamp: Vec<u32>,
+    /// By node id: the query that last met the node in its extended box.
     seen: Vec<u32>,
-    scalars: Vec<NodeScalars>,
     query: u32,
-    found: Vec<(NodeId, DVec2)>,
     roads: Vec<GridRoad>,
     /// Exact segment-intersection tests run (the rest were excluded by `r`/`s`).
     pub exact_tests: u64,
@@ -94,33 +94,27 @@ impl Snapper {
     }
 
     fn begin(&mut self, nodes: usize) {
-        if self.stamp.len() < nodes {
-            self.stamp.resize(nodes, 0);
+        if self.seen.len() < nodes {
             self.seen.resize(nodes, 0);
-            self.scalars.resize(nodes, NodeScalars::default());
         }
         self.query = self.query.wrapping_add(1);
         if self.query == 0 {
-            self.stamp.fill(0);
             self.seen.fill(0);
             self.query = 1;
         }
     }
 
+    /// Whether node `n` is met for the first time in this query (then marked).
     #[inline]
-    fn scalars(&mut self, n: NodeId, p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
-        let i = n.index();
-        if let (Some(&st), Some(&sc)) = (self.stamp.get(i), self.scalars.get(i))
-            && st == self.query
-        {
-            return sc;
+    fn first_sight(&mut self, n: NodeId) -> bool {
+        match self.seen.get_mut(n.index()) {
+            Some(mark) if *mark == self.query => false,
+            Some(mark) => {
+                *mark = self.query;
+                true
+            }
+            None => true,
         }
-        let sc = compute(p, a, b);
-        if let (Some(st), Some(slot)) = (self.stamp.get_mut(i), self.scalars.get_mut(i)) {
-            *st = self.query;
-            *slot = sc;
-        }
-        sc
     }
 
     /// The roads the last query gathered (those whose boxes meet its extended box), with
@@ -196,35 +190,21 @@ impl Snapper {
         // The grid reports each road once, in an order fixed by the growth so far; every
         // choice below breaks ties by id, so the order does not matter.
         self.box_hits += roads.len() as u64;
-        // Test 1: node proximity.
+        // Test 1: node proximity, over the ends of these roads in the extended box (each
+        // node once; only `r` and `s` are needed here).
         let mut best: Option<(f64, NodeId)> = None;
         let mut best_r = 1.0 + radius / len;
-        let mut found = std::mem::take(&mut self.found);
-        found.clear();
-        for road in &roads {
-            for (n, p) in [(road.u, road.pu), (road.v, road.pv)] {
-                // Each node once: `seen` is stamped with the query number.
-                let Some(mark) = self.seen.get_mut(n.index()) else {
-                    continue;
-                };
-                if *mark == self.query {
-                    continue;
-                }
-                *mark = self.query;
-                if ext.contains(p) {
-                    found.push((n, p));
-                }
+        let mut node = |n: NodeId, p: DVec2| {
+            if !ext.contains(p) || !self.first_sight(n) {
+                return;
             }
-        }
-        for &(n, p) in &found {
-            let sc = self.scalars(n, p, a, b);
-            let r = sc.r;
+            let (r, s) = along(p, a, d, len2);
             let better = r < best_r || (r == best_r && best.is_some_and(|(_, m)| n < m));
             if !(r > 0.0 && better) {
-                continue;
+                return;
             }
             let hit = if r <= 1.0 {
-                sc.s.abs() * len <= radius
+                s.abs() * len <= radius
             } else {
                 p.distance_squared(b) <= radius * radius
             };
@@ -232,18 +212,24 @@ impl Snapper {
                 best_r = r;
                 best = Some((r, n));
             }
+        };
+        for road in &roads {
+            node(road.u, road.pu);
+            node(road.v, road.pv);
         }
-        self.found = found;
-        // Test 2: segment intersection before the benchmark.
+        // Test 2: segment intersection before the benchmark. A road that crosses `a–b`
+        // meets the segment's own box, so only those roads are tested (the exact test
+        // below would refuse the others).
         let limit = best_r.min(1.0);
+        let segment_box = Aabb2::new(a, b);
         let mut cross: Option<(f64, usize, DVec2)> = None;
         for (i, road) in roads.iter().enumerate() {
             let (u, v, pu, pv) = (road.u, road.v, road.pu, road.pv);
-            if u == root || v == root {
+            if u == root || v == root || !Aabb2::new(pu, pv).intersects(&segment_box) {
                 continue;
             }
-            let su = self.scalars(u, pu, a, b);
-            let sv = self.scalars(v, pv, a, b);
+            let su = compute(pu, a, b);
+            let sv = compute(pv, a, b);
             if su.side * sv.side >= 0 {
                 continue; // same side of the line ab, or touching it (a node event)
             }
@@ -395,20 +381,23 @@ pub(super) fn folds_onto_root(
 }
 
 /// Kelly's `r` and `s` of `p` against `a–b`, with the exact side of `p`.
+#[inline]
 fn compute(p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
     let ab = b - a;
-    let ap = p - a;
-    let len2 = ab.length_squared();
+    let (r, s) = along(p, a, ab, ab.length_squared());
     let side = match orient2d(a, b, p) {
         Orientation::CounterClockwise => 1,
         Orientation::Clockwise => -1,
         Orientation::Collinear => 0,
     };
-    NodeScalars {
-        r: ap.dot(ab) / len2,
-        s: ab.perp_dot(ap) / len2,
-        side,
-    }
+    NodeScalars { r, s, side }
+}
+
+/// Kelly's `r` and `s` of `p` against the segment from `a` along `ab` (`len2 = |ab|²`).
+#[inline]
+fn along(p: DVec2, a: DVec2, ab: DVec2, len2: f64) -> (f64, f64) {
+    let ap = p - a;
+    (ap.dot(ab) / len2, ab.perp_dot(ap) / len2)
 }
 
 #[cfg(test)]
