@@ -371,7 +371,16 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         while let Some((id, frame, path)) = stack.pop() {
             let node = &scene.nodes[id.index()];
             let is_root = id == root;
-            let layer_name = node.metadata.get("layer").and_then(|v| v.as_str());
+            // One pass over the metadata (a building has a dozen entries): its layer,
+            // its LOD level and whether it has any other entry (then it is a feature).
+            let (mut layer_name, mut lod_value, mut own_feature) = (None, None, false);
+            for (k, v) in node.metadata.iter() {
+                match k {
+                    "layer" => layer_name = v.as_str(),
+                    "lod" => lod_value = v.as_f64(),
+                    _ => own_feature = true,
+                }
+            }
             let info = if is_root {
                 None
             } else {
@@ -381,7 +390,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     (None, Some(p)) => p.layer,
                     (None, None) => layer_set.index(&node.name),
                 };
-                let lod = match node.metadata.get("lod").and_then(|v| v.as_f64()) {
+                let lod = match lod_value {
                     Some(l) if l >= 0.0 && l.fract() == 0.0 && l <= f64::from(u16::MAX) => {
                         Some(l as u32)
                     }
@@ -396,8 +405,6 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     }
                     None => inherited.and_then(|p| p.lod),
                 };
-                let own_feature = !node.metadata.is_empty()
-                    && node.metadata.keys().any(|k| k != "layer" && k != "lod");
                 let feature = if own_feature {
                     Some((id, layer))
                 } else {
