@@ -745,7 +745,11 @@ fn document(
             _ => serde_json::Map::new(),
         };
         let none = serde_json::Map::new();
-        let extras = Merged(&metadata, pn.extras.as_ref().unwrap_or(&none));
+        let extras = Merged(
+            &metadata,
+            pn.extras.as_ref().unwrap_or(&none),
+            &pn.raw_extras,
+        );
         let name = match source {
             Some(node) => named(&node.name),
             None => named(&pn.name),
@@ -809,28 +813,39 @@ fn document(
     Ok((root, instance_accessors))
 }
 
-/// Two JSON objects serialized as one, without copying either: keys in sorted order (as
-/// `serde_json::Map` orders them), the second object's value where both have a key.
+/// A node's metadata, the layout's extras and its arrays of elements already written as
+/// text, serialized as one JSON object without copying any: keys in sorted order (as
+/// `serde_json::Map` orders them); where several have a key, the array, else the second
+/// object's value.
 struct Merged<'a>(
     &'a serde_json::Map<String, serde_json::Value>,
     &'a serde_json::Map<String, serde_json::Value>,
+    &'a [(&'static str, Vec<Box<serde_json::value::RawValue>>)],
 );
 
 impl Merged<'_> {
     fn is_empty(&self) -> bool {
-        self.0.is_empty() && self.1.is_empty()
+        self.0.is_empty() && self.1.is_empty() && self.2.is_empty()
     }
 }
 
 impl Serialize for Merged<'_> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let mut keys: Vec<&String> = self.0.keys().chain(self.1.keys()).collect();
+        let mut keys: Vec<&str> = self
+            .0
+            .keys()
+            .chain(self.1.keys())
+            .map(String::as_str)
+            .chain(self.2.iter().map(|(k, _)| *k))
+            .collect();
         keys.sort_unstable();
         keys.dedup();
         let mut map = s.serialize_map(Some(keys.len()))?;
         for k in keys {
-            if let Some(v) = self.1.get(k).or_else(|| self.0.get(k)) {
+            if let Some((_, v)) = self.2.iter().find(|(name, _)| *name == k) {
+                map.serialize_entry(k, v)?;
+            } else if let Some(v) = self.1.get(k).or_else(|| self.0.get(k)) {
                 map.serialize_entry(k, v)?;
             }
         }

@@ -97,6 +97,10 @@ pub(crate) struct PlannedNode {
     pub name: String,
     /// Entries added to the extras (after the scene node's metadata).
     pub extras: Option<serde_json::Map<String, serde_json::Value>>,
+    /// Entries added to the extras whose value is an array of elements already written
+    /// as JSON text (the tiled layout's feature table in the plain profile); where
+    /// `extras` has the same key, this one is written.
+    pub raw_extras: Vec<(&'static str, Vec<Box<serde_json::value::RawValue>>)>,
     pub mesh: Option<usize>,
     pub children: Vec<u32>,
     /// `EXT_mesh_gpu_instancing`: the scene nodes whose transforms are the instances
@@ -110,6 +114,7 @@ impl PlannedNode {
             source: Some(source),
             name: String::new(),
             extras: None,
+            raw_extras: Vec::new(),
             mesh: None,
             children: Vec::new(),
             instances: Vec::new(),
@@ -125,6 +130,7 @@ impl PlannedNode {
                 serde_json::Value::Object(m) => Some(m),
                 _ => None,
             },
+            raw_extras: Vec::new(),
             mesh: None,
             children: Vec::new(),
             instances: Vec::new(),

@@ -30,8 +30,10 @@ use std::collections::{BTreeMap, HashMap};
 
 use polis_geom::glam::{DMat4, DVec3, Vec3};
 use polis_geom::mesh::{TileIndex, tile_of};
-use polis_geom::scene::{MaterialId, MetaValue, NodeId, Scene};
+use polis_geom::scene::{MaterialId, Node, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
+use serde::ser::{Serialize, SerializeMap, Serializer};
+use serde_json::value::RawValue;
 use serde_json::{Map, Value, json};
 
 use super::options::{GlbOptions, GlbProfile};
@@ -268,13 +270,75 @@ struct PathInfo {
     feature: Option<(NodeId, usize)>,
 }
 
-/// A metadata value as JSON (as its `Serialize` writes it: a non-finite number, which
-/// metadata never holds, would be `null`).
-fn meta_json(v: &MetaValue) -> Value {
-    match v {
-        MetaValue::String(s) => Value::from(s.as_ref()),
-        MetaValue::Number(x) => Value::from(*x),
-        MetaValue::Bool(b) => Value::Bool(*b),
+/// One record of a root's feature table: its node's name, its layer and the node's
+/// metadata less any `name` and `layer` entry, keys in sorted order (the order of a
+/// `serde_json::Map`), serialized from the scene without building JSON values.
+struct Record<'s> {
+    node: &'s Node,
+    layer: &'s str,
+}
+
+impl Serialize for Record<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        // The metadata iterates in key order: `layer` and `name` go in where they sort.
+        let fixed = [("layer", self.layer), ("name", self.node.name.as_str())];
+        let mut next = 0;
+        let mut map = s.serialize_map(None)?;
+        for (k, v) in self.node.metadata.iter() {
+            while let Some(&(f, text)) = fixed.get(next)
+                && f < k
+            {
+                map.serialize_entry(f, text)?;
+                next += 1;
+            }
+            if k != "layer" && k != "name" {
+                map.serialize_entry(k, v)?;
+            }
+        }
+        for &(f, text) in fixed.get(next..).unwrap_or_default() {
+            map.serialize_entry(f, text)?;
+        }
+        map.end()
+    }
+}
+
+/// A root's feature table, each record written when its node is met (its metadata
+/// then at hand): in the plain profile as JSON text (no JSON values built and dropped),
+/// in the web profile as values for [`by_column`].
+enum Table {
+    Rows(Vec<Box<RawValue>>),
+    Values(Vec<Value>),
+}
+
+impl Table {
+    fn new(profile: GlbProfile) -> Self {
+        match profile {
+            GlbProfile::Plain => Table::Rows(Vec::new()),
+            GlbProfile::Web => Table::Values(Vec::new()),
+        }
+    }
+
+    /// Adds `record`; returns its index.
+    fn push(&mut self, record: Record<'_>) -> Result<u32, ExportError> {
+        let error = ExportError::json("extras");
+        let len = match self {
+            Table::Rows(rows) => {
+                rows.push(serde_json::value::to_raw_value(&record).map_err(error)?);
+                rows.len()
+            }
+            Table::Values(values) => {
+                values.push(serde_json::to_value(record).map_err(error)?);
+                values.len()
+            }
+        };
+        Ok(len as u32 - 1)
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            Table::Rows(rows) => rows.len(),
+            Table::Values(values) => values.len(),
+        }
     }
 }
 
@@ -299,7 +363,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
 
         // Walk the subtree in pre-order: objects, their frame, path info.
         let mut layer_set = Layers::default();
-        let mut features: Vec<Value> = Vec::new();
+        let mut features = Table::new(options.profile);
         let mut record_of: BTreeMap<NodeId, u32> = BTreeMap::new();
         let mut merge = Merge::default();
         let mut levels: Vec<u32> = Vec::new();
@@ -307,7 +371,16 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
         while let Some((id, frame, path)) = stack.pop() {
             let node = &scene.nodes[id.index()];
             let is_root = id == root;
-            let layer_name = node.metadata.get("layer").and_then(|v| v.as_str());
+            // One pass over the metadata (a building has a dozen entries): its layer,
+            // its LOD level and whether it has any other entry (then it is a feature).
+            let (mut layer_name, mut lod_value, mut own_feature) = (None, None, false);
+            for (k, v) in node.metadata.iter() {
+                match k {
+                    "layer" => layer_name = v.as_str(),
+                    "lod" => lod_value = v.as_f64(),
+                    _ => own_feature = true,
+                }
+            }
             let info = if is_root {
                 None
             } else {
@@ -317,7 +390,7 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     (None, Some(p)) => p.layer,
                     (None, None) => layer_set.index(&node.name),
                 };
-                let lod = match node.metadata.get("lod").and_then(|v| v.as_f64()) {
+                let lod = match lod_value {
                     Some(l) if l >= 0.0 && l.fract() == 0.0 && l <= f64::from(u16::MAX) => {
                         Some(l as u32)
                     }
@@ -332,8 +405,6 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                     }
                     None => inherited.and_then(|p| p.lod),
                 };
-                let own_feature = !node.metadata.is_empty()
-                    && node.metadata.keys().any(|k| k != "layer" && k != "lod");
                 let feature = if own_feature {
                     Some((id, layer))
                 } else {
@@ -383,17 +454,10 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 Some((owner, layer)) => match record_of.get(&owner) {
                     Some(&k) => k,
                     None => {
-                        let owner_node = &scene.nodes[owner.index()];
-                        let mut record = Map::new();
-                        record.insert("name".into(), Value::from(owner_node.name.as_str()));
-                        record.insert("layer".into(), Value::from(layer_set.names[layer].as_str()));
-                        for (k, v) in owner_node.metadata.iter() {
-                            if k != "name" && k != "layer" {
-                                record.insert(k.to_string(), meta_json(v));
-                            }
-                        }
-                        features.push(Value::Object(record));
-                        let k = features.len() as u32 - 1;
+                        let k = features.push(Record {
+                            node: &scene.nodes[owner.index()],
+                            layer: &layer_set.names[layer],
+                        })?;
                         record_of.insert(owner, k);
                         k
                     }
@@ -565,12 +629,17 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             .collect();
         extras.insert("layers".into(), json!(named));
         plan.features += features.len();
-        let table = match options.profile {
-            GlbProfile::Plain => Value::Array(features),
-            GlbProfile::Web => by_column(features),
-        };
-        extras.insert("features".into(), table);
-        plan.nodes[root_index as usize].extras = Some(extras);
+        match features {
+            Table::Rows(rows) => {
+                let root_node = &mut plan.nodes[root_index as usize];
+                root_node.extras = Some(extras);
+                root_node.raw_extras.push(("features", rows));
+            }
+            Table::Values(values) => {
+                extras.insert("features".into(), by_column(values));
+                plan.nodes[root_index as usize].extras = Some(extras);
+            }
+        }
     }
     plan.count_meshes(scene, &used);
     Ok(plan)
@@ -614,6 +683,7 @@ fn compact_number(v: Value) -> Value {
 mod tests {
     use super::*;
     use polis_geom::glam::Vec2;
+    use polis_geom::scene::MetaValue;
     use proptest::prelude::*;
 
     /// A strip of `n` triangles with coordinates from `seed` (a −0 among them), with or
@@ -642,6 +712,53 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
+        /// A record written as text is the JSON object of its name, its layer and the
+        /// node's other metadata (a `name` or `layer` entry of the node replaced), keys
+        /// sorted, byte for byte; the web profile's value is that object.
+        #[test]
+        fn a_record_is_the_sorted_object_of_name_layer_and_metadata(
+            entries in proptest::collection::vec(
+                (
+                    prop_oneof![
+                        Just("name".to_string()),
+                        Just("layer".to_string()),
+                        Just("lod".to_string()),
+                        "[a-z_]{0,6}",
+                    ],
+                    prop_oneof![
+                        "[ -~é\n]{0,8}".prop_map(MetaValue::from),
+                        any::<f64>().prop_map(MetaValue::from),
+                        any::<bool>().prop_map(MetaValue::from),
+                    ],
+                ),
+                0..12,
+            ),
+            name in "[ -~é]{0,8}",
+            layer in "[a-z]{1,8}",
+        ) {
+            let mut node = Node::new(name.clone());
+            for (k, v) in entries {
+                node.metadata.insert(k, v);
+            }
+            let mut expect = Map::new();
+            expect.insert("name".into(), Value::from(name.as_str()));
+            expect.insert("layer".into(), Value::from(layer.as_str()));
+            for (k, v) in node.metadata.iter() {
+                if k != "name" && k != "layer" {
+                    expect.insert(k.to_string(), serde_json::to_value(v).unwrap());
+                }
+            }
+            let record = Record { node: &node, layer: &layer };
+            let text = serde_json::value::to_raw_value(&record).unwrap();
+            prop_assert_eq!(text.get(), serde_json::to_string(&expect).unwrap());
+            let mut table = Table::new(GlbProfile::Web);
+            prop_assert_eq!(table.push(record).unwrap(), 0);
+            let Table::Values(values) = table else {
+                unreachable!("the web profile's table holds values");
+            };
+            prop_assert_eq!(&values[0], &Value::Object(expect));
+        }
+
         /// The merge gives, per geometry, what appending its pieces one by one in walk
         /// order gives (positions moved in `f64`, feature ids with the null id where a
         /// piece has none, the union of the pieces' bounds), and every array it copies

@@ -12,7 +12,7 @@
 //!   it uses. A vertex on a tile border is copied into every tile that uses it, bit for
 //!   bit, so the tiles meet without a seam.
 
-use glam::Vec3;
+use glam::Vec3A;
 
 use super::{Aabb3, Mesh};
 use crate::par::prelude::*;
@@ -180,29 +180,35 @@ impl Mesh {
         // One pass over the triangles: the first-use numbering, and the extremes of
         // the corner sums `a + b + c` in x and z. Dividing by 3 (correctly rounded, by a
         // positive number) is monotone, so the extreme centroids are the extreme sums
-        // divided once; a sum is finite exactly when its centroid is.
+        // divided once; a sum is finite exactly when its centroid is. Without branches
+        // on the data: an index is in first-use order when it is at most the next new
+        // number (then the next is past it), and `sum × 0` is 0 for a finite sum, NaN
+        // otherwise, so their total says whether every sum was finite. The extremes
+        // of finite sums are the same in the four lanes of `Vec3A` (up to the sign of
+        // a zero, which gives the same tile).
         let mut next = 0usize;
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        let mut finite = true;
-        for tri in self.indices.chunks_exact(3) {
-            let mut sum = Vec3::ZERO;
-            for (k, &i) in tri.iter().enumerate() {
+        let mut ordered = true;
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        let mut nonfinite = Vec3A::ZERO;
+        let (triangles, _) = self.indices.as_chunks::<3>();
+        for tri in triangles {
+            let mut corners = [Vec3A::ZERO; 3];
+            for (corner, &i) in corners.iter_mut().zip(tri) {
                 let i = i as usize;
-                if i == next {
-                    next += 1;
-                } else if i > next {
-                    return None;
-                }
-                let p = *self.positions.get(i)?;
-                // `a + b + c` as `triangle_tile` adds them (the first corner not added
-                // to zero: a −0 stays −0).
-                sum = if k == 0 { p } else { sum + p };
+                ordered &= i <= next;
+                next = next.max(i + 1);
+                *corner = Vec3A::from(*self.positions.get(i)?);
             }
-            finite &= sum.is_finite();
+            // `a + b + c` as `triangle_tile` adds them (the first corner not added to
+            // zero: a −0 stays −0).
+            let [a, b, c] = corners;
+            let sum = a + b + c;
+            nonfinite += sum * 0.0;
             lo = lo.min(sum);
             hi = hi.max(sum);
         }
-        if next != n || !finite {
+        let finite = nonfinite.is_finite();
+        if !ordered || next != n || !finite {
             return None;
         }
         let tile = tile_of(lo.x / 3.0, lo.z / 3.0, size);
@@ -241,6 +247,15 @@ mod tests {
         u.add_vertex(DVec3::ZERO, DVec3::Y, DVec2::ZERO);
         assert_eq!(u.whole_tile(100.0), None);
         assert_eq!(Mesh::new(None).whole_tile(100.0), None);
+        // A corner that is not finite (in any coordinate), an index past the vertices.
+        for (axis, value) in [(0, f32::NAN), (1, f32::INFINITY), (2, f32::NEG_INFINITY)] {
+            let mut f = m.clone();
+            f.positions[3][axis] = value;
+            assert_eq!(f.whole_tile(100.0), None);
+        }
+        let mut past = m.clone();
+        past.indices[5] = 4;
+        assert_eq!(past.whole_tile(100.0), None);
         // Each of those is cut into meshes that are.
         for mesh in [r, u, pair(99.0, 20.0)] {
             for (tile, part, _) in mesh.cut_into_tiles(100.0) {
