@@ -418,6 +418,37 @@ impl Counts {
 /// No value in a stream (a mesh without texture coordinates or normals).
 const ABSENT: u32 = u32::MAX;
 
+/// The values seen in a node so far, by the bits of their text, per stream: one set of
+/// maps per thread, cleared for each node (their memory is kept).
+#[derive(Default)]
+struct WeldMaps {
+    positions: HashMap<[u32; 3], u32, FxBuild>,
+    uvs: HashMap<[u32; 2], u32, FxBuild>,
+    normals: HashMap<[u32; 3], u32, FxBuild>,
+}
+
+impl WeldMaps {
+    /// Empties the maps for the next node. Clearing costs the capacity, so maps a large
+    /// node grew are dropped instead of being cleared for every small node after it.
+    fn clear(&mut self) {
+        const KEEP: usize = 1 << 12;
+        if self.positions.capacity() > KEEP
+            || self.uvs.capacity() > KEEP
+            || self.normals.capacity() > KEEP
+        {
+            *self = WeldMaps::default();
+        } else {
+            self.positions.clear();
+            self.uvs.clear();
+            self.normals.clear();
+        }
+    }
+}
+
+thread_local! {
+    static WELD: std::cell::RefCell<WeldMaps> = std::cell::RefCell::default();
+}
+
 /// One node's geometry in world coordinates, welded: each distinct position, texture
 /// coordinate and normal once (by the bits of the value written, so identical text),
 /// in first-use order over the node's meshes, and for every mesh vertex its three
@@ -443,41 +474,41 @@ impl NodeGeometry {
             normals: Vec::new(),
             corners: Vec::new(),
         };
-        let mut seen_p: HashMap<[u32; 3], u32, FxBuild> = HashMap::default();
-        let mut seen_t: HashMap<[u32; 2], u32, FxBuild> = HashMap::default();
-        let mut seen_n: HashMap<[u32; 3], u32, FxBuild> = HashMap::default();
-        for m in meshes {
-            let n = m.vertex_count();
-            g.corners.reserve(n);
-            let with_uvs = m.uvs.len() == n;
-            let with_normals = m.normals.len() == n;
-            for k in 0..n {
-                let p = if identity {
-                    m.positions[k]
-                } else {
-                    world.transform_point3(m.positions[k].as_dvec3()).as_vec3()
-                };
-                let ip = index_of(&mut seen_p, &mut g.positions, p, p.to_array());
-                let it = if with_uvs {
-                    let t = Vec2::new(m.uvs[k].x, 1.0 - m.uvs[k].y);
-                    index_of(&mut seen_t, &mut g.uvs, t, t.to_array())
-                } else {
-                    ABSENT
-                };
-                let inn = if with_normals {
-                    let v = m.normals[k];
-                    let v = if identity {
-                        v.normalize_or_zero()
+        WELD.with_borrow_mut(|seen| {
+            seen.clear();
+            for m in meshes {
+                let n = m.vertex_count();
+                g.corners.reserve(n);
+                let with_uvs = m.uvs.len() == n;
+                let with_normals = m.normals.len() == n;
+                for k in 0..n {
+                    let p = if identity {
+                        m.positions[k]
                     } else {
-                        (normal_matrix * v.as_dvec3()).normalize_or_zero().as_vec3()
+                        world.transform_point3(m.positions[k].as_dvec3()).as_vec3()
                     };
-                    index_of(&mut seen_n, &mut g.normals, v, v.to_array())
-                } else {
-                    ABSENT
-                };
-                g.corners.push([ip, it, inn]);
+                    let ip = index_of(&mut seen.positions, &mut g.positions, p, p.to_array());
+                    let it = if with_uvs {
+                        let t = Vec2::new(m.uvs[k].x, 1.0 - m.uvs[k].y);
+                        index_of(&mut seen.uvs, &mut g.uvs, t, t.to_array())
+                    } else {
+                        ABSENT
+                    };
+                    let inn = if with_normals {
+                        let v = m.normals[k];
+                        let v = if identity {
+                            v.normalize_or_zero()
+                        } else {
+                            (normal_matrix * v.as_dvec3()).normalize_or_zero().as_vec3()
+                        };
+                        index_of(&mut seen.normals, &mut g.normals, v, v.to_array())
+                    } else {
+                        ABSENT
+                    };
+                    g.corners.push([ip, it, inn]);
+                }
             }
-        }
+        });
         g
     }
 

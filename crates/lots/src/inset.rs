@@ -143,13 +143,7 @@ impl Inset {
         }
         reset_checked(&mut self.engine, polygon, weights);
         self.engine.run_through(d)?;
-        // Such a component would come out unchanged at every later distance.
-        if self.engine.steps_enclose_a_region() {
-            return Err(LotsError::SkeletonFailed {
-                reason: crate::skeleton::STEPS_ENCLOSE,
-            });
-        }
-        Ok(wavefront_at(&self.engine, d))
+        wavefront_at(&self.engine, d)
     }
 }
 
@@ -234,8 +228,10 @@ fn convex_before_any_event(
     )
 }
 
-/// The rings of the wavefront at time `d`, grouped into shapes.
-fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
+/// The rings of the wavefront at time `d`, grouped into shapes. A ring made of weighted
+/// steps alone is refused (`STEPS_ENCLOSE`, as the skeleton refuses it): nothing moves
+/// it, so it would come out unchanged at every later distance.
+fn wavefront_at(engine: &Engine, d: f64) -> Result<Vec<InsetShape>, LotsError> {
     let mut seen = vec![false; engine.verts.len()];
     let mut outers: Vec<InsetRing> = Vec::new();
     let mut holes: Vec<InsetRing> = Vec::new();
@@ -259,6 +255,11 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
                 break;
             }
         }
+        if ring.sources.iter().all(Option::is_none) {
+            return Err(LotsError::SkeletonFailed {
+                reason: crate::skeleton::STEPS_ENCLOSE,
+            });
+        }
         for (ring, outer) in finish_ring(ring, engine.eps) {
             if outer {
                 outers.push(ring);
@@ -280,7 +281,7 @@ fn wavefront_at(engine: &Engine, d: f64) -> Vec<InsetShape> {
             shapes[i].holes.push(h);
         }
     }
-    shapes
+    Ok(shapes)
 }
 
 /// Cleans a wavefront ring (zero-length edges, pinches) into simple rings, each with
@@ -538,7 +539,7 @@ mod tests {
         let mut engine = Engine::default();
         crate::skeleton::prepare(&mut engine, polygon, weights).unwrap();
         engine.run_through(d).unwrap();
-        wavefront_at(&engine, d)
+        wavefront_at(&engine, d).unwrap()
     }
 
     fn ring(points: &[(f64, f64)]) -> InsetRing {

@@ -73,6 +73,8 @@ pub(crate) struct Query {
     pub p0: DVec2,
     pub t0: f64,
     pub vel: DVec2,
+    /// `vel.length()`, computed once per query.
+    pub speed: f64,
     pub in_edge: u32,
     pub out_edge: u32,
     /// Only candidates after this one (the last of the previous batch).
@@ -156,7 +158,7 @@ impl SplitLines {
             ahead,
             q.t0,
             eps,
-            TOUCH_SLOPE_REL * (q.vel.length() + self.w[i]),
+            TOUCH_SLOPE_REL * (q.speed + self.w[i]),
         )
     }
 
@@ -170,7 +172,7 @@ impl SplitLines {
         // `hit_time`, written out over the arrays).
         let (nxs, nys, cs, ws) = (&self.nx[..m], &self.ny[..m], &self.c[..m], &self.w[..m]);
         let (px, py, vx, vy, t0, eps) = (q.p0.x, q.p0.y, q.vel.x, q.vel.y, q.t0, b.eps);
-        let speed = q.vel.length();
+        let speed = q.speed;
         for (i, slot) in times.iter_mut().enumerate() {
             let slope = nxs[i] * vx + nys[i] * vy - ws[i];
             let ahead = nxs[i] * px + nys[i] * py - cs[i] - ws[i] * t0;
@@ -254,7 +256,7 @@ fn exit_time(q: &Query, b: &Bounds) -> f64 {
         }
     }
     let size = b.bbox_min.abs().max(b.bbox_max.abs()).max_element();
-    let slack = 4.0 * (b.eps + 1e-15 * size) / q.vel.length();
+    let slack = 4.0 * (b.eps + 1e-15 * size) / q.speed;
     q.t0 + tau.max(0.0) + slack
 }
 
@@ -476,7 +478,7 @@ impl LineIndex {
         let cell = self.cell_of(q.p0);
         let rel = q.p0 - self.centre(cell);
         let shift = (cell * self.lines) as u32;
-        let (qn, speed) = (rel.length(), q.vel.length());
+        let (qn, speed) = (rel.length(), q.speed);
         let mut heap = std::mem::take(&mut self.windows);
         heap.clear();
         for (k, bk) in self.buckets.iter().enumerate() {

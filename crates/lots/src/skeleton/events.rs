@@ -554,10 +554,12 @@ impl Engine {
     /// The `CANDIDATE_BATCH` earliest hits of vertex `x` on edge lines after `after` (in
     /// the order time, then edge).
     fn scan_candidates(&mut self, x: &Vertex, after: Option<Candidate>) -> CandidateBatch {
+        let vel = x.velocity();
         let q = Query {
             p0: x.p0,
             t0: x.t0,
-            vel: x.velocity(),
+            vel,
+            speed: vel.length(),
             in_edge: x.in_edge,
             out_edge: x.out_edge,
             after,
