@@ -22,6 +22,10 @@
 //! session 16 retuned `default` on seeds 1–40 and checked it on 41–200 (streets curving
 //! 16° instead of 36°, more dead ends, and smaller grid patches that average out over the
 //! city, so its orientation order no longer swings with the seed): see BENCHMARKS.md.
+//! `old_town`'s culs-de-sac became side streets one link long in session 17
+//! (`dead_end_links: "first"`; before, a cul-de-sac could end any street and with it the
+//! growth front behind it, so the network's size and circuity swung with the seed), its
+//! Basic streets retuned on seeds 1–40 and 41–120.
 //! Tunnels (issue 27) changed `san_francisco` seeds 1–2: highways pass under the hills
 //! they used to stop at. `citygen_us` and `milan` joined the test in session 11 (their
 //! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` keeps

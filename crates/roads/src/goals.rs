@@ -669,7 +669,8 @@ impl DefaultGoals {
         };
         let (mut left, mut right, mut dead_end) = (false, false, false);
         if at_branch_point {
-            match rules.branch(rng) {
+            let first_link = rule.age.saturating_add(1) == n;
+            match rules.branch_at(first_link, rng) {
                 BranchChoice::DeadEnd => dead_end = true,
                 BranchChoice::Go { left: l, right: r } => {
                     let populated = pop > prm.population_threshold;

@@ -117,5 +117,5 @@ pub use modules::{Proposal, QueryState, RoadAttr, RoadModule, RuleAttr};
 pub use network::{Junction, NetworkStats, Road, RoadClass, RoadNetwork, network_stats};
 pub use params::{Pattern, RoadParams};
 pub use primary::{PrimaryEditor, PrimaryError, PrimaryNetwork};
-pub use street_rules::{BranchChoice, StreetRules};
+pub use street_rules::{BranchChoice, DeadEndLinks, StreetRules};
 pub use tunnels::{Portal, portal_mesh, portals};

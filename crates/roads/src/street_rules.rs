@@ -14,7 +14,9 @@
 //! [`branch_probability`](StreetRules::branch_probability): to both sides (a crossroads)
 //! with [`crossroads_probability`](StreetRules::crossroads_probability), else to one
 //! side drawn at random (a T); or it ends, with
-//! [`dead_end_probability`](StreetRules::dead_end_probability) (a cul-de-sac). A street
+//! [`dead_end_probability`](StreetRules::dead_end_probability) (a cul-de-sac): at any of
+//! its branch points, or, with [`DeadEndLinks::First`], only at the end of its first link,
+//! so that culs-de-sac are short side streets and never end a growth front. A street
 //! that crosses an existing road goes on through the crossing with
 //! [`cross_through_probability`](StreetRules::cross_through_probability), else it ends
 //! there as §3.3.1 has it.
@@ -55,6 +57,10 @@ pub struct StreetRules {
     /// Probability that a street ends at a branch point with nothing after it (a
     /// cul-de-sac), in [0, 1]. Default: 0.
     pub dead_end_probability: f64,
+    /// Which branch points of a street may end it
+    /// ([`dead_end_probability`](Self::dead_end_probability)): any of them, or only the
+    /// end of its first link. Default: [`DeadEndLinks::Any`].
+    pub dead_end_links: DeadEndLinks,
     /// Probability that a street whose segment crossed an existing road goes on through
     /// the crossing (a four-way junction, as grid streets cross avenues) instead of
     /// ending there (a T, §3.3.1's default), in [0, 1]. Default: 0.
@@ -84,6 +90,7 @@ impl Default for StreetRules {
             branch_probability: 0.99,
             crossroads_probability: 0.82,
             dead_end_probability: 0.0,
+            dead_end_links: DeadEndLinks::Any,
             cross_through_probability: 0.0,
             segments_per_link: 1,
             curve_deg: 0.0,
@@ -91,6 +98,24 @@ impl Default for StreetRules {
             lattice: false,
         }
     }
+}
+
+/// Which links of a street may end in a cul-de-sac
+/// ([`StreetRules::dead_end_links`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeadEndLinks {
+    /// Any link: a street may end at any of its branch points. With a high dead-end
+    /// probability this is a branching process near extinction: whether a growth front
+    /// lives on is left to a few early draws, so the network's size (and with it its
+    /// statistics) swings widely from seed to seed, and land is left without streets.
+    #[default]
+    Any,
+    /// Only the first link: a street that ends is a side street one link long (a
+    /// cul-de-sac off the street it branched from); a street past its first link always
+    /// goes on until a road, the population or the map stops it, so culs-de-sac never
+    /// cut off a growth front and the streets fill their land on every seed.
+    First,
 }
 
 /// What happens at a street's branch point.
@@ -184,11 +209,21 @@ impl StreetRules {
         (turn, scale)
     }
 
-    /// Decides what happens at a branch point (three draws, always, so the generator's
-    /// sequence does not depend on the outcome).
+    /// Decides what happens at the branch point ending a street's first link (three
+    /// draws, always, so the generator's sequence does not depend on the outcome); the
+    /// same as [`branch_at`](Self::branch_at) with `first_link` true.
     pub fn branch(&self, rng: &mut Pcg64Mcg) -> BranchChoice {
+        self.branch_at(true, rng)
+    }
+
+    /// Decides what happens at a branch point, `first_link` telling whether it ends the
+    /// street's first link (three draws, always, so the generator's sequence does not
+    /// depend on the outcome). Past the first link, a street ends only when
+    /// [`dead_end_links`](Self::dead_end_links) is [`DeadEndLinks::Any`].
+    pub fn branch_at(&self, first_link: bool, rng: &mut Pcg64Mcg) -> BranchChoice {
         let (r_end, r_branch, r_kind) = (unit_f64(rng), unit_f64(rng), unit_f64(rng));
-        if r_end < self.dead_end_probability {
+        let may_end = first_link || self.dead_end_links == DeadEndLinks::Any;
+        if may_end && r_end < self.dead_end_probability {
             return BranchChoice::DeadEnd;
         }
         if r_branch >= self.branch_probability {
@@ -256,6 +291,40 @@ mod tests {
         assert!((f(cross) - 0.9 * 0.8 * 0.25).abs() < 0.015);
         assert!((f(left) - 0.9 * 0.8 * 0.375).abs() < 0.015);
         assert!((f(right) - f(left)).abs() < 0.02);
+    }
+
+    /// With `First`, a street past its first link never ends, and the draws (so the
+    /// generator's sequence) are the same as with `Any`; on the first link both agree.
+    #[test]
+    fn dead_ends_only_on_first_links() {
+        let any = StreetRules {
+            dead_end_probability: 0.4,
+            ..StreetRules::default()
+        };
+        let first = StreetRules {
+            dead_end_links: DeadEndLinks::First,
+            ..any
+        };
+        let (mut ra, mut rf) = (Pcg64Mcg::seed_from_u64(3), Pcg64Mcg::seed_from_u64(3));
+        let mut ended_any = 0;
+        for i in 0..2_000 {
+            let on_first = i % 2 == 0;
+            let a = any.branch_at(on_first, &mut ra);
+            let f = first.branch_at(on_first, &mut rf);
+            if on_first {
+                assert_eq!(a, f);
+            } else {
+                assert_ne!(f, BranchChoice::DeadEnd);
+                if a == BranchChoice::DeadEnd {
+                    ended_any += 1;
+                } else {
+                    assert_eq!(a, f);
+                }
+            }
+        }
+        assert!(ended_any > 300, "{ended_any}");
+        assert_eq!(ra, rf);
+        assert_eq!(any.branch(&mut ra), any.branch_at(true, &mut rf));
     }
 
     #[test]
