@@ -428,10 +428,11 @@ pub(crate) struct SceneInputs<'a> {
     pub terrains: Option<&'a dyn GroundReuse>,
 }
 
-/// Terrains an editor keeps between runs. A terrain is a function of the ground it
-/// follows, the map and the terrain options: a memo keyed by the configuration's digest
-/// (which fixes the map, the options and the elevation map) and the water bed's
-/// ([`Water::bed_key`](crate::water::Water)) hands back the terrain made before.
+/// Terrains (and the water map's outlines) an editor keeps between runs. A terrain is
+/// a function of the ground it follows, the map and the terrain options: a memo keyed by
+/// the configuration's digest (which fixes the map, the options and the elevation map)
+/// and the water bed's ([`Water::bed_key`](crate::water::Water)) hands back the terrain
+/// made before.
 pub(crate) trait GroundReuse: Sync {
     /// The terrain made earlier on the ground with the water bed of digest `bed` (none:
     /// no water), if kept.
@@ -443,6 +444,12 @@ pub(crate) trait GroundReuse: Sync {
         report: polis_geom::mesh::TerrainReport,
         tiles: &[Mesh],
     );
+    /// The water map's outlines ([`smooth_mask`](crate::smooth_mask)) an earlier run on
+    /// the same maps made, if kept. They read only the configuration's maps, seed and
+    /// size (no map paint reaches the water map).
+    fn water_outlines(&self) -> Option<Vec<PolygonWithHoles>>;
+    /// Keeps the water map's outlines made in this run.
+    fn keep_water_outlines(&self, outlines: &[PolygonWithHoles]);
 }
 
 /// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
