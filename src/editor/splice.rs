@@ -363,3 +363,37 @@ impl SceneReuse for OldScene {
         Some(leaf)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `lend` takes the `k`-th building node for building `k` only when its id says so:
+    /// with the buildings listed in the opposite order to their nodes, each building
+    /// still gets the node named after it.
+    #[test]
+    fn lend_finds_building_nodes_out_of_order() {
+        let mut config = CityConfig::preset("milan").unwrap();
+        config.size_m = 900.0;
+        let mut city = crate::generate(&config).unwrap();
+        assert!(
+            city.buildings.len() > 20,
+            "{} buildings",
+            city.buildings.len()
+        );
+        city.buildings.reverse();
+        city.building_cells.reverse();
+        city.dresses.reverse();
+        let before: Vec<String> = city.scene.nodes.iter().map(|n| n.name.clone()).collect();
+        let lent = OldScene::lend(&mut city);
+        for (k, b) in city.buildings.iter().enumerate() {
+            let (node, slot) = lent.buildings[k].expect("every building has a node");
+            assert_eq!(
+                before[node.0 as usize],
+                crate::scene::building_node_name(b.id)
+            );
+            assert_eq!(lent.names[slot].0, before[node.0 as usize]);
+            assert_eq!(lent.named[slot], node);
+        }
+    }
+}
