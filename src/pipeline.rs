@@ -415,7 +415,13 @@ impl Pipeline {
         let scene = if keep && self.scene {
             // Water bodies at their level over their bed, with the roads and blocks as
             // land: the bed is part of the ground everything stands on.
-            let water = crate::water::Water::of_city(config, &maps, &network, &kept.blocks)?;
+            // The water map's outlines read neither the roads nor the ground's grading.
+            let outlines = self
+                .terrains
+                .as_deref()
+                .map(|t| t as &dyn crate::scene::GroundReuse);
+            let water =
+                crate::water::Water::of_city(config, &maps, &network, &kept.blocks, outlines)?;
             let bed = water.as_ref().map(|w| w.bed(ground));
             let ground: &dyn polis_geom::Field = match &bed {
                 Some(b) => b,

@@ -428,10 +428,11 @@ pub(crate) struct SceneInputs<'a> {
     pub terrains: Option<&'a dyn GroundReuse>,
 }
 
-/// Terrains an editor keeps between runs. A terrain is a function of the ground it
-/// follows, the map and the terrain options: a memo keyed by the configuration's digest
-/// (which fixes the map, the options and the elevation map) and the water bed's
-/// ([`Water::bed_key`](crate::water::Water)) hands back the terrain made before.
+/// Terrains (and the water map's outlines) an editor keeps between runs. A terrain is
+/// a function of the ground it follows, the map and the terrain options: a memo keyed by
+/// the configuration's digest (which fixes the map, the options and the elevation map)
+/// and the water bed's ([`Water::bed_key`](crate::water::Water)) hands back the terrain
+/// made before.
 pub(crate) trait GroundReuse: Sync {
     /// The terrain made earlier on the ground with the water bed of digest `bed` (none:
     /// no water), if kept.
@@ -443,6 +444,12 @@ pub(crate) trait GroundReuse: Sync {
         report: polis_geom::mesh::TerrainReport,
         tiles: &[Mesh],
     );
+    /// The water map's outlines ([`smooth_mask`](crate::smooth_mask)) an earlier run on
+    /// the same maps made, if kept. They read only the configuration's maps, seed and
+    /// size (no map paint reaches the water map).
+    fn water_outlines(&self) -> Option<Vec<PolygonWithHoles>>;
+    /// Keeps the water map's outlines made in this run.
+    fn keep_water_outlines(&self, outlines: &[PolygonWithHoles]);
 }
 
 /// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
@@ -450,15 +457,20 @@ pub(crate) trait GroundReuse: Sync {
 /// it made; an implementation must only return parts whose inputs (the item, the
 /// ground, the palette, the configuration) are those of the earlier scene.
 pub(crate) trait SceneReuse: Sync {
-    /// The leaf of building `b` (with skin `dress`, in cell `cell`).
+    /// Called once with the buildings of the scene to make, in order, before any of
+    /// their leaves is asked for; `index` below is a position in this list.
+    fn prepare(&self, buildings: &[std::sync::Arc<Building>]);
+    /// The leaf of building `b`, at `index` (with skin `dress`, in cell `cell`).
     fn building(
         &self,
+        index: usize,
         b: &std::sync::Arc<Building>,
         dress: Option<&std::sync::Arc<Dress>>,
         cell: Option<u64>,
     ) -> Option<Reused>;
-    /// The coarse level-of-detail box of building `b` (`Some(None)`: it had none).
-    fn coarse(&self, b: &std::sync::Arc<Building>) -> Option<Option<Mesh>>;
+    /// The coarse level-of-detail box of building `b`, at `index` (`Some(None)`: it had
+    /// none).
+    fn coarse(&self, index: usize, b: &std::sync::Arc<Building>) -> Option<Option<Mesh>>;
     /// The leaf of block `b`.
     fn block(&self, b: &Block) -> Option<Reused>;
 }
@@ -699,6 +711,9 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     // diagonal's rise on the bank).
     let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
+    if let Some(r) = inp.reuse {
+        r.prepare(inp.buildings);
+    }
     // Each building's node (name, placement, metadata) and meshes.
     let buildings_job = || -> Vec<Leaf> {
         inp.buildings
@@ -707,6 +722,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .map(|(i, b)| {
                 let reused = inp.reuse.and_then(|r| {
                     r.building(
+                        i,
                         b,
                         inp.dresses.get(i).and_then(Option::as_ref),
                         inp.building_cells.get(i).copied(),
@@ -933,8 +949,9 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             .buildings
             .par_iter()
             .take(building_count)
-            .map(|b| {
-                if let Some(made) = inp.reuse.and_then(|r| r.coarse(b)) {
+            .enumerate()
+            .map(|(i, b)| {
+                if let Some(made) = inp.reuse.and_then(|r| r.coarse(i, b)) {
                     return made;
                 }
                 coarse_box(inp.config, elevation, &pal, b, foot)

@@ -299,17 +299,28 @@ impl Water {
     }
 
     /// The water bodies of a city's water map (none without one), with its roads and
-    /// blocks as land.
+    /// blocks as land. The map's outlines are taken from `kept` where it holds those of
+    /// the same configuration (the editor's memo), and handed to it when made.
     pub(crate) fn of_city(
         config: &crate::CityConfig,
         maps: &crate::CityMaps,
         network: &polis_roads::RoadNetwork,
         blocks: &[polis_lots::Block],
+        kept: Option<&dyn crate::scene::GroundReuse>,
     ) -> Result<Option<Water>> {
         if !maps.has_water {
             return Ok(None);
         }
-        let outlines = crate::city::smooth_mask(maps.inputs.water.as_ref(), config.size_m)?;
+        let outlines = match kept.and_then(|k| k.water_outlines()) {
+            Some(outlines) => outlines,
+            None => {
+                let made = crate::city::smooth_mask(maps.inputs.water.as_ref(), config.size_m)?;
+                if let Some(k) = kept {
+                    k.keep_water_outlines(&made);
+                }
+                made
+            }
+        };
         Water::new(
             outlines,
             maps.inputs.elevation.as_ref(),

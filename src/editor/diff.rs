@@ -193,8 +193,9 @@ pub(super) fn changes(
     let spliced = spliced.filter(|s| std::ptr::eq(s.city(), old));
     let same_building = |i: usize| spliced.is_some_and(|s| s.same_building_at(i));
     let same_block = |i: usize| spliced.is_some_and(|s| s.same_block_at(i));
-    // The three comparisons are independent: two threads take them.
-    let ((lots, buildings), block_nodes) = par::join(
+    // The three comparisons are independent: two threads take them. The buildings by
+    // id are kept to find their cells below.
+    let ((lots, (buildings, old_of, new_of)), block_nodes) = par::join(
         || {
             par::join(
                 || {
@@ -204,9 +205,11 @@ pub(super) fn changes(
                     )
                 },
                 || {
-                    delta_by(&buildings_of(old), &buildings_of(new), |(i, v), (_, w)| {
+                    let (old_of, new_of) = (buildings_of(old), buildings_of(new));
+                    let d = delta_by(&old_of, &new_of, |(i, v), (_, w)| {
                         !same_building(*i) && differ(v, w)
-                    })
+                    });
+                    (d, old_of, new_of)
                 },
             )
         },
@@ -236,27 +239,17 @@ pub(super) fn changes(
         .extend(blocks.added.iter().map(|c| name("cell", c)));
     let mut touched: BTreeSet<u64> = blocks.changed.iter().copied().collect();
     // The cell of each building the events name, looked up by id.
-    let cells_of = |c: &City| -> Vec<(u64, u64)> {
-        by_key(
-            c.buildings
-                .iter()
-                .zip(&c.building_cells)
-                .map(|(b, &cell)| (b.id, cell))
-                .collect(),
-        )
-    };
-    let find = |of: &[(u64, u64)], id: u64| {
+    let find = |c: &City, of: &[(u64, (usize, Dressed<'_>))], id: u64| {
         of.binary_search_by_key(&id, |p| p.0)
             .ok()
             .and_then(|k| of.get(k))
-            .map(|p| p.1)
+            .and_then(|p| c.building_cells.get(p.1.0).copied())
     };
-    let (old_of, new_of) = (cells_of(old), cells_of(new));
     for &id in buildings.changed.iter().chain(&buildings.added) {
-        touched.extend(find(&new_of, id));
+        touched.extend(find(new, &new_of, id));
     }
     for &id in &buildings.removed {
-        touched.extend(find(&old_of, id));
+        touched.extend(find(old, &old_of, id));
     }
     let gone: BTreeSet<u64> = blocks
         .removed

@@ -82,11 +82,12 @@
 //!   (their inputs are the whole city), looks up every road-graph cell's lots in the
 //!   memo and copies them out (a cell whose inputs are unchanged then takes its
 //!   buildings and skins whole, in one look-up), meshes the road surfaces again, assembles
-//!   the scene again (reused leaves take their meshes, names and metadata from the old
-//!   scene without copying them; the terrain is reused while the water bed under it is
-//!   unchanged) and the change events compare the lots and blocks of the two cities. Its
-//!   cost is therefore still proportional to the city's size, not to the dirty set:
-//!   about 0.7 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
+//!   the scene again (reused leaves, matched to the old ones by position, take their
+//!   meshes, names and metadata from the old scene without copying them; the terrain is
+//!   reused while the water bed under it is unchanged, the water map's outlines while
+//!   the maps are) and the change events compare the lots and blocks of the two cities.
+//!   Its cost is therefore still proportional to the city's size, not to the dirty set:
+//!   about 0.5 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
 //!   BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene
 //!   is not spliced and the terrain not reused (the ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it

@@ -12,7 +12,7 @@
 //! reuse only skips recomputing identical parts.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 use polis_buildings::Building;
 use polis_geom::metadata::Metadata;
@@ -62,8 +62,14 @@ pub(super) struct OldScene {
     /// The editor's memo: which buildings and skins were made from the same keys as
     /// the old city's (equal without comparing them).
     memo: Arc<Memo>,
-    /// Building id → (index in the city's buildings, node, slot in `names`).
-    buildings: IdMap<(usize, NodeId, usize)>,
+    /// Per old building (by index in the city's buildings): its node and slot in
+    /// `names`, if it has one.
+    buildings: Vec<Option<(NodeId, usize)>>,
+    /// Building id → index in the city's buildings.
+    building_at: IdMap<usize>,
+    /// Per new building (by index, see [`SceneReuse::prepare`]): the index of the old
+    /// building with its id, if any.
+    matched: OnceLock<Vec<Option<usize>>>,
     /// Block id → (index in the city's blocks, node, slot in `names`).
     blocks: IdMap<(usize, NodeId, usize)>,
     /// Per old building (by index): found equal to the new one (building, skin and cell)
@@ -79,7 +85,8 @@ pub(super) struct Lent {
     meshes: Vec<Mesh>,
     names: Vec<(String, Metadata)>,
     named: Vec<NodeId>,
-    buildings: IdMap<(usize, NodeId, usize)>,
+    buildings: Vec<Option<(NodeId, usize)>>,
+    building_at: IdMap<usize>,
     blocks: IdMap<(usize, NodeId, usize)>,
 }
 
@@ -99,6 +106,11 @@ fn unslot_all<T>(slots: Vec<Mutex<Option<T>>>) -> Option<Vec<T>> {
 impl OldScene {
     /// Indexes `city`'s scene leaves by the ids in their names and moves out of it its
     /// scene's meshes and its leaves' names and metadata.
+    ///
+    /// The scene [`assemble`](crate::scene::assemble) makes (and the in-place patch
+    /// keeps) has the buildings' nodes in the order of the city's buildings, so the
+    /// `k`-th building node is building `k`'s: that is checked by id, and a node out of
+    /// that order is found through the ids instead.
     pub(super) fn lend(city: &mut City) -> Lent {
         let building_at: IdMap<usize> = city
             .buildings
@@ -112,18 +124,24 @@ impl OldScene {
             .enumerate()
             .map(|(i, b)| (b.id(), i))
             .collect();
-        let mut buildings = IdMap::with_capacity_and_hasher(building_at.len(), IdBits);
+        let mut buildings = vec![None; city.buildings.len()];
         let mut blocks = IdMap::with_capacity_and_hasher(block_at.len(), IdBits);
         let mut names = Vec::with_capacity(building_at.len() + block_at.len());
         let mut named = Vec::with_capacity(names.capacity());
+        // The index the next building node has in the assembled order.
+        let mut next_building = 0;
         for (n, node) in city.scene.nodes.iter_mut().enumerate() {
             let id = |kind: &str| crate::scene::node_id(&node.name, kind);
             let node_id = NodeId(n as u32);
             let slot = names.len();
             let indexed = if let Some(id) = id("building") {
-                building_at
-                    .get(&id)
-                    .map(|&i| buildings.insert(id, (i, node_id, slot)))
+                let at = match city.buildings.get(next_building) {
+                    Some(b) if b.id == id => Some(next_building),
+                    _ => building_at.get(&id).copied(),
+                };
+                next_building += 1;
+                at.and_then(|i| buildings.get_mut(i))
+                    .map(|entry| *entry = Some((node_id, slot)))
                     .is_some()
             } else if let Some(id) = id("block") {
                 block_at
@@ -146,6 +164,7 @@ impl OldScene {
             names,
             named,
             buildings,
+            building_at,
             blocks,
         }
     }
@@ -162,6 +181,8 @@ impl OldScene {
             same_blocks: flags(city.blocks.len()),
             city,
             buildings: lent.buildings,
+            building_at: lent.building_at,
+            matched: OnceLock::new(),
             blocks: lent.blocks,
         }
     }
@@ -234,22 +255,47 @@ impl OldScene {
         Some((name, translation, metadata, meshes))
     }
 
-    /// The old building with `b`'s id if it equals `b`: its index and node.
-    fn same_building(&self, b: &Arc<Building>) -> Option<(usize, NodeId)> {
-        let &(i, n, _) = self.buildings.get(&b.id)?;
-        let old = self.city.buildings.get(i)?;
-        (Arc::ptr_eq(old, b) || **old == **b).then_some((i, n))
+    /// The index of the old building with the id of new building `index` (see
+    /// [`SceneReuse::prepare`]).
+    fn old_index(&self, index: usize) -> Option<usize> {
+        self.matched.get()?.get(index).copied().flatten()
     }
 }
 
 impl SceneReuse for OldScene {
+    fn prepare(&self, buildings: &[Arc<Building>]) {
+        // The new city lists the buildings of the cells it reused in the old city's
+        // order, shared with it: a cursor through the old buildings meets them by
+        // pointer, without reading a building; the others are looked up by id.
+        let old = &self.city.buildings;
+        let mut next = 0;
+        let matched = buildings
+            .iter()
+            .map(|b| {
+                let at = match old.get(next) {
+                    Some(o) if Arc::ptr_eq(o, b) => Some(next),
+                    _ => self.building_at.get(&b.id).copied(),
+                };
+                if let Some(i) = at {
+                    next = i + 1;
+                }
+                at
+            })
+            .collect();
+        // A second call (none is made) keeps the first's matching, made of the same
+        // buildings.
+        let _ = self.matched.set(matched);
+    }
+
     fn building(
         &self,
+        index: usize,
         b: &Arc<Building>,
         dress: Option<&Arc<Dress>>,
         cell: Option<u64>,
     ) -> Option<Reused> {
-        let &(i, n, slot) = self.buildings.get(&b.id)?;
+        let i = self.old_index(index)?;
+        let (n, slot) = self.buildings.get(i).copied().flatten()?;
         let old_cell = self.city.building_cells.get(i).copied();
         if old_cell != cell {
             return None;
@@ -280,12 +326,16 @@ impl SceneReuse for OldScene {
         Some(leaf)
     }
 
-    fn coarse(&self, b: &Arc<Building>) -> Option<Option<Mesh>> {
+    fn coarse(&self, index: usize, b: &Arc<Building>) -> Option<Option<Mesh>> {
+        let i = self.old_index(index)?;
+        let (n, _) = self.buildings.get(i).copied().flatten()?;
         // A building reused whole was compared already.
-        let n = match self.buildings.get(&b.id) {
-            Some(&(i, n, _)) if self.same_building_at(i) => n,
-            _ => self.same_building(b)?.1,
-        };
+        if !self.same_building_at(i) {
+            let old = self.city.buildings.get(i)?;
+            if !(Arc::ptr_eq(old, b) || **old == **b) {
+                return None;
+            }
+        }
         let scene = &self.city.scene;
         let node = scene.nodes.get(n.0 as usize)?;
         let lod = node.children.iter().find_map(|c| {
@@ -311,5 +361,39 @@ impl SceneReuse for OldScene {
             f.store(true, Ordering::Relaxed);
         }
         Some(leaf)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `lend` takes the `k`-th building node for building `k` only when its id says so:
+    /// with the buildings listed in the opposite order to their nodes, each building
+    /// still gets the node named after it.
+    #[test]
+    fn lend_finds_building_nodes_out_of_order() {
+        let mut config = CityConfig::preset("milan").unwrap();
+        config.size_m = 900.0;
+        let mut city = crate::generate(&config).unwrap();
+        assert!(
+            city.buildings.len() > 20,
+            "{} buildings",
+            city.buildings.len()
+        );
+        city.buildings.reverse();
+        city.building_cells.reverse();
+        city.dresses.reverse();
+        let before: Vec<String> = city.scene.nodes.iter().map(|n| n.name.clone()).collect();
+        let lent = OldScene::lend(&mut city);
+        for (k, b) in city.buildings.iter().enumerate() {
+            let (node, slot) = lent.buildings[k].expect("every building has a node");
+            assert_eq!(
+                before[node.0 as usize],
+                crate::scene::building_node_name(b.id)
+            );
+            assert_eq!(lent.names[slot].0, before[node.0 as usize]);
+            assert_eq!(lent.named[slot], node);
+        }
     }
 }
