@@ -498,7 +498,12 @@ impl FoldBound {
     /// Whether every proposal deviated from `turned` folds onto the road of unit
     /// direction `w` and length `len`.
     fn folds(&self, turned: DVec2, w: DVec2, len: f64) -> bool {
-        let (cos, sin) = (turned.dot(w), turned.perp_dot(w).abs());
+        let cos = turned.dot(w);
+        if cos <= 0.0 {
+            // A road at a right angle or more: `cos_min` below is at most 0.
+            return false;
+        }
+        let sin = turned.perp_dot(w).abs();
         // sin and cos of the angle plus the widest deviation.
         let sin_max = sin * self.cos_dev + cos * self.sin_dev;
         let cos_min = cos * self.cos_dev - sin * self.sin_dev;

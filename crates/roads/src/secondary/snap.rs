@@ -391,15 +391,23 @@ pub(super) fn folds_onto_root(ends: &[(NodeId, DVec2)], a: DVec2, b: DVec2, radi
     let d = b - a;
     let len2 = d.length_squared();
     let len = len2.sqrt();
+    let r2 = radius * radius;
     ends.iter().any(|&(_, p)| {
         let ap = p - a;
-        let r = ap.dot(d) / len2;
+        let along = ap.dot(d);
+        if along <= 0.0 {
+            // A road at a right angle or more to the proposal: `r ≤ 0` (no node event),
+            // and the road's point closest to `b` is `a` itself (the same arithmetic as
+            // below: the same dot product, clamped to 0).
+            return len2 <= r2;
+        }
+        let r = along / len2;
         let node = if r > 0.0 && r <= 1.0 {
             (d.perp_dot(ap) / len2).abs() * len <= radius
         } else {
-            r > 1.0 && p.distance_squared(b) <= radius * radius
+            r > 1.0 && p.distance_squared(b) <= r2
         };
-        node || closest_point(b, a, p).distance_squared(b) <= radius * radius
+        node || closest_point(b, a, p).distance_squared(b) <= r2
     })
 }
 
