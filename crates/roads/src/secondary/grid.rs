@@ -202,12 +202,21 @@ impl SnapGrid {
         let (c0, c1) = (self.col(a.x.min(b.x)), self.col(a.x.max(b.x)));
         let (r0, r1) = (self.row(a.y.min(b.y)), self.row(a.y.max(b.y)));
         let dx = b.x - a.x;
+        // In one row or one column the cover is the box's squares.
+        if r0 == r1 || c0 == c1 || dx == 0.0 {
+            for r in r0..=r1 {
+                if let Some(row) = self.squares.get_mut(r * self.nx + c0..=r * self.nx + c1) {
+                    for s in row {
+                        s.push(id);
+                    }
+                }
+            }
+            return;
+        }
         // A margin that covers the rounding of the slab ends' y values.
         let eps = 1e-9 * (self.size + a.abs().max_element() + b.abs().max_element());
         for c in c0..=c1 {
-            let (lo, hi) = if c0 == c1 || dx == 0.0 {
-                (r0, r1)
-            } else {
+            let (lo, hi) = {
                 // The segment's y range over this column's x slab (the border columns
                 // reach to infinity, as coordinates clamp).
                 let x_lo = if c == c0 {

@@ -303,7 +303,8 @@ impl SecondaryGrowth {
             decided: Vec::new(),
             scratch: std::mem::take(&mut self.scratch),
             root_roads: Vec::new(),
-            root: (None, 0),
+            root_ends: Vec::new(),
+            root: (None, (0, 0)),
             joins: (0, 0),
         };
         let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
@@ -497,7 +498,12 @@ impl FoldBound {
     /// Whether every proposal deviated from `turned` folds onto the road of unit
     /// direction `w` and length `len`.
     fn folds(&self, turned: DVec2, w: DVec2, len: f64) -> bool {
-        let (cos, sin) = (turned.dot(w), turned.perp_dot(w).abs());
+        let cos = turned.dot(w);
+        if cos <= 0.0 {
+            // A road at a right angle or more: `cos_min` below is at most 0.
+            return false;
+        }
+        let sin = turned.perp_dot(w).abs();
         // sin and cos of the angle plus the widest deviation.
         let sin_max = sin * self.cos_dev + cos * self.sin_dev;
         let cos_min = cos * self.cos_dev - sin * self.sin_dev;
@@ -524,9 +530,11 @@ struct Run<'a> {
     scratch: Vec<GridRoad>,
     /// The roads of a node as (unit direction, length), for
     /// [`folds_for_sure`](Self::folds_for_sure), and the node and the graph's edge
-    /// bound they were read at.
+    /// bound and count they were read at.
     root_roads: Vec<(DVec2, f64)>,
-    root: (Option<NodeId>, usize),
+    /// The far end (node and position) of every road at that node, for the snap search.
+    root_ends: Vec<(NodeId, DVec2)>,
+    root: (Option<NodeId>, (usize, usize)),
     /// Joins onto a road made directly and by planar insertion.
     joins: (u64, u64),
 }
@@ -549,23 +557,47 @@ impl Run<'_> {
         turned: DVec2,
         bound: &FoldBound,
     ) -> Result<bool, SecondaryError> {
-        // The node's roads as (unit direction, length), read again after any change.
-        if self.root.0 != Some(source) || self.root.1 != self.g.edge_bound() {
-            self.root_roads.clear();
-            let a = self.g.position(source)?;
-            for &e in self.g.edges_at(source)? {
-                let ap = self.g.position(self.g.other_end(e, source)?)? - a;
-                let len = ap.length();
-                if len > 0.0 {
-                    self.root_roads.push((ap / len, len));
-                }
-            }
-            self.root = (Some(source), self.g.edge_bound());
-        }
+        self.read_root(source)?;
         Ok(self
             .root_roads
             .iter()
             .any(|&(w, len)| bound.folds(turned, w, len)))
+    }
+
+    /// Reads the roads at `source` into [`root_ends`](Self::root_ends) and
+    /// [`root_roads`](Self::root_roads), unless they were read at this node and the graph
+    /// has made or removed no road since (a change of the edge bound or count).
+    #[inline]
+    fn read_root(&mut self, source: NodeId) -> Result<(), SecondaryError> {
+        let roads = (self.g.edge_bound(), self.g.edge_count());
+        if self.root == (Some(source), roads) {
+            return Ok(());
+        }
+        self.read_root_again(source, roads)
+    }
+
+    /// [`read_root`](Self::read_root)'s reading, when the roads read are out of date.
+    #[inline(never)]
+    fn read_root_again(
+        &mut self,
+        source: NodeId,
+        roads: (usize, usize),
+    ) -> Result<(), SecondaryError> {
+        self.root_roads.clear();
+        self.root_ends.clear();
+        let a = self.g.position(source)?;
+        for &e in self.g.edges_at(source)? {
+            let n = self.g.other_end(e, source)?;
+            let p = self.g.position(n)?;
+            self.root_ends.push((n, p));
+            let ap = p - a;
+            let len = ap.length();
+            if len > 0.0 {
+                self.root_roads.push((ap / len, len));
+            }
+        }
+        self.root = (Some(source), roads);
+        Ok(())
     }
 
     /// A proposal [`folds_for_sure`](Self::folds_for_sure): counted as test 0 counts it,
@@ -610,7 +642,11 @@ impl Run<'_> {
         let width = self.p.road_width_m.sample(self.rng);
         let a = self.g.position(source)?;
         let b = a + dir * len;
-        let target = match self.snapper.snap(&self.g, source, a, b, snap) {
+        self.read_root(source)?;
+        let target = match self
+            .snapper
+            .snap_from(&self.g, source, &self.root_ends, a, b, snap)
+        {
             SnapEvent::None => Target::Free(b),
             SnapEvent::Blocked => {
                 self.report.refused_blocked += 1;
@@ -849,8 +885,14 @@ impl Run<'_> {
     /// `a–t` is among that query's candidates.
     fn clear(&self, source: NodeId, a: DVec2, t: DVec2, target: &Target) -> bool {
         use polis_geom::predicates::{SegmentIntersection as X, segment_intersection};
+        let reach = polis_geom::Aabb2::new(a, t);
         for road in self.snapper.candidates() {
             let (key, u, v, pu, pv) = (road.edge, road.u, road.v, road.pu, road.pv);
+            // Segments whose boxes do not meet are disjoint (the intersection's own first
+            // test, here without the call).
+            if !reach.intersects(&polis_geom::Aabb2::new(pu, pv)) {
+                continue;
+            }
             let at_end = |p: DVec2| p == a || p == t;
             let ok = match (segment_intersection(a, t, pu, pv), target) {
                 (X::Overlap { .. }, _) | (X::Crossing { .. }, Target::Free(_)) => false,
@@ -880,7 +922,7 @@ mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
     use crate::secondary::Neighbourhood;
-    use crate::secondary::snap::folds_onto_root;
+    use crate::secondary::snap::{folds_onto_root, root_ends};
 
     /// Where [`FoldBound`] says a direction folds for every draw, test 0 folds every
     /// proposal drawn in it (directions deviated, lengths on the aspect ellipse and snap
@@ -933,8 +975,10 @@ mod tests {
                         let l = along * size / ((size * c).powi(2) + (along * sn).powi(2)).sqrt();
                         let radius =
                             p.snap_size_m.value * (1.0 + p.snap_size_m.deviance * (2.0 * r - 1.0));
+                        let mut ends = Vec::new();
+                        root_ends(&g, root, &mut ends);
                         assert!(
-                            folds_onto_root(&g, root, a, a + d * l, radius),
+                            folds_onto_root(&ends, a, a + d * l, radius),
                             "{n:?} degree {degree}: {dir} {w} {len} {l} {radius}"
                         );
                     }

@@ -72,6 +72,8 @@ pub struct Snapper {
     seen: Vec<u32>,
     query: u32,
     roads: Vec<GridRoad>,
+    /// Scratch of [`snap`](Self::snap): the root's roads' far ends.
+    root_ends: Vec<(NodeId, DVec2)>,
     /// Exact segment-intersection tests run (the rest were excluded by `r`/`s`).
     pub exact_tests: u64,
     /// Roads that passed the extended bounding box.
@@ -157,6 +159,38 @@ impl Snapper {
         b: DVec2,
         radius: f64,
     ) -> SnapEvent {
+        let mut ends = std::mem::take(&mut self.root_ends);
+        root_ends(g, root, &mut ends);
+        let event = self.snap_from(g, root, &ends, a, b, radius);
+        self.root_ends = ends;
+        event
+    }
+
+    /// [`snap`](Self::snap) with the root's roads given: `ends` holds the far end (node
+    /// and position) of every road at `root`, in any order, as [`root_ends`] reads them.
+    /// Growth keeps them for the node it expands, so test 0 and the adjacency checks
+    /// read no graph.
+    pub(crate) fn snap_from(
+        &mut self,
+        g: &RoadNetwork,
+        root: NodeId,
+        ends: &[(NodeId, DVec2)],
+        a: DVec2,
+        b: DVec2,
+        radius: f64,
+    ) -> SnapEvent {
+        debug_assert!(
+            {
+                let mut now = Vec::new();
+                root_ends(g, root, &mut now);
+                let mut given = ends.to_vec();
+                let key = |x: &(NodeId, DVec2)| (x.0, x.1.x.to_bits(), x.1.y.to_bits());
+                now.sort_unstable_by_key(key);
+                given.sort_unstable_by_key(key);
+                now == given
+            },
+            "the root's roads given are not those of the graph"
+        );
         let d = b - a;
         let len2 = d.length_squared();
         if !(len2 > 0.0 && len2.is_finite()) {
@@ -164,7 +198,7 @@ impl Snapper {
         }
         let len = len2.sqrt();
         let radius = radius.max(0.0);
-        if folds_onto_root(g, root, a, b, radius) {
+        if folds_onto_root(ends, a, b, radius) {
             self.folded += 1;
             self.roads.clear();
             return SnapEvent::Blocked;
@@ -258,7 +292,8 @@ impl Snapper {
                 cross = Some((r, i, point));
             }
         }
-        let adjacent = |n: NodeId| g.find_edge(root, n).is_some();
+        // A node is adjacent to the root when it ends one of the root's roads.
+        let adjacent = |n: NodeId| ends.iter().any(|&(m, _)| m == n);
         // A crossing within the snap size of an end of the crossed road joins that end
         // (the nearer one) instead of splitting the road next to it.
         let cross = cross.and_then(|(r, i, p)| {
@@ -352,32 +387,44 @@ fn closest_point(p: DVec2, u: DVec2, v: DVec2) -> DVec2 {
 /// root's own roads: that road's other end is in the snap area (test 1's condition), or
 /// `b` is within `radius` of the road (test 3's). Such a proposal can only fold onto the
 /// road it starts beside, so it is answered before the grid is searched.
-pub(super) fn folds_onto_root(
-    g: &RoadNetwork,
-    root: NodeId,
-    a: DVec2,
-    b: DVec2,
-    radius: f64,
-) -> bool {
-    let Ok(edges) = g.edges_at(root) else {
-        return false;
-    };
+pub(super) fn folds_onto_root(ends: &[(NodeId, DVec2)], a: DVec2, b: DVec2, radius: f64) -> bool {
     let d = b - a;
     let len2 = d.length_squared();
     let len = len2.sqrt();
-    edges.iter().any(|&e| {
-        let Ok(p) = g.other_end(e, root).and_then(|n| g.position(n)) else {
-            return false;
-        };
+    let r2 = radius * radius;
+    ends.iter().any(|&(_, p)| {
         let ap = p - a;
-        let r = ap.dot(d) / len2;
+        let along = ap.dot(d);
+        if along <= 0.0 {
+            // A road at a right angle or more to the proposal: `r ≤ 0` (no node event),
+            // and the road's point closest to `b` is `a` itself (the same arithmetic as
+            // below: the same dot product, clamped to 0).
+            return len2 <= r2;
+        }
+        let r = along / len2;
         let node = if r > 0.0 && r <= 1.0 {
             (d.perp_dot(ap) / len2).abs() * len <= radius
         } else {
-            r > 1.0 && p.distance_squared(b) <= radius * radius
+            r > 1.0 && p.distance_squared(b) <= r2
         };
-        node || closest_point(b, a, p).distance_squared(b) <= radius * radius
+        node || closest_point(b, a, p).distance_squared(b) <= r2
     })
+}
+
+/// Fills `out` with the far end (node and position) of every road of `g` at `root`, in
+/// the order of its adjacency (empty for a dead node).
+pub(crate) fn root_ends(g: &RoadNetwork, root: NodeId, out: &mut Vec<(NodeId, DVec2)>) {
+    out.clear();
+    let Ok(edges) = g.edges_at(root) else {
+        return;
+    };
+    for &e in edges {
+        if let Ok(n) = g.other_end(e, root)
+            && let Ok(p) = g.position(n)
+        {
+            out.push((n, p));
+        }
+    }
 }
 
 /// Kelly's `r` and `s` of `p` against `a–b`, with the exact side of `p`.
