@@ -1132,12 +1132,14 @@ fn rings_network(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
     use crate::CityConfig;
 
-    fn small_rings() -> CityConfig {
+    /// A small Citygen city: two rings and six spokes in 1.4 km (the editor's unit
+    /// tests edit it too).
+    pub(crate) fn small_rings() -> CityConfig {
         let mut c = CityConfig::preset("milan").unwrap();
         c.size_m = 1400.0;
         c.citygen.primary = PrimarySource::Rings {

@@ -222,6 +222,10 @@ pub(crate) struct Memo {
     /// With the output, every city cell (grown, then ungrown) for the editor.
     roads: Mutex<Option<(Key, RoadsOutput, Vec<crate::citygen::District>)>>,
     cells: Mutex<Option<(Key, polis_cells::CellDecomposition)>>,
+    /// A test's injected failure: the city cell whose growth fails when it is grown
+    /// (not when its roads are taken from the memo), as a stage error would.
+    #[cfg(test)]
+    pub(super) fail_growth: Mutex<Option<u64>>,
 }
 
 /// A road-graph cell's buildings and skins, with the memo's entries of each (so a run
@@ -413,6 +417,15 @@ impl GrowthMemo for Memo {
         let hit = lock(&self.growth).get(key);
         if let Some(v) = hit {
             return Ok(v.value.clone());
+        }
+        #[cfg(test)]
+        if *lock(&self.fail_growth) == Some(id) {
+            return Err(crate::Error::Roads(
+                polis_roads::RoadError::InvalidParameter {
+                    name: "secondary",
+                    reason: format!("cell {id}: a growth failure injected by a test"),
+                },
+            ));
         }
         let v = grow()?;
         lock(&self.growth).put(key, v.clone());

@@ -71,7 +71,10 @@
 //!   sequences).
 //! * A rejected edit (unknown id, NaN, out of range, outside the map, refused by the
 //!   primary network's validity checks) or undo with nothing to undo returns a typed
-//!   error and leaves the editor unchanged.
+//!   error and leaves the editor unchanged. So does an edit, undo or redo whose run
+//!   fails in a stage: the city before it is kept, byte for byte (when the run failed
+//!   before the scene was assembled, the same city with the scene it lent to the
+//!   splice put back; otherwise made again from the memo).
 //! * Replaying an [`EditingFile`] gives the identical city and history.
 //!
 //! # Limitations

@@ -49,7 +49,8 @@ pub(super) fn scene_key(config: &CityConfig) -> Option<Key> {
 /// metadata of its block and building leaves, are moved out of the city (which keeps its
 /// node tree) into slots, and a reused leaf takes them from their slots rather than
 /// copying them: the city before the edit is dropped when the edit succeeds, and what it
-/// lent is put back ([`OldScene::restore`]) when it fails.
+/// lent is put back ([`OldScene::restore`], which first lets go of the scene's own
+/// reference to the city) when it fails.
 pub(super) struct OldScene {
     city: Arc<City>,
     /// The city's scene meshes, by mesh id; `None` once taken by a reused leaf.
@@ -207,13 +208,27 @@ impl OldScene {
             .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
-    /// What the city lent put back into it, if no leaf took any of it (the edit failed
-    /// before the scene was assembled); `false` (and `city` unchanged) otherwise.
-    pub(super) fn restore(self, city: &mut City) -> bool {
-        let (Some(meshes), Some(names)) = (unslot_all(self.meshes), unslot_all(self.names)) else {
+    /// Puts what `city` lent back into it, if no leaf took any of it (the edit failed
+    /// before the scene was assembled); returns whether it did. This scene's own
+    /// reference to the city is released first, so that `city` can be written to when
+    /// the caller holds the only other one. On `false` the city may lack what was lent
+    /// and must be made again.
+    pub(super) fn restore(self, city: &mut Arc<City>) -> bool {
+        let OldScene {
+            city: lent_by,
+            meshes,
+            names,
+            named,
+            ..
+        } = self;
+        drop(lent_by);
+        let (Some(meshes), Some(names)) = (unslot_all(meshes), unslot_all(names)) else {
             return false;
         };
-        for (n, (name, metadata)) in self.named.iter().zip(names) {
+        let Some(city) = Arc::get_mut(city) else {
+            return false;
+        };
+        for (n, (name, metadata)) in named.iter().zip(names) {
             if let Some(node) = city.scene.nodes.get_mut(n.0 as usize) {
                 node.name = name;
                 node.metadata = metadata;
