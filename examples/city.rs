@@ -38,6 +38,9 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
+#[path = "../benches/common/process.rs"]
+mod process;
+
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -336,9 +339,14 @@ fn run(args: &Args, progress: &Progress) -> Result<(), Box<dyn std::error::Error
     }
     let city = pipeline.generate(c)?;
     progress.end(true);
+    // The process's CPU (user + system, all threads) at the end of the generation and
+    // of the writing (Linux; nothing printed elsewhere): beside the wall times below,
+    // what a machine shared with other jobs leaves of each phase.
+    let cpu_generated = process::cpu_seconds();
     let t = Instant::now();
     let written = city.write_all_with(&args.out, &args.write)?;
     let write_time = t.elapsed();
+    let cpu_written = process::cpu_seconds();
 
     let s = &city.stats;
     println!("  road segments   {:>9}", s.road_segments);
@@ -375,6 +383,14 @@ fn run(args: &Args, progress: &Progress) -> Result<(), Box<dyn std::error::Error
         "write files",
         write_time.as_secs_f64() * 1e3
     );
+    if let (Some(generated), Some(written)) = (cpu_generated, cpu_written) {
+        println!("  {:<15} {:>7.0} ms", "generate (CPU)", generated * 1e3);
+        println!(
+            "  {:<15} {:>7.0} ms",
+            "write (CPU)",
+            (written - generated) * 1e3
+        );
+    }
     for f in &written.files {
         println!("wrote {}", f.display());
     }
