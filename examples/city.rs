@@ -12,8 +12,9 @@
 //!
 //! With no arguments it builds the `default` preset and writes `out/city.glb`,
 //! `out/city.obj` (+ `city.mtl` and the facade textures in `out/textures/`),
-//! `out/city.svg` and `out/city.geojson`, then prints counts, per-stage timings and every
-//! file written. `--formats` picks the outputs; `--anchor LON,LAT` writes the GeoJSON in
+//! `out/city.svg` and `out/city.geojson`, then prints counts, per-stage timings, the wall
+//! time of generating and of writing (and on Linux the process's CPU time of each) and
+//! every file written. `--formats` picks the outputs; `--anchor LON,LAT` writes the GeoJSON in
 //! WGS 84 longitude/latitude around that point (local metres otherwise). A grey-scale PNG map
 //! covers the whole city square (top row = north edge); its values in [0, 1] are used as
 //! they are, except elevation and maximum height, which are scaled to the given metres
