@@ -607,17 +607,20 @@ fn building_leaf(
     let style = dress
         .and_then(|d| cx.tile_sets.get(d.style))
         .map_or("", |t| t.style.as_str());
-    let mut metadata = Metadata::from([
+    // Room for every entry (up to `style` and `cell`), the ids' text moved in: one
+    // allocation for the entries and one per id.
+    let mut metadata = Metadata::with_capacity(11);
+    metadata.extend([
         ("layer", MetaValue::from_static("buildings")),
         // The id as text (exact in JavaScript above 2^53) and as a number.
-        ("id", MetaValue::from(b.id.to_string().as_str())),
+        ("id", MetaValue::from(b.id.to_string())),
         ("id_number", MetaValue::from(b.id as f64)),
         ("kind", MetaValue::from_static(kind_class(b.kind))),
         ("type", MetaValue::from_static(b.kind.name())),
         ("height", MetaValue::from(b.height)),
         ("floors", MetaValue::from(f64::from(b.floors))),
         ("lot", MetaValue::from(b.lot_id as f64)),
-        ("lot_id", MetaValue::from(b.lot_id.to_string().as_str())),
+        ("lot_id", MetaValue::from(b.lot_id.to_string())),
     ]);
     if !style.is_empty() {
         metadata.insert("style", MetaValue::from(style));

@@ -16,8 +16,12 @@
 //!   three separately: the corners of a flat face share one `vn` line, and a corner shared
 //!   by faces of different normals or texture coordinates one `v` line), then per mesh a
 //!   `usemtl` line and its `f p/t/n p/t/n p/t/n` triangles. Values are distinct when
-//!   their text differs (they are compared by their bits). `citygen`'s OBJ has 41 %
-//!   fewer bytes than with one line of each per mesh vertex (395 against 674 MB). Texture
+//!   their text differs (they are compared by their bits). Face indices are relative
+//!   (negative, OBJ's "relative reference numbers": `-1` is the last value of its stream
+//!   written so far), which within a group are short numbers where absolute indices grow
+//!   to seven digits. `citygen`'s OBJ has 41 % fewer bytes than with one line of each
+//!   per mesh vertex (395 against 674 MB), and relative indices take a further third off
+//!   (see BENCHMARKS.md, "Issue 25, session 17"). Texture
 //!   coordinates are converted from glTF's `v`-down convention to OBJ's `v`-up:
 //!   `vt u (1 − v)`, so an image maps the same way in both files.
 //! * `<stem>.mtl`: per scene material `newmtl m<index>_<name>` with `Kd` (base colour, linear
@@ -215,7 +219,7 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
         let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
         NodeGeometry::new(drawn_meshes(i), &world)
     };
-    let node_text = |(&(i, _), (g, first)): (&(usize, u64), (&NodeGeometry, Counts))| -> Vec<u8> {
+    let node_text = |&(i, _): &(usize, u64), g: &NodeGeometry| -> Vec<u8> {
         let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
         let mirror = DMat3::from_mat4(world).determinant() < 0.0;
         let mut out = Vec::with_capacity(g.text_estimate());
@@ -233,29 +237,33 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
                 None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
             }
             out.push(b'\n');
-            g.push_faces(&mut out, m, corner, first, mirror);
+            g.push_faces(&mut out, m, corner, mirror);
             corner += m.vertex_count();
         }
         out
     };
     // Batches of about 256 Ki vertices (some tens of MiB of text): the next batch is
     // formatted on the thread pool while this thread writes the last one. A batch's nodes
-    // are welded in parallel, numbered in node order from where the batch before ended,
-    // then formatted in parallel.
+    // are welded and formatted in parallel (a node's text does not depend on the nodes
+    // before it: its faces index relative to its own values); the streams' running
+    // counts are only for the report.
     let batches = batch_bounds(&drawn, batch_vertices);
     let format = |range: &std::ops::Range<usize>, start: Counts| -> (Vec<Vec<u8>>, Counts) {
         let nodes = drawn.get(range.clone()).unwrap_or_default();
-        let welded: Vec<NodeGeometry> = nodes.par_iter().map(geometry).collect();
-        let mut firsts = Vec::with_capacity(welded.len());
-        let mut next = start;
-        for g in &welded {
-            firsts.push(next);
-            next = next.after(g);
-        }
-        let texts = nodes
+        let made: Vec<(Vec<u8>, Counts)> = nodes
             .par_iter()
-            .zip(welded.par_iter().zip(firsts))
-            .map(node_text)
+            .map(|node| {
+                let g = geometry(node);
+                (node_text(node, &g), Counts::ZERO.after(&g))
+            })
+            .collect();
+        let mut next = start;
+        let texts = made
+            .into_iter()
+            .map(|(text, counts)| {
+                next = next.plus(counts);
+                text
+            })
             .collect();
         (texts, next)
     };
@@ -405,6 +413,22 @@ struct Counts {
 }
 
 impl Counts {
+    /// No values.
+    const ZERO: Counts = Counts {
+        positions: 0,
+        uvs: 0,
+        normals: 0,
+    };
+
+    /// The sum of two counts.
+    fn plus(self, other: Counts) -> Counts {
+        Counts {
+            positions: self.positions + other.positions,
+            uvs: self.uvs + other.uvs,
+            normals: self.normals + other.normals,
+        }
+    }
+
     /// The counts after a node's vertices.
     fn after(self, g: &NodeGeometry) -> Counts {
         Counts {
@@ -533,24 +557,33 @@ impl NodeGeometry {
     }
 
     /// Appends mesh `m`'s triangles, whose vertices are this node's corners from
-    /// `corner` on; `first` gives the OBJ index of the node's first value in each stream.
-    fn push_faces(&self, out: &mut Vec<u8>, m: &Mesh, corner: usize, first: Counts, mirror: bool) {
-        let starts = [first.positions, first.uvs, first.normals];
+    /// `corner` on, with indices relative to the end of each stream (`-1` is the node's
+    /// last value): the node's values are the last ones written before its faces.
+    fn push_faces(&self, out: &mut Vec<u8>, m: &Mesh, corner: usize, mirror: bool) {
+        let lens = [
+            self.positions.len() as u64,
+            self.uvs.len() as u64,
+            self.normals.len() as u64,
+        ];
+        let relative = |out: &mut Vec<u8>, stream: usize, id: u32| {
+            out.push(b'-');
+            push_u64(out, lens[stream] - u64::from(id));
+        };
         for [a, b, c] in m.triangles() {
             let (b, c) = if mirror { (c, b) } else { (b, c) };
             out.push(b'f');
             for k in [a, b, c] {
                 let ids = self.corners[corner + k as usize];
                 out.push(b' ');
-                push_u64(out, starts[0] + u64::from(ids[0]));
+                relative(out, 0, ids[0]);
                 if ids[1] != ABSENT || ids[2] != ABSENT {
                     out.push(b'/');
                     if ids[1] != ABSENT {
-                        push_u64(out, starts[1] + u64::from(ids[1]));
+                        relative(out, 1, ids[1]);
                     }
                     if ids[2] != ABSENT {
                         out.push(b'/');
-                        push_u64(out, starts[2] + u64::from(ids[2]));
+                        relative(out, 2, ids[2]);
                     }
                 }
             }

@@ -19,8 +19,29 @@ pub(crate) fn push_f32(out: &mut Vec<u8>, x: f32) {
         let _ = write!(out, "{x}");
         return;
     }
+    // Whole numbers below 2^24 (every such `f32` is exact; normals and texture
+    // coordinates are often 0 or ±1): their digits, with the sign `core` writes (`-0`).
+    if x.abs() < 16_777_216.0 && x == x.trunc() {
+        if x.is_sign_negative() {
+            out.push(b'-');
+        }
+        push_u64(out, x.abs() as u64);
+        return;
+    }
     let mut buffer = zmij::Buffer::new();
     let text = buffer.format_finite(x).as_bytes();
+    // Most values: zmij wrote plain `[-]digits.digits` without a trailing zero, which is
+    // `core`'s text too unless x is a midpoint (the last digit's exponent rules that out).
+    if let Some(dot) = text.iter().position(|&c| c == b'.') {
+        let fraction = text.get(dot + 1..).unwrap_or_default();
+        if fraction.last().is_some_and(|&c| c != b'0')
+            && fraction.iter().all(u8::is_ascii_digit)
+            && !midpoint_exponent(-(fraction.len() as i32), x)
+        {
+            out.extend_from_slice(text);
+            return;
+        }
+    }
     let (negative, text) = match text.split_first() {
         Some((b'-', rest)) => (true, rest),
         _ => (false, text),
@@ -145,6 +166,18 @@ fn parse_exponent(text: &[u8]) -> i32 {
 /// so its power of 2 comes from 10^q alone, which is checked first and rules out almost
 /// every value.
 fn is_midpoint_above(digits: &[u8], q: i32, x: f32) -> bool {
+    if !midpoint_exponent(q, x) || digits.len() > 18 {
+        return false;
+    }
+    let (m, _) = mantissa(x);
+    let twos_m = m.trailing_zeros() as i32;
+    let (a, fives_a) = without_fives(2 * value(digits) + 1);
+    let (b, fives_m) = without_fives(m >> twos_m);
+    a == b && q + fives_a == fives_m
+}
+
+/// |x| = m × 2^e with m an integer (the significand with its hidden bit).
+fn mantissa(x: f32) -> (u64, i32) {
     let bits = x.to_bits() & 0x7fff_ffff;
     let (mut m, mut e) = (u64::from(bits & 0x7f_ffff), (bits >> 23) as i32);
     if e == 0 {
@@ -152,17 +185,15 @@ fn is_midpoint_above(digits: &[u8], q: i32, x: f32) -> bool {
     } else {
         m |= 1 << 23;
     }
-    e -= 150;
-    if m == 0 {
-        return false;
-    }
-    let twos_m = m.trailing_zeros() as i32;
-    if q != e + 1 + twos_m || digits.len() > 18 {
-        return false;
-    }
-    let (a, fives_a) = without_fives(2 * value(digits) + 1);
-    let (b, fives_m) = without_fives(m >> twos_m);
-    a == b && q + fives_a == fives_m
+    (m, e - 150)
+}
+
+/// Whether digits whose last one stands for 10^q can make x a midpoint (d + ½) × 10^q:
+/// the powers of 2 of both sides must agree, q = e + 1 + (trailing zeros of m), which
+/// rules out almost every value before any digit is read.
+fn midpoint_exponent(q: i32, x: f32) -> bool {
+    let (m, e) = mantissa(x);
+    m != 0 && q == e + 1 + m.trailing_zeros() as i32
 }
 
 /// `v` without its factors of 5, and how many there were.
@@ -213,7 +244,15 @@ mod tests {
             f32::INFINITY,
             f32::NEG_INFINITY,
         ];
-        for x in cases {
+        let edges = [
+            16_777_215.0f32,
+            -16_777_215.0,
+            16_777_216.0,
+            16_777_218.0,
+            -1.0,
+            0.5,
+        ];
+        for x in cases.into_iter().chain(edges) {
             assert_eq!(text(x), format!("{x}"), "bits {:#x}", x.to_bits());
         }
     }
@@ -243,6 +282,14 @@ mod tests {
         fn any_f32_matches_display(bits in any::<u32>()) {
             let x = f32::from_bits(bits);
             prop_assert_eq!(text(x), format!("{x}"));
+        }
+
+        /// Whole numbers, on both sides of 2^24 where the whole-number path ends.
+        #[test]
+        fn whole_f32_match_display(n in -(1i32 << 25)..(1 << 25)) {
+            let x = n as f32;
+            prop_assert_eq!(text(x), format!("{x}"));
+            prop_assert_eq!(text(x * 64.0), format!("{}", x * 64.0));
         }
 
         /// Values with few binary digits, where midpoints live.

@@ -46,7 +46,9 @@
 //! outside the other region).
 
 use polis_geom::glam::{Vec2, Vec3};
-use polis_geom::hash::point_key;
+use std::collections::HashMap;
+
+use polis_geom::hash::{FxBuild, point_key};
 use polis_geom::lines::{ccw_cmp_from, innermost_ring_containing};
 use polis_geom::mesh::{edge_use, to_world};
 use polis_geom::polygon::ring_signed_area;
@@ -265,38 +267,40 @@ fn try_merge(parts: &[Part]) -> Result<MergedSolid, Why> {
 }
 
 /// Merges vertices with identical position, normal and texture coordinates (a flat face
-/// then shares its corners, as the parts' meshes did).
+/// then shares its corners, as the parts' meshes did). Each class of identical vertices
+/// keeps its lowest-numbered member's values (`-0.0` and `+0.0` are one value), and the
+/// kept vertices are numbered in first-use order of the indices.
 fn weld(m: &mut Mesh) {
     let n = m.positions.len();
     let key = |i: usize| {
         let (p, nr, uv) = (m.positions[i], m.normals[i], m.uvs[i]);
         [p.x, p.y, p.z, nr.x, nr.y, nr.z, uv.x, uv.y].map(|v| (v + 0.0).to_bits())
     };
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&i| (key(i), i));
-    let mut remap = vec![0u32; n];
-    let mut keep: Vec<usize> = Vec::with_capacity(n);
-    for (k, &i) in order.iter().enumerate() {
-        if k == 0 || key(order[k - 1]) != key(i) {
-            keep.push(i);
-        }
-        remap[i] = keep.len() as u32 - 1;
-    }
+    // Each vertex's representative: the first vertex with its key.
+    let mut first_of: HashMap<[u32; 8], u32, FxBuild> =
+        HashMap::with_capacity_and_hasher(n, FxBuild::default());
+    let rep: Vec<u32> = (0..n)
+        .map(|i| *first_of.entry(key(i)).or_insert(i as u32))
+        .collect();
+    let classes = first_of.len();
+    drop(first_of);
     // Renumber in first-use order for a stable, cache-friendly layout.
-    let mut first = vec![u32::MAX; keep.len()];
-    let mut positions: Vec<Vec3> = Vec::with_capacity(keep.len());
-    let mut normals: Vec<Vec3> = Vec::with_capacity(keep.len());
-    let mut uvs: Vec<Vec2> = Vec::with_capacity(keep.len());
+    let mut first = vec![u32::MAX; n];
+    let mut positions: Vec<Vec3> = Vec::with_capacity(classes);
+    let mut normals: Vec<Vec3> = Vec::with_capacity(classes);
+    let mut uvs: Vec<Vec2> = Vec::with_capacity(classes);
     for idx in &mut m.indices {
-        let c = remap[*idx as usize] as usize;
-        if first[c] == u32::MAX {
-            first[c] = positions.len() as u32;
-            let src = keep[c];
+        let Some(&src) = rep.get(*idx as usize) else {
+            continue;
+        };
+        let src = src as usize;
+        if first[src] == u32::MAX {
+            first[src] = positions.len() as u32;
             positions.push(m.positions[src]);
             normals.push(m.normals[src]);
             uvs.push(m.uvs[src]);
         }
-        *idx = first[c];
+        *idx = first[src];
     }
     m.positions = positions;
     m.normals = normals;
@@ -791,6 +795,95 @@ mod tests {
         let m = merge_parts(&[a, b]);
         assert!(!m.closed);
         assert!(merge_parts(&[]).meshes.is_empty());
+    }
+
+    /// The weld as it was first written: vertices sorted by (key, index), each class's
+    /// lowest index kept, renumbered in first-use order. [`weld`] must give the same
+    /// mesh bit for bit.
+    fn weld_by_sorting(m: &mut Mesh) {
+        let n = m.positions.len();
+        let key = |i: usize| {
+            let (p, nr, uv) = (m.positions[i], m.normals[i], m.uvs[i]);
+            [p.x, p.y, p.z, nr.x, nr.y, nr.z, uv.x, uv.y].map(|v| (v + 0.0).to_bits())
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by_key(|&i| (key(i), i));
+        let mut remap = vec![0u32; n];
+        let mut keep: Vec<usize> = Vec::with_capacity(n);
+        for (k, &i) in order.iter().enumerate() {
+            if k == 0 || key(order[k - 1]) != key(i) {
+                keep.push(i);
+            }
+            remap[i] = keep.len() as u32 - 1;
+        }
+        let mut first = vec![u32::MAX; keep.len()];
+        let (mut positions, mut normals, mut uvs) = (Vec::new(), Vec::new(), Vec::new());
+        for idx in &mut m.indices {
+            let c = remap[*idx as usize] as usize;
+            if first[c] == u32::MAX {
+                first[c] = positions.len() as u32;
+                positions.push(m.positions[keep[c]]);
+                normals.push(m.normals[keep[c]]);
+                uvs.push(m.uvs[keep[c]]);
+            }
+            *idx = first[c];
+        }
+        m.positions = positions;
+        m.normals = normals;
+        m.uvs = uvs;
+    }
+
+    fn same_bits(a: &Mesh, b: &Mesh) -> bool {
+        let v3 = |v: &[Vec3]| {
+            v.iter()
+                .flat_map(|p| p.to_array())
+                .map(f32::to_bits)
+                .collect::<Vec<_>>()
+        };
+        let v2 = |v: &[Vec2]| {
+            v.iter()
+                .flat_map(|p| p.to_array())
+                .map(f32::to_bits)
+                .collect::<Vec<_>>()
+        };
+        a.indices == b.indices
+            && v3(&a.positions) == v3(&b.positions)
+            && v3(&a.normals) == v3(&b.normals)
+            && v2(&a.uvs) == v2(&b.uvs)
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+        /// Welding by hashing equals welding by sorting, bit for bit: same kept values
+        /// (a class's lowest vertex, `-0.0` against `+0.0` included), same numbering, on
+        /// meshes with many repeated vertices in any order and unused ones.
+        #[test]
+        fn weld_by_hashing_equals_weld_by_sorting(
+            vertices in proptest::collection::vec((0u8..4, 0u8..3, 0u8..3, proptest::bool::ANY), 1..60),
+            triangles in proptest::collection::vec((0usize..1000, 0usize..1000, 0usize..1000), 0..40),
+        ) {
+            let value = |k: u8, negative: bool| match (k, negative) {
+                (0, true) => -0.0,
+                (0, false) => 0.0,
+                (k, _) => f32::from(k) * 0.25,
+            };
+            let mut m = Mesh::new(None);
+            for &(p, nr, uv, neg) in &vertices {
+                m.positions.push(Vec3::new(value(p, neg), value(p % 2, !neg), 1.0));
+                m.normals.push(Vec3::new(0.0, value(nr, neg), 1.0));
+                m.uvs.push(Vec2::new(value(uv, !neg), 0.5));
+            }
+            let n = vertices.len();
+            for &(a, b, c) in &triangles {
+                m.indices.extend([a % n, b % n, c % n].map(|i| i as u32));
+            }
+            let mut hashed = m.clone();
+            weld(&mut hashed);
+            let mut sorted = m;
+            weld_by_sorting(&mut sorted);
+            proptest::prop_assert!(same_bits(&hashed, &sorted));
+        }
     }
 
     proptest::proptest! {

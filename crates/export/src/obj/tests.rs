@@ -354,7 +354,7 @@ pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
                     let (b, c) = if mirror { (c, b) } else { (b, c) };
                     [a, b, c].map(|k| ids[k as usize])
                 })
-                .collect();
+                .collect::<Vec<[[u64; 3]; 3]>>();
             faces.push((name, tris));
         }
         let _ = writeln!(w, "g {}_{i}", sanitize(&node.name, "node"));
@@ -367,9 +367,22 @@ pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
         for [x, y, z] in &ns {
             let _ = writeln!(w, "vn {x} {y} {z}");
         }
+        vb += ps.len() as u64;
+        tb += ts.len() as u64;
+        nb += ns.len() as u64;
+        // Indices relative to the end of each stream: the absolute 1-based index less
+        // the count of values written so far, less one (`-1` is the last value).
+        let rel = |[p, t, n]: [u64; 3]| {
+            [
+                p as i64 - vb as i64,
+                t as i64 - tb as i64,
+                n as i64 - nb as i64,
+            ]
+        };
         for (name, tris) in faces {
             let _ = writeln!(w, "usemtl {name}");
             for [a, b, c] in tris {
+                let [a, b, c] = [a, b, c].map(rel);
                 let _ = writeln!(
                     w,
                     "f {}/{}/{} {}/{}/{} {}/{}/{}",
@@ -377,9 +390,6 @@ pub(crate) fn reference_obj(scene: &Scene, stem: &str) -> Vec<u8> {
                 );
             }
         }
-        vb += ps.len() as u64;
-        tb += ts.len() as u64;
-        nb += ns.len() as u64;
     }
     w
 }
