@@ -687,6 +687,28 @@ impl GradedGround<'_> {
     }
 }
 
+/// Whether cones that each hold the ground `g` and whose bounds lie within
+/// `[wide_lo, wide_hi]` (a lower bound at most `wide_lo`, an upper at least `wide_hi`)
+/// leave [`clamp_into`]`(g, lo, hi)` as it is. With them the range is
+/// `[max(lo, l), min(hi, h)]`, `l ≤ min(g, wide_lo)`, `h ≥ max(g, wide_hi)`:
+/// * `lo ≤ g ≤ hi`: still holds `g`, the value `g`;
+/// * `g < lo ≤ hi`: the value stays `lo` while `h ≥ lo`, sure when `wide_hi ≥ lo`;
+/// * `lo ≤ hi < g`: likewise `hi` while `wide_lo ≤ hi`;
+/// * `lo > hi` (the meeting height): `l ≤ lo` and `h ≥ hi` keep both bounds.
+fn wide_cones_agree(g: f64, lo: f64, hi: f64, wide_lo: f64, wide_hi: f64) -> bool {
+    if lo <= hi {
+        if g < lo {
+            wide_hi >= lo
+        } else if g > hi {
+            wide_lo <= hi
+        } else {
+            true
+        }
+    } else {
+        wide_lo <= lo && wide_hi >= hi
+    }
+}
+
 /// The ground `g` clamped into the cones' common range `[lo, hi]`, or their meeting
 /// height where they leave none.
 fn clamp_into(g: f64, lo: f64, hi: f64) -> f64 {
@@ -732,17 +754,40 @@ impl Field for GradedGround<'_> {
             }
             return;
         };
+        // The natural ground's range over the batch.
+        let (mut g_lo, mut g_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &g in out.iter().filter(|g| g.is_finite()) {
+            g_lo = g_lo.min(g);
+            g_hi = g_hi.max(g);
+        }
         let mut near = Vec::new();
+        let mut wide = Vec::new();
         // Pieces whose cone binds nowhere in the box (past the bank and the wall face at
-        // its centre's distance less its half diagonal) are left out.
+        // its centre's distance less its half diagonal) are left out. Pieces whose cone
+        // holds the batch's whole ground range at every point of the box (`wide`: their
+        // narrowest rise there, at the box's nearest distance, reaches from every height
+        // of the piece past that range) are read only at points where the others'
+        // range might not stand with them (`wide_cones_agree`).
         let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
         let wall_end = self.max_bank + RETAINING_WALL_M + BOX_SLACK_M;
+        let (mut wide_lo, mut wide_hi) = (f64::NEG_INFINITY, f64::INFINITY);
         self.index
             .for_each_candidate(&b.expanded(self.reach), |k, _| {
                 if let Some(piece) = self.pieces.get(k as usize) {
                     let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
                     if beyond < wall_end {
-                        near.push(k);
+                        // The cone's narrowest at the box, less rounding.
+                        let rise = cone_rise(beyond.max(0.0), self.slope, self.max_bank)
+                            .map(|r| r * (1.0 - 1e-9) - BOX_SLACK_M);
+                        let (r_lo, r_hi) = (piece.ha.min(piece.hb), piece.ha.max(piece.hb));
+                        match rise {
+                            Some(rise) if r_hi - rise <= g_lo && r_lo + rise >= g_hi => {
+                                wide_lo = wide_lo.max(r_hi - rise);
+                                wide_hi = wide_hi.min(r_lo + rise);
+                                wide.push(k);
+                            }
+                            _ => near.push(k),
+                        }
                     }
                 }
             });
@@ -753,6 +798,11 @@ impl Field for GradedGround<'_> {
             let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
             for &k in &near {
                 self.narrow(k, p, &mut lo, &mut hi);
+            }
+            if !wide_cones_agree(*o, lo, hi, wide_lo, wide_hi) {
+                for &k in &wide {
+                    self.narrow(k, p, &mut lo, &mut hi);
+                }
             }
             *o = clamp_into(*o, lo, hi);
         }
