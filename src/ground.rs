@@ -86,10 +86,12 @@ pub(crate) fn map_bounds(config: &CityConfig) -> Aabb2 {
     Aabb2::new(DVec2::splat(-h), DVec2::splat(h))
 }
 
-/// Builds the terrain of `elevation` and paints the land-use classes.
+/// Builds the terrain of `elevation` (allowed `slack` metres further below it, where
+/// given: [`Terrain::build_with_slack`]) and paints the land-use classes.
 pub(crate) fn build_ground<'a>(
     config: &CityConfig,
     elevation: &dyn Field,
+    slack: Option<&dyn Field>,
     water: &[PolygonWithHoles],
     parks: &[PolygonWithHoles],
     blocks: impl Iterator<Item = &'a PolygonWithHoles> + Send,
@@ -115,7 +117,12 @@ pub(crate) fn build_ground<'a>(
         if let Some(made) = made {
             return Ok(made);
         }
-        let terrain = Terrain::build(elevation, bounds, &scene.terrain_mesh, None)?;
+        let terrain = match slack {
+            Some(slack) => {
+                Terrain::build_with_slack(elevation, slack, bounds, &scene.terrain_mesh, None)?
+            }
+            None => Terrain::build(elevation, bounds, &scene.terrain_mesh, None)?,
+        };
         // Cut here, once, rather than by every tiled glb written: the writer appends a
         // mesh that is already one tile's cut whole.
         let tiles = terrain

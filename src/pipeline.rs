@@ -430,10 +430,13 @@ impl Pipeline {
             assemble(&SceneInputs {
                 ground,
                 water: water.as_ref(),
-                cut_in: graded
-                    .as_ref()
-                    .filter(|g| g.moves_ground())
-                    .map(|g| g.cut_in(crate::scene::CORRIDOR_CUT_M, 1.0)),
+                cut_in: graded.as_ref().filter(|g| g.moves_ground()).map(|g| {
+                    g.cut_in(
+                        crate::scene::CORRIDOR_CUT_M,
+                        1.0,
+                        crate::scene::CORRIDOR_CUT_TAPER_M,
+                    )
+                }),
                 config,
                 maps: &maps,
                 network: &network,

@@ -275,10 +275,18 @@ impl Targets {
 }
 
 /// How deep the terrain is cut in under graded road corridors (and 1 m beyond, tapering
-/// over the next metre), metres: the terrain mesh's triangles span the sharp foot of a
-/// cut's banks without vertices on the corridor's edge, and this keeps them under the
-/// road surface.
+/// over the next [`CORRIDOR_CUT_TAPER_M`]), metres: the terrain mesh's triangles span the
+/// sharp foot of a cut's banks without vertices on the corridor's edge, and this keeps
+/// them under the road surface. The cut is an upper bound on the terrain only: over the
+/// cut and one more taper beyond it the terrain may also sag by this much under it
+/// (`CutIn::slack`), so it is refined where it would rise over the cut, not where it
+/// only sags under it.
 pub const CORRIDOR_CUT_M: f64 = 0.5;
+
+/// Over how many metres the corridors' cut tapers back to the ground, metres: gentle
+/// (1:16 for the 0.5 m cut), so the taper's own bends need no small terrain leaves (a 1 m
+/// taper refined both of its edges to the smallest leaf along every road).
+pub const CORRIDOR_CUT_TAPER_M: f64 = 8.0;
 
 /// How far a block plinth draped on an elevation map reaches below the ground, metres: a
 /// foundation, so the ground between the plinth's vertices never shows under it.
@@ -495,7 +503,8 @@ pub(crate) fn node_id(name: &str, kind: &str) -> Option<u64> {
 pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
 /// How far buildings and plinths reach below the ground: the terrain's one-sided
-/// allowance (2 e) and, on graded ground (`graded`), the corridor cut and the lowering of
+/// allowance (2 e) and, on graded ground (`graded`), the corridor cut, the terrain's slack
+/// under it (as deep again) and the lowering of
 /// smallest leaves that miss the bound at the foot of a bank (their diagonal's rise on
 /// the bank). Metres; 0 without terrain.
 fn foot_of(config: &CityConfig, graded: bool) -> f64 {
@@ -504,7 +513,7 @@ fn foot_of(config: &CityConfig, graded: bool) -> f64 {
         return 0.0;
     }
     let graded = if graded {
-        CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
+        2.0 * CORRIDOR_CUT_M + 2.0 * sc.terrain_mesh.min_cell_m * sc.road_grading.embankment_slope
     } else {
         0.0
     };
@@ -709,8 +718,8 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         )?))
     };
     // Buildings and plinths reach below the ground as far as the terrain may lie below
-    // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut and the
-    // lowering of smallest leaves that miss the bound at the foot of a bank (their
+    // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut, the
+    // slack under it and the lowering of smallest leaves that miss the bound at the foot of a bank (their
     // diagonal's rise on the bank).
     let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
@@ -831,7 +840,19 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             let memo = inp.terrains.filter(|_| inp.cut_in.is_none());
             let made = memo.and_then(|m| m.terrain(bed));
             let fresh = made.is_none();
-            let ground = build_ground(inp.config, terrain_field, &water, &parks, blocks, made)?;
+            // The cut is an upper bound only: the terrain may sag under it by its depth
+            // around the corridors (`CutIn::slack`).
+            let slack = inp.cut_in.as_ref().map(|c| c.slack());
+            let slack = slack.as_ref().map(|s| s as &dyn Field);
+            let ground = build_ground(
+                inp.config,
+                terrain_field,
+                slack,
+                &water,
+                &parks,
+                blocks,
+                made,
+            )?;
             if let Some(m) = memo.filter(|_| fresh) {
                 m.keep_terrain(bed, ground.report, &ground.tiles);
             }

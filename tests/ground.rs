@@ -134,7 +134,7 @@ fn stands_on_its_ground(city: &City) {
 
     // Road surfaces: above the terrain, and at most the terrain's allowance plus their
     // lift above it.
-    let (mut roads, mut worst_float) = (0, 0.0f64);
+    let (mut roads, mut worst_float, mut least_clearance) = (0, 0.0f64, f64::INFINITY);
     let (mut buried, mut worst_buried) = (0, 0.0f64);
     for (mesh, w) in node_meshes(scene, &worlds, "roads") {
         for p in &mesh.positions {
@@ -148,11 +148,13 @@ fn stands_on_its_ground(city: &City) {
                 worst_buried = worst_buried.max(g - h);
             }
             worst_float = worst_float.max(h - g);
+            least_clearance = least_clearance.min(h - g);
             roads += 1;
         }
     }
     eprintln!(
-        "{buried} of {roads} road vertices buried, worst {worst_buried} m; terrain {:?}",
+        "{buried} of {roads} road vertices buried, worst {worst_buried} m, least clearance \
+         {least_clearance} m; terrain {:?}",
         ground_meta(scene)
     );
     assert_eq!(buried, 0, "road vertices buried (worst {worst_buried} m)");

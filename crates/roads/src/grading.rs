@@ -506,14 +506,15 @@ impl GradedGround<'_> {
 
     /// This ground cut in under the road corridors, for a terrain mesh: `depth` metres
     /// lower within `margin` metres beyond each corridor (off bridges), tapering back to
-    /// the ground over the next `margin` metres. A mesh that interpolates this field
+    /// the ground over the next `taper` metres. A mesh that interpolates this field
     /// stays below the road surfaces where the graded ground bends sharply (the foot of
     /// a cut's banks) although its vertices do not lie on the corridors' edges.
-    pub fn cut_in(&self, depth: f64, margin: f64) -> CutIn<'_> {
+    pub fn cut_in(&self, depth: f64, margin: f64, taper: f64) -> CutIn<'_> {
         CutIn {
             graded: self,
             depth: depth.max(0.0),
             margin: margin.max(0.0),
+            taper: taper.max(0.0),
         }
     }
 }
@@ -523,28 +524,118 @@ pub struct CutIn<'a> {
     graded: &'a GradedGround<'a>,
     depth: f64,
     margin: f64,
+    taper: f64,
 }
 
-impl CutIn<'_> {
-    /// How far the corridors' cut reaches beyond a centre line, metres.
-    fn reach(&self) -> f64 {
-        self.graded.corridor_reach + 2.0 * self.margin
+impl<'a> CutIn<'a> {
+    /// The share of the cut depth piece `k` asks for at `p` (1 within the corridor and
+    /// its margin, tapering to 0 over the taper beyond).
+    fn share(&self, k: u32, p: DVec2) -> f64 {
+        self.share_beyond(k, p, self.margin)
     }
 
-    /// The share of the cut depth piece `k` asks for at `p` (1 within the corridor and
-    /// its margin, tapering to 0 over the next margin).
-    fn share(&self, k: u32, p: DVec2) -> f64 {
+    /// 1 within `flat` metres beyond the corridor of piece `k`, tapering to 0 over the
+    /// next `taper` metres.
+    fn share_beyond(&self, k: u32, p: DVec2, flat: f64) -> f64 {
         let Some(piece) = self.graded.pieces.get(k as usize) else {
             return 0.0;
         };
         let (_, d) = piece.project(p);
-        let beyond = d - piece.half_width - self.margin;
+        let beyond = d - piece.half_width - flat;
         if beyond <= 0.0 {
             1.0
-        } else if self.margin > 0.0 {
-            (1.0 - beyond / self.margin).max(0.0)
+        } else if self.taper > 0.0 {
+            (1.0 - beyond / self.taper).max(0.0)
         } else {
             0.0
+        }
+    }
+
+    /// The largest share of the cut depth any corridor asks for at `p`, flat `flat`
+    /// metres beyond the corridors.
+    fn sink(&self, p: DVec2, flat: f64) -> f64 {
+        let mut sink = 0.0f64;
+        let b = Aabb2::new(p, p).expanded(self.graded.corridor_reach + flat + self.taper);
+        self.graded.corridors.for_each_candidate(&b, |k, _| {
+            sink = sink.max(self.share_beyond(k, p, flat));
+        });
+        sink
+    }
+
+    /// The corridors near the box of `points` whose share, flat `flat` metres beyond the
+    /// corridor, may be above 0 somewhere in it (`None` for no finite point).
+    fn near(&self, points: &[DVec2], flat: f64) -> Option<Vec<u32>> {
+        let b = Aabb2::of_finite_points(points)?;
+        let mut near = Vec::new();
+        // Corridors that cut nowhere in the box (at least `flat` and the taper beyond it
+        // at its centre's distance less its half diagonal) share 0 at every point: left
+        // out.
+        let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
+        let reach = self.graded.corridor_reach + flat + self.taper;
+        self.graded
+            .corridors
+            .for_each_candidate(&b.expanded(reach), |k, _| {
+                if let Some(piece) = self.graded.pieces.get(k as usize) {
+                    let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
+                    if beyond < flat + self.taper + BOX_SLACK_M {
+                        near.push(k);
+                    }
+                }
+            });
+        Some(near)
+    }
+
+    /// How far a terrain of this field may lie below it (for
+    /// [`Terrain::build_with_slack`](polis_geom::mesh::Terrain::build_with_slack)): the
+    /// cut's depth over the whole cut (its flat part and its taper), tapering to 0 over
+    /// one more taper. The terrain then keeps the cut as an upper bound there: it
+    /// refines where its fans would rise over the cut (the foot of a cut's bank at a
+    /// corridor's edge, the foot of a fill bank) but not where they only sag under it
+    /// (the top of a fill bank at a corridor's edge, a crest along a road).
+    pub fn slack(&self) -> CutSlack<'a> {
+        CutSlack {
+            cut: CutIn {
+                graded: self.graded,
+                depth: self.depth,
+                margin: self.margin,
+                taper: self.taper,
+            },
+        }
+    }
+}
+
+/// How far a terrain may lie under a [`CutIn`]: see [`CutIn::slack`].
+pub struct CutSlack<'a> {
+    cut: CutIn<'a>,
+}
+
+impl CutSlack<'_> {
+    /// The flat part of the slack beyond a corridor: the cut's flat part and its taper.
+    fn flat(&self) -> f64 {
+        self.cut.margin + self.cut.taper
+    }
+}
+
+impl Field for CutSlack<'_> {
+    fn sample(&self, p: DVec2) -> f64 {
+        self.cut.depth * self.cut.sink(p, self.flat())
+    }
+
+    /// One look-up of the corridors around all the points, then the values of
+    /// [`sample`](Field::sample) (combined by `max`, as the cut's shares).
+    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+        let flat = self.flat();
+        let Some(near) = self.cut.near(points, flat) else {
+            for (p, o) in points.iter().zip(out.iter_mut()) {
+                *o = self.sample(*p);
+            }
+            return;
+        };
+        for (&p, o) in points.iter().zip(out.iter_mut()) {
+            let sink = near.iter().fold(0.0f64, |sink, &k| {
+                sink.max(self.cut.share_beyond(k, p, flat))
+            });
+            *o = self.cut.depth * sink;
         }
     }
 }
@@ -552,12 +643,7 @@ impl CutIn<'_> {
 impl Field for CutIn<'_> {
     fn sample(&self, p: DVec2) -> f64 {
         let g = self.graded.sample(p);
-        let mut sink = 0.0f64;
-        let b = Aabb2::new(p, p).expanded(self.reach());
-        self.graded.corridors.for_each_candidate(&b, |k, _| {
-            sink = sink.max(self.share(k, p));
-        });
-        g - self.depth * sink
+        g - self.depth * self.sink(p, self.margin)
     }
 
     /// One look-up of the corridors around all the points, then the values of
@@ -565,26 +651,12 @@ impl Field for CutIn<'_> {
     /// superset of the corridors near each point change nothing).
     fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
         self.graded.sample_many(points, out);
-        let Some(b) = Aabb2::of_finite_points(points) else {
+        let Some(near) = self.near(points, self.margin) else {
             for (p, o) in points.iter().zip(out.iter_mut()) {
                 *o = self.sample(*p);
             }
             return;
         };
-        let mut near = Vec::new();
-        // Corridors that cut nowhere in the box (at least twice the margin beyond it at
-        // its centre's distance less its half diagonal) share 0 at every point: left out.
-        let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
-        self.graded
-            .corridors
-            .for_each_candidate(&b.expanded(self.reach()), |k, _| {
-                if let Some(piece) = self.graded.pieces.get(k as usize) {
-                    let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
-                    if beyond < 2.0 * self.margin + BOX_SLACK_M {
-                        near.push(k);
-                    }
-                }
-            });
         for (&p, o) in points.iter().zip(out.iter_mut()) {
             let sink = near
                 .iter()
@@ -612,6 +684,28 @@ impl GradedGround<'_> {
             *lo = lo.max(r - rise);
             *hi = hi.min(r + rise);
         }
+    }
+}
+
+/// Whether cones that each hold the ground `g` and whose bounds lie within
+/// `[wide_lo, wide_hi]` (a lower bound at most `wide_lo`, an upper at least `wide_hi`)
+/// leave [`clamp_into`]`(g, lo, hi)` as it is. With them the range is
+/// `[max(lo, l), min(hi, h)]`, `l ≤ min(g, wide_lo)`, `h ≥ max(g, wide_hi)`:
+/// * `lo ≤ g ≤ hi`: still holds `g`, the value `g`;
+/// * `g < lo ≤ hi`: the value stays `lo` while `h ≥ lo`, sure when `wide_hi ≥ lo`;
+/// * `lo ≤ hi < g`: likewise `hi` while `wide_lo ≤ hi`;
+/// * `lo > hi` (the meeting height): `l ≤ lo` and `h ≥ hi` keep both bounds.
+fn wide_cones_agree(g: f64, lo: f64, hi: f64, wide_lo: f64, wide_hi: f64) -> bool {
+    if lo <= hi {
+        if g < lo {
+            wide_hi >= lo
+        } else if g > hi {
+            wide_lo <= hi
+        } else {
+            true
+        }
+    } else {
+        wide_lo <= lo && wide_hi >= hi
     }
 }
 
@@ -660,17 +754,40 @@ impl Field for GradedGround<'_> {
             }
             return;
         };
+        // The natural ground's range over the batch.
+        let (mut g_lo, mut g_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &g in out.iter().filter(|g| g.is_finite()) {
+            g_lo = g_lo.min(g);
+            g_hi = g_hi.max(g);
+        }
         let mut near = Vec::new();
+        let mut wide = Vec::new();
         // Pieces whose cone binds nowhere in the box (past the bank and the wall face at
-        // its centre's distance less its half diagonal) are left out.
+        // its centre's distance less its half diagonal) are left out. Pieces whose cone
+        // holds the batch's whole ground range at every point of the box (`wide`: their
+        // narrowest rise there, at the box's nearest distance, reaches from every height
+        // of the piece past that range) are read only at points where the others'
+        // range might not stand with them (`wide_cones_agree`).
         let (centre, half_diagonal) = (b.center(), 0.5 * b.size().length());
         let wall_end = self.max_bank + RETAINING_WALL_M + BOX_SLACK_M;
+        let (mut wide_lo, mut wide_hi) = (f64::NEG_INFINITY, f64::INFINITY);
         self.index
             .for_each_candidate(&b.expanded(self.reach), |k, _| {
                 if let Some(piece) = self.pieces.get(k as usize) {
                     let beyond = piece.project(centre).1 - half_diagonal - piece.half_width;
                     if beyond < wall_end {
-                        near.push(k);
+                        // The cone's narrowest at the box, less rounding.
+                        let rise = cone_rise(beyond.max(0.0), self.slope, self.max_bank)
+                            .map(|r| r * (1.0 - 1e-9) - BOX_SLACK_M);
+                        let (r_lo, r_hi) = (piece.ha.min(piece.hb), piece.ha.max(piece.hb));
+                        match rise {
+                            Some(rise) if r_hi - rise <= g_lo && r_lo + rise >= g_hi => {
+                                wide_lo = wide_lo.max(r_hi - rise);
+                                wide_hi = wide_hi.min(r_lo + rise);
+                                wide.push(k);
+                            }
+                            _ => near.push(k),
+                        }
                     }
                 }
             });
@@ -681,6 +798,11 @@ impl Field for GradedGround<'_> {
             let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
             for &k in &near {
                 self.narrow(k, p, &mut lo, &mut hi);
+            }
+            if !wide_cones_agree(*o, lo, hi, wide_lo, wide_hi) {
+                for &k in &wide {
+                    self.narrow(k, p, &mut lo, &mut hi);
+                }
             }
             *o = clamp_into(*o, lo, hi);
         }

@@ -25,8 +25,17 @@
 //! corners) are then never buried by the terrain, and float above it by at most
 //! `2·max_error_m` plus their own lift.
 //!
+//! [`Terrain::build_with_slack`] also takes a *slack* field: the surface may lie that much
+//! further below the field (the check's lower side moves down by it; its upper side and
+//! the vertices stay with the field). A kink that bends down (a ridge, a bank's top, the
+//! outer edge of a cut) makes a fan sag under the field, never rise over it, so where the
+//! slack covers the sag the kink needs no refinement; kinks that bend up (a valley, the
+//! foot of a bank) refine as before. A caller that must keep things under the field
+//! unburied (the graded ground's road corridors) keeps the field's upper side.
+//!
 //! # Guarantees
-//! * At every check point of every leaf, `field − 2·max_error_m ≤ surface ≤ field`,
+//! * At every check point of every leaf, `field − slack − 2·max_error_m ≤ surface ≤
+//!   field` (`slack` is 0 without a slack field),
 //!   except in [`TerrainReport::unresolved_leaves`] (leaves at the minimum size or
 //!   beyond the leaf budget that still miss the bound — cliffs, steps; their largest miss
 //!   is [`TerrainReport::max_error_m`]). Those leaves' vertices are lowered by their fan's
@@ -38,7 +47,7 @@
 //!   lower than `field − 2·max_error_m` near them, by at most that rise.
 //! * The mesh is a 2-manifold with boundary (every interior edge used twice, in opposite
 //!   directions), every triangle faces up, and it covers the rectangle exactly.
-//! * Deterministic: a pure function of the field, the rectangle and the options.
+//! * Deterministic: a pure function of the field (and slack), the rectangle and the options.
 //!
 //! # Limitations
 //! * Between check points (a quarter of a leaf apart) the miss can exceed the bound by
@@ -129,7 +138,9 @@ pub struct TerrainReport {
     pub leaves: usize,
     /// Triangles of the mesh.
     pub triangles: usize,
-    /// Largest miss `|interpolated − field|` met at the check points, metres.
+    /// Largest miss met at the check points, metres: `|interpolated − field|`, or with a
+    /// slack field how far the interpolation lies above the field or below the field less
+    /// the slack.
     pub max_error_m: f64,
     /// Leaves that still miss the bound (at the minimum size or beyond the leaf budget).
     pub unresolved_leaves: usize,
@@ -199,6 +210,36 @@ impl Terrain {
         options: &TerrainOptions,
         material: Option<MaterialId>,
     ) -> Result<Terrain, GeomError> {
+        Terrain::build_inner(field, None, bounds, options, material)
+    }
+
+    /// Builds the terrain of `field` over `bounds` where the surface may also lie up to
+    /// `slack` metres further below the field (see the [module docs](self)): a check
+    /// point misses when the fan lies more than `max_error_m` above the field or more
+    /// than `max_error_m` below the field less the slack there. The vertices still take
+    /// the field's values, so a kink that only bends down (a ridge, the outer edge of a
+    /// cut) needs no refinement where the slack covers the fan's sag under it. Slack
+    /// values below 0 or not a number count as 0; a slack of 0 everywhere builds the
+    /// terrain [`build`](Terrain::build) builds.
+    ///
+    /// Fails as [`build`](Terrain::build) does.
+    pub fn build_with_slack(
+        field: &dyn Field,
+        slack: &dyn Field,
+        bounds: Aabb2,
+        options: &TerrainOptions,
+        material: Option<MaterialId>,
+    ) -> Result<Terrain, GeomError> {
+        Terrain::build_inner(field, Some(slack), bounds, options, material)
+    }
+
+    fn build_inner(
+        field: &dyn Field,
+        slack: Option<&dyn Field>,
+        bounds: Aabb2,
+        options: &TerrainOptions,
+        material: Option<MaterialId>,
+    ) -> Result<Terrain, GeomError> {
         options.validate()?;
         let ok = |v: f64| v.is_finite() && v.abs() <= MAX_COORDINATE;
         let size = bounds.max - bounds.min;
@@ -233,10 +274,10 @@ impl Terrain {
             root,
         };
         let e = options.max_error_m;
-        let refined = refine::refine(&grid, field, e, options.max_leaves)?;
+        let refined = refine::refine(&grid, field, slack, e, options.max_leaves)?;
         let (leaves, checks): (Vec<Leaf>, Vec<refine::Checks>) = refined.leaves.into_iter().unzip();
         let (mut rows, mut cols) = (refined.rows, refined.cols);
-        let mut centre_heights: Vec<f64> = checks.iter().map(|c| c[12]).collect();
+        let mut centre_heights: Vec<f64> = checks.iter().map(|c| c.field[12]).collect();
         // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
         // lowered by the fan's largest rise above the field at their check points (the
         // fan is linear in its vertex heights, so it then lies below the field there);
@@ -255,7 +296,7 @@ impl Terrain {
                 continue;
             }
             let profiles = edge_profiles(leaf, &rows, &cols);
-            let rise = leaf_rise(&profiles, &checks[k]);
+            let rise = leaf_rise(&profiles, &checks[k].field);
             if rise > 0.0 {
                 drops.push((k, rise));
             }
@@ -493,7 +534,7 @@ fn fan_height(profiles: &[EdgeProfile; 4], centre: f64, u: f64, v: f64) -> f64 {
 /// The fan's largest rise above the field at the leaf's check points (0 when it lies
 /// below the field at all of them); check points where the field is not finite are
 /// skipped.
-fn leaf_rise(profiles: &[EdgeProfile; 4], checks: &refine::Checks) -> f64 {
+fn leaf_rise(profiles: &[EdgeProfile; 4], checks: &[f64; 25]) -> f64 {
     let mut worst = 0.0f64;
     for (k, &f) in checks.iter().enumerate() {
         let (u, v) = (

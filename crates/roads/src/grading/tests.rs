@@ -82,13 +82,23 @@ fn gentle_ground_is_followed_exactly_and_moves_nothing() {
     let g = grade_roads(&net, &ground, &params).unwrap();
     assert!(!g.moves_ground());
     // Cut in: half a metre under a corridor, tapering to nothing 2 m beyond it.
-    let cut = g.cut_in(0.5, 1.0);
+    let cut = g.cut_in(0.5, 1.0, 1.0);
     let on_street = DVec2::new(80.0, 40.0); // on the street x = 80
     assert!((cut.sample(on_street) - (ground.sample(on_street) - 0.5)).abs() < 1e-9);
     let beside = DVec2::new(80.0 + 3.0 + 1.5, 40.0); // half width 3, 1.5 m beyond
     assert!((cut.sample(beside) - (ground.sample(beside) - 0.25)).abs() < 1e-9);
     let away = DVec2::new(80.0 + 3.0 + 2.5, 40.0);
     assert_eq!(cut.sample(away), ground.sample(away));
+    // The terrain may sag by the depth over the whole cut (2 m beyond the corridor),
+    // tapering to nothing one more taper (1 m) out.
+    let slack = cut.slack();
+    assert_eq!(slack.sample(on_street), 0.5);
+    assert_eq!(slack.sample(beside), 0.5);
+    assert!((slack.sample(away) - 0.25).abs() < 1e-9);
+    let tapering = DVec2::new(80.0 + 3.0 + 2.0 + 0.25, 40.0);
+    assert!((slack.sample(tapering) - 0.375).abs() < 1e-9);
+    let past = DVec2::new(80.0 + 3.0 + 3.0 + 0.01, 40.0);
+    assert_eq!(slack.sample(past), 0.0);
     assert_eq!(g.earthworks.cut_m3, 0.0);
     assert_eq!(g.earthworks.fill_m3, 0.0);
     for p in g.pieces() {
@@ -329,7 +339,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// A batch of points, close together or spread over the map and beyond it, gets the
-    /// values of one sample each, bit for bit, from the graded ground and its cut-in.
+    /// values of one sample each, bit for bit, from the graded ground, its cut-in and the
+    /// cut-in's slack.
     #[test]
     fn sampling_many_points_is_sampling_each(
         seed in 0u64..500,
@@ -338,20 +349,22 @@ proptest! {
         centre_y in -40.0f64..260.0,
         spread in 0.0f64..200.0,
         margin in 0.0f64..3.0,
+        taper in 0.0f64..6.0,
     ) {
         let fbm = Fbm::new(FbmParams { seed, wavelength_m: 150.0, octaves: 3, ..FbmParams::default() }).unwrap();
         let ground = fbm.scaled(amplitude);
         let net = grid(4, 70.0);
         let g = grade_roads(&net, &ground, &GradeParams::default()).unwrap();
         prop_assert!(g.moves_ground());
-        let cut = g.cut_in(0.3, margin);
+        let cut = g.cut_in(0.3, margin, taper);
+        let slack = cut.slack();
         let points: Vec<DVec2> = (0..41u32)
             .map(|k| {
                 let a = f64::from(k) * 2.399;
                 DVec2::new(centre_x, centre_y) + DVec2::new(a.cos(), a.sin()) * spread * f64::from(k) / 40.0
             })
             .collect();
-        for field in [&g as &dyn Field, &cut] {
+        for field in [&g as &dyn Field, &cut, &slack] {
             let mut many = vec![f64::NAN; points.len()];
             field.sample_many(&points, &mut many);
             for (p, v) in points.iter().zip(&many) {

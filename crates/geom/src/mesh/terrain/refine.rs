@@ -31,9 +31,17 @@ use crate::field::Field;
 use crate::par::prelude::*;
 use crate::{GeomError, MAX_COORDINATE};
 
-/// The field at a leaf's 5 × 5 check points, row by row: entry `5·j + i` is the point
-/// `(i/4, j/4)` of the leaf (its corners are entries 0, 4, 20 and 24, its centre 12).
-pub(super) type Checks = [f64; 25];
+/// The field and the slack at a leaf's 5 × 5 check points, row by row: entry `5·j + i`
+/// is the point `(i/4, j/4)` of the leaf (its corners are entries 0, 4, 20 and 24, its
+/// centre 12).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Checks {
+    /// The field.
+    pub field: [f64; 25],
+    /// How far below the field the fan may lie there (≥ 0, rounded down to `f32`; all 0
+    /// without a slack field).
+    pub slack: [f32; 25],
+}
 
 /// Entries of [`Checks`] that are vertices of the leaf's own fan: the corners in the
 /// order bottom left, bottom right, top right, top left, then the centre.
@@ -70,6 +78,7 @@ struct Node {
 pub(super) fn refine(
     grid: &Lattice,
     field: &dyn Field,
+    slack: Option<&dyn Field>,
     max_error: f64,
     max_leaves: usize,
 ) -> Result<Refined, GeomError> {
@@ -86,7 +95,7 @@ pub(super) fn refine(
     }
     let mut work: Vec<(Leaf, Checks)> = roots
         .par_iter()
-        .map(|&leaf| (leaf, root_checks(grid, field, leaf)))
+        .map(|&leaf| (leaf, root_checks(grid, field, slack, leaf)))
         .collect();
 
     // 1. Own fans, level by level.
@@ -128,7 +137,7 @@ pub(super) fn refine(
             .par_iter()
             .map(|&k| {
                 let (leaf, checks) = &work[k];
-                children_of(grid, field, *leaf, checks)
+                children_of(grid, field, slack, *leaf, checks)
             })
             .collect();
         work = children.into_iter().flatten().collect();
@@ -201,7 +210,7 @@ pub(super) fn refine(
         }
         let children: Vec<[(Leaf, Checks); 4]> = splitting
             .par_iter()
-            .map(|n| children_of(grid, field, n.leaf, &store[n.slot]))
+            .map(|n| children_of(grid, field, slack, n.leaf, &store[n.slot]))
             .collect();
         for (_, checks) in children.iter().flatten() {
             store.push(*checks);
@@ -242,12 +251,32 @@ pub(super) fn check_point(grid: &Lattice, leaf: Leaf, k: usize) -> DVec2 {
     )
 }
 
-/// The field at a root's check points.
-fn root_checks(grid: &Lattice, field: &dyn Field, leaf: Leaf) -> Checks {
+/// The field and the slack at a root's check points.
+fn root_checks(grid: &Lattice, field: &dyn Field, slack: Option<&dyn Field>, leaf: Leaf) -> Checks {
     let points: [DVec2; 25] = std::array::from_fn(|k| check_point(grid, leaf, k));
-    let mut checks = [0.0; 25];
-    field.sample_many(&points, &mut checks);
+    let mut checks = Checks {
+        field: [0.0; 25],
+        slack: [0.0; 25],
+    };
+    field.sample_many(&points, &mut checks.field);
+    if let Some(slack) = slack {
+        let mut values = [0.0; 25];
+        slack.sample_many(&points, &mut values);
+        for (s, v) in checks.slack.iter_mut().zip(values) {
+            *s = slack_of(v);
+        }
+    }
     checks
+}
+
+/// A slack as stored: `v` rounded down to `f32`, 0 where it is negative or not a number
+/// (an infinite slack stays infinite).
+fn slack_of(v: f64) -> f32 {
+    if v.is_nan() || v <= 0.0 {
+        return 0.0;
+    }
+    let r = v as f32;
+    if f64::from(r) > v { r.next_down() } else { r }
 }
 
 /// The four children of `leaf` (in [`split`] order) with their check points: the leaf's
@@ -255,19 +284,23 @@ fn root_checks(grid: &Lattice, field: &dyn Field, leaf: Leaf) -> Checks {
 fn children_of(
     grid: &Lattice,
     field: &dyn Field,
+    slack: Option<&dyn Field>,
     leaf: Leaf,
     checks: &Checks,
 ) -> [(Leaf, Checks); 4] {
     // The leaf at twice the resolution: 9 × 9 points an eighth of its side apart.
     let s = leaf.size as f64;
     let mut fine = [0.0f64; 81];
+    let mut fine_slack = [0.0f32; 81];
     let mut points = Vec::with_capacity(56);
     let mut slots = Vec::with_capacity(56);
     for j in 0..9u32 {
         for i in 0..9u32 {
             let k = (9 * j + i) as usize;
             if i % 2 == 0 && j % 2 == 0 {
-                fine[k] = checks[(5 * (j / 2) + i / 2) as usize];
+                let own = (5 * (j / 2) + i / 2) as usize;
+                fine[k] = checks.field[own];
+                fine_slack[k] = checks.slack[own];
             } else {
                 // Exact: eighths of a power-of-two side in lattice units, as the child's
                 // own quarter points would be computed.
@@ -281,17 +314,27 @@ fn children_of(
     }
     let mut values = vec![0.0; points.len()];
     field.sample_many(&points, &mut values);
-    for (&k, v) in slots.iter().zip(values) {
+    for (&k, &v) in slots.iter().zip(&values) {
         fine[k] = v;
+    }
+    if let Some(slack) = slack {
+        slack.sample_many(&points, &mut values);
+        for (&k, &v) in slots.iter().zip(&values) {
+            fine_slack[k] = slack_of(v);
+        }
     }
     let mut children = Vec::with_capacity(4);
     split(leaf, &mut children);
     std::array::from_fn(|c| {
         let (ox, oy) = ((c % 2) * 4, (c / 2) * 4);
         let child = children.get(c).copied().unwrap_or(leaf);
+        let at = |k: usize| 9 * (oy + k / 5) + ox + k % 5;
         (
             child,
-            std::array::from_fn(|k| fine[9 * (oy + k / 5) + ox + k % 5]),
+            Checks {
+                field: std::array::from_fn(|k| fine[at(k)]),
+                slack: std::array::from_fn(|k| fine_slack[at(k)]),
+            },
         )
     })
 }
@@ -307,7 +350,7 @@ fn not_finite(v: f64, p: DVec2) -> GeomError {
 /// The leaf's fan vertices must be finite and within [`MAX_COORDINATE`].
 fn check_vertices(grid: &Lattice, leaf: Leaf, checks: &Checks) -> Result<(), GeomError> {
     for k in VERTICES {
-        let v = checks[k];
+        let v = checks.field[k];
         if !(v.is_finite() && v.abs() <= MAX_COORDINATE) {
             return Err(not_finite(v, check_point(grid, leaf, k)));
         }
@@ -315,8 +358,9 @@ fn check_vertices(grid: &Lattice, leaf: Leaf, checks: &Checks) -> Result<(), Geo
     Ok(())
 }
 
-/// The largest miss of the fan with border `profiles` against the field at the leaf's
-/// check points (the corners and the centre are vertices).
+/// The largest miss of the fan with border `profiles` at the leaf's check points (the
+/// corners and the centre are vertices): how far it lies above the field, or below the
+/// field less the slack there (`|fan − field|` without slack).
 fn fan_miss(
     grid: &Lattice,
     leaf: Leaf,
@@ -324,7 +368,7 @@ fn fan_miss(
     checks: &Checks,
 ) -> Result<f64, GeomError> {
     let mut worst = 0.0f64;
-    for (k, &f) in checks.iter().enumerate() {
+    for (k, (&f, &slack)) in checks.field.iter().zip(&checks.slack).enumerate() {
         if VERTICES.contains(&k) {
             continue;
         }
@@ -335,7 +379,10 @@ fn fan_miss(
             f64::from((k % 5) as u32) / 4.0,
             f64::from((k / 5) as u32) / 4.0,
         );
-        worst = worst.max((fan_height(profiles, checks[12], u, v) - f).abs());
+        // Above the field by `d`, or below the field less the slack by `−d − slack`;
+        // with no slack the larger of the two is `|d|` exactly.
+        let d = fan_height(profiles, checks.field[12], u, v) - f;
+        worst = worst.max(d.max(-d - f64::from(slack)));
     }
     Ok(worst)
 }
@@ -343,7 +390,8 @@ fn fan_miss(
 /// The miss of the leaf's own fan (its corners and centre).
 fn own_miss(grid: &Lattice, leaf: Leaf, checks: &Checks) -> Result<f64, GeomError> {
     check_vertices(grid, leaf, checks)?;
-    let [bl, br, tr, tl] = [checks[0], checks[4], checks[24], checks[20]];
+    let c = &checks.field;
+    let [bl, br, tr, tl] = [c[0], c[4], c[24], c[20]];
     let profiles = [
         vec![(0.0, bl), (1.0, br)],
         vec![(0.0, br), (1.0, tr)],
@@ -403,7 +451,7 @@ fn gained_corner(leaf: Leaf, new_rows: &[(Corner, f64)], new_cols: &[(Corner, f6
 fn corners_of<'a>(leaves: impl Iterator<Item = (Leaf, &'a Checks)>) -> (CornerList, CornerList) {
     let mut rows = Vec::new();
     for (l, c) in leaves {
-        let s = l.size;
+        let (s, c) = (l.size, &c.field);
         rows.extend([
             ((l.y, l.x), c[0]),
             ((l.y, l.x + s), c[4]),
@@ -434,7 +482,7 @@ fn split_corners(
 ) -> (CornerList, CornerList) {
     let mut added = Vec::with_capacity(5 * splitting.len());
     for n in splitting {
-        let (l, c) = (n.leaf, &store[n.slot]);
+        let (l, c) = (n.leaf, &store[n.slot].field);
         let h = l.size / 2;
         for (key, k) in [
             ((l.y, l.x + h), 2),

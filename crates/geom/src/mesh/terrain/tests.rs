@@ -280,6 +280,29 @@ fn the_mesh_does_not_depend_on_the_thread_count() {
     assert_eq!(one.mesh.positions, three.mesh.positions);
     assert_eq!(one.mesh.indices, three.mesh.indices);
     assert_eq!(one.mesh.normals, three.mesh.normals);
+    // With a slack (a band along a line, as beside a road corridor) too.
+    let slack = FnField(|p: DVec2| {
+        if (p.x - 0.3 * p.y).abs() < 20.0 {
+            0.4
+        } else {
+            0.0
+        }
+    });
+    let build = |threads: usize| {
+        crate::par::install(threads, || {
+            Terrain::build_with_slack(&field, &slack, bounds, &options, None).unwrap()
+        })
+        .unwrap()
+    };
+    let (one_slack, three_slack) = (build(1), build(3));
+    assert!(
+        one_slack.report.leaves < one.report.leaves,
+        "{:?}",
+        one_slack.report
+    );
+    assert_eq!(one_slack.report, three_slack.report);
+    assert_eq!(one_slack.mesh.positions, three_slack.mesh.positions);
+    assert_eq!(one_slack.mesh.indices, three_slack.mesh.indices);
 }
 
 /// A leaf split for its final fan (hanging vertices of smaller neighbours) has children
@@ -350,4 +373,66 @@ fn terrain_tiles_meet_without_seams() {
     assert_eq!(seen, t.mesh.triangle_count());
     // The whole mesh is not one tile's cut.
     assert_eq!(t.mesh.whole_tile(size), None);
+}
+
+/// The band with a slack at every check point of every leaf:
+/// `field − slack − 2e ≤ surface ≤ field`.
+fn check_band(t: &Terrain, field: &dyn Field, slack: &dyn Field, e: f64) {
+    assert_eq!(t.report.unresolved_leaves, 0, "{:?}", t.report);
+    assert!(t.report.max_error_m <= e);
+    for p in check_points(t) {
+        let (f, s) = (field.sample(p), slack.sample(p).max(0.0));
+        let h = t.height_at(p).unwrap();
+        assert!(
+            h <= f + 1e-9 && h >= f - s - 2.0 * e - 1e-9,
+            "{h} vs {f} (slack {s}) at {p}"
+        );
+    }
+}
+
+/// A slack lets a kink that bends down (the outer edge of a cut along a line across
+/// fBm hills, as beside a road corridor) go unrefined while the surface stays under
+/// the field at every check point; a kink that bends up (the cut's inner edge) still
+/// refines. With a slack of 0 everywhere (or below 0, or not a number) the terrain is
+/// `build`'s, bit for bit.
+#[test]
+fn a_slack_spares_the_kinks_that_bend_down() {
+    let fbm = fbm(23, 80.0, 3);
+    let angle = 0.9f64;
+    let dir = DVec2::new(angle.cos(), angle.sin());
+    let share = move |p: DVec2, flat: f64| {
+        let beyond = (p.dot(dir) - 6.2).abs() - 5.0 - flat;
+        if beyond <= 0.0 {
+            1.0
+        } else {
+            (1.0 - beyond).max(0.0)
+        }
+    };
+    let field = FnField(move |p: DVec2| fbm.sample(p) * 5.0 - 0.5 * share(p, 1.0));
+    let slack = FnField(move |p: DVec2| 0.5 * share(p, 2.0));
+    let bounds = rect(160.0, 120.0);
+    let options = TerrainOptions {
+        max_error_m: 0.1,
+        min_cell_m: 0.25,
+        max_cell_m: 32.0,
+        ..TerrainOptions::default()
+    };
+    let plain = Terrain::build(&field, bounds, &options, None).unwrap();
+    let slacked = Terrain::build_with_slack(&field, &slack, bounds, &options, None).unwrap();
+    check_sheet(&slacked, bounds);
+    check_bound(&plain, &field, 0.1);
+    check_band(&slacked, &field, &slack, 0.1);
+    assert!(
+        slacked.report.leaves * 10 < plain.report.leaves * 9,
+        "{:?} against {:?}",
+        slacked.report,
+        plain.report
+    );
+    for v in [0.0, -3.0, f64::NAN] {
+        let zero = FnField(move |_: DVec2| v);
+        let same = Terrain::build_with_slack(&field, &zero, bounds, &options, None).unwrap();
+        assert_eq!(same.report, plain.report);
+        assert_eq!(same.mesh.positions, plain.mesh.positions);
+        assert_eq!(same.mesh.indices, plain.mesh.indices);
+    }
 }
