@@ -981,7 +981,7 @@ mod tests {
         let mut ms = Vec::new();
         for &cell in &cells {
             fail_growth(&ed, Some(cell));
-            let t = std::time::Instant::now();
+            let t = crate::clock::Instant::now();
             let failed = ed.apply(Edit::SetCellSeed { cell, seed: 7 });
             ms.push(t.elapsed().as_secs_f64() * 1e3);
             assert!(failed.is_err());
