@@ -28,9 +28,8 @@
 //! Basic streets retuned on seeds 1–40 and 41–120.
 //! Tunnels (issue 27) changed `san_francisco` seeds 1–2: highways pass under the hills
 //! they used to stop at. `citygen_us` and `milan` joined the test in session 11 (their
-//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` kept
-//! one circuity miss, seed 1's until session 13's highway rays, seed 2's since, until
-//! session 17 held its highways to 22° of turn per segment: no known miss is left). `citygen` itself is Kelly's test city
+//! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` keeps
+//! one circuity miss, seed 1's until session 13's highway rays, seed 2's since). `citygen` itself is Kelly's test city
 //! (issue 18: 16 km², ≥ 15,000 roads, ≥ 57,000 buildings, the workload of issue 25's
 //! timings), whose street density no real city's band admits; it is not tested here.
 //!
@@ -68,9 +67,8 @@ fn misses(preset: &str, seed: u64) -> Vec<String> {
         .collect()
 }
 
-/// (preset, seed, metric) out of band today; everything else must be in band. Empty
-/// since session 17; a miss found later is listed here with its reason until fixed.
-const KNOWN_MISSES: &[(&str, u64, &str)] = &[];
+/// (preset, seed, metric) out of band today; everything else must be in band.
+const KNOWN_MISSES: &[(&str, u64, &str)] = &[("citygen_us", 2, "circuity")];
 
 fn check(preset: &str) {
     let mut unexpected = Vec::new();
