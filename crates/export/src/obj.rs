@@ -254,7 +254,7 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
             .par_iter()
             .map(|node| {
                 let g = geometry(node);
-                (node_text(node, &g), Counts::ZERO.after(&g))
+                (node_text(node, &g), Counts::of(&g))
             })
             .collect();
         let mut next = start;
@@ -413,13 +413,6 @@ struct Counts {
 }
 
 impl Counts {
-    /// No values.
-    const ZERO: Counts = Counts {
-        positions: 0,
-        uvs: 0,
-        normals: 0,
-    };
-
     /// The sum of two counts.
     fn plus(self, other: Counts) -> Counts {
         Counts {
@@ -429,12 +422,12 @@ impl Counts {
         }
     }
 
-    /// The counts after a node's vertices.
-    fn after(self, g: &NodeGeometry) -> Counts {
+    /// How many values of each stream a node writes.
+    fn of(g: &NodeGeometry) -> Counts {
         Counts {
-            positions: self.positions + g.positions.len() as u64,
-            uvs: self.uvs + g.uvs.len() as u64,
-            normals: self.normals + g.normals.len() as u64,
+            positions: g.positions.len() as u64,
+            uvs: g.uvs.len() as u64,
+            normals: g.normals.len() as u64,
         }
     }
 }
@@ -560,11 +553,8 @@ impl NodeGeometry {
     /// `corner` on, with indices relative to the end of each stream (`-1` is the node's
     /// last value): the node's values are the last ones written before its faces.
     fn push_faces(&self, out: &mut Vec<u8>, m: &Mesh, corner: usize, mirror: bool) {
-        let lens = [
-            self.positions.len() as u64,
-            self.uvs.len() as u64,
-            self.normals.len() as u64,
-        ];
+        let own = Counts::of(self);
+        let lens = [own.positions, own.uvs, own.normals];
         let relative = |out: &mut Vec<u8>, stream: usize, id: u32| {
             out.push(b'-');
             push_u64(out, lens[stream] - u64::from(id));

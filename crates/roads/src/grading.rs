@@ -520,6 +520,7 @@ impl GradedGround<'_> {
 }
 
 /// A [`GradedGround`] cut in under its road corridors: see [`GradedGround::cut_in`].
+#[derive(Clone, Copy)]
 pub struct CutIn<'a> {
     graded: &'a GradedGround<'a>,
     depth: f64,
@@ -593,14 +594,7 @@ impl<'a> CutIn<'a> {
     /// corridor's edge, the foot of a fill bank) but not where they only sag under it
     /// (the top of a fill bank at a corridor's edge, a crest along a road).
     pub fn slack(&self) -> CutSlack<'a> {
-        CutSlack {
-            cut: CutIn {
-                graded: self.graded,
-                depth: self.depth,
-                margin: self.margin,
-                taper: self.taper,
-            },
-        }
+        CutSlack { cut: *self }
     }
 }
 
