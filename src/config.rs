@@ -715,16 +715,22 @@ mod tests {
         assert_eq!(z.zone(f64::NAN).0, BuildingKind::Industrial);
     }
 
-    fn png_map(scale: f64) -> MapSpec {
-        let extent = polis_geom::Aabb2::new(
-            polis_geom::DVec2::splat(-100.0),
-            polis_geom::DVec2::splat(100.0),
-        );
+    /// A map scaled by `scale`. With PNG maps built, the scaled field is a PNG file that
+    /// does not exist, so a test passes only if validation judges the scale before it
+    /// reads any file; without them a constant field stands in.
+    fn scaled_map(scale: f64) -> MapSpec {
+        #[cfg(feature = "png")]
+        let field = polis_geom::field::FieldSpec::Png {
+            path: "/nonexistent/map.png".into(),
+            extent: polis_geom::Aabb2::new(
+                polis_geom::DVec2::splat(-100.0),
+                polis_geom::DVec2::splat(100.0),
+            ),
+        };
+        #[cfg(not(feature = "png"))]
+        let field = polis_geom::field::FieldSpec::Constant { value: 1.0 };
         MapSpec::Field(polis_geom::field::FieldSpec::Scaled {
-            field: Box::new(polis_geom::field::FieldSpec::Png {
-                path: "/nonexistent/map.png".into(),
-                extent,
-            }),
+            field: Box::new(field),
             factor: scale,
         })
     }
@@ -757,7 +763,7 @@ mod tests {
         }
         for scale in [f64::NAN, 1e300, f64::INFINITY, -13_000.0] {
             let mut c = base.clone();
-            c.maps.elevation = Some(png_map(scale));
+            c.maps.elevation = Some(scaled_map(scale));
             assert_eq!(
                 field_of(c.validate().unwrap_err()),
                 "maps.elevation",
@@ -765,11 +771,11 @@ mod tests {
             );
         }
         let mut c = base.clone();
-        c.maps.elevation = Some(png_map(300.0));
+        c.maps.elevation = Some(scaled_map(300.0));
         c.validate().unwrap();
         for scale in [-50.0, f64::NAN, 1e6] {
             let mut c = base.clone();
-            c.maps.max_height = Some(png_map(scale));
+            c.maps.max_height = Some(scaled_map(scale));
             assert_eq!(
                 field_of(c.validate().unwrap_err()),
                 "maps.max_height",
@@ -777,7 +783,7 @@ mod tests {
             );
         }
         let mut c = base.clone();
-        c.maps.population = png_map(f64::NAN);
+        c.maps.population = scaled_map(f64::NAN);
         assert_eq!(field_of(c.validate().unwrap_err()), "maps.population");
         let mut c = base.clone();
         c.zoning.bands[0].max_height_m = 5_000.0;
@@ -833,7 +839,7 @@ mod tests {
     fn empty_but_valid_settings_are_warned_about() {
         let mut c = CityConfig::default();
         assert!(c.warnings().is_empty(), "{:?}", c.warnings());
-        c.maps.max_height = Some(png_map(0.0));
+        c.maps.max_height = Some(scaled_map(0.0));
         c.validate().unwrap();
         let w = c.warnings();
         assert!(w.len() == 1 && w[0].contains("maps.max_height"), "{w:?}");

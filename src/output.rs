@@ -154,7 +154,7 @@ mod tests {
     #[test]
     fn parses_lists_and_refuses_unknown_names() {
         assert_eq!("glb,obj,svg,geojson".parse::<Formats>(), Ok(Formats::ALL));
-        assert_eq!("all".parse::<Formats>(), Ok(Formats::ALL));
+        assert_eq!("all".parse::<Formats>(), Ok(Formats::AVAILABLE));
         let only = " SVG , glb,glb".parse::<Formats>().unwrap();
         assert_eq!(
             only,

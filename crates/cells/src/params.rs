@@ -57,6 +57,7 @@ mod tests {
         assert!(p.check_planarity);
     }
 
+    #[cfg(feature = "serde")]
     #[test]
     fn serde_round_trip_and_defaults_for_missing_fields() {
         let p = CellParams {

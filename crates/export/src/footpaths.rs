@@ -393,6 +393,7 @@ mod tests {
         m.check_closed().unwrap();
     }
 
+    #[cfg(all(feature = "gltf", feature = "obj"))]
     #[test]
     fn roads_and_footpaths_export_to_glb_and_obj() {
         use crate::map::{MapRoad, RoadClass};

@@ -112,5 +112,12 @@ pub use error::ExportError;
 #[cfg(test)]
 mod testing;
 
+// Random scenes and maps through every writer.
 #[cfg(test)]
+#[cfg(all(
+    feature = "gltf",
+    feature = "obj",
+    feature = "svg",
+    feature = "geojson"
+))]
 mod proptests;

@@ -1,7 +1,20 @@
 //! Test fixtures and independent readers shared by the unit and property tests.
+//!
+//! Each item needs the features of what it reads or writes; with some writers left out
+//! (`--no-default-features`) the fixtures of the others go unused.
+#![cfg_attr(
+    not(all(
+        feature = "gltf",
+        feature = "obj",
+        feature = "svg",
+        feature = "geojson"
+    )),
+    allow(dead_code, unused_imports)
+)]
 
 use std::collections::BTreeMap;
 
+#[cfg(feature = "gltf")]
 use gltf::accessor::{DataType, Dimensions};
 use polis_geom::glam::{DQuat, DVec3};
 use polis_geom::mesh::prism;
@@ -10,6 +23,7 @@ use polis_geom::scene::{
 };
 use polis_geom::{DVec2, Mesh, Polygon};
 
+#[cfg(feature = "png")]
 /// A scene with textures (raw and PNG), three materials, an instanced prism, a mesh without
 /// material, an empty mesh, metadata, and a transform hierarchy.
 pub fn sample_scene() -> Scene {
@@ -161,6 +175,7 @@ pub fn grid_scene(n: usize) -> Scene {
     s
 }
 
+#[cfg(feature = "gltf")]
 /// One primitive read back from a glb, decoded from the BIN chunk by hand.
 #[derive(Debug, Clone)]
 pub struct Prim {
@@ -172,6 +187,7 @@ pub struct Prim {
     pub material: Option<usize>,
 }
 
+#[cfg(feature = "gltf")]
 /// A node read back: name, mesh, children, extras.
 pub type NodeInfo = (
     Option<String>,
@@ -180,6 +196,7 @@ pub type NodeInfo = (
     Option<serde_json::Value>,
 );
 
+#[cfg(feature = "gltf")]
 /// A glb read back with the `gltf` crate and checked.
 #[derive(Debug)]
 pub struct Decoded {
@@ -200,11 +217,13 @@ pub struct Decoded {
     pub tangent_prims: usize,
 }
 
+#[cfg(feature = "gltf")]
 fn extras(e: &gltf::json::Extras) -> Option<serde_json::Value> {
     e.as_ref()
         .map(|raw| serde_json::from_str(raw.get()).unwrap())
 }
 
+#[cfg(feature = "gltf")]
 /// Reads a glb with `gltf::Gltf::from_slice` (which validates the document) and checks
 /// what glTF requires and the reader does not: the container matches what
 /// `gltf::binary::Glb::to_writer` writes; accessors lie inside their views and are aligned;
@@ -396,6 +415,7 @@ pub fn decode_glb(bytes: &[u8]) -> Decoded {
     }
 }
 
+#[cfg(feature = "serde")]
 /// The metadata of a node as the JSON object the writers put in `extras`.
 pub fn metadata_json(scene: &Scene, node: NodeId) -> Option<serde_json::Value> {
     let m = &scene.nodes[node.index()].metadata;
