@@ -142,8 +142,27 @@ impl SecondaryRoads {
 pub struct SecondaryGrowth {
     params: SecondaryParams,
     snapper: Snapper,
-    scratch: Vec<GridRoad>,
+    buffers: Buffers,
     joins: (u64, u64),
+}
+
+/// The growth's own buffers, kept between cells so that a worker that grows many cells
+/// (one per thread of a pool) allocates them once.
+#[derive(Debug, Clone, Default)]
+struct Buffers {
+    /// Scratch of [`join::plan`].
+    scratch: Vec<GridRoad>,
+    /// The FIFO queue of Fig. 42: `(node, incoming direction)`.
+    queue: VecDeque<(NodeId, DVec2)>,
+    /// By node id: whether the node has branched.
+    expanded: Vec<bool>,
+    /// The connectivity decisions of the node being expanded, per road or junction met.
+    decided: Vec<(JoinKey, bool)>,
+    /// The roads of the node read last as (unit direction, length), for
+    /// [`Run::folds_for_sure`].
+    root_roads: Vec<(DVec2, f64)>,
+    /// The far end (node and position) of every road at that node, for the snap search.
+    root_ends: Vec<(NodeId, DVec2)>,
 }
 
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
@@ -177,9 +196,21 @@ impl SecondaryGrowth {
         Ok(SecondaryGrowth {
             params,
             snapper: Snapper::default(),
-            scratch: Vec::new(),
+            buffers: Buffers::default(),
             joins: (0, 0),
         })
+    }
+
+    /// Takes `params` for the next growths, keeping the worker's buffers (a pool thread
+    /// that grows cells of several neighbourhoods keeps one worker).
+    ///
+    /// # Errors
+    /// [`SecondaryError::InvalidParameter`] from [`SecondaryParams::validate`]; the
+    /// worker's parameters are then unchanged.
+    pub fn set_params(&mut self, params: SecondaryParams) -> Result<(), SecondaryError> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
     }
 
     /// The parameters.
@@ -300,14 +331,17 @@ impl SecondaryGrowth {
             edges: 0,
             guard,
             tolerance: (p.segment_size_m.value * INSERT_TOLERANCE).max(1e-3),
-            decided: Vec::new(),
-            scratch: std::mem::take(&mut self.scratch),
-            root_roads: Vec::new(),
-            root_ends: Vec::new(),
+            buffers: std::mem::take(&mut self.buffers),
             root: (None, (0, 0)),
             joins: (0, 0),
         };
-        let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
+        run.buffers.decided.clear();
+        run.buffers.root_roads.clear();
+        run.buffers.root_ends.clear();
+        let mut queue = std::mem::take(&mut run.buffers.queue);
+        queue.clear();
+        let mut expanded = std::mem::take(&mut run.buffers.expanded);
+        expanded.clear();
         // Initial segments from deviated midpoints of the longest sides: the first
         // `start_sides` sides, longest first, whose first segment can be placed.
         let mut started = 0;
@@ -333,7 +367,7 @@ impl SecondaryGrowth {
                 let t = 0.5 + p.segment_size_m.deviance * (u - 0.5);
                 let t = t.clamp(snap_max / len, 1.0 - snap_max / len);
                 let mid = a.lerp(b, t);
-                run.decided.clear();
+                run.buffers.decided.clear();
                 // The perpendicular deviates by up to ± degree deviance × 45°.
                 let dir = run.deviate(inward, std::f64::consts::FRAC_PI_2);
                 // Split the side only if the first segment fits.
@@ -359,7 +393,6 @@ impl SecondaryGrowth {
             }
         }
         // Road growth.
-        let mut expanded: Vec<bool> = Vec::new();
         while let Some((source, dir)) = queue.pop_front() {
             if p.max_steps.is_some_and(|m| run.report.steps >= m)
                 || run.edges >= run.guard
@@ -387,7 +420,7 @@ impl SecondaryGrowth {
                 .round()
                 .max(1.0) as u32;
             let step = std::f64::consts::TAU / degree as f64;
-            run.decided.clear();
+            run.buffers.decided.clear();
             // Direction i is `dir` turned by i steps: one rotation applied i times.
             let (sin, cos) = step.sin_cos();
             let certain = FoldBound::new(&p, step);
@@ -419,7 +452,9 @@ impl SecondaryGrowth {
         let report = run.report;
         self.joins.0 += run.joins.0;
         self.joins.1 += run.joins.1;
-        self.scratch = run.scratch;
+        self.buffers = run.buffers;
+        self.buffers.queue = queue;
+        self.buffers.expanded = expanded;
         let network = run.g;
         Ok(SecondaryRoads {
             cell: cell.id,
@@ -524,16 +559,10 @@ struct Run<'a> {
     edges: u32,
     guard: u32,
     tolerance: f64,
-    /// The connectivity decisions of the node being expanded, per road or junction met.
-    decided: Vec<(JoinKey, bool)>,
-    /// Scratch of [`join::plan`].
-    scratch: Vec<GridRoad>,
-    /// The roads of a node as (unit direction, length), for
-    /// [`folds_for_sure`](Self::folds_for_sure), and the node and the graph's edge
-    /// bound and count they were read at.
-    root_roads: Vec<(DVec2, f64)>,
-    /// The far end (node and position) of every road at that node, for the snap search.
-    root_ends: Vec<(NodeId, DVec2)>,
+    /// The worker's buffers.
+    buffers: Buffers,
+    /// The node whose roads the buffers hold, and the graph's edge bound and count they
+    /// were read at.
     root: (Option<NodeId>, (usize, usize)),
     /// Joins onto a road made directly and by planar insertion.
     joins: (u64, u64),
@@ -559,13 +588,13 @@ impl Run<'_> {
     ) -> Result<bool, SecondaryError> {
         self.read_root(source)?;
         Ok(self
+            .buffers
             .root_roads
             .iter()
             .any(|&(w, len)| bound.folds(turned, w, len)))
     }
 
-    /// Reads the roads at `source` into [`root_ends`](Self::root_ends) and
-    /// [`root_roads`](Self::root_roads), unless they were read at this node and the graph
+    /// Reads the roads at `source` into the buffers' `root_ends` and `root_roads`, unless they were read at this node and the graph
     /// has made or removed no road since (a change of the edge bound or count).
     #[inline]
     fn read_root(&mut self, source: NodeId) -> Result<(), SecondaryError> {
@@ -583,17 +612,17 @@ impl Run<'_> {
         source: NodeId,
         roads: (usize, usize),
     ) -> Result<(), SecondaryError> {
-        self.root_roads.clear();
-        self.root_ends.clear();
+        self.buffers.root_roads.clear();
+        self.buffers.root_ends.clear();
         let a = self.g.position(source)?;
         for &e in self.g.edges_at(source)? {
             let n = self.g.other_end(e, source)?;
             let p = self.g.position(n)?;
-            self.root_ends.push((n, p));
+            self.buffers.root_ends.push((n, p));
             let ap = p - a;
             let len = ap.length();
             if len > 0.0 {
-                self.root_roads.push((ap / len, len));
+                self.buffers.root_roads.push((ap / len, len));
             }
         }
         self.root = (Some(source), roads);
@@ -643,27 +672,28 @@ impl Run<'_> {
         let a = self.g.position(source)?;
         let b = a + dir * len;
         self.read_root(source)?;
-        let target = match self
-            .snapper
-            .snap_from(&self.g, source, &self.root_ends, a, b, snap)
-        {
-            SnapEvent::None => Target::Free(b),
-            SnapEvent::Blocked => {
-                self.report.refused_blocked += 1;
-                return Ok(None);
-            }
-            ev => {
-                if !self.may_join(ev) {
-                    self.report.refused_connectivity += 1;
+        let target =
+            match self
+                .snapper
+                .snap_from(&self.g, source, &self.buffers.root_ends, a, b, snap)
+            {
+                SnapEvent::None => Target::Free(b),
+                SnapEvent::Blocked => {
+                    self.report.refused_blocked += 1;
                     return Ok(None);
                 }
-                match ev {
-                    SnapEvent::Node(n) => Target::Node(n),
-                    SnapEvent::Cross(e, q) | SnapEvent::Road(e, q) => Target::OnEdge(e, q),
-                    SnapEvent::None | SnapEvent::Blocked => return Ok(None),
+                ev => {
+                    if !self.may_join(ev) {
+                        self.report.refused_connectivity += 1;
+                        return Ok(None);
+                    }
+                    match ev {
+                        SnapEvent::Node(n) => Target::Node(n),
+                        SnapEvent::Cross(e, q) | SnapEvent::Road(e, q) => Target::OnEdge(e, q),
+                        SnapEvent::None | SnapEvent::Blocked => return Ok(None),
+                    }
                 }
-            }
-        };
+            };
         let t = match target {
             Target::Free(q) | Target::OnEdge(_, q) => q,
             Target::Node(n) => self.g.position(n)?,
@@ -736,7 +766,7 @@ impl Run<'_> {
                 let plan = join::plan(
                     &self.g,
                     self.snapper,
-                    &mut self.scratch,
+                    &mut self.buffers.scratch,
                     source,
                     (a, t),
                     e,
@@ -857,12 +887,12 @@ impl Run<'_> {
             SnapEvent::Cross(e, _) | SnapEvent::Road(e, _) => JoinKey::Road(e),
             SnapEvent::None | SnapEvent::Blocked => return false,
         };
-        if let Some(&(_, join)) = self.decided.iter().find(|(k, _)| *k == key) {
+        if let Some(&(_, join)) = self.buffers.decided.iter().find(|(k, _)| *k == key) {
             return join;
         }
         let connectivity = self.p.connectivity.sample(self.rng).clamp(0.0, 1.0);
         let join = self.rng.random::<f64>() < connectivity;
-        self.decided.push((key, join));
+        self.buffers.decided.push((key, join));
         join
     }
 

@@ -212,6 +212,21 @@ fn growth_is_deterministic_and_sub_seeded_by_the_cell_id() {
     let json = |r: &SecondaryRoads| serde_json::to_string(&r.network).unwrap();
     assert_eq!(json(&a), json(&b));
     assert_eq!(a.report, b.report);
+    // So does a worker that grew cells of other neighbourhoods first (as a pool thread's
+    // worker does), and a refused parameter set leaves its parameters as they were.
+    let mut bad = params.clone();
+    bad.connectivity = Deviated::new(2.0, 0.0);
+    for n in Neighbourhood::ALL {
+        worker.set_params(n.params().unwrap()).unwrap();
+        for other in fixed_cells().iter().skip(1) {
+            let _ = worker.grow(other, &CellMaps::none(), 11);
+        }
+        worker.set_params(params.clone()).unwrap();
+        assert!(worker.set_params(bad.clone()).is_err());
+        let c = worker.grow(&cell, &CellMaps::none(), 5).unwrap();
+        assert_eq!(json(&a), json(&c), "after {n:?}");
+        assert_eq!(a.report, c.report);
+    }
     // Another id (same geometry) or another seed grows another network.
     let mut other = cell.clone();
     other.id += 1;
