@@ -273,10 +273,13 @@ impl SnapGrid {
                     let fresh = slot.stamp != query;
                     slot.stamp = query;
                     let road = slot.road;
-                    let meets = (road.pu.x.min(road.pv.x) <= hi.x)
-                        & (lo.x <= road.pu.x.max(road.pv.x))
-                        & (road.pu.y.min(road.pv.y) <= hi.y)
-                        & (lo.y <= road.pu.y.max(road.pv.y));
+                    // The road's box meets `b` (positions are finite: `min(p, q) ≤ h` is
+                    // `p ≤ h | q ≤ h`, without `min`'s NaN handling).
+                    let (p, q) = (road.pu, road.pv);
+                    let meets = ((p.x <= hi.x) | (q.x <= hi.x))
+                        & ((lo.x <= p.x) | (lo.x <= q.x))
+                        & ((p.y <= hi.y) | (q.y <= hi.y))
+                        & ((lo.y <= p.y) | (lo.y <= q.y));
                     let keep = fresh & slot.alive & meets;
                     out.push(road);
                     let len = out.len() - usize::from(!keep);
