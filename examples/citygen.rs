@@ -7,7 +7,8 @@
 //!     [--threads N] [--out DIR] [--bench-growth RUNS]
 //! ```
 //!
-//! `--bench-growth RUNS` grows every Kelly cell serially on one thread `RUNS` times and
+//! `--bench-growth RUNS` grows every Kelly cell serially on one thread `RUNS` times (one growth worker, its
+//! buffers kept from cell to cell as each pool thread of the pipeline keeps one) and
 //! prints CPU time and a digest of the grown graphs; then each cell's least time over
 //! those runs, with what the cells would take on the pool's number of idle cores (handed
 //! out in their order, or largest first); then grows them `RUNS` times on the thread pool
@@ -171,6 +172,12 @@ fn thread_cpu_ns() -> u64 {
         .unwrap_or(0)
 }
 
+std::thread_local! {
+    /// The growth worker of each thread of the benchmark's pool.
+    static WORKER: std::cell::RefCell<Option<polis::roads::secondary::SecondaryGrowth>> =
+        const { std::cell::RefCell::new(None) };
+}
+
 /// Grows every cell of the primary network serially on this thread, `runs` times, and
 /// prints wall and CPU time per run (the inputs are prepared before the clock starts);
 /// then `runs` times on `pool`'s threads, printing wall time.
@@ -224,19 +231,25 @@ fn growth_bench(
         let (t, c) = (Instant::now(), thread_cpu_ns());
         let mut roads = 0;
         let mut digest = 0u64;
-        let mut joins = (0, 0);
+        // One worker for all cells, as each thread of the pipeline's pool keeps one.
+        let mut growth: Option<SecondaryGrowth> = None;
         for ((cell, p), best) in inputs.iter().zip(&mut cell_ns) {
             let started = Instant::now();
-            let mut growth = SecondaryGrowth::new(p.clone())?;
-            let grown = growth.grow(cell, &maps, seed);
+            let worker = match growth.as_mut() {
+                Some(w) => {
+                    w.set_params(p.clone())?;
+                    w
+                }
+                None => growth.insert(SecondaryGrowth::new(p.clone())?),
+            };
+            let grown = worker.grow(cell, &maps, seed);
             *best = (*best).min(started.elapsed().as_nanos() as u64);
             if let Ok(r) = grown {
                 roads += r.segments().count();
                 digest = polis::geom::hash::splitmix64(digest ^ graph_digest(&r.network));
             }
-            let (direct, general) = growth.join_counters();
-            joins = (joins.0 + direct, joins.1 + general);
         }
+        let joins = growth.as_ref().map_or((0, 0), |w| w.join_counters());
         let (wall, cpu) = (
             t.elapsed().as_secs_f64() * 1e3,
             (thread_cpu_ns() - c) as f64 / 1e6,
@@ -258,11 +271,21 @@ fn growth_bench(
             inputs
                 .par_iter()
                 .map(|(cell, p)| {
-                    let mut growth = SecondaryGrowth::new(p.clone()).ok()?;
-                    growth
-                        .grow(cell, &maps, seed)
-                        .ok()
-                        .map(|r| graph_digest(&r.network))
+                    // One worker per pool thread, as the pipeline keeps.
+                    WORKER.with(|w| {
+                        let mut slot = w.try_borrow_mut().ok()?;
+                        let worker = match slot.as_mut() {
+                            Some(w) => {
+                                w.set_params(p.clone()).ok()?;
+                                w
+                            }
+                            None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
+                        };
+                        worker
+                            .grow(cell, &maps, seed)
+                            .ok()
+                            .map(|r| graph_digest(&r.network))
+                    })
                 })
                 .collect()
         });

@@ -660,8 +660,7 @@ fn grow_cell(
     let id = input.id;
     match pattern {
         CellPatternChoice::Kelly(_) => {
-            let result =
-                SecondaryGrowth::new(p.clone()).and_then(|mut g| g.grow(input, maps, seed));
+            let result = with_kelly_worker(p, |g| g.grow(input, maps, seed));
             match result {
                 Ok(r) => Ok(Ok(r)),
                 Err(e) if e.is_skip() => Ok(Err(skip(e.to_string()))),
@@ -678,6 +677,36 @@ fn grow_cell(
             Err(e) => Err(Error::config("citygen.neighbourhood", e.to_string())),
         },
     }
+}
+
+std::thread_local! {
+    /// This thread's Kelly growth worker: its snap grid, queues and scratch are kept from
+    /// cell to cell (a pool thread grows many cells), so they are allocated once per
+    /// thread rather than once per cell. A worker's output depends only on its parameters
+    /// and inputs, never on the cells it grew before.
+    static KELLY_WORKER: std::cell::RefCell<Option<SecondaryGrowth>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` on this thread's Kelly growth worker set to `params` (a fresh worker if the
+/// thread's is in use).
+fn with_kelly_worker<T>(
+    params: &polis_roads::secondary::SecondaryParams,
+    f: impl FnOnce(&mut SecondaryGrowth) -> std::result::Result<T, SecondaryError>,
+) -> std::result::Result<T, SecondaryError> {
+    KELLY_WORKER.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut slot) => {
+            let worker = match slot.as_mut() {
+                Some(w) => {
+                    w.set_params(params.clone())?;
+                    w
+                }
+                None => slot.insert(SecondaryGrowth::new(params.clone())?),
+            };
+            f(worker)
+        }
+        Err(_) => f(&mut SecondaryGrowth::new(params.clone())?),
+    })
 }
 
 /// The Citygen road stage's memo of grown cells (the editor's): returns the cell's

@@ -244,13 +244,53 @@ impl SnapGrid {
         }
     }
 
-    /// Calls `f` once with every live road entered in a square under `b` (each road
-    /// once per call, as its current segment): every road whose segment meets `b` is
-    /// among them, and roads near `b` may be too.
-    pub(crate) fn for_each_in(&mut self, b: &Aabb2, mut f: impl FnMut(&GridRoad)) {
+    /// Appends to `out` every live road whose box meets `b`, each once, as its current
+    /// segment (the roads [`for_each_in`](Self::for_each_in) reports whose boxes meet
+    /// `b`, in the same order).
+    ///
+    /// The walk decides without branching: every entry is stamped, and a copy of its road
+    /// appended then kept or dropped by one flag (first seen in this query, alive, and
+    /// its box meeting `b`). Which entries are repeats, dead or out of the box follows no
+    /// pattern a processor can predict, and a wrong guess costs more than the few
+    /// instructions of deciding all three every time.
+    pub(crate) fn gather(&mut self, b: &Aabb2, out: &mut Vec<GridRoad>) {
         if self.nx == 0 || b.is_empty() {
             return;
         }
+        let query = self.next_query();
+        let (c0, c1) = (self.col(b.min.x), self.col(b.max.x));
+        let (r0, r1) = (self.row(b.min.y), self.row(b.max.y));
+        let (lo, hi) = (b.min, b.max);
+        for r in r0..=r1 {
+            let Some(row) = self.squares.get(r * self.nx + c0..=r * self.nx + c1) else {
+                continue;
+            };
+            for s in row {
+                for &id in s {
+                    let Some(slot) = self.slots.get_mut(id as usize) else {
+                        continue;
+                    };
+                    let fresh = slot.stamp != query;
+                    slot.stamp = query;
+                    let road = slot.road;
+                    // The road's box meets `b` (positions are finite: `min(p, q) ≤ h` is
+                    // `p ≤ h | q ≤ h`, without `min`'s NaN handling).
+                    let (p, q) = (road.pu, road.pv);
+                    let meets = ((p.x <= hi.x) | (q.x <= hi.x))
+                        & ((lo.x <= p.x) | (lo.x <= q.x))
+                        & ((p.y <= hi.y) | (q.y <= hi.y))
+                        & ((lo.y <= p.y) | (lo.y <= q.y));
+                    let keep = fresh & slot.alive & meets;
+                    out.push(road);
+                    let len = out.len() - usize::from(!keep);
+                    out.truncate(len);
+                }
+            }
+        }
+    }
+
+    /// The next query's stamp (every slot's stamp is reset when the counter wraps).
+    fn next_query(&mut self) -> u32 {
         self.query = self.query.wrapping_add(1);
         if self.query == 0 {
             for slot in &mut self.slots {
@@ -258,6 +298,18 @@ impl SnapGrid {
             }
             self.query = 1;
         }
+        self.query
+    }
+
+    /// Calls `f` once with every live road entered in a square under `b` (each road
+    /// once per call, as its current segment): every road whose segment meets `b` is
+    /// among them, and roads near `b` may be too.
+    #[cfg(test)]
+    pub(crate) fn for_each_in(&mut self, b: &Aabb2, mut f: impl FnMut(&GridRoad)) {
+        if self.nx == 0 || b.is_empty() {
+            return;
+        }
+        self.next_query();
         let (c0, c1) = (self.col(b.min.x), self.col(b.max.x));
         let (r0, r1) = (self.row(b.min.y), self.row(b.max.y));
         for r in r0..=r1 {
@@ -326,6 +378,7 @@ mod tests {
     }
 
     /// The grid's roads whose boxes meet `b`, each checked against the graph.
+    /// [`SnapGrid::gather`] gives the same roads in the same order.
     fn listed(grid: &mut SnapGrid, g: &RoadNetwork, b: &Aabb2) -> Vec<EdgeId> {
         grid.sync(g);
         let mut out = Vec::new();
@@ -336,6 +389,10 @@ mod tests {
                 out.push(r.edge);
             }
         });
+        let mut gathered = vec![Slot::default().road; 3];
+        grid.gather(b, &mut gathered);
+        let gathered: Vec<EdgeId> = gathered.iter().skip(3).map(|r| r.edge).collect();
+        assert_eq!(gathered, out);
         out.sort_unstable();
         out
     }

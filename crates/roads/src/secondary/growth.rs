@@ -142,8 +142,27 @@ impl SecondaryRoads {
 pub struct SecondaryGrowth {
     params: SecondaryParams,
     snapper: Snapper,
-    scratch: Vec<GridRoad>,
+    buffers: Buffers,
     joins: (u64, u64),
+}
+
+/// The growth's own buffers, kept between cells so that a worker that grows many cells
+/// (one per thread of a pool) allocates them once.
+#[derive(Debug, Clone, Default)]
+struct Buffers {
+    /// Scratch of [`join::plan`].
+    scratch: Vec<GridRoad>,
+    /// The FIFO queue of Fig. 42: `(node, incoming direction)`.
+    queue: VecDeque<(NodeId, DVec2)>,
+    /// By node id: whether the node has branched.
+    expanded: Vec<bool>,
+    /// The connectivity decisions of the node being expanded, per road or junction met.
+    decided: Vec<(JoinKey, bool)>,
+    /// The roads of the node read last as (unit direction, length), for
+    /// [`Run::folds_for_sure`].
+    root_roads: Vec<(DVec2, f64)>,
+    /// The far end (node and position) of every road at that node, for the snap search.
+    root_ends: Vec<(NodeId, DVec2)>,
 }
 
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
@@ -177,9 +196,21 @@ impl SecondaryGrowth {
         Ok(SecondaryGrowth {
             params,
             snapper: Snapper::default(),
-            scratch: Vec::new(),
+            buffers: Buffers::default(),
             joins: (0, 0),
         })
+    }
+
+    /// Takes `params` for the next growths, keeping the worker's buffers (a pool thread
+    /// that grows cells of several neighbourhoods keeps one worker).
+    ///
+    /// # Errors
+    /// [`SecondaryError::InvalidParameter`] from [`SecondaryParams::validate`]; the
+    /// worker's parameters are then unchanged.
+    pub fn set_params(&mut self, params: SecondaryParams) -> Result<(), SecondaryError> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
     }
 
     /// The parameters.
@@ -300,14 +331,17 @@ impl SecondaryGrowth {
             edges: 0,
             guard,
             tolerance: (p.segment_size_m.value * INSERT_TOLERANCE).max(1e-3),
-            decided: Vec::new(),
-            scratch: std::mem::take(&mut self.scratch),
-            root_roads: Vec::new(),
-            root_ends: Vec::new(),
+            buffers: std::mem::take(&mut self.buffers),
             root: (None, (0, 0)),
             joins: (0, 0),
         };
-        let mut queue: VecDeque<(NodeId, DVec2)> = VecDeque::new();
+        run.buffers.decided.clear();
+        run.buffers.root_roads.clear();
+        run.buffers.root_ends.clear();
+        let mut queue = std::mem::take(&mut run.buffers.queue);
+        queue.clear();
+        let mut expanded = std::mem::take(&mut run.buffers.expanded);
+        expanded.clear();
         // Initial segments from deviated midpoints of the longest sides: the first
         // `start_sides` sides, longest first, whose first segment can be placed.
         let mut started = 0;
@@ -333,7 +367,7 @@ impl SecondaryGrowth {
                 let t = 0.5 + p.segment_size_m.deviance * (u - 0.5);
                 let t = t.clamp(snap_max / len, 1.0 - snap_max / len);
                 let mid = a.lerp(b, t);
-                run.decided.clear();
+                run.buffers.decided.clear();
                 // The perpendicular deviates by up to ± degree deviance × 45°.
                 let dir = run.deviate(inward, std::f64::consts::FRAC_PI_2);
                 // Split the side only if the first segment fits.
@@ -359,7 +393,7 @@ impl SecondaryGrowth {
             }
         }
         // Road growth.
-        let mut expanded: Vec<bool> = Vec::new();
+        let mut turns: Vec<Turn> = Vec::new();
         while let Some((source, dir)) = queue.pop_front() {
             if p.max_steps.is_some_and(|m| run.report.steps >= m)
                 || run.edges >= run.guard
@@ -386,11 +420,19 @@ impl SecondaryGrowth {
             let degree = ((p.degree as f64) * (1.0 + p.degree_deviance * (2.0 * du - 1.0)))
                 .round()
                 .max(1.0) as u32;
-            let step = std::f64::consts::TAU / degree as f64;
-            run.decided.clear();
-            // Direction i is `dir` turned by i steps: one rotation applied i times.
-            let (sin, cos) = step.sin_cos();
-            let certain = FoldBound::new(&p, step);
+            run.buffers.decided.clear();
+            // Direction i is `dir` turned by i steps: one rotation applied i times. The
+            // step, its rotation and its fold bound depend on the degree alone, so they
+            // are computed once per degree drawn in this cell.
+            let turn = match turns.iter().find(|t| t.degree == degree) {
+                Some(t) => *t,
+                None => {
+                    let t = Turn::new(&p, degree);
+                    turns.push(t);
+                    t
+                }
+            };
+            let (step, sin, cos, certain) = (turn.step, turn.sin, turn.cos, turn.certain);
             let mut turned = dir;
             for _ in 0..degree {
                 // A direction that folds onto a road at the node whatever its draws is
@@ -419,7 +461,9 @@ impl SecondaryGrowth {
         let report = run.report;
         self.joins.0 += run.joins.0;
         self.joins.1 += run.joins.1;
-        self.scratch = run.scratch;
+        self.buffers = run.buffers;
+        self.buffers.queue = queue;
+        self.buffers.expanded = expanded;
         let network = run.g;
         Ok(SecondaryRoads {
             cell: cell.id,
@@ -448,9 +492,77 @@ pub fn grow_cell(
     SecondaryGrowth::new(params.clone())?.grow(cell, maps, seed)
 }
 
+/// The turn between the directions of a node of one degree: the step (radians), its
+/// sine and cosine, and the fold bound of its directions.
+#[derive(Clone, Copy)]
+struct Turn {
+    degree: u32,
+    step: f64,
+    sin: f64,
+    cos: f64,
+    certain: Option<FoldBound>,
+}
+
+impl Turn {
+    fn new(p: &SecondaryParams, degree: u32) -> Turn {
+        let step = std::f64::consts::TAU / f64::from(degree);
+        let (sin, cos) = step.sin_cos();
+        Turn {
+            degree,
+            step,
+            sin,
+            cos,
+            certain: FoldBound::new(p, step),
+        }
+    }
+}
+
+/// `v` turned by `angle` radians (counter-clockwise).
+///
+/// The deviations of growth's directions are small angles (at most the degree deviance
+/// times half the step: 45° at the most for the start segments and for every degree of
+/// 4 or more), so up to 45° the sine and cosine are their Taylor polynomials to the 15th
+/// and 16th power (the first term left out is under 5·10⁻¹⁷, below half an ulp of
+/// either there; the results are within a few ulps of the exact values), evaluated by
+/// Horner's rule without fused multiply-adds: the same bits on every machine (libm
+/// picks its `sin_cos` by the processor), in fewer instructions than libm's call.
+/// Larger angles take `sin_cos`.
 fn rotate(v: DVec2, angle: f64) -> DVec2 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = if angle.abs() <= std::f64::consts::FRAC_PI_4 {
+        small_sin_cos(angle)
+    } else {
+        angle.sin_cos()
+    };
     DVec2::new(v.x * c - v.y * s, v.x * s + v.y * c)
+}
+
+/// The sine and cosine of `x` (|x| ≤ π/4) by their Taylor polynomials (see [`rotate`]).
+#[inline]
+fn small_sin_cos(x: f64) -> (f64, f64) {
+    // 1/n! with the Taylor series' signs, rounded once each at compile time.
+    const S: [f64; 7] = [
+        -1.0 / 6.0,
+        1.0 / 120.0,
+        -1.0 / 5_040.0,
+        1.0 / 362_880.0,
+        -1.0 / 39_916_800.0,
+        1.0 / 6_227_020_800.0,
+        -1.0 / 1_307_674_368_000.0,
+    ];
+    const C: [f64; 8] = [
+        -1.0 / 2.0,
+        1.0 / 24.0,
+        -1.0 / 720.0,
+        1.0 / 40_320.0,
+        -1.0 / 3_628_800.0,
+        1.0 / 479_001_600.0,
+        -1.0 / 87_178_291_200.0,
+        1.0 / 20_922_789_888_000.0,
+    ];
+    let x2 = x * x;
+    let s = S.iter().rev().fold(0.0, |acc, &k| acc * x2 + k);
+    let c = C.iter().rev().fold(0.0, |acc, &k| acc * x2 + k);
+    (x + x * (x2 * s), 1.0 + x2 * c)
 }
 
 /// What every proposal of one expanded node can be, for test 0 before the draws: the
@@ -465,6 +577,7 @@ fn rotate(v: DVec2, angle: f64) -> DVec2 {
 /// `|p − a| · sin θ` of the segment, before its end. With `|θ|` at most the angle of the
 /// undeviated direction plus the widest deviation, this holds for every draw when it
 /// holds for the bounds.
+#[derive(Clone, Copy)]
 struct FoldBound {
     len_max: f64,
     radius_min: f64,
@@ -524,16 +637,10 @@ struct Run<'a> {
     edges: u32,
     guard: u32,
     tolerance: f64,
-    /// The connectivity decisions of the node being expanded, per road or junction met.
-    decided: Vec<(JoinKey, bool)>,
-    /// Scratch of [`join::plan`].
-    scratch: Vec<GridRoad>,
-    /// The roads of a node as (unit direction, length), for
-    /// [`folds_for_sure`](Self::folds_for_sure), and the node and the graph's edge
-    /// bound and count they were read at.
-    root_roads: Vec<(DVec2, f64)>,
-    /// The far end (node and position) of every road at that node, for the snap search.
-    root_ends: Vec<(NodeId, DVec2)>,
+    /// The worker's buffers.
+    buffers: Buffers,
+    /// The node whose roads the buffers hold, and the graph's edge bound and count they
+    /// were read at.
     root: (Option<NodeId>, (usize, usize)),
     /// Joins onto a road made directly and by planar insertion.
     joins: (u64, u64),
@@ -559,13 +666,13 @@ impl Run<'_> {
     ) -> Result<bool, SecondaryError> {
         self.read_root(source)?;
         Ok(self
+            .buffers
             .root_roads
             .iter()
             .any(|&(w, len)| bound.folds(turned, w, len)))
     }
 
-    /// Reads the roads at `source` into [`root_ends`](Self::root_ends) and
-    /// [`root_roads`](Self::root_roads), unless they were read at this node and the graph
+    /// Reads the roads at `source` into the buffers' `root_ends` and `root_roads`, unless they were read at this node and the graph
     /// has made or removed no road since (a change of the edge bound or count).
     #[inline]
     fn read_root(&mut self, source: NodeId) -> Result<(), SecondaryError> {
@@ -583,17 +690,17 @@ impl Run<'_> {
         source: NodeId,
         roads: (usize, usize),
     ) -> Result<(), SecondaryError> {
-        self.root_roads.clear();
-        self.root_ends.clear();
+        self.buffers.root_roads.clear();
+        self.buffers.root_ends.clear();
         let a = self.g.position(source)?;
         for &e in self.g.edges_at(source)? {
             let n = self.g.other_end(e, source)?;
             let p = self.g.position(n)?;
-            self.root_ends.push((n, p));
+            self.buffers.root_ends.push((n, p));
             let ap = p - a;
             let len = ap.length();
             if len > 0.0 {
-                self.root_roads.push((ap / len, len));
+                self.buffers.root_roads.push((ap / len, len));
             }
         }
         self.root = (Some(source), roads);
@@ -643,27 +750,28 @@ impl Run<'_> {
         let a = self.g.position(source)?;
         let b = a + dir * len;
         self.read_root(source)?;
-        let target = match self
-            .snapper
-            .snap_from(&self.g, source, &self.root_ends, a, b, snap)
-        {
-            SnapEvent::None => Target::Free(b),
-            SnapEvent::Blocked => {
-                self.report.refused_blocked += 1;
-                return Ok(None);
-            }
-            ev => {
-                if !self.may_join(ev) {
-                    self.report.refused_connectivity += 1;
+        let target =
+            match self
+                .snapper
+                .snap_from(&self.g, source, &self.buffers.root_ends, a, b, snap)
+            {
+                SnapEvent::None => Target::Free(b),
+                SnapEvent::Blocked => {
+                    self.report.refused_blocked += 1;
                     return Ok(None);
                 }
-                match ev {
-                    SnapEvent::Node(n) => Target::Node(n),
-                    SnapEvent::Cross(e, q) | SnapEvent::Road(e, q) => Target::OnEdge(e, q),
-                    SnapEvent::None | SnapEvent::Blocked => return Ok(None),
+                ev => {
+                    if !self.may_join(ev) {
+                        self.report.refused_connectivity += 1;
+                        return Ok(None);
+                    }
+                    match ev {
+                        SnapEvent::Node(n) => Target::Node(n),
+                        SnapEvent::Cross(e, q) | SnapEvent::Road(e, q) => Target::OnEdge(e, q),
+                        SnapEvent::None | SnapEvent::Blocked => return Ok(None),
+                    }
                 }
-            }
-        };
+            };
         let t = match target {
             Target::Free(q) | Target::OnEdge(_, q) => q,
             Target::Node(n) => self.g.position(n)?,
@@ -736,7 +844,7 @@ impl Run<'_> {
                 let plan = join::plan(
                     &self.g,
                     self.snapper,
-                    &mut self.scratch,
+                    &mut self.buffers.scratch,
                     source,
                     (a, t),
                     e,
@@ -857,12 +965,12 @@ impl Run<'_> {
             SnapEvent::Cross(e, _) | SnapEvent::Road(e, _) => JoinKey::Road(e),
             SnapEvent::None | SnapEvent::Blocked => return false,
         };
-        if let Some(&(_, join)) = self.decided.iter().find(|(k, _)| *k == key) {
+        if let Some(&(_, join)) = self.buffers.decided.iter().find(|(k, _)| *k == key) {
             return join;
         }
         let connectivity = self.p.connectivity.sample(self.rng).clamp(0.0, 1.0);
         let join = self.rng.random::<f64>() < connectivity;
-        self.decided.push((key, join));
+        self.buffers.decided.push((key, join));
         join
     }
 
@@ -923,6 +1031,36 @@ mod tests {
     use super::*;
     use crate::secondary::Neighbourhood;
     use crate::secondary::snap::{folds_onto_root, root_ends};
+
+    /// The deviations' sine and cosine polynomials are within two ulps of libm's up to
+    /// 45° (at the bounds, at zero, and at random), and a rotation keeps a unit vector's
+    /// length to within a few ulps; beyond 45° `rotate` is libm's.
+    #[test]
+    fn small_angles_turn_as_sin_cos_does() {
+        let mut rng = Pcg64Mcg::seed_from_u64(18);
+        let quarter = std::f64::consts::FRAC_PI_4;
+        let mut xs = vec![0.0, -0.0, quarter, -quarter, 1e-300, 1e-8, 0.3];
+        xs.extend((0..100_000).map(|_| (2.0 * rng.random::<f64>() - 1.0) * quarter));
+        for x in xs {
+            let (s, c) = small_sin_cos(x);
+            let (ls, lc) = x.sin_cos();
+            assert!(
+                (s - ls).abs() <= 2.0 * f64::EPSILON * ls.abs().max(f64::MIN_POSITIVE),
+                "sin {x}: {s} {ls}"
+            );
+            assert!(
+                (c - lc).abs() <= 2.0 * f64::EPSILON * lc,
+                "cos {x}: {c} {lc}"
+            );
+            let v = rotate(DVec2::from_angle(x * 7.0), x);
+            assert!((v.length() - 1.0).abs() <= 4.0 * f64::EPSILON, "{x}: {v}");
+        }
+        let v = DVec2::new(0.6, -0.8);
+        assert_eq!(rotate(v, 1.0), {
+            let (s, c) = 1.0f64.sin_cos();
+            DVec2::new(v.x * c - v.y * s, v.x * s + v.y * c)
+        });
+    }
 
     /// Where [`FoldBound`] says a direction folds for every draw, test 0 folds every
     /// proposal drawn in it (directions deviated, lengths on the aspect ellipse and snap

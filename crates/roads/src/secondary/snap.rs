@@ -136,11 +136,7 @@ impl Snapper {
     /// snap grid lists it (each once; the last query's candidates stay as they were).
     pub(crate) fn roads_in(&mut self, g: &RoadNetwork, b: &Aabb2, out: &mut Vec<GridRoad>) {
         self.grid.sync(g);
-        self.grid.for_each_in(b, |r| {
-            if Aabb2::new(r.pu, r.pv).intersects(b) {
-                out.push(*r);
-            }
-        });
+        self.grid.gather(b, out);
     }
 
     /// Road `e` of `g` was split or removed since the last query (see
@@ -211,11 +207,7 @@ impl Snapper {
         let mut roads = std::mem::take(&mut self.roads);
         roads.clear();
         self.grid.sync(g);
-        self.grid.for_each_in(&ext, |road| {
-            if Aabb2::new(road.pu, road.pv).intersects(&ext) {
-                roads.push(*road);
-            }
-        });
+        self.grid.gather(&ext, &mut roads);
         debug_assert!(
             roads.iter().all(|r| GridRoad::of(g, r.edge)
                 .is_some_and(|c| (c.u, c.v, c.pu, c.pv) == (r.u, r.v, r.pu, r.pv))),
