@@ -38,8 +38,20 @@ pub struct CityLot {
     pub id: u64,
     /// The cell it lies in.
     pub cell: u64,
-    /// The lot.
-    pub lot: Lot,
+    /// The lot, behind an `Arc` like [`City::buildings`]: a lot an edit leaves alone is
+    /// shared between the cities before and after it (and the editor's memo) rather than
+    /// copied; `Arc::make_mut` gives a private copy to change.
+    pub lot: Arc<Lot>,
+}
+
+impl CityLot {
+    /// Whether `self` and `other` are equal, looking first whether they share their lot
+    /// (as an edited city's unchanged cells do), then at the lots themselves.
+    pub fn same_as(&self, other: &CityLot) -> bool {
+        self.id == other.id
+            && self.cell == other.cell
+            && (Arc::ptr_eq(&self.lot, &other.lot) || self.lot == other.lot)
+    }
 }
 
 /// Time spent in one stage.
@@ -143,15 +155,17 @@ pub struct City {
     pub growth: Option<GrowthReport>,
     /// Cells of the road graph.
     pub cells: CellDecomposition,
-    /// Blocks, cell by cell.
-    pub blocks: Vec<Block>,
-    /// Lots, cell by cell.
+    /// Blocks, cell by cell. Each is behind an `Arc`, shared like
+    /// [`buildings`](Self::buildings).
+    pub blocks: Vec<Arc<Block>>,
+    /// Lots, cell by cell (each lot behind an `Arc`: [`CityLot::lot`]).
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
     /// The lot subdivision's split lines in the order they were cut, with the id of the
-    /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]).
-    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
+    /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]). Each line
+    /// is behind an `Arc`, shared like [`buildings`](Self::buildings).
+    pub lot_splits: Vec<(u64, Arc<polis_lots::SplitLine>)>,
     /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
     /// building an edit leaves alone is shared between the cities before and after it
     /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy

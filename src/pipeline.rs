@@ -978,14 +978,14 @@ impl CellMemoRun<'_> {
 pub struct CityChunk {
     /// Ids of the cells, ascending.
     pub cells: Vec<u64>,
-    /// Blocks, cell by cell.
-    pub blocks: Vec<Block>,
+    /// Blocks, cell by cell (each behind an `Arc`, as in [`City::blocks`]).
+    pub blocks: Vec<Arc<Block>>,
     /// Lots, cell by cell.
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
     /// The lot subdivision's split lines with their block ids, cell by cell.
-    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
+    pub lot_splits: Vec<(u64, Arc<polis_lots::SplitLine>)>,
     /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
     /// building an edit leaves alone is shared between the cities before and after it
     /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy
