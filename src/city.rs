@@ -513,6 +513,46 @@ mod tests {
     use polis_geom::field::FnField;
 
     #[test]
+    fn city_lots_are_the_same_when_shared_or_equal() {
+        let lot = |x: f64| Lot {
+            polygon: Polygon::new(vec![
+                DVec2::new(x, 0.0),
+                DVec2::new(x + 10.0, 0.0),
+                DVec2::new(x + 10.0, 20.0),
+            ]),
+            street_edges: vec![0],
+            block_id: 7,
+            area: 100.0,
+        };
+        let shared = Arc::new(lot(0.0));
+        let a = CityLot {
+            id: 1 << 24,
+            cell: 1,
+            lot: Arc::clone(&shared),
+        };
+        let b = CityLot {
+            lot: shared,
+            ..a.clone()
+        };
+        assert!(a.same_as(&b), "one lot, shared");
+        let copy = CityLot {
+            lot: Arc::new(lot(0.0)),
+            ..a.clone()
+        };
+        assert!(a.same_as(&copy), "an equal copy");
+        let moved = CityLot {
+            lot: Arc::new(lot(1.0)),
+            ..a.clone()
+        };
+        assert!(!a.same_as(&moved), "another polygon");
+        let renumbered = CityLot {
+            id: a.id + 1,
+            ..a.clone()
+        };
+        assert!(!a.same_as(&renumbered), "one lot under another id");
+    }
+
+    #[test]
     fn traced_mask_area_matches_the_sampled_area() {
         // A disc of radius 300 m: traced area within one cell ring of π r².
         let disc = FnField::new(|p: DVec2| if p.length() < 300.0 { 1.0 } else { 0.0 });
