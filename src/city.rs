@@ -38,8 +38,20 @@ pub struct CityLot {
     pub id: u64,
     /// The cell it lies in.
     pub cell: u64,
-    /// The lot.
-    pub lot: Lot,
+    /// The lot, behind an `Arc` like [`City::buildings`]: a lot an edit leaves alone is
+    /// shared between the cities before and after it (and the editor's memo) rather than
+    /// copied; `Arc::make_mut` gives a private copy to change.
+    pub lot: Arc<Lot>,
+}
+
+impl CityLot {
+    /// Whether `self` and `other` are equal, looking first whether they share their lot
+    /// (as an edited city's unchanged cells do), then at the lots themselves.
+    pub fn same_as(&self, other: &CityLot) -> bool {
+        self.id == other.id
+            && self.cell == other.cell
+            && (Arc::ptr_eq(&self.lot, &other.lot) || self.lot == other.lot)
+    }
 }
 
 /// Time spent in one stage.
@@ -143,15 +155,17 @@ pub struct City {
     pub growth: Option<GrowthReport>,
     /// Cells of the road graph.
     pub cells: CellDecomposition,
-    /// Blocks, cell by cell.
-    pub blocks: Vec<Block>,
-    /// Lots, cell by cell.
+    /// Blocks, cell by cell. Each is behind an `Arc`, shared like
+    /// [`buildings`](Self::buildings).
+    pub blocks: Vec<Arc<Block>>,
+    /// Lots, cell by cell (each lot behind an `Arc`: [`CityLot::lot`]).
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
     /// The lot subdivision's split lines in the order they were cut, with the id of the
-    /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]).
-    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
+    /// block each belongs to (Kelly §5.5.1's debug view; [`City::debug_map`]). Each line
+    /// is behind an `Arc`, shared like [`buildings`](Self::buildings).
+    pub lot_splits: Vec<(u64, Arc<polis_lots::SplitLine>)>,
     /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
     /// building an edit leaves alone is shared between the cities before and after it
     /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy
@@ -497,6 +511,46 @@ pub fn trace_mask(mask: &dyn Field, size_m: f64, cell_m: f64) -> Vec<PolygonWith
 mod tests {
     use super::*;
     use polis_geom::field::FnField;
+
+    #[test]
+    fn city_lots_are_the_same_when_shared_or_equal() {
+        let lot = |x: f64| Lot {
+            polygon: Polygon::new(vec![
+                DVec2::new(x, 0.0),
+                DVec2::new(x + 10.0, 0.0),
+                DVec2::new(x + 10.0, 20.0),
+            ]),
+            street_edges: vec![0],
+            block_id: 7,
+            area: 100.0,
+        };
+        let shared = Arc::new(lot(0.0));
+        let a = CityLot {
+            id: 1 << 24,
+            cell: 1,
+            lot: Arc::clone(&shared),
+        };
+        let b = CityLot {
+            lot: shared,
+            ..a.clone()
+        };
+        assert!(a.same_as(&b), "one lot, shared");
+        let copy = CityLot {
+            lot: Arc::new(lot(0.0)),
+            ..a.clone()
+        };
+        assert!(a.same_as(&copy), "an equal copy");
+        let moved = CityLot {
+            lot: Arc::new(lot(1.0)),
+            ..a.clone()
+        };
+        assert!(!a.same_as(&moved), "another polygon");
+        let renumbered = CityLot {
+            id: a.id + 1,
+            ..a.clone()
+        };
+        assert!(!a.same_as(&renumbered), "one lot under another id");
+    }
 
     #[test]
     fn traced_mask_area_matches_the_sampled_area() {

@@ -374,8 +374,9 @@ impl CitygenConfig {
 pub struct CitygenNetwork {
     /// The primary network.
     pub primary: RoadNetwork,
-    /// Every grown cell's secondary roads, in cell order.
-    pub cells: Vec<SecondaryRoads>,
+    /// Every grown cell's secondary roads, in cell order. Each is behind an `Arc`: the
+    /// editor's memo hands a cell an edit left alone back without copying its graph.
+    pub cells: Vec<Arc<SecondaryRoads>>,
     /// Every grown cell's id, region, pattern and traits (parallel to `cells`).
     pub districts: Vec<District>,
     /// The cells whose growth was skipped (too small or invalid for their pattern; the
@@ -528,7 +529,7 @@ pub(crate) fn citygen_network_with(
     let ids = cell_ids(&decomposition, &primary, kelly_roads.as_deref());
     let zoning = zoning_of(cx)?;
     let started = crate::clock::Instant::now();
-    type Grown = std::result::Result<(SecondaryRoads, District), (Skip, Option<District>)>;
+    type Grown = std::result::Result<(Arc<SecondaryRoads>, District), (Skip, Option<District>)>;
     let grown: Vec<Result<Grown>> = decomposition
         .cells
         .par_iter()
@@ -607,7 +608,7 @@ pub(crate) fn citygen_network_with(
                     }
                     m.grow(id, key, &grow)?
                 }
-                _ => grow()?,
+                _ => grow()?.map(Arc::new),
             };
             Ok(match roads {
                 Ok(r) => Ok((r, district)),
@@ -722,7 +723,7 @@ pub(crate) trait GrowthMemo: Send + Sync {
         id: u64,
         key: crate::editor::key::Key,
         grow: &(dyn Fn() -> Result<std::result::Result<SecondaryRoads, Skip>> + Sync),
-    ) -> Result<std::result::Result<SecondaryRoads, Skip>>;
+    ) -> Result<std::result::Result<Arc<SecondaryRoads>, Skip>>;
 }
 
 /// A city cell as the later stages see it: its stable id, region, pattern and the lot
@@ -921,7 +922,7 @@ pub fn neighbourhood_of(
 }
 
 /// Primary and secondary roads in one planar graph, cells joined in order.
-fn union(primary: &RoadNetwork, cells: &[SecondaryRoads]) -> Result<RoadNetwork> {
+fn union(primary: &RoadNetwork, cells: &[Arc<SecondaryRoads>]) -> Result<RoadNetwork> {
     let mut net = primary.clone();
     let snap = SnapOptions {
         snap_distance: 0.01,

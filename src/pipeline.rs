@@ -357,7 +357,7 @@ impl Pipeline {
                 len: chunk.len(),
                 total,
             };
-            let (out, chunk_timings) = self.chunk(
+            let (out, chunk_timings, triangles) = self.chunk(
                 chunk,
                 ids.get(span.first..span.first + span.len)
                     .unwrap_or_default(),
@@ -375,11 +375,7 @@ impl Pipeline {
             counts.lots += out.lots.len();
             counts.buildings += out.buildings.len();
             counts.dressed_buildings += out.dresses.iter().filter(|d| d.is_some()).count();
-            counts.building_triangles += out
-                .buildings
-                .iter()
-                .map(|b| b.triangle_count())
-                .sum::<usize>();
+            counts.building_triangles += triangles;
             if keep {
                 kept.append(out);
             } else {
@@ -497,7 +493,9 @@ impl Pipeline {
         })
     }
 
-    /// Blocks, lots, buildings and skins of a run of cells; the wall time of each stage.
+    /// Blocks, lots, buildings and skins of a run of cells; the wall time of each stage
+    /// and the triangles of the buildings' meshes (a reused cell's counted when it was
+    /// made: no pass over every building's meshes).
     #[allow(clippy::too_many_arguments)]
     fn chunk(
         &self,
@@ -511,7 +509,7 @@ impl Pipeline {
         dresser: &dyn DressBuilding,
         cell_memo: Option<&CellMemoRun<'_>>,
         report: &mut SkipReport,
-    ) -> Result<(CityChunk, [StageTiming; 3])> {
+    ) -> Result<(CityChunk, [StageTiming; 3], usize)> {
         let mut clock = Instant::now();
         let mut lap = |stage: Stage| StageTiming {
             stage,
@@ -777,12 +775,22 @@ impl Pipeline {
         out.dresses.reserve_exact(out.buildings.len());
         let mut dressed = dressed.into_iter();
         let mut made = made.into_iter();
+        let mut triangles = 0;
         for ((range, hit), key) in spans.into_iter().zip(&hits).zip(&keys) {
             if let Some(h) = hit {
                 out.dresses.extend(h.dresses.iter().cloned());
                 report.skipped.extend(h.facade_skips.iter().cloned());
+                triangles += h.triangles;
                 continue;
             }
+            let cell_triangles = out
+                .buildings
+                .get(range.clone())
+                .unwrap_or_default()
+                .iter()
+                .map(|b| b.triangle_count())
+                .sum::<usize>();
+            triangles += cell_triangles;
             let mut skips = Vec::new();
             for b in out.buildings.get(range.clone()).unwrap_or_default() {
                 out.dresses.push(match dressed.next() {
@@ -810,13 +818,14 @@ impl Pipeline {
                     dresses: out.dresses.get(range).unwrap_or_default().to_vec(),
                     building_skips,
                     facade_skips: skips,
+                    triangles: cell_triangles,
                 };
                 m.reuse.put(*key, cell, &ids);
             }
         }
         let facades_time = lap(Stage::Facades);
         self.report(Stage::Facades, span.done());
-        Ok((out, [lots_time, buildings_time, facades_time]))
+        Ok((out, [lots_time, buildings_time, facades_time], triangles))
     }
 }
 
@@ -898,6 +907,8 @@ pub(crate) struct CellBuilt {
     pub building_skips: Vec<Skip>,
     /// Buildings whose skin failed, in building order.
     pub facade_skips: Vec<Skip>,
+    /// Triangles of its buildings' meshes (counted once, when the cell is made).
+    pub triangles: usize,
 }
 
 /// Whole road-graph cells of earlier runs (the editor's memo): a cell whose key is known
@@ -978,14 +989,14 @@ impl CellMemoRun<'_> {
 pub struct CityChunk {
     /// Ids of the cells, ascending.
     pub cells: Vec<u64>,
-    /// Blocks, cell by cell.
-    pub blocks: Vec<Block>,
+    /// Blocks, cell by cell (each behind an `Arc`, as in [`City::blocks`]).
+    pub blocks: Vec<Arc<Block>>,
     /// Lots, cell by cell.
     pub lots: Vec<CityLot>,
     /// Green spaces inside blocks.
     pub green_spaces: Vec<PolygonWithHoles>,
     /// The lot subdivision's split lines with their block ids, cell by cell.
-    pub lot_splits: Vec<(u64, polis_lots::SplitLine)>,
+    pub lot_splits: Vec<(u64, Arc<polis_lots::SplitLine>)>,
     /// Buildings (one per built lot; `id` = the lot's id). Each is behind an `Arc`: a
     /// building an edit leaves alone is shared between the cities before and after it
     /// (and the editor's memo) rather than copied; `Arc::make_mut` gives a private copy

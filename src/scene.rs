@@ -421,7 +421,7 @@ pub(crate) struct SceneInputs<'a> {
     pub config: &'a CityConfig,
     pub maps: &'a CityMaps,
     pub network: &'a RoadNetwork,
-    pub blocks: &'a [Block],
+    pub blocks: &'a [std::sync::Arc<Block>],
     pub buildings: &'a [std::sync::Arc<Building>],
     /// Cell id of each building.
     pub building_cells: &'a [u64],
@@ -480,7 +480,7 @@ pub(crate) trait SceneReuse: Sync {
     /// none).
     fn coarse(&self, index: usize, b: &std::sync::Arc<Building>) -> Option<Option<Mesh>>;
     /// The leaf of block `b`.
-    fn block(&self, b: &Block) -> Option<Reused>;
+    fn block(&self, b: &std::sync::Arc<Block>) -> Option<Reused>;
 }
 
 /// The scene node name of building `id`; [`node_id`] reads it back.

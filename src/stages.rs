@@ -238,17 +238,19 @@ pub struct CellInput<'a> {
 /// What the lot stage makes of one cell.
 #[derive(Debug, Clone, Default)]
 pub struct CellLots {
-    /// Blocks (the cell inset by the roads' half widths, with footpaths).
-    pub blocks: Vec<Block>,
-    /// Lots, each inside one of the blocks.
-    pub lots: Vec<Lot>,
+    /// Blocks (the cell inset by the roads' half widths, with footpaths). Each is
+    /// behind an `Arc`, so a stage that keeps its results (the editor's memo) hands them
+    /// out again without copying them.
+    pub blocks: Vec<Arc<Block>>,
+    /// Lots, each inside one of the blocks (behind an `Arc`, as the blocks).
+    pub lots: Vec<Arc<Lot>>,
     /// Green spaces (parks inside blocks).
     pub green_spaces: Vec<PolygonWithHoles>,
     /// Degenerate pieces skipped (counted in the city's report).
     pub skipped: Vec<Skip>,
     /// The lot subdivision's split lines, in order, with the id of the block each cut
     /// (a debug record: [`City::debug_map`](crate::City::debug_map)). Default: empty.
-    pub splits: Vec<(u64, polis_lots::SplitLine)>,
+    pub splits: Vec<(u64, Arc<polis_lots::SplitLine>)>,
 }
 
 /// Turns one cell into blocks and lots. Called for every cell, possibly in parallel.
@@ -295,14 +297,16 @@ impl LotStage for KellyLots {
             match subdivider.subdivide_block(&block, params, &mut rng) {
                 Ok(sub) => {
                     let id = block.id();
-                    out.splits.extend(sub.splits.into_iter().map(|s| (id, s)));
+                    out.splits
+                        .extend(sub.splits.into_iter().map(|s| (id, Arc::new(s))));
                     out.lots.extend(
                         sub.lots
                             .into_iter()
-                            .filter(|lot| clear_of_roads(&lot.polygon, &input.nearby_roads)),
+                            .filter(|lot| clear_of_roads(&lot.polygon, &input.nearby_roads))
+                            .map(Arc::new),
                     );
                     out.green_spaces.extend(sub.green_spaces);
-                    out.blocks.push(block);
+                    out.blocks.push(Arc::new(block));
                 }
                 Err(e) => out.skipped.push(Skip {
                     stage: Stage::Lots,

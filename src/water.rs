@@ -305,7 +305,7 @@ impl Water {
         config: &crate::CityConfig,
         maps: &crate::CityMaps,
         network: &polis_roads::RoadNetwork,
-        blocks: &[polis_lots::Block],
+        blocks: &[std::sync::Arc<polis_lots::Block>],
         kept: Option<&dyn crate::scene::GroundReuse>,
     ) -> Result<Option<Water>> {
         if !maps.has_water {

@@ -398,16 +398,16 @@ impl LotStage for WholeParcels {
             for parcel in &block.parcels {
                 let polygon = Polygon::new(parcel.outer.points.clone());
                 let area = polygon.area();
-                out.lots.push(polis::lots::Lot {
+                out.lots.push(std::sync::Arc::new(polis::lots::Lot {
                     street_edges: (0..polygon.len())
                         .filter(|&i| parcel.outer.street.get(i).copied().unwrap_or(false))
                         .collect(),
                     polygon,
                     block_id: block.id(),
                     area,
-                });
+                }));
             }
-            out.blocks.push(block);
+            out.blocks.push(std::sync::Arc::new(block));
         }
         Ok(out)
     }

@@ -30,12 +30,6 @@ fn by_key<K: Ord, V>(mut v: Vec<(K, V)>) -> Vec<(K, V)> {
     out
 }
 
-/// Removed, added and changed keys between two maps sorted by key ([`by_key`]; values
-/// compared with `==`).
-fn delta<K: Ord + Clone, V: PartialEq>(old: &[(K, V)], new: &[(K, V)]) -> Delta<K> {
-    delta_by(old, new, |v, w| v != w)
-}
-
 /// Removed, added and changed keys between two maps sorted by key ([`by_key`]),
 /// `changed` telling whether an old value and the new one differ; each list ascending.
 fn delta_by<K: Ord + Clone, V, W>(
@@ -199,9 +193,12 @@ pub(super) fn changes(
         || {
             par::join(
                 || {
-                    delta(
+                    // A lot of a cell the edit left alone is the old city's, shared:
+                    // found equal by its pointer.
+                    delta_by(
                         &by_key(old.lots.iter().map(|l| (l.id, l)).collect()),
                         &by_key(new.lots.iter().map(|l| (l.id, l)).collect()),
+                        |v, w| !v.same_as(w),
                     )
                 },
                 || {
@@ -223,7 +220,7 @@ pub(super) fn changes(
                         .collect(),
                 ),
                 &by_key(new.blocks.iter().map(|b| (b.id(), b)).collect()),
-                |(i, v), w| !same_block(*i) && v != w,
+                |(i, v), w| !same_block(*i) && !Arc::ptr_eq(v, w) && v != w,
             )
         },
     );

@@ -194,7 +194,7 @@ struct Fingerprints {
 /// The memo shared by the wrapped stages of one editor.
 #[derive(Default)]
 pub(crate) struct Memo {
-    growth: Mutex<Store<std::result::Result<SecondaryRoads, Skip>>>,
+    growth: Mutex<Store<std::result::Result<Arc<SecondaryRoads>, Skip>>>,
     lots: Mutex<Store<CellLots>>,
     buildings: Mutex<Store<Option<Arc<Building>>>>,
     dresses: Mutex<Store<Option<Arc<Dress>>>>,
@@ -413,7 +413,7 @@ impl GrowthMemo for Memo {
         id: u64,
         key: Key,
         grow: &(dyn Fn() -> Result<std::result::Result<SecondaryRoads, Skip>> + Sync),
-    ) -> Result<std::result::Result<SecondaryRoads, Skip>> {
+    ) -> Result<std::result::Result<Arc<SecondaryRoads>, Skip>> {
         let hit = lock(&self.growth).get(key);
         if let Some(v) = hit {
             return Ok(v.value.clone());
@@ -427,7 +427,7 @@ impl GrowthMemo for Memo {
                 },
             ));
         }
-        let v = grow()?;
+        let v = grow()?.map(Arc::new);
         lock(&self.growth).put(key, v.clone());
         lock(&self.redone).cells.insert(id);
         Ok(v)

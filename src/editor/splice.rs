@@ -366,9 +366,10 @@ impl SceneReuse for OldScene {
         }
     }
 
-    fn block(&self, b: &Block) -> Option<Reused> {
+    fn block(&self, b: &Arc<Block>) -> Option<Reused> {
         let &(i, n, slot) = self.blocks.get(&b.id())?;
-        if self.city.blocks.get(i)? != b {
+        let old = self.city.blocks.get(i)?;
+        if !Arc::ptr_eq(old, b) && old != b {
             return None;
         }
         let leaf = self.leaf(n, slot)?;
