@@ -279,8 +279,9 @@ impl Targets {
 /// sharp foot of a cut's banks without vertices on the corridor's edge, and this keeps
 /// them under the road surface. The cut is an upper bound on the terrain only: over the
 /// cut and one more taper beyond it the terrain may also sag by this much under it
-/// (`CutIn::slack`), so it is refined where it would rise over the cut, not where it
-/// only sags under it.
+/// (`CutIn::slack`), and its vertices sit half that under the cut, so it is refined
+/// where it would rise over the cut or sag under the slack's floor, not at every bend of
+/// the graded ground.
 pub const CORRIDOR_CUT_M: f64 = 0.5;
 
 /// Over how many metres the corridors' cut tapers back to the ground, metres: gentle

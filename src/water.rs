@@ -387,6 +387,11 @@ impl Water {
     }
 }
 
+/// How far every shore stays from a batch of bed samples that [`WaterBed::sample_many`]
+/// reads as lying on one side of all shores, metres: far beyond the rounding of the
+/// shore crossings [`Water::body_at`] counts.
+const SHORE_CLEAR_M: f64 = 1.0;
+
 /// A ground field with the water bodies' bed cut into it: see [`Water::bed`].
 pub(crate) struct WaterBed<'a> {
     water: &'a Water,
@@ -436,6 +441,20 @@ impl Field for WaterBed<'_> {
                 }
             }
             None => {
+                // No shore within a metre of the points' box: every point lies in the
+                // body of the first, or on land with it (depth 0 at every point).
+                let dry = Aabb2::of_finite_points(points).is_some_and(|b| {
+                    let b = b.expanded(SHORE_CLEAR_M);
+                    let mut hit = false;
+                    w.shore
+                        .index
+                        .for_each_candidate(&b, |_, s| hit |= s.intersects_box(&b));
+                    !hit && points.iter().all(|p| p.is_finite())
+                        && points.first().is_some_and(|&p| w.body_at(p).is_none())
+                });
+                if dry {
+                    return;
+                }
                 for (&p, o) in points.iter().zip(out.iter_mut()) {
                     *o -= w.depth(p, *o);
                 }

@@ -589,10 +589,11 @@ impl<'a> CutIn<'a> {
     /// How far a terrain of this field may lie below it (for
     /// [`Terrain::build_with_slack`](polis_geom::mesh::Terrain::build_with_slack)): the
     /// cut's depth over the whole cut (its flat part and its taper), tapering to 0 over
-    /// one more taper. The terrain then keeps the cut as an upper bound there: it
-    /// refines where its fans would rise over the cut (the foot of a cut's bank at a
-    /// corridor's edge, the foot of a fill bank) but not where they only sag under it
-    /// (the top of a fill bank at a corridor's edge, a crest along a road).
+    /// one more taper. The terrain then keeps the cut as an upper bound there, with its
+    /// vertices half the slack under the cut: it refines where its fans would rise over
+    /// the cut or sag under the slack's floor, not at every bend of the graded ground
+    /// (the foot or the top of a bank at a corridor's edge, a crest along a road). The
+    /// slack is continuous (it tapers), so the terrain's vertices do not step with it.
     pub fn slack(&self) -> CutSlack<'a> {
         CutSlack { cut: *self }
     }

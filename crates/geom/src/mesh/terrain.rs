@@ -18,20 +18,22 @@
 //! gained a corner. The decisions are taken in leaf order, so the mesh does not depend on
 //! the thread count.
 //!
-//! The surface is **one-sided**: every vertex lies `max_error_m` *below* the field, so
-//! where the interpolation is within the bound the surface lies between `2·max_error_m`
-//! below the field and the field itself. Things that stand on the field (road surfaces a
+//! The surface is **one-sided**: every vertex lies `max_error_m` *below* the field (and
+//! half the slack lower where [`Terrain::build_with_slack`] gives one), so where the
+//! interpolation is within the bound the surface lies between `2·max_error_m` (plus the
+//! slack) below the field and the field itself. Things that stand on the field (road surfaces a
 //! few centimetres above it, plinths reaching below it, buildings seated at their
 //! corners) are then never buried by the terrain, and float above it by at most
 //! `2·max_error_m` plus their own lift.
 //!
 //! [`Terrain::build_with_slack`] also takes a *slack* field: the surface may lie that much
-//! further below the field (the check's lower side moves down by it; its upper side and
-//! the vertices stay with the field). A kink that bends down (a ridge, a bank's top, the
-//! outer edge of a cut) makes a fan sag under the field, never rise over it, so where the
-//! slack covers the sag the kink needs no refinement; kinks that bend up (a valley, the
-//! foot of a bank) refine as before. A caller that must keep things under the field
-//! unburied (the graded ground's road corridors) keeps the field's upper side.
+//! further below the field (the check's lower side moves down by it; its upper side
+//! stays with the field). The vertices then sit half the slack under the field, in the
+//! middle of the band the check allows, so a fan may sag under them (a kink that bends
+//! down: a ridge, a bank's top, the outer edge of a cut) or rise over them (a kink that
+//! bends up: a valley, the foot of a bank) by half the slack more than `max_error_m`
+//! before its leaf splits. A caller that must keep things under the field unburied (the
+//! graded ground's road corridors) keeps the field's upper side.
 //!
 //! # Guarantees
 //! * At every check point of every leaf, `field − slack − 2·max_error_m ≤ surface ≤
@@ -216,11 +218,14 @@ impl Terrain {
     /// Builds the terrain of `field` over `bounds` where the surface may also lie up to
     /// `slack` metres further below the field (see the [module docs](self)): a check
     /// point misses when the fan lies more than `max_error_m` above the field or more
-    /// than `max_error_m` below the field less the slack there. The vertices still take
-    /// the field's values, so a kink that only bends down (a ridge, the outer edge of a
-    /// cut) needs no refinement where the slack covers the fan's sag under it. Slack
-    /// values below 0 or not a number count as 0; a slack of 0 everywhere builds the
-    /// terrain [`build`](Terrain::build) builds.
+    /// than `max_error_m` below the field less the slack there. The vertices lie half
+    /// the slack under the field (the middle of that band), so a kink that bends down
+    /// (a ridge, the outer edge of a cut) or up (a valley, the foot of a bank) needs no
+    /// refinement where half the slack covers the fan's sag under, or rise over, its
+    /// vertices. Slack values below 0 or not a number count as 0; a slack of 0
+    /// everywhere builds the terrain [`build`](Terrain::build) builds. The vertices
+    /// follow the slack, so a slack that jumps makes the surface step where it does
+    /// (leaves there may end unresolved): give it a taper.
     ///
     /// Fails as [`build`](Terrain::build) does.
     pub fn build_with_slack(
@@ -277,7 +282,7 @@ impl Terrain {
         let refined = refine::refine(&grid, field, slack, e, options.max_leaves)?;
         let (leaves, checks): (Vec<Leaf>, Vec<refine::Checks>) = refined.leaves.into_iter().unzip();
         let (mut rows, mut cols) = (refined.rows, refined.cols);
-        let mut centre_heights: Vec<f64> = checks.iter().map(|c| c.field[12]).collect();
+        let mut centre_heights: Vec<f64> = checks.iter().map(|c| c.vertex(12)).collect();
         // Leaves that still miss the bound (cliffs, steps): every vertex of their fan is
         // lowered by the fan's largest rise above the field at their check points (the
         // fan is linear in its vertex heights, so it then lies below the field there);
@@ -296,13 +301,16 @@ impl Terrain {
                 continue;
             }
             let profiles = edge_profiles(leaf, &rows, &cols);
-            let rise = leaf_rise(&profiles, &checks[k].field);
+            let rise = leaf_rise(&profiles, &checks[k]);
             if rise > 0.0 {
                 drops.push((k, rise));
             }
         }
-        let (row_orig, col_orig, centre_orig) =
-            (rows.clone(), cols.clone(), centre_heights.clone());
+        let (row_orig, col_orig, centre_orig) = if drops.is_empty() {
+            (Vec::new(), Vec::new(), Vec::new())
+        } else {
+            (rows.clone(), cols.clone(), centre_heights.clone())
+        };
         for &(k, drop) in &drops {
             let leaf = leaves[k];
             let sz = leaf.size;
@@ -481,9 +489,18 @@ fn edge_ranges(
 /// parametrised from its lower-left end, through every corner on it (see
 /// [`edge_ranges`]).
 fn edge_profiles(leaf: Leaf, rows: &[(Corner, f64)], cols: &[(Corner, f64)]) -> [EdgeProfile; 4] {
+    profiles_in(leaf, rows, cols, &edge_ranges(leaf, rows, cols))
+}
+
+/// [`edge_profiles`] from the leaf's [`edge_ranges`], found already.
+fn profiles_in(
+    leaf: Leaf,
+    rows: &[(Corner, f64)],
+    cols: &[(Corner, f64)],
+    ranges: &[std::ops::Range<usize>; 4],
+) -> [EdgeProfile; 4] {
     let (s, from) = (leaf.size, [leaf.x, leaf.y, leaf.x, leaf.y]);
     let keys = [rows, cols, rows, cols];
-    let ranges = edge_ranges(leaf, rows, cols);
     std::array::from_fn(|e| {
         keys[e]
             .get(ranges[e].clone())
@@ -534,15 +551,15 @@ fn fan_height(profiles: &[EdgeProfile; 4], centre: f64, u: f64, v: f64) -> f64 {
 /// The fan's largest rise above the field at the leaf's check points (0 when it lies
 /// below the field at all of them); check points where the field is not finite are
 /// skipped.
-fn leaf_rise(profiles: &[EdgeProfile; 4], checks: &[f64; 25]) -> f64 {
+fn leaf_rise(profiles: &[EdgeProfile; 4], checks: &refine::Checks) -> f64 {
     let mut worst = 0.0f64;
-    for (k, &f) in checks.iter().enumerate() {
+    for (k, &f) in checks.field.iter().enumerate() {
         let (u, v) = (
             f64::from((k % 5) as u32) / 4.0,
             f64::from((k / 5) as u32) / 4.0,
         );
         if f.is_finite() {
-            worst = worst.max(fan_height(profiles, checks[12], u, v) - f);
+            worst = worst.max(fan_height(profiles, checks.vertex(12), u, v) - f);
         }
     }
     worst

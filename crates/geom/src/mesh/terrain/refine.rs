@@ -26,7 +26,7 @@
 
 use glam::DVec2;
 
-use super::{Corner, EdgeProfile, Lattice, Leaf, edge_profiles, edge_ranges, fan_height, split};
+use super::{Corner, EdgeProfile, Lattice, Leaf, edge_ranges, fan_height, profiles_in, split};
 use crate::field::Field;
 use crate::par::prelude::*;
 use crate::{GeomError, MAX_COORDINATE};
@@ -42,6 +42,23 @@ pub(super) struct Checks {
     /// without a slack field).
     pub slack: [f32; 25],
 }
+
+impl Checks {
+    /// The height a vertex of the fan takes at check entry `k` (before the terrain's
+    /// offset): the field less [`MIDLINE_SHARE`] of the slack there, the middle of the
+    /// band the check allows (the field itself without slack).
+    pub fn vertex(&self, k: usize) -> f64 {
+        self.field[k] - MIDLINE_SHARE * f64::from(self.slack[k])
+    }
+}
+
+/// Which share of the slack the fans' vertices sit under the field: a half, the middle
+/// of the band `[field − slack − 2e, field]` the check allows, so a fan may rise over its
+/// vertices (a kink that bends up: a valley, the foot of a bank) by half the slack and
+/// sag under them (a ridge, a bank's top) by half the slack, besides `max_error_m`
+/// either way, before the leaf splits. Without slack the vertices take the field's
+/// values.
+pub(super) const MIDLINE_SHARE: f64 = 0.5;
 
 /// Entries of [`Checks`] that are vertices of the leaf's own fan: the corners in the
 /// order bottom left, bottom right, top right, top left, then the centre.
@@ -381,7 +398,7 @@ fn fan_miss(
         );
         // Above the field by `d`, or below the field less the slack by `−d − slack`;
         // with no slack the larger of the two is `|d|` exactly.
-        let d = fan_height(profiles, checks.field[12], u, v) - f;
+        let d = fan_height(profiles, checks.vertex(12), u, v) - f;
         worst = worst.max(d.max(-d - f64::from(slack)));
     }
     Ok(worst)
@@ -390,8 +407,8 @@ fn fan_miss(
 /// The miss of the leaf's own fan (its corners and centre).
 fn own_miss(grid: &Lattice, leaf: Leaf, checks: &Checks) -> Result<f64, GeomError> {
     check_vertices(grid, leaf, checks)?;
-    let c = &checks.field;
-    let [bl, br, tr, tl] = [c[0], c[4], c[24], c[20]];
+    let v = |k: usize| checks.vertex(k);
+    let [bl, br, tr, tl] = [v(0), v(4), v(24), v(20)];
     let profiles = [
         vec![(0.0, bl), (1.0, br)],
         vec![(0.0, br), (1.0, tr)],
@@ -412,14 +429,15 @@ fn final_miss(
     cols: &[(Corner, f64)],
 ) -> Result<f64, GeomError> {
     check_vertices(grid, leaf, checks)?;
-    if edge_ranges(leaf, rows, cols).iter().all(|r| r.len() <= 2) {
+    let ranges = edge_ranges(leaf, rows, cols);
+    if ranges.iter().all(|r| r.len() <= 2) {
         return if own_checked {
             Ok(0.0)
         } else {
             own_miss(grid, leaf, checks)
         };
     }
-    let profiles = edge_profiles(leaf, rows, cols);
+    let profiles = profiles_in(leaf, rows, cols, &ranges);
     fan_miss(grid, leaf, &profiles, checks)
 }
 
@@ -451,12 +469,12 @@ fn gained_corner(leaf: Leaf, new_rows: &[(Corner, f64)], new_cols: &[(Corner, f6
 fn corners_of<'a>(leaves: impl Iterator<Item = (Leaf, &'a Checks)>) -> (CornerList, CornerList) {
     let mut rows = Vec::new();
     for (l, c) in leaves {
-        let (s, c) = (l.size, &c.field);
+        let s = l.size;
         rows.extend([
-            ((l.y, l.x), c[0]),
-            ((l.y, l.x + s), c[4]),
-            ((l.y + s, l.x), c[20]),
-            ((l.y + s, l.x + s), c[24]),
+            ((l.y, l.x), c.vertex(0)),
+            ((l.y, l.x + s), c.vertex(4)),
+            ((l.y + s, l.x), c.vertex(20)),
+            ((l.y + s, l.x + s), c.vertex(24)),
         ]);
     }
     sort_corners(rows)
@@ -482,7 +500,7 @@ fn split_corners(
 ) -> (CornerList, CornerList) {
     let mut added = Vec::with_capacity(5 * splitting.len());
     for n in splitting {
-        let (l, c) = (n.leaf, &store[n.slot].field);
+        let (l, c) = (n.leaf, &store[n.slot]);
         let h = l.size / 2;
         for (key, k) in [
             ((l.y, l.x + h), 2),
@@ -492,7 +510,7 @@ fn split_corners(
             ((l.y + h, l.x + h), 12),
         ] {
             if rows.binary_search_by_key(&key, |&(q, _)| q).is_err() {
-                added.push((key, c[k]));
+                added.push((key, c.vertex(k)));
             }
         }
     }
