@@ -7,7 +7,7 @@ use gltf::json;
 use polis_geom::glam::Vec3;
 use polis_geom::scene::{Material, MaterialId, Scene};
 
-use super::plan::{Geometry, Plan};
+use super::plan::{FeatureIds, Geometry, Plan};
 use super::tangents;
 use crate::ExportError;
 
@@ -288,8 +288,10 @@ pub(crate) fn writes_tangents(scene: &Scene, material: Option<MaterialId>) -> bo
 }
 
 /// The component type of a geometry's feature ids, checking the `f32` limit.
-pub(crate) fn feature_component(ids: &[u32]) -> Result<json::accessor::ComponentType, ExportError> {
-    let max = ids.iter().copied().max().unwrap_or(0);
+pub(crate) fn feature_component(
+    ids: &FeatureIds,
+) -> Result<json::accessor::ComponentType, ExportError> {
+    let max = ids.max();
     if max <= U16_FEATURE_LIMIT {
         Ok(json::accessor::ComponentType::U16)
     } else if max < F32_EXACT {
@@ -501,15 +503,28 @@ fn write_array<W: Write>(
             }
         }
         Slot::Feature => {
-            let ids = g.features.as_deref().unwrap_or_default();
-            if a.component == json::accessor::ComponentType::F32 {
-                for &f in ids {
-                    w.put(&(f as f32).to_le_bytes())?;
-                }
-            } else {
-                for &f in ids {
+            let Some(ids) = &g.features else {
+                return Ok(());
+            };
+            // Each run is one id repeated: its four bytes laid out once in a block,
+            // and the block written as often as the run needs.
+            const BLOCK: usize = 1024;
+            let mut block = [0u8; 4 * BLOCK];
+            for &(n, f) in ids.runs() {
+                let bytes = if a.component == json::accessor::ComponentType::F32 {
+                    (f as f32).to_le_bytes()
+                } else {
                     let [lo, hi] = (f as u16).to_le_bytes();
-                    w.put(&[lo, hi, 0, 0])?;
+                    [lo, hi, 0, 0]
+                };
+                let mut left = n as usize;
+                for c in block.chunks_exact_mut(4).take(left.min(BLOCK)) {
+                    c.copy_from_slice(&bytes);
+                }
+                while left > 0 {
+                    let k = left.min(BLOCK);
+                    w.put(&block[..4 * k])?;
+                    left -= k;
                 }
             }
         }
