@@ -65,6 +65,7 @@ mod extrude;
 mod normals;
 mod planar;
 mod small_cdt;
+mod survey;
 mod terrain;
 mod tiles;
 mod triangulate;
@@ -72,6 +73,7 @@ mod triangulate;
 pub use edge_use::{EdgeUseReport, ReportedEdge, edge_use};
 pub use extrude::{Facing, flat_polygon, prism};
 pub use planar::{FRAME_TOLERANCE, PlaneFrame};
+pub use survey::MeshSurvey;
 pub use terrain::{Terrain, TerrainOptions, TerrainReport};
 pub use tiles::{TileIndex, tile_of, triangles_by_tile};
 pub use triangulate::{RefineOptions, RefinedTriangulation, triangulate, triangulate_refined};
@@ -519,62 +521,7 @@ impl Mesh {
     ///
     /// The first problem found is reported, scanning vertices then triangles in order.
     pub fn validate(&self) -> Result<(), GeomError> {
-        let n = self.positions.len();
-        if self.normals.len() != n {
-            return Err(GeomError::MeshAttributeLength {
-                attribute: "normals",
-                len: self.normals.len(),
-                expected: n,
-            });
-        }
-        if self.uvs.len() != n {
-            return Err(GeomError::MeshAttributeLength {
-                attribute: "uvs",
-                len: self.uvs.len(),
-                expected: n,
-            });
-        }
-        if !self.indices.len().is_multiple_of(3) {
-            return Err(GeomError::MeshIndexCount {
-                len: self.indices.len(),
-            });
-        }
-        for (i, ((p, nrm), uv)) in self
-            .positions
-            .iter()
-            .zip(&self.normals)
-            .zip(&self.uvs)
-            .enumerate()
-        {
-            if !p.is_finite() {
-                return Err(invalid_vertex("position", i, "not finite"));
-            }
-            if !nrm.is_finite() {
-                return Err(invalid_vertex("normal", i, "not finite"));
-            }
-            if (nrm.length() - 1.0).abs() > NORMAL_LENGTH_TOLERANCE {
-                return Err(invalid_vertex("normal", i, "not of unit length"));
-            }
-            if !uv.is_finite() {
-                return Err(invalid_vertex("uv", i, "not finite"));
-            }
-        }
-        for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
-            let [a, b, c] = tri.map(|i| self.positions[i as usize]);
-            if triangle_is_degenerate(a, b, c) {
-                return Err(GeomError::DegenerateTriangle { triangle: t });
-            }
-        }
-        Ok(())
+        self.check::<false>().map(|_| ())
     }
 
     /// Checks that the mesh is a closed, consistently oriented surface: after welding
