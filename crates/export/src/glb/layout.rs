@@ -454,6 +454,33 @@ pub(crate) fn write_view<W: Write>(
     w.pad4()
 }
 
+/// The little-endian bytes of `p`.
+fn vec3_bytes(p: Vec3) -> [u8; 12] {
+    let mut b = [0u8; 12];
+    b[0..4].copy_from_slice(&p.x.to_le_bytes());
+    b[4..8].copy_from_slice(&p.y.to_le_bytes());
+    b[8..12].copy_from_slice(&p.z.to_le_bytes());
+    b
+}
+
+/// Writes `items` as `bytes` gives each, a block of them at a time (one buffered write
+/// per block instead of one per element).
+fn put_all<W: Write, T, const N: usize>(
+    w: &mut Chunked<'_, W>,
+    items: &[T],
+    bytes: impl Fn(&T) -> [u8; N],
+) -> std::io::Result<()> {
+    const BLOCK: usize = 4096;
+    let mut block = [0u8; BLOCK];
+    for chunk in items.chunks(BLOCK / N) {
+        for (out, item) in block.chunks_exact_mut(N).zip(chunk) {
+            out.copy_from_slice(&bytes(item));
+        }
+        w.put(&block[..chunk.len() * N])?;
+    }
+    Ok(())
+}
+
 /// Streams one array of a geometry.
 fn write_array<W: Write>(
     w: &mut Chunked<'_, W>,
@@ -462,46 +489,28 @@ fn write_array<W: Write>(
 ) -> std::io::Result<()> {
     let m = &g.mesh;
     match a.slot {
-        Slot::Position | Slot::Normal => {
-            let normals = a.slot == Slot::Normal;
-            let src = if normals { &m.normals } else { &m.positions };
-            for p in src {
-                let p = if normals { p.normalize_or_zero() } else { *p };
-                let mut b = [0u8; 12];
-                b[0..4].copy_from_slice(&p.x.to_le_bytes());
-                b[4..8].copy_from_slice(&p.y.to_le_bytes());
-                b[8..12].copy_from_slice(&p.z.to_le_bytes());
-                w.put(&b)?;
-            }
-        }
-        Slot::Uv => {
-            for t in &m.uvs {
-                let mut b = [0u8; 8];
-                b[0..4].copy_from_slice(&t.x.to_le_bytes());
-                b[4..8].copy_from_slice(&t.y.to_le_bytes());
-                w.put(&b)?;
-            }
-        }
+        Slot::Position => put_all(w, &m.positions, |p| vec3_bytes(*p))?,
+        Slot::Normal => put_all(w, &m.normals, |n| vec3_bytes(n.normalize_or_zero()))?,
+        Slot::Uv => put_all(w, &m.uvs, |t| {
+            let mut b = [0u8; 8];
+            b[0..4].copy_from_slice(&t.x.to_le_bytes());
+            b[4..8].copy_from_slice(&t.y.to_le_bytes());
+            b
+        })?,
         Slot::Index => {
             if a.component == json::accessor::ComponentType::U32 {
-                for &i in &m.indices {
-                    w.put(&i.to_le_bytes())?;
-                }
+                put_all(w, &m.indices, |i| i.to_le_bytes())?;
             } else {
-                for &i in &m.indices {
-                    w.put(&(i as u16).to_le_bytes())?;
-                }
+                put_all(w, &m.indices, |&i| (i as u16).to_le_bytes())?;
             }
         }
-        Slot::Tangent => {
-            for t in tangents::tangents(m) {
-                let mut b = [0u8; 16];
-                for (k, c) in t.to_array().into_iter().enumerate() {
-                    b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-                }
-                w.put(&b)?;
+        Slot::Tangent => put_all(w, &tangents::tangents(m), |t| {
+            let mut b = [0u8; 16];
+            for (k, c) in t.to_array().into_iter().enumerate() {
+                b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
             }
-        }
+            b
+        })?,
         Slot::Feature => {
             let Some(ids) = &g.features else {
                 return Ok(());
