@@ -556,15 +556,7 @@ impl Mesh {
         // (low, high, runs low → high)
         let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(self.indices.len());
         for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
+            triangle_in_range(t, tri, n)?;
             let c = tri.map(|i| canon[i as usize]);
             if c[0] == c[1] || c[1] == c[2] || c[2] == c[0] {
                 return Err(GeomError::DegenerateTriangle { triangle: t });
@@ -618,6 +610,18 @@ impl Mesh {
 fn triangle_is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
     let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
     (b - a).cross(c - a) == DVec3::ZERO
+}
+
+/// Triangle `t`'s indices `tri` all below the vertex count `n`, or the first that is not.
+fn triangle_in_range(t: usize, tri: [u32; 3], n: usize) -> Result<(), GeomError> {
+    match tri.into_iter().find(|&i| i as usize >= n) {
+        Some(index) => Err(GeomError::MeshIndexOutOfRange {
+            triangle: t,
+            index,
+            vertex_count: n,
+        }),
+        None => Ok(()),
+    }
 }
 
 fn invalid_vertex(attribute: &'static str, vertex: usize, reason: &'static str) -> GeomError {

@@ -11,7 +11,9 @@
 
 use glam::Vec3A;
 
-use super::{Aabb3, Mesh, NORMAL_LENGTH_TOLERANCE, TileIndex, invalid_vertex, tile_of};
+use super::{
+    Aabb3, Mesh, NORMAL_LENGTH_TOLERANCE, TileIndex, invalid_vertex, tile_of, triangle_in_range,
+};
 use crate::GeomError;
 
 /// What one validating pass learned about a valid mesh ([`Mesh::survey`]).
@@ -112,15 +114,7 @@ impl Mesh {
         let (mut sum_lo, mut sum_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         let mut nonfinite = Vec3A::ZERO;
         for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
+            triangle_in_range(t, tri, n)?;
             let [a, b, c] = tri.map(|i| self.positions[i as usize]);
             if super::triangle_is_degenerate(a, b, c) {
                 return Err(GeomError::DegenerateTriangle { triangle: t });
