@@ -414,6 +414,29 @@ impl<'w, W: Write> Chunked<'w, W> {
         Ok(())
     }
 
+    /// Writes `items` as `bytes` gives each: converted 4 kB at a time straight into the
+    /// buffer (one length check per block, no second copy).
+    pub fn put_all<T, const N: usize>(
+        &mut self,
+        items: &[T],
+        bytes: impl Fn(&T) -> [u8; N],
+    ) -> std::io::Result<()> {
+        const BLOCK: usize = 4096;
+        for chunk in items.chunks((BLOCK / N).max(1)) {
+            let len = chunk.len() * N;
+            if self.buf.len() + len > CHUNK {
+                self.drain()?;
+            }
+            let start = self.buf.len();
+            self.buf.resize(start + len, 0);
+            for (out, item) in self.buf[start..].chunks_exact_mut(N).zip(chunk) {
+                out.copy_from_slice(&bytes(item));
+            }
+            self.written += len as u64;
+        }
+        Ok(())
+    }
+
     pub fn pad4(&mut self) -> std::io::Result<()> {
         while !self.written.is_multiple_of(4) {
             self.put(&[0])?;
@@ -463,24 +486,6 @@ fn vec3_bytes(p: Vec3) -> [u8; 12] {
     b
 }
 
-/// Writes `items` as `bytes` gives each, a block of them at a time (one buffered write
-/// per block instead of one per element).
-fn put_all<W: Write, T, const N: usize>(
-    w: &mut Chunked<'_, W>,
-    items: &[T],
-    bytes: impl Fn(&T) -> [u8; N],
-) -> std::io::Result<()> {
-    const BLOCK: usize = 4096;
-    let mut block = [0u8; BLOCK];
-    for chunk in items.chunks(BLOCK / N) {
-        for (out, item) in block.chunks_exact_mut(N).zip(chunk) {
-            out.copy_from_slice(&bytes(item));
-        }
-        w.put(&block[..chunk.len() * N])?;
-    }
-    Ok(())
-}
-
 /// Streams one array of a geometry.
 fn write_array<W: Write>(
     w: &mut Chunked<'_, W>,
@@ -489,9 +494,9 @@ fn write_array<W: Write>(
 ) -> std::io::Result<()> {
     let m = &g.mesh;
     match a.slot {
-        Slot::Position => put_all(w, &m.positions, |p| vec3_bytes(*p))?,
-        Slot::Normal => put_all(w, &m.normals, |n| vec3_bytes(n.normalize_or_zero()))?,
-        Slot::Uv => put_all(w, &m.uvs, |t| {
+        Slot::Position => w.put_all(&m.positions, |p| vec3_bytes(*p))?,
+        Slot::Normal => w.put_all(&m.normals, |n| vec3_bytes(n.normalize_or_zero()))?,
+        Slot::Uv => w.put_all(&m.uvs, |t| {
             let mut b = [0u8; 8];
             b[0..4].copy_from_slice(&t.x.to_le_bytes());
             b[4..8].copy_from_slice(&t.y.to_le_bytes());
@@ -499,12 +504,12 @@ fn write_array<W: Write>(
         })?,
         Slot::Index => {
             if a.component == json::accessor::ComponentType::U32 {
-                put_all(w, &m.indices, |i| i.to_le_bytes())?;
+                w.put_all(&m.indices, |i| i.to_le_bytes())?;
             } else {
-                put_all(w, &m.indices, |&i| (i as u16).to_le_bytes())?;
+                w.put_all(&m.indices, |&i| (i as u16).to_le_bytes())?;
             }
         }
-        Slot::Tangent => put_all(w, &tangents::tangents(m), |t| {
+        Slot::Tangent => w.put_all(&tangents::tangents(m), |t| {
             let mut b = [0u8; 16];
             for (k, c) in t.to_array().into_iter().enumerate() {
                 b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
