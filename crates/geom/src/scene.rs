@@ -36,7 +36,7 @@ use std::borrow::Cow;
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::GeomError;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshSurvey};
 pub use crate::metadata::{MetaValue, Metadata};
 
 macro_rules! typed_id {
@@ -524,6 +524,22 @@ impl Scene {
     /// factors in `[0, 1]`; images consistent; metadata numbers finite; every mesh valid
     /// ([`Mesh::validate`]). Reports the first problem in array order.
     pub fn validate(&self) -> Result<(), GeomError> {
+        self.checked::<false>().map(|_| ())
+    }
+
+    /// Checks the scene as [`validate`](Self::validate) does (the same first problem
+    /// reported) and returns the survey of every mesh ([`Mesh::survey`]: its box and
+    /// tile facts, gathered in the validating pass), in [`meshes`](Self::meshes) order.
+    /// The surveys describe the meshes as they are while borrowed: a writer that
+    /// validates the scene anyway reads each mesh's box from here instead of reading
+    /// the positions again.
+    pub fn survey(&self) -> Result<Vec<MeshSurvey>, GeomError> {
+        self.checked::<true>()
+    }
+
+    /// The checks of [`validate`](Self::validate); with `SURVEY`, the mesh surveys too
+    /// (else none).
+    fn checked<const SURVEY: bool>(&self) -> Result<Vec<MeshSurvey>, GeomError> {
         let nodes = self.nodes.len();
         for (k, &r) in self.roots.iter().enumerate() {
             if r.index() >= nodes {
@@ -557,6 +573,7 @@ impl Scene {
             }
         }
         self.validate_tree()?;
+        let mut surveys = Vec::with_capacity(if SURVEY { self.meshes.len() } else { 0 });
         for (i, mesh) in self.meshes.iter().enumerate() {
             if let Some(m) = mesh.material
                 && m.index() >= self.materials.len()
@@ -568,10 +585,15 @@ impl Scene {
                     self.materials.len(),
                 ));
             }
-            mesh.validate().map_err(|e| GeomError::InMesh {
+            let in_mesh = |e| GeomError::InMesh {
                 mesh: i,
                 source: Box::new(e),
-            })?;
+            };
+            if SURVEY {
+                surveys.push(mesh.survey().map_err(in_mesh)?);
+            } else {
+                mesh.validate().map_err(in_mesh)?;
+            }
         }
         for (i, mat) in self.materials.iter().enumerate() {
             let who = || format!("material {i} ({:?})", mat.name);
@@ -610,7 +632,7 @@ impl Scene {
                 return Err(invalid(format!("image {i} ({:?})", img.name), &reason));
             }
         }
-        Ok(())
+        Ok(surveys)
     }
 
     /// The node graph is a forest under the roots. Assumes ids are in range.

@@ -7,7 +7,7 @@ use gltf::json;
 use polis_geom::glam::Vec3;
 use polis_geom::scene::{Material, MaterialId, Scene};
 
-use super::plan::{Geometry, Plan};
+use super::plan::{FeatureIds, Geometry, Plan};
 use super::tangents;
 use crate::ExportError;
 
@@ -288,8 +288,10 @@ pub(crate) fn writes_tangents(scene: &Scene, material: Option<MaterialId>) -> bo
 }
 
 /// The component type of a geometry's feature ids, checking the `f32` limit.
-pub(crate) fn feature_component(ids: &[u32]) -> Result<json::accessor::ComponentType, ExportError> {
-    let max = ids.iter().copied().max().unwrap_or(0);
+pub(crate) fn feature_component(
+    ids: &FeatureIds,
+) -> Result<json::accessor::ComponentType, ExportError> {
+    let max = ids.max();
     if max <= U16_FEATURE_LIMIT {
         Ok(json::accessor::ComponentType::U16)
     } else if max < F32_EXACT {
@@ -412,6 +414,29 @@ impl<'w, W: Write> Chunked<'w, W> {
         Ok(())
     }
 
+    /// Writes `items` as `bytes` gives each: converted 4 kB at a time straight into the
+    /// buffer (one length check per block, no second copy).
+    pub fn put_all<T, const N: usize>(
+        &mut self,
+        items: &[T],
+        bytes: impl Fn(&T) -> [u8; N],
+    ) -> std::io::Result<()> {
+        const BLOCK: usize = 4096;
+        for chunk in items.chunks((BLOCK / N).max(1)) {
+            let len = chunk.len() * N;
+            if self.buf.len() + len > CHUNK {
+                self.drain()?;
+            }
+            let start = self.buf.len();
+            self.buf.resize(start + len, 0);
+            for (out, item) in self.buf[start..].chunks_exact_mut(N).zip(chunk) {
+                out.copy_from_slice(&bytes(item));
+            }
+            self.written += len as u64;
+        }
+        Ok(())
+    }
+
     pub fn pad4(&mut self) -> std::io::Result<()> {
         while !self.written.is_multiple_of(4) {
             self.put(&[0])?;
@@ -452,6 +477,15 @@ pub(crate) fn write_view<W: Write>(
     w.pad4()
 }
 
+/// The little-endian bytes of `p`.
+fn vec3_bytes(p: Vec3) -> [u8; 12] {
+    let mut b = [0u8; 12];
+    b[0..4].copy_from_slice(&p.x.to_le_bytes());
+    b[4..8].copy_from_slice(&p.y.to_le_bytes());
+    b[8..12].copy_from_slice(&p.z.to_le_bytes());
+    b
+}
+
 /// Streams one array of a geometry.
 fn write_array<W: Write>(
     w: &mut Chunked<'_, W>,
@@ -460,56 +494,51 @@ fn write_array<W: Write>(
 ) -> std::io::Result<()> {
     let m = &g.mesh;
     match a.slot {
-        Slot::Position | Slot::Normal => {
-            let normals = a.slot == Slot::Normal;
-            let src = if normals { &m.normals } else { &m.positions };
-            for p in src {
-                let p = if normals { p.normalize_or_zero() } else { *p };
-                let mut b = [0u8; 12];
-                b[0..4].copy_from_slice(&p.x.to_le_bytes());
-                b[4..8].copy_from_slice(&p.y.to_le_bytes());
-                b[8..12].copy_from_slice(&p.z.to_le_bytes());
-                w.put(&b)?;
-            }
-        }
-        Slot::Uv => {
-            for t in &m.uvs {
-                let mut b = [0u8; 8];
-                b[0..4].copy_from_slice(&t.x.to_le_bytes());
-                b[4..8].copy_from_slice(&t.y.to_le_bytes());
-                w.put(&b)?;
-            }
-        }
+        Slot::Position => w.put_all(&m.positions, |p| vec3_bytes(*p))?,
+        Slot::Normal => w.put_all(&m.normals, |n| vec3_bytes(n.normalize_or_zero()))?,
+        Slot::Uv => w.put_all(&m.uvs, |t| {
+            let mut b = [0u8; 8];
+            b[0..4].copy_from_slice(&t.x.to_le_bytes());
+            b[4..8].copy_from_slice(&t.y.to_le_bytes());
+            b
+        })?,
         Slot::Index => {
             if a.component == json::accessor::ComponentType::U32 {
-                for &i in &m.indices {
-                    w.put(&i.to_le_bytes())?;
-                }
+                w.put_all(&m.indices, |i| i.to_le_bytes())?;
             } else {
-                for &i in &m.indices {
-                    w.put(&(i as u16).to_le_bytes())?;
-                }
+                w.put_all(&m.indices, |&i| (i as u16).to_le_bytes())?;
             }
         }
-        Slot::Tangent => {
-            for t in tangents::tangents(m) {
-                let mut b = [0u8; 16];
-                for (k, c) in t.to_array().into_iter().enumerate() {
-                    b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-                }
-                w.put(&b)?;
+        Slot::Tangent => w.put_all(&tangents::tangents(m), |t| {
+            let mut b = [0u8; 16];
+            for (k, c) in t.to_array().into_iter().enumerate() {
+                b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
             }
-        }
+            b
+        })?,
         Slot::Feature => {
-            let ids = g.features.as_deref().unwrap_or_default();
-            if a.component == json::accessor::ComponentType::F32 {
-                for &f in ids {
-                    w.put(&(f as f32).to_le_bytes())?;
-                }
-            } else {
-                for &f in ids {
+            let Some(ids) = &g.features else {
+                return Ok(());
+            };
+            // Each run is one id repeated: its four bytes laid out once in a block,
+            // and the block written as often as the run needs.
+            const BLOCK: usize = 1024;
+            let mut block = [0u8; 4 * BLOCK];
+            for &(n, f) in ids.runs() {
+                let bytes = if a.component == json::accessor::ComponentType::F32 {
+                    (f as f32).to_le_bytes()
+                } else {
                     let [lo, hi] = (f as u16).to_le_bytes();
-                    w.put(&[lo, hi, 0, 0])?;
+                    [lo, hi, 0, 0]
+                };
+                let mut left = n as usize;
+                for c in block.chunks_exact_mut(4).take(left.min(BLOCK)) {
+                    c.copy_from_slice(&bytes);
+                }
+                while left > 0 {
+                    let k = left.min(BLOCK);
+                    w.put(&block[..4 * k])?;
+                    left -= k;
                 }
             }
         }

@@ -193,11 +193,18 @@ pub fn write_glb<W: Write>(
     mut out: W,
 ) -> Result<GlbReport, ExportError> {
     options.validate()?;
-    scene.validate()?;
     let mut plan = match options.batching {
-        Batching::PerNode => plan::per_node(scene),
-        Batching::PerParentAndMaterial => plan::batched(scene)?,
-        Batching::Tiled => tiles::tiled(scene, options)?,
+        Batching::PerNode => {
+            scene.validate()?;
+            plan::per_node(scene)
+        }
+        Batching::PerParentAndMaterial => {
+            scene.validate()?;
+            plan::batched(scene)?
+        }
+        // The validating pass also surveys each mesh (its box, whether it is one
+        // tile's cut): the tiled plan reads those instead of the meshes.
+        Batching::Tiled => tiles::tiled(scene, &scene.survey()?, options)?,
     };
     if options.gpu_instancing && options.batching == Batching::PerNode {
         instancing::instance(scene, &mut plan)?;

@@ -55,8 +55,8 @@ impl Plan<'_> {
 #[derive(Debug)]
 pub(crate) struct Geometry<'a> {
     pub mesh: Cow<'a, Mesh>,
-    /// `_FEATURE_ID_0` per vertex.
-    pub features: Option<Vec<u32>>,
+    /// `_FEATURE_ID_0` per vertex, as runs.
+    pub features: Option<FeatureIds>,
     /// The bounds of `mesh`'s positions when the plan already knows them (the tiled
     /// layout tracks them while merging); `None`: computed from the mesh.
     pub bounds: Option<Aabb3>,
@@ -74,6 +74,65 @@ impl<'a> Geometry<'a> {
     /// The bounding box of the positions.
     pub fn bbox(&self) -> Aabb3 {
         self.bounds.unwrap_or_else(|| self.mesh.bbox())
+    }
+}
+
+/// A geometry's feature id per vertex, stored as runs of equal ids (a merged geometry's
+/// pieces each give all their vertices one id): no array as long as the vertices is
+/// allocated, filled and scanned for its largest id; the writer expands the runs as it
+/// streams them.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub(crate) struct FeatureIds {
+    /// (vertices, id) in vertex order; no run is empty and no two neighbours share an id.
+    runs: Vec<(u32, u32)>,
+    max: u32,
+}
+
+impl FeatureIds {
+    /// Room for `runs` runs.
+    pub fn with_capacity(runs: usize) -> Self {
+        FeatureIds {
+            runs: Vec::with_capacity(runs),
+            max: 0,
+        }
+    }
+
+    /// Gives the next `count` vertices the id `id`.
+    pub fn push(&mut self, id: u32, mut count: usize) {
+        self.max = self.max.max(id);
+        if let Some(last) = self.runs.last_mut()
+            && last.1 == id
+        {
+            let room = (u32::MAX - last.0) as usize;
+            let add = room.min(count);
+            last.0 += add as u32;
+            count -= add;
+        }
+        while count > 0 {
+            let n = count.min(u32::MAX as usize);
+            self.runs.push((n as u32, id));
+            count -= n;
+        }
+    }
+
+    /// The largest id (0 without vertices).
+    pub fn max(&self) -> u32 {
+        self.max
+    }
+
+    /// The (vertices, id) runs in vertex order.
+    pub fn runs(&self) -> &[(u32, u32)] {
+        &self.runs
+    }
+
+    /// The id of every vertex, in order.
+    pub fn to_vec(&self) -> Vec<u32> {
+        let len = self.runs.iter().map(|&(n, _)| n as usize).sum();
+        let mut out = Vec::with_capacity(len);
+        for &(n, id) in &self.runs {
+            out.resize(out.len() + n as usize, id);
+        }
+        out
     }
 }
 
@@ -389,4 +448,26 @@ pub(crate) fn batched(scene: &Scene) -> Result<Plan<'_>, ExportError> {
     plan.roots = scene.roots.iter().map(|r| new_index[r.index()]).collect();
     plan.count_meshes(scene, &used);
     Ok(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FeatureIds;
+
+    /// Runs expand to the ids pushed, neighbours with one id merged, empty pushes
+    /// dropped; the length and the largest id follow.
+    #[test]
+    fn feature_runs_expand_to_the_ids_pushed() {
+        let mut ids = FeatureIds::with_capacity(0);
+        assert_eq!((ids.max(), ids.to_vec()), (0, vec![]));
+        let pushes = [(7, 2), (7, 1), (3, 0), (9, 3), (2, 1), (7, 2)];
+        let mut expect = Vec::new();
+        for (id, n) in pushes {
+            ids.push(id, n);
+            expect.extend(std::iter::repeat_n(id, n));
+        }
+        assert_eq!(ids.to_vec(), expect);
+        assert_eq!(ids.max(), 9);
+        assert_eq!(ids.runs(), &[(3, 7), (3, 9), (1, 2), (2, 7)]);
+    }
 }

@@ -24,12 +24,15 @@
 //!   centroid). A mesh that is already one tile's cut ([`Mesh::whole_tile`]: a polis
 //!   ground, cut into the scene's tiles where it is built) is appended whole, which
 //!   gives the same bytes as cutting it again without the vertex map.
+//! * A scene mesh's box and whether it is one tile's cut are read from its
+//!   [`MeshSurvey`], taken by the pass that validates the scene ([`Scene::survey`]), so
+//!   the plan reads a mesh's vertices once, when it copies them.
 
 use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 
 use polis_geom::glam::{DMat4, DVec3, Vec3};
-use polis_geom::mesh::{TileIndex, tile_of};
+use polis_geom::mesh::{MeshSurvey, TileIndex, tile_of};
 use polis_geom::scene::{MaterialId, Node, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
 use serde::ser::{Serialize, SerializeMap, Serializer};
@@ -37,7 +40,7 @@ use serde_json::value::RawValue;
 use serde_json::{Map, Value, json};
 
 use super::options::{GlbOptions, GlbProfile};
-use super::plan::{Geometry, Plan, PlannedMesh, PlannedNode};
+use super::plan::{FeatureIds, Geometry, Plan, PlannedMesh, PlannedNode};
 use crate::ExportError;
 
 /// No feature yet (replaced by the table's length once it is known).
@@ -106,7 +109,7 @@ fn moved_box(b: Aabb3, t: DVec3) -> Aabb3 {
 
 /// A merged geometry: the mesh (the scene's own when it is the geometry's only piece,
 /// unmoved) and, when any piece has a feature, the feature id of every vertex.
-type Merged<'a> = (Cow<'a, Mesh>, Option<Vec<u32>>);
+type Merged<'a> = (Cow<'a, Mesh>, Option<FeatureIds>);
 
 /// The merged geometries of one group: (material, geometry, bounds) per material.
 type GroupGeometries<'a> = Vec<(Option<MaterialId>, Merged<'a>, Aabb3)>;
@@ -186,7 +189,11 @@ impl<'a> Merge<'a> {
                     Source::Scene(..) => None,
                 };
                 if let Some(m) = whole {
-                    let ids = spec.featured.then(|| vec![feature; m.positions.len()]);
+                    let ids = spec.featured.then(|| {
+                        let mut ids = FeatureIds::with_capacity(1);
+                        ids.push(feature, m.positions.len());
+                        ids
+                    });
                     *slot = Some((m, ids));
                     continue;
                 }
@@ -199,7 +206,8 @@ impl<'a> Merge<'a> {
                 m.indices.reserve_exact(spec.indices);
                 (
                     Cow::Owned(m),
-                    spec.featured.then(|| Vec::with_capacity(spec.vertices)),
+                    spec.featured
+                        .then(|| FeatureIds::with_capacity(spec.pieces)),
                 )
             });
             let out = out.to_mut();
@@ -221,7 +229,7 @@ impl<'a> Merge<'a> {
             out.uvs.extend_from_slice(&m.uvs);
             out.indices.extend(m.indices.iter().map(|&i| base + i));
             if let Some(ids) = ids {
-                ids.resize(ids.len() + m.positions.len(), feature);
+                ids.push(feature, m.positions.len());
             }
             if let Source::Owned(k) = piece.source {
                 owned[k] = None;
@@ -352,7 +360,14 @@ fn translation_only(frame: &DMat4) -> Option<DVec3> {
 }
 
 /// The layout described in the [module docs](self).
-pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'a>, ExportError> {
+///
+/// `surveys` are the scene's mesh surveys ([`Scene::survey`], one per mesh in order):
+/// a scene mesh's box and its tile facts are read from there, not from its positions.
+pub(crate) fn tiled<'a>(
+    scene: &'a Scene,
+    surveys: &[MeshSurvey],
+    options: &GlbOptions,
+) -> Result<Plan<'a>, ExportError> {
     let size = options.tile_size_m;
     let mut plan = Plan::empty();
     let mut used = vec![false; scene.meshes.len()];
@@ -425,13 +440,14 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
                 let m = frame * scene.nodes[c.index()].transform.matrix();
                 stack.push((c, m, info));
             }
-            let drawn: Vec<&Mesh> = node
+            let drawn: Vec<(&Mesh, &MeshSurvey)> = node
                 .meshes
                 .iter()
                 .filter_map(|m| {
                     let mesh = scene.meshes.get(m.index())?;
+                    let survey = surveys.get(m.index())?;
                     used[m.index()] = true;
-                    (!mesh.is_empty()).then_some(mesh)
+                    (!mesh.is_empty()).then_some((mesh, survey))
                 })
                 .collect();
             if drawn.is_empty() {
@@ -468,47 +484,56 @@ pub(crate) fn tiled<'a>(scene: &'a Scene, options: &GlbOptions) -> Result<Plan<'
             let shift = translation_only(&frame);
             if let Some(t) = shift {
                 let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-                let boxes: Vec<Aabb3> = drawn.iter().map(|m| m.bbox()).collect();
-                for b in &boxes {
-                    lo = lo.min(b.min.as_dvec3() + t);
-                    hi = hi.max(b.max.as_dvec3() + t);
+                for (_, s) in &drawn {
+                    lo = lo.min(s.bounds.min.as_dvec3() + t);
+                    hi = hi.max(s.bounds.max.as_dvec3() + t);
                 }
                 if hi.x - lo.x <= size && hi.z - lo.z <= size {
                     let c = ((lo + hi) * 0.5).as_vec3();
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
-                    for (m, b) in drawn.into_iter().zip(boxes) {
-                        merge.add_moved(key, m, b, t, feature);
+                    for (m, s) in drawn {
+                        merge.add_moved(key, m, s.bounds, t, feature);
                     }
                     continue;
                 }
             }
-            let placed: Vec<Cow<'a, Mesh>> = if frame == DMat4::IDENTITY {
-                drawn.into_iter().map(Cow::Borrowed).collect()
+            // Each mesh in the root's frame with its box and, when it is the scene's
+            // own, its survey (a transformed copy has none).
+            type Placed<'m, 's> = (Cow<'m, Mesh>, Aabb3, Option<&'s MeshSurvey>);
+            let placed: Vec<Placed<'a, '_>> = if frame == DMat4::IDENTITY {
+                drawn
+                    .into_iter()
+                    .map(|(m, s)| (Cow::Borrowed(m), s.bounds, Some(s)))
+                    .collect()
             } else {
                 let mut out = Vec::with_capacity(drawn.len());
-                for m in drawn {
+                for (m, _) in drawn {
                     let mut m = m.clone();
                     m.transform(&frame)?;
-                    out.push(Cow::Owned(m));
+                    let b = m.bbox();
+                    out.push((Cow::Owned(m), b, None));
                 }
                 out
             };
             let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-            let boxes: Vec<Aabb3> = placed.iter().map(|m| m.bbox()).collect();
-            for b in &boxes {
+            for (_, b, _) in &placed {
                 lo = lo.min(b.min);
                 hi = hi.max(b.max);
             }
             let whole = f64::from(hi.x - lo.x) <= size && f64::from(hi.z - lo.z) <= size;
-            for (m, b) in placed.into_iter().zip(boxes) {
+            for (m, b, survey) in placed {
                 // Whole (its box moved by zero: a −0 bound made +0), already one
                 // tile's cut (the ground, cut where it is built: the bytes its cut would
                 // give, its box too, −0 kept), or cut into tiles by triangle centroids.
+                let one_tile = || match survey {
+                    Some(s) => s.whole_tile(size),
+                    None => m.whole_tile(size),
+                };
                 let (key, b) = if whole {
                     let c = (lo + hi) * 0.5;
                     let key = (info.layer, tile_of(c.x, c.z, size), info.lod);
                     (key, moved_box(b, DVec3::ZERO))
-                } else if let Some(tile) = m.whole_tile(size) {
+                } else if let Some(tile) = one_tile() {
                     ((info.layer, tile, info.lod), b)
                 } else {
                     for (tile, part, b) in m.cut_into_tiles(size) {
@@ -825,7 +850,10 @@ mod tests {
                 prop_assert_eq!(&**g_mesh, &mesh);
                 prop_assert_eq!(g_bounds, &bounds);
                 match g_ids {
-                    Some(g) => prop_assert_eq!(g, &ids),
+                    Some(g) => {
+                        prop_assert_eq!(g.to_vec(), ids.clone());
+                        prop_assert_eq!(g.max(), ids.iter().copied().max().unwrap_or(0));
+                    }
                     None => prop_assert!(ids.iter().all(|&f| f == null_id)),
                 }
                 // A lone piece made by the walk is moved in; anything else was copied
@@ -834,9 +862,6 @@ mod tests {
                     prop_assert_eq!(g_mesh.positions.capacity(), g_mesh.positions.len());
                     prop_assert_eq!(g_mesh.normals.capacity(), g_mesh.normals.len());
                     prop_assert_eq!(g_mesh.indices.capacity(), g_mesh.indices.len());
-                    if let Some(g) = g_ids {
-                        prop_assert_eq!(g.capacity(), g.len());
-                    }
                 }
             }
         }

@@ -284,8 +284,9 @@ fn encode(
         data.push(Data::Vertex(octahedral(&unit, n, ws)?));
     }
 
-    if let Some(ids) = &g.features {
-        let c = feature_component(ids)?;
+    if let Some(runs) = &g.features {
+        let c = feature_component(runs)?;
+        let ids = runs.to_vec();
         let mut bytes = Vec::with_capacity(4 * n);
         for &f in order.iter().filter_map(|&v| ids.get(v)) {
             if c == C::F32 {

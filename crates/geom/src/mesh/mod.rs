@@ -65,6 +65,7 @@ mod extrude;
 mod normals;
 mod planar;
 mod small_cdt;
+mod survey;
 mod terrain;
 mod tiles;
 mod triangulate;
@@ -72,6 +73,7 @@ mod triangulate;
 pub use edge_use::{EdgeUseReport, ReportedEdge, edge_use};
 pub use extrude::{Facing, flat_polygon, prism};
 pub use planar::{FRAME_TOLERANCE, PlaneFrame};
+pub use survey::MeshSurvey;
 pub use terrain::{Terrain, TerrainOptions, TerrainReport};
 pub use tiles::{TileIndex, tile_of, triangles_by_tile};
 pub use triangulate::{RefineOptions, RefinedTriangulation, triangulate, triangulate_refined};
@@ -519,62 +521,7 @@ impl Mesh {
     ///
     /// The first problem found is reported, scanning vertices then triangles in order.
     pub fn validate(&self) -> Result<(), GeomError> {
-        let n = self.positions.len();
-        if self.normals.len() != n {
-            return Err(GeomError::MeshAttributeLength {
-                attribute: "normals",
-                len: self.normals.len(),
-                expected: n,
-            });
-        }
-        if self.uvs.len() != n {
-            return Err(GeomError::MeshAttributeLength {
-                attribute: "uvs",
-                len: self.uvs.len(),
-                expected: n,
-            });
-        }
-        if !self.indices.len().is_multiple_of(3) {
-            return Err(GeomError::MeshIndexCount {
-                len: self.indices.len(),
-            });
-        }
-        for (i, ((p, nrm), uv)) in self
-            .positions
-            .iter()
-            .zip(&self.normals)
-            .zip(&self.uvs)
-            .enumerate()
-        {
-            if !p.is_finite() {
-                return Err(invalid_vertex("position", i, "not finite"));
-            }
-            if !nrm.is_finite() {
-                return Err(invalid_vertex("normal", i, "not finite"));
-            }
-            if (nrm.length() - 1.0).abs() > NORMAL_LENGTH_TOLERANCE {
-                return Err(invalid_vertex("normal", i, "not of unit length"));
-            }
-            if !uv.is_finite() {
-                return Err(invalid_vertex("uv", i, "not finite"));
-            }
-        }
-        for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
-            let [a, b, c] = tri.map(|i| self.positions[i as usize]);
-            if triangle_is_degenerate(a, b, c) {
-                return Err(GeomError::DegenerateTriangle { triangle: t });
-            }
-        }
-        Ok(())
+        self.check::<false>().map(|_| ())
     }
 
     /// Checks that the mesh is a closed, consistently oriented surface: after welding
@@ -609,15 +556,7 @@ impl Mesh {
         // (low, high, runs low → high)
         let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(self.indices.len());
         for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
+            triangle_in_range(t, tri, n)?;
             let c = tri.map(|i| canon[i as usize]);
             if c[0] == c[1] || c[1] == c[2] || c[2] == c[0] {
                 return Err(GeomError::DegenerateTriangle { triangle: t });
@@ -671,6 +610,18 @@ impl Mesh {
 fn triangle_is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
     let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
     (b - a).cross(c - a) == DVec3::ZERO
+}
+
+/// Triangle `t`'s indices `tri` all below the vertex count `n`, or the first that is not.
+fn triangle_in_range(t: usize, tri: [u32; 3], n: usize) -> Result<(), GeomError> {
+    match tri.into_iter().find(|&i| i as usize >= n) {
+        Some(index) => Err(GeomError::MeshIndexOutOfRange {
+            triangle: t,
+            index,
+            vertex_count: n,
+        }),
+        None => Ok(()),
+    }
 }
 
 fn invalid_vertex(attribute: &'static str, vertex: usize, reason: &'static str) -> GeomError {

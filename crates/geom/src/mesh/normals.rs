@@ -2,7 +2,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 
-use super::Mesh;
+use super::{Mesh, triangle_in_range};
 use crate::GeomError;
 
 impl Mesh {
@@ -80,15 +80,7 @@ impl Mesh {
     fn check_indices(&self) -> Result<(), GeomError> {
         let n = self.positions.len();
         for (t, tri) in self.triangles().enumerate() {
-            for index in tri {
-                if index as usize >= n {
-                    return Err(GeomError::MeshIndexOutOfRange {
-                        triangle: t,
-                        index,
-                        vertex_count: n,
-                    });
-                }
-            }
+            triangle_in_range(t, tri, n)?;
         }
         Ok(())
     }
