@@ -125,7 +125,8 @@ impl FeatureIds {
         &self.runs
     }
 
-    /// The id of every vertex, in order.
+    /// The id of every vertex, in order (the web profile's per-vertex attribute).
+    #[cfg(any(test, feature = "web"))]
     pub fn to_vec(&self) -> Vec<u32> {
         let len = self.runs.iter().map(|&(n, _)| n as usize).sum();
         let mut out = Vec::with_capacity(len);
