@@ -11,12 +11,13 @@ fi
 command -v node >/dev/null || { apt-get update -q; DEBIAN_FRONTEND=noninteractive apt-get install -y -q nodejs npm; }
 (cd examples/editor/e2e && npm ci --no-audit --no-fund --loglevel=error)
 PROFILE_FLAG=()
-BIN=target/debug/examples/editor
+TARGET="${CARGO_TARGET_DIR:-$PWD/target}"
+BIN="$TARGET/debug/examples/editor"
 if [ "${BENCH:-0}" != "0" ]; then
     PROFILE_FLAG=(--release)
-    BIN=target/release/examples/editor
+    BIN="$TARGET/release/examples/editor"
 fi
 cargo build --quiet "${PROFILE_FLAG[@]}" --example editor
-export EDITOR_BIN="$PWD/$BIN"
-export OUT="${OUT:-$PWD/target/editor-e2e}"
+export EDITOR_BIN="$BIN"
+export OUT="${OUT:-$TARGET/editor-e2e}"
 node examples/editor/e2e/editor.test.mjs
