@@ -42,6 +42,10 @@ use std::time::Instant;
 #[path = "../benches/common/process.rs"]
 mod process;
 
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
+
 use clap::error::ErrorKind;
 use clap::{CommandFactory, Parser};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -57,7 +61,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 #[command(name = "city", version)]
 struct Cli {
     /// Start from a built-in preset (the other flags override it). Default: default.
-    #[arg(long, value_name = "NAME", value_parser = preset_names(), conflicts_with = "config")]
+    #[arg(long, value_name = "NAME", value_parser = cli::preset_names(), conflicts_with = "config")]
     preset: Option<String>,
     /// Start from a JSON configuration file (the other flags override it).
     #[arg(long, value_name = "FILE")]
@@ -66,7 +70,7 @@ struct Cli {
     #[arg(long, value_name = "N")]
     seed: Option<u64>,
     /// Side of the square map in metres (10 to 1,000,000).
-    #[arg(long, value_name = "METRES", value_parser = metres)]
+    #[arg(long, value_name = "METRES", value_parser = cli::metres)]
     size: Option<f64>,
     /// Level of detail of the buildings, 0 to the configuration's `buildings.max_lod`.
     #[arg(long, value_name = "N")]
@@ -138,21 +142,6 @@ fn lon_lat(text: &str) -> Result<[f64; 2], String> {
     }
 }
 
-/// The preset names, so clap lists them in `--help` and suggests the nearest.
-fn preset_names() -> clap::builder::PossibleValuesParser {
-    clap::builder::PossibleValuesParser::new(CityConfig::preset_names())
-}
-
-/// A finite, positive number of metres.
-fn metres(text: &str) -> Result<f64, String> {
-    let v: f64 = text.parse().map_err(|e| format!("{e}"))?;
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("{text} is not a positive number of metres"))
-    }
-}
-
 struct Args {
     config: CityConfig,
     out: PathBuf,
@@ -214,7 +203,7 @@ fn configure(cli: Cli) -> Result<Args, clap::Error> {
         other => other,
     };
     let pair = |cmd: &mut clap::Command, flag: &str, v: &[String]| match v {
-        [path, m] => metres(m)
+        [path, m] => cli::metres(m)
             .map(|m| (PathBuf::from(path), m))
             .map_err(|e| fail(cmd, ErrorKind::ValueValidation, format!("{flag}: {e}"))),
         _ => Err(fail(

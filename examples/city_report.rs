@@ -10,49 +10,37 @@
 //!
 //! Without `--preset` every preset is measured; `--seeds` defaults to 1-5 and `--size`
 //! to each preset's own size. `--no-report` only generates (to time the report by
-//! difference).
+//! difference). Flags are parsed by clap (`--help` lists them).
 
 use std::time::Instant;
 
+use clap::Parser;
 use polis::stats::{CityReport, RealismRow};
 use polis::{CityConfig, generate};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-struct Args {
-    presets: Vec<String>,
-    seeds: (u64, u64),
-    size: Option<f64>,
-    report: bool,
-}
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
 
-fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
-    let mut args = Args {
-        presets: Vec::new(),
-        seeds: (1, 5),
-        size: None,
-        report: true,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(flag) = it.next() {
-        let mut value = || it.next().ok_or_else(|| format!("{flag} needs a value"));
-        match flag.as_str() {
-            "--preset" => args.presets.push(value()?),
-            "--seeds" => {
-                let v = value()?;
-                let (a, b) = v.split_once('-').unwrap_or((&v, &v));
-                args.seeds = (a.parse()?, b.parse()?);
-            }
-            "--size" => args.size = Some(value()?.parse()?),
-            "--no-report" => args.report = false,
-            other => return Err(format!("unknown flag {other}").into()),
-        }
-    }
-    if args.presets.is_empty() {
-        args.presets = CityConfig::preset_names().map(String::from).collect();
-    }
-    Ok(args)
+/// The statistics report of each preset against its real city, over several seeds.
+#[derive(Debug, Parser)]
+#[command(name = "city_report")]
+struct Args {
+    /// A preset to measure (repeat for several; default: every preset).
+    #[arg(long = "preset", value_name = "NAME", value_parser = cli::preset_names())]
+    presets: Vec<String>,
+    /// The seeds: N or FIRST-LAST.
+    #[arg(long, value_name = "FIRST-LAST", default_value = "1-5", value_parser = cli::seeds)]
+    seeds: cli::Seeds,
+    /// The city's size, metres (default: each preset's own).
+    #[arg(long, value_name = "METRES", value_parser = cli::metres)]
+    size: Option<f64>,
+    /// Only generate (to time the report by difference).
+    #[arg(long)]
+    no_report: bool,
 }
 
 /// A metric beyond the realism rows: name and how to read it from a report.
@@ -103,7 +91,10 @@ fn main() {
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse_args()?;
+    let mut args = Args::parse();
+    if args.presets.is_empty() {
+        args.presets = CityConfig::preset_names().map(String::from).collect();
+    }
     for name in &args.presets {
         let mut reports = Vec::new();
         let (mut gen_ms, mut rep_ms) = (Vec::new(), Vec::new());
@@ -111,12 +102,12 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(s) = args.size {
             config.size_m = s;
         }
-        for seed in args.seeds.0..=args.seeds.1 {
+        for seed in args.seeds.iter() {
             config.seed = seed;
             let t = Instant::now();
             let city = generate(&config)?;
             gen_ms.push(t.elapsed().as_secs_f64() * 1e3);
-            if args.report {
+            if !args.no_report {
                 let t = Instant::now();
                 reports.push(city.statistics()?);
                 rep_ms.push(t.elapsed().as_secs_f64() * 1e3);
@@ -125,8 +116,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         println!(
             "\n### {name} ({:.1} km, seeds {}–{}) against {}\n",
             config.size_m / 1000.0,
-            args.seeds.0,
-            args.seeds.1,
+            args.seeds.first,
+            args.seeds.last,
             config.imitates.as_deref().unwrap_or("—")
         );
         println!(

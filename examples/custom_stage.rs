@@ -4,6 +4,8 @@
 //! cargo run --release --example custom_stage -- [SPACING_M] [OUT_DIR]
 //! ```
 //!
+//! Arguments are parsed by clap (`--help` lists them).
+//!
 //! `GridRoads` replaces Parish & Müller's L-system with a jittered grid: streets every
 //! `spacing_m` metres, every `highway_every`-th line a highway, each junction moved by a
 //! seeded random offset of at most `jitter` × spacing (so the city is not a perfect
@@ -18,12 +20,17 @@
 
 use std::path::PathBuf;
 
+use clap::Parser;
 use polis::geom::DVec2;
 use polis::lots::rand::{RngExt, SeedableRng};
 use polis::lots::rand_pcg::Pcg64Mcg;
 use polis::prelude::*;
 use polis::roads::{Junction, Road, RoadClass, RoadNetwork};
 use polis::stages::{RoadStage, RoadsOutput, StageContext};
+
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
 
 /// A jittered grid of streets and highways.
 #[derive(Debug, Clone, Copy)]
@@ -134,6 +141,18 @@ impl RoadStage for GridRoads {
     }
 }
 
+/// A full city on a jittered grid of streets: a custom road stage in the pipeline.
+#[derive(Debug, Parser)]
+#[command(name = "custom_stage")]
+struct Args {
+    /// The grid's street spacing, metres (the stage refuses less than 20).
+    #[arg(value_name = "SPACING_M", default_value = "110", value_parser = cli::metres)]
+    spacing_m: f64,
+    /// The folder the SVG and glb are written to.
+    #[arg(value_name = "OUT_DIR", default_value = "out/custom_stage")]
+    out: PathBuf,
+}
+
 fn main() {
     if let Err(e) = run() {
         eprintln!("error: {e}");
@@ -142,12 +161,7 @@ fn main() {
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
-    let spacing_m: f64 = match args.next() {
-        Some(s) => s.parse().map_err(|e| format!("SPACING_M {s:?}: {e}"))?,
-        None => 110.0,
-    };
-    let out = PathBuf::from(args.next().unwrap_or_else(|| "out/custom_stage".into()));
+    let Args { spacing_m, out } = Args::parse();
     let mut config = CityConfig::preset("default")?;
     config.size_m = 1500.0;
     let stage = GridRoads {

@@ -6,28 +6,39 @@
 //! ```text
 //! cargo run --release --example edit_city -- [--size METRES] [--out DIR] [--glb]
 //! ```
+//!
+//! Flags are parsed by clap (`--help` lists them).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
+use clap::Parser;
 use polis::editor::{ChangeEvents, CityEditor, Edit, End};
 use polis::geom::DVec2;
 use polis::roads::secondary::Neighbourhood;
 use polis::{CityConfig, Formats};
 
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
+
+/// A scripted editing session on a Citygen city, written after each step.
+#[derive(Debug, Parser)]
+#[command(name = "edit_city")]
+struct Args {
+    /// The city's size, metres.
+    #[arg(long, value_name = "METRES", default_value = "2000", value_parser = cli::metres)]
+    size: f64,
+    /// The folder the steps are written to.
+    #[arg(long, value_name = "DIR", default_value = "out/edit_city")]
+    out: PathBuf,
+    /// Also write each step's glb.
+    #[arg(long)]
+    glb: bool,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut size = 2000.0;
-    let mut out = PathBuf::from("out/edit_city");
-    let mut glb = false;
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--size" => size = args.next().ok_or("--size needs metres")?.parse()?,
-            "--out" => out = args.next().ok_or("--out needs a folder")?.into(),
-            "--glb" => glb = true,
-            other => return Err(format!("unknown argument {other:?}").into()),
-        }
-    }
+    let Args { size, out, glb } = Args::parse();
     let formats = Formats {
         glb,
         svg: true,

@@ -14,19 +14,25 @@
 //! 10 ms ticks; `-` where it cannot be read). The last lines check the targets of issue 26: tiled draw calls ≤ 4 ×
 //! materials × tiles; the web profile ≤ 25 % of the per-cell plain bytes; the tiled plain
 //! write no slower than the per-cell plain write. `--only tiled:plain` writes that one
-//! row once (for whole-process timings of one configuration). `--save DIR` also writes
-//! each row's file to `DIR/<preset>-<layout>-<profile>.glb`.
+//! row, once unless `--runs` says otherwise (for whole-process timings of one
+//! configuration). `--save DIR` also writes each row's file to
+//! `DIR/<preset>-<layout>-<profile>.glb`. Flags are parsed by clap (`--help` lists them).
 
 use std::time::Instant;
 
 #[path = "../benches/common/process.rs"]
 mod process;
 
+use clap::Parser;
 use polis::CityConfig;
 use polis::export::glb::{Batching, GlbOptions, GlbProfile, write_glb};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
 
 const LAYOUTS: [(&str, Batching); 3] = [
     ("tiled", Batching::Tiled),
@@ -34,29 +40,50 @@ const LAYOUTS: [(&str, Batching); 3] = [
     ("building", Batching::PerNode),
 ];
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut presets = Vec::new();
-    let mut runs = 5usize;
-    let mut only: Option<(String, String)> = None;
-    let mut save: Option<std::path::PathBuf> = None;
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--runs" => runs = args.next().ok_or("--runs N")?.parse()?,
-            "--save" => save = Some(args.next().ok_or("--save DIR")?.into()),
-            "--only" => {
-                let v = args.next().ok_or("--only LAYOUT:PROFILE")?;
-                let (l, p) = v.split_once(':').ok_or("--only LAYOUT:PROFILE")?;
-                only = Some((l.to_string(), p.to_string()));
-                runs = 1;
-            }
-            _ => presets.push(a),
-        }
+/// The glb's layouts and profiles side by side: file size, draw calls and write time.
+#[derive(Debug, Parser)]
+#[command(name = "glb_profiles")]
+struct Args {
+    /// The presets to generate (default: `default` and `citygen`).
+    #[arg(value_name = "PRESET", value_parser = cli::preset_names())]
+    presets: Vec<String>,
+    /// Writes per row (default 5; 1 with `--only`).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    runs: Option<u32>,
+    /// Write only this row: LAYOUT:PROFILE, LAYOUT one of tiled, cell, building and
+    /// PROFILE one of plain, web.
+    #[arg(long, value_name = "LAYOUT:PROFILE", value_parser = row)]
+    only: Option<(String, String)>,
+    /// Also write each row's file to DIR/<preset>-<layout>-<profile>.glb.
+    #[arg(long, value_name = "DIR")]
+    save: Option<std::path::PathBuf>,
+}
+
+/// `LAYOUT:PROFILE`, both known.
+fn row(text: &str) -> Result<(String, String), String> {
+    let (l, p) = text
+        .split_once(':')
+        .ok_or("give LAYOUT:PROFILE, e.g. tiled:plain")?;
+    if !LAYOUTS.iter().any(|(name, _)| *name == l) {
+        return Err(format!("layout {l:?}: give tiled, cell or building"));
     }
+    if !["plain", "web"].contains(&p) {
+        return Err(format!("profile {p:?}: give plain or web"));
+    }
+    Ok((l.to_string(), p.to_string()))
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let Args {
+        mut presets,
+        runs,
+        only,
+        save,
+    } = Args::parse();
     if presets.is_empty() {
         presets = vec!["default".into(), "citygen".into()];
     }
-    let runs = runs.max(1);
+    let runs = runs.unwrap_or(if only.is_some() { 1 } else { 5 }) as usize;
     for name in &presets {
         let config = CityConfig::preset(name)?;
         let city = polis::generate(&config)?;

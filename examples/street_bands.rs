@@ -11,40 +11,32 @@
 //! `--config` reads a configuration file instead of a preset. Without either: every preset
 //! that names a reference city, in either road mode (Parish & Müller, or Citygen's
 //! secondary growth per cell). `--seeds` defaults to 1-5, `--size` to each preset's own
-//! size.
+//! size. Flags are parsed by clap (`--help` lists them).
 
+use clap::Parser;
 use polis::CityConfig;
 
-struct Args {
-    presets: Vec<String>,
-    files: Vec<String>,
-    seeds: (u64, u64),
-    size: Option<f64>,
-}
+#[allow(dead_code)]
+#[path = "common/cli.rs"]
+mod cli;
 
-fn parse_args() -> Result<Args, Box<dyn std::error::Error>> {
-    let mut args = Args {
-        presets: Vec::new(),
-        files: Vec::new(),
-        seeds: (1, 5),
-        size: None,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(flag) = it.next() {
-        let mut value = || it.next().ok_or_else(|| format!("{flag} needs a value"));
-        match flag.as_str() {
-            "--preset" => args.presets.push(value()?),
-            "--config" => args.files.push(value()?),
-            "--seeds" => {
-                let v = value()?;
-                let (a, b) = v.split_once('-').unwrap_or((&v, &v));
-                args.seeds = (a.parse()?, b.parse()?);
-            }
-            "--size" => args.size = Some(value()?.parse()?),
-            other => return Err(format!("unknown flag {other}").into()),
-        }
-    }
-    Ok(args)
+/// The street network of each preset against its real city (maps and roads only).
+#[derive(Debug, Parser)]
+#[command(name = "street_bands")]
+struct Args {
+    /// A preset to measure (repeat for several). Without `--preset` or `--config`:
+    /// every preset that names a reference city.
+    #[arg(long = "preset", value_name = "NAME", value_parser = cli::preset_names())]
+    presets: Vec<String>,
+    /// A configuration file to measure instead of a preset (repeatable).
+    #[arg(long = "config", value_name = "FILE")]
+    files: Vec<String>,
+    /// The seeds: N or FIRST-LAST.
+    #[arg(long, value_name = "FIRST-LAST", default_value = "1-5", value_parser = cli::seeds)]
+    seeds: cli::Seeds,
+    /// The city's size, metres (default: each preset's own).
+    #[arg(long, value_name = "METRES", value_parser = cli::metres)]
+    size: Option<f64>,
 }
 
 fn main() {
@@ -55,7 +47,7 @@ fn main() {
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse_args()?;
+    let args = Args::parse();
     let explicit = !(args.presets.is_empty() && args.files.is_empty());
     let mut configs = Vec::new();
     for name in &args.presets {
@@ -78,7 +70,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
         println!("## {name} ({} m) against {city}", config.size_m);
         let mut tally: Vec<(String, usize, usize)> = Vec::new();
-        for seed in args.seeds.0..=args.seeds.1 {
+        for seed in args.seeds.iter() {
             config.seed = seed;
             let report = polis::road_statistics(&config)?;
             let mut line = format!("seed {seed}:");

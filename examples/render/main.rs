@@ -26,6 +26,9 @@
 //!   encoded as sRGB, then quantised to a 256-colour palette (median cut and k-means,
 //!   no dithering) and written as an indexed PNG, a third of the RGB file's size.
 
+#[allow(dead_code)]
+#[path = "../common/cli.rs"]
+mod cli;
 mod palette;
 
 use std::path::PathBuf;
@@ -49,7 +52,7 @@ type BoxResult<T> = Result<T, Box<dyn std::error::Error>>;
 #[command(name = "render", version)]
 struct Cli {
     /// The built-in preset to generate.
-    #[arg(long, value_name = "NAME", default_value = "default", value_parser = preset_names())]
+    #[arg(long, value_name = "NAME", default_value = "default", value_parser = cli::preset_names())]
     preset: String,
     /// The city seed.
     #[arg(long, value_name = "N")]
@@ -101,11 +104,6 @@ struct Args {
     height: usize,
     samples: usize,
     out: PathBuf,
-}
-
-/// The preset names, so clap lists them in `--help` and suggests the nearest.
-fn preset_names() -> clap::builder::PossibleValuesParser {
-    clap::builder::PossibleValuesParser::new(CityConfig::preset_names())
 }
 
 /// `N` comma-separated finite numbers.

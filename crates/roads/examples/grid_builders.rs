@@ -2,8 +2,11 @@
 //! side by side, as SVG (the report's Images 4.1 and 4.2, seen from above).
 //!
 //! ```text
-//! cargo run --release -p polis-roads --example grid_builders -- [out.svg] [seed] [grid m] [starts]
+//! cargo run --release -p polis-roads --example grid_builders -- [OUT_SVG] [SEED] [GRID_M] [STARTS]
 //! ```
+//!
+//! Arguments are parsed by clap (`--help` lists them); the rule sets check the grid
+//! spacing and the number of builders.
 //!
 //! The cell is concave (a notch cut into its north side), has a hole (a block ringed by
 //! primary roads), a lake (water) and a park; streets keep out of all three. For each
@@ -13,6 +16,7 @@
 use std::fmt::Write as _;
 use std::sync::Arc;
 
+use clap::Parser;
 use polis_roads::RoadInputs;
 use polis_roads::geom::field::{Constant, FnField};
 use polis_roads::geom::{DVec2, Polygon, PolygonWithHoles};
@@ -130,12 +134,31 @@ fn panel(svg: &mut String, title: &str, roads: &GridRoads, cell: &PolygonWithHol
     );
 }
 
+/// The course report's Downtown and Residential grid road builders in one cell, as SVG.
+#[derive(Debug, Parser)]
+#[command(name = "grid_builders")]
+struct Args {
+    /// The SVG file to write.
+    #[arg(value_name = "OUT_SVG", default_value = "grid_builders.svg")]
+    path: std::path::PathBuf,
+    /// The growth seed.
+    #[arg(value_name = "SEED", default_value = "4")]
+    seed: u64,
+    /// The builders' grid spacing, metres (default: each rule set's own).
+    #[arg(value_name = "GRID_M")]
+    grid: Option<f64>,
+    /// How many builders start (default: each rule set's own).
+    #[arg(value_name = "STARTS")]
+    starts: Option<u32>,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
-    let path = args.next().unwrap_or_else(|| "grid_builders.svg".into());
-    let seed: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(4);
-    let grid: Option<f64> = args.next().map(|s| s.parse()).transpose()?;
-    let starts: Option<u32> = args.next().map(|s| s.parse()).transpose()?;
+    let Args {
+        path,
+        seed,
+        grid,
+        starts,
+    } = Args::parse();
     let cell = cell();
     let maps = maps();
     let mut svg = String::new();
@@ -178,6 +201,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     svg.push_str("</svg>\n");
     std::fs::write(&path, svg)?;
-    println!("wrote {path}");
+    println!("wrote {}", path.display());
     Ok(())
 }

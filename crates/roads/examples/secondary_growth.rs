@@ -4,10 +4,12 @@
 //!   cell (Citygen Fig. 76), plus Raster and Organic (Fig. 44);
 //! * `secondary_steps.svg`: one cell after 10, 100, 300 and 1000 growth steps (Fig. 43).
 //!
-//! Run: `cargo run --release -p polis-roads --example secondary_growth [out_dir]`.
+//! Run: `cargo run --release -p polis-roads --example secondary_growth [OUT_DIR]`
+//! (`--help` lists the arguments).
 
 use std::fmt::Write as _;
 
+use clap::Parser;
 use polis_roads::RoadClass;
 use polis_roads::geom::{DVec2, Polygon};
 use polis_roads::secondary::{
@@ -79,8 +81,17 @@ fn write(path: &std::path::Path, panels: usize, body: &str) -> std::io::Result<(
     std::fs::write(path, svg)
 }
 
+/// Kelly's neighbourhood presets side by side, and one cell's growth step by step, as SVG.
+#[derive(Debug, Parser)]
+#[command(name = "secondary_growth")]
+struct Args {
+    /// The folder the two SVG files are written to.
+    #[arg(value_name = "OUT_DIR", default_value = ".")]
+    out: std::path::PathBuf,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
+    let Args { out } = Args::parse();
     std::fs::create_dir_all(&out)?;
     let cell = cell();
     let maps = CellMaps::none();
