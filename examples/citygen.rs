@@ -14,7 +14,8 @@
 //! out in their order, largest first, or largest first by the pipeline's estimate); then
 //! grows them `RUNS` times on the thread pool (`--threads`, default all cores), largest
 //! first by that estimate as the pipeline does, and prints wall time and the digest (the
-//! serial one).
+//! serial one); each such run is followed by one in rayon's own splitting of the cells
+//! in halves, for a paired comparison of the two schedules.
 //!
 //! `--city` also generates the whole city (without the 3-D scene) after the road part;
 //! `--city-only` only generates the whole city, scene included (for timing any preset).
@@ -269,41 +270,57 @@ fn growth_bench(
         .collect();
     schedules(&cell_ns, &estimates, pool.current_num_threads());
     // The same growth with the cells spread over the pool's threads (as the pipeline
-    // grows them): wall time, and the digest, which must be the serial one.
+    // grows them): wall time, and the digest, which must be the serial one. Each run is
+    // followed by one with rayon's own splitting of the cells in halves (the pipeline's
+    // schedule before session 19), for a paired comparison of the two schedules.
+    let grow_one = |(cell, p): &(SecondaryCell, polis::roads::secondary::SecondaryParams)| {
+        // One worker per pool thread, as the pipeline keeps.
+        WORKER.with(|w| {
+            let mut slot = w.try_borrow_mut().ok()?;
+            let worker = match slot.as_mut() {
+                Some(w) => {
+                    w.set_params(p.clone()).ok()?;
+                    w
+                }
+                None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
+            };
+            worker
+                .grow(cell, &maps, seed)
+                .ok()
+                .map(|r| graph_digest(&r.network))
+        })
+    };
+    let digest_of = |grown: &[Option<u64>]| {
+        grown
+            .iter()
+            .flatten()
+            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g))
+    };
     for run in 0..runs {
         let t = Instant::now();
+        // Largest first by the pipeline's estimate, as the pipeline schedules them.
         let grown: Vec<Option<u64>> = pool.install(|| {
-            // Largest first by the pipeline's estimate, as the pipeline schedules them.
             polis::geom::par::map_costliest_first(
                 &inputs,
                 |(cell, p)| estimated_work(p, cell.region.area()),
-                |(cell, p)| {
-                    // One worker per pool thread, as the pipeline keeps.
-                    WORKER.with(|w| {
-                        let mut slot = w.try_borrow_mut().ok()?;
-                        let worker = match slot.as_mut() {
-                            Some(w) => {
-                                w.set_params(p.clone()).ok()?;
-                                w
-                            }
-                            None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
-                        };
-                        worker
-                            .grow(cell, &maps, seed)
-                            .ok()
-                            .map(|r| graph_digest(&r.network))
-                    })
-                },
+                grow_one,
             )
         });
         let wall = t.elapsed().as_secs_f64() * 1e3;
-        let digest = grown
-            .iter()
-            .flatten()
-            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g));
         println!(
-            "parallel run {run}: {} threads, digest {digest:016x}, wall {wall:.2} ms",
-            pool.current_num_threads()
+            "parallel run {run}: {} threads, digest {:016x}, wall {wall:.2} ms",
+            pool.current_num_threads(),
+            digest_of(&grown)
+        );
+        let t = Instant::now();
+        let grown: Vec<Option<u64>> = pool.install(|| {
+            use rayon::prelude::*;
+            inputs.par_iter().map(grow_one).collect()
+        });
+        let wall = t.elapsed().as_secs_f64() * 1e3;
+        println!(
+            "  the same in rayon's halves: digest {:016x}, wall {wall:.2} ms",
+            digest_of(&grown)
         );
     }
     Ok(())
