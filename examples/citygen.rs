@@ -11,8 +11,11 @@
 //! buffers kept from cell to cell as each pool thread of the pipeline keeps one) and
 //! prints CPU time and a digest of the grown graphs; then each cell's least time over
 //! those runs, with what the cells would take on the pool's number of idle cores (handed
-//! out in their order, or largest first); then grows them `RUNS` times on the thread pool
-//! (`--threads`, default all cores) and prints wall time and the digest (the serial one).
+//! out in their order, largest first, or largest first by the pipeline's estimate); then
+//! grows them `RUNS` times on the thread pool (`--threads`, default all cores), largest
+//! first by that estimate as the pipeline does, and prints wall time and the digest (the
+//! serial one); each such run is followed by one in rayon's own splitting of the cells
+//! in halves, for a paired comparison of the two schedules.
 //!
 //! `--city` also generates the whole city (without the 3-D scene) after the road part;
 //! `--city-only` only generates the whole city, scene included (for timing any preset).
@@ -187,8 +190,7 @@ fn growth_bench(
     runs: usize,
     pool: &rayon::ThreadPool,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth};
-    use rayon::prelude::*;
+    use polis::roads::secondary::{CellMaps, SecondaryCell, SecondaryGrowth, estimated_work};
     let cg = &cx.config.citygen;
     let cells = polis::cells::extract_with(primary, &cx.config.cells)?;
     let zoning = polis::citygen::zoning_of(cx)?;
@@ -262,41 +264,63 @@ fn growth_bench(
             joins.1
         );
     }
-    schedules(&cell_ns, pool.current_num_threads());
+    let estimates: Vec<f64> = inputs
+        .iter()
+        .map(|(cell, p)| estimated_work(p, cell.region.area()))
+        .collect();
+    schedules(&cell_ns, &estimates, pool.current_num_threads());
     // The same growth with the cells spread over the pool's threads (as the pipeline
-    // grows them): wall time, and the digest, which must be the serial one.
-    for run in 0..runs {
-        let t = Instant::now();
-        let grown: Vec<Option<u64>> = pool.install(|| {
-            inputs
-                .par_iter()
-                .map(|(cell, p)| {
-                    // One worker per pool thread, as the pipeline keeps.
-                    WORKER.with(|w| {
-                        let mut slot = w.try_borrow_mut().ok()?;
-                        let worker = match slot.as_mut() {
-                            Some(w) => {
-                                w.set_params(p.clone()).ok()?;
-                                w
-                            }
-                            None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
-                        };
-                        worker
-                            .grow(cell, &maps, seed)
-                            .ok()
-                            .map(|r| graph_digest(&r.network))
-                    })
-                })
-                .collect()
-        });
-        let wall = t.elapsed().as_secs_f64() * 1e3;
-        let digest = grown
+    // grows them): wall time, and the digest, which must be the serial one. Each run is
+    // followed by one with rayon's own splitting of the cells in halves (the pipeline's
+    // schedule before session 19), for a paired comparison of the two schedules.
+    let grow_one = |(cell, p): &(SecondaryCell, polis::roads::secondary::SecondaryParams)| {
+        // One worker per pool thread, as the pipeline keeps.
+        WORKER.with(|w| {
+            let mut slot = w.try_borrow_mut().ok()?;
+            let worker = match slot.as_mut() {
+                Some(w) => {
+                    w.set_params(p.clone()).ok()?;
+                    w
+                }
+                None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
+            };
+            worker
+                .grow(cell, &maps, seed)
+                .ok()
+                .map(|r| graph_digest(&r.network))
+        })
+    };
+    let digest_of = |grown: &[Option<u64>]| {
+        grown
             .iter()
             .flatten()
-            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g));
+            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g))
+    };
+    for run in 0..runs {
+        let t = Instant::now();
+        // Largest first by the pipeline's estimate, as the pipeline schedules them.
+        let grown: Vec<Option<u64>> = pool.install(|| {
+            polis::geom::par::map_costliest_first(
+                &inputs,
+                |(cell, p)| estimated_work(p, cell.region.area()),
+                grow_one,
+            )
+        });
+        let wall = t.elapsed().as_secs_f64() * 1e3;
         println!(
-            "parallel run {run}: {} threads, digest {digest:016x}, wall {wall:.2} ms",
-            pool.current_num_threads()
+            "parallel run {run}: {} threads, digest {:016x}, wall {wall:.2} ms",
+            pool.current_num_threads(),
+            digest_of(&grown)
+        );
+        let t = Instant::now();
+        let grown: Vec<Option<u64>> = pool.install(|| {
+            use rayon::prelude::*;
+            inputs.par_iter().map(grow_one).collect()
+        });
+        let wall = t.elapsed().as_secs_f64() * 1e3;
+        println!(
+            "  the same in rayon's halves: digest {:016x}, wall {wall:.2} ms",
+            digest_of(&grown)
         );
     }
     Ok(())
@@ -304,9 +328,9 @@ fn growth_bench(
 
 /// Prints the cells' growth times (each cell's least over the serial runs) and what they
 /// would take on `threads` idle cores: the lower bound (the largest cell, or the sum
-/// shared evenly), cells handed out in their order to whichever core is free first, and
-/// largest first.
-fn schedules(cell_ns: &[u64], threads: usize) {
+/// shared evenly), cells handed out to whichever core is free first in their order,
+/// largest first, and largest first by the pipeline's `estimates` (as it runs them).
+fn schedules(cell_ns: &[u64], estimates: &[f64], threads: usize) {
     let threads = threads.max(1);
     let ms = |ns: u64| ns as f64 / 1e6;
     let sum: u64 = cell_ns.iter().sum();
@@ -321,9 +345,17 @@ fn schedules(cell_ns: &[u64], threads: usize) {
         }
         free.into_iter().max().unwrap_or(0)
     };
+    let mut by_estimate: Vec<(f64, usize, u64)> = estimates
+        .iter()
+        .zip(cell_ns)
+        .enumerate()
+        .map(|(i, (&e, &t))| (e, i, t))
+        .collect();
+    by_estimate.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let by_estimate: Vec<u64> = by_estimate.into_iter().map(|(_, _, t)| t).collect();
     let largest = sorted.first().copied().unwrap_or(0);
     println!(
-        "cells: sum of least times {:.2} ms, largest {:.2} ms, next {:.2} / {:.2} / {:.2} ms; on {threads} idle cores: bound {:.2} ms, in order {:.2} ms, largest first {:.2} ms",
+        "cells: sum of least times {:.2} ms, largest {:.2} ms, next {:.2} / {:.2} / {:.2} ms; on {threads} idle cores: bound {:.2} ms, in order {:.2} ms, largest first {:.2} ms, by estimate {:.2} ms",
         ms(sum),
         ms(largest),
         ms(sorted.get(1).copied().unwrap_or(0)),
@@ -332,6 +364,7 @@ fn schedules(cell_ns: &[u64], threads: usize) {
         ms(largest.max(sum.div_ceil(threads as u64))),
         ms(makespan(cell_ns)),
         ms(makespan(&sorted)),
+        ms(makespan(&by_estimate)),
     );
 }
 

@@ -26,11 +26,13 @@ use std::sync::Arc;
 use polis_cells::Cell;
 use polis_geom::graph::SnapOptions;
 use polis_geom::hash::splitmix64;
+use polis_geom::par::map_costliest_first;
 use polis_geom::par::prelude::*;
 use polis_geom::{DVec2, Field};
 use polis_roads::grid_builders::{GridBuilderGrowth, GridError, GridMaps, GridParams};
 use polis_roads::secondary::{
     CellMaps, Neighbourhood, SecondaryCell, SecondaryError, SecondaryGrowth, SecondaryRoads,
+    estimated_work,
 };
 use polis_roads::{Junction, Road, RoadClass, RoadNetwork};
 use serde::{Deserialize, Serialize};
@@ -529,8 +531,16 @@ pub(crate) fn citygen_network_with(
     let ids = cell_ids(&decomposition, &primary, kelly_roads.as_deref());
     let zoning = zoning_of(cx)?;
     let started = crate::clock::Instant::now();
-    type Grown = std::result::Result<(Arc<SecondaryRoads>, District), (Skip, Option<District>)>;
-    let grown: Vec<Result<Grown>> = decomposition
+    /// A cell ready to grow.
+    struct Ready {
+        input: SecondaryCell,
+        district: District,
+        pattern: CellPatternChoice,
+        params: polis_roads::secondary::SecondaryParams,
+        seed: u64,
+    }
+    // Each cell's inputs, pattern and parameters, or the reason it is skipped.
+    let prepared: Vec<std::result::Result<Ready, Skip>> = decomposition
         .cells
         .par_iter()
         .zip(ids.par_iter())
@@ -542,7 +552,7 @@ pub(crate) fn citygen_network_with(
             };
             let region = match cell.polygon_with_holes() {
                 Ok(r) => r,
-                Err(e) => return Ok(Err((skip(format!("cell {id}: {e}")), None))),
+                Err(e) => return Err(skip(format!("cell {id}: {e}"))),
             };
             let settings = cg.cells.iter().find(|s| s.cell == id);
             let chosen = choose_pattern(cx, zoning.as_ref(), &region);
@@ -591,8 +601,45 @@ pub(crate) fn citygen_network_with(
                 params: p.clone(),
                 seed,
             };
+            Ok(Ready {
+                input,
+                district,
+                pattern,
+                params: p,
+                seed,
+            })
+        })
+        .collect();
+    // The growth, largest cells first (by an estimate from their area and parameters),
+    // so that the pool's threads finish together; the results stay in cell order.
+    type Grown = std::result::Result<Arc<SecondaryRoads>, Skip>;
+    let grown: Vec<Result<Grown>> = map_costliest_first(
+        &prepared,
+        |prep| match prep {
+            Ok(r) => estimated_work(&r.params, r.input.region.area()),
+            Err(_) => 0.0,
+        },
+        |prep| {
+            let ready = match prep {
+                Ok(r) => r,
+                // Not grown: `prepared` keeps the reason.
+                Err(s) => return Ok(Err(s.clone())),
+            };
+            let Ready {
+                input,
+                pattern,
+                params: p,
+                seed,
+                ..
+            } = ready;
+            let (id, pattern, seed) = (input.id, *pattern, *seed);
+            let skip = |reason: String| Skip {
+                stage: Stage::Roads,
+                id,
+                reason,
+            };
             let grow = || -> Result<std::result::Result<SecondaryRoads, Skip>> {
-                grow_cell(&input, &maps, pattern, &p, seed, &skip)
+                grow_cell(input, &maps, pattern, p, seed, &skip)
             };
             let roads = match (memo, shared) {
                 (Some(m), Some(shared)) => {
@@ -610,26 +657,24 @@ pub(crate) fn citygen_network_with(
                 }
                 _ => grow()?.map(Arc::new),
             };
-            Ok(match roads {
-                Ok(r) => Ok((r, district)),
-                Err(s) => Err((s, Some(district))),
-            })
-        })
-        .collect();
+            Ok(roads)
+        },
+    );
     let secondary_s = started.elapsed().as_secs_f64();
     let mut cells = Vec::with_capacity(grown.len());
     let mut districts = Vec::with_capacity(grown.len());
     let mut skipped = Vec::new();
     let mut ungrown = Vec::new();
-    for g in grown {
-        match g? {
-            Ok((r, d)) => {
+    for (prep, g) in prepared.into_iter().zip(grown) {
+        match (prep, g?) {
+            (Err(s), _) => skipped.push(s),
+            (Ok(ready), Ok(r)) => {
                 cells.push(r);
-                districts.push(d);
+                districts.push(ready.district);
             }
-            Err((s, d)) => {
+            (Ok(ready), Err(s)) => {
                 skipped.push(s);
-                ungrown.extend(d);
+                ungrown.push(ready.district);
             }
         }
     }

@@ -2,11 +2,12 @@
 //!
 //! Crates that run work in parallel write their loops against this module instead of
 //! against rayon: `use polis_geom::par::prelude::*;` gives `par_iter`, `par_iter_mut`,
-//! `into_par_iter` and `par_extend`, and [`join`], [`run_beside`] and [`install`] cover
-//! the other patterns. With the feature `parallel` (on through the `parallel` feature of
-//! polis-stats, polis-export and the facade, all on by default) they are rayon's; without
-//! it they are plain iterators and sequential calls, so a build without rayon (for
-//! example for wasm32 or a single-threaded embedder) needs no change at any call site.
+//! `into_par_iter` and `par_extend`, and [`join`], [`run_beside`], [`install`] and
+//! [`map_costliest_first`] cover the other patterns. With the feature `parallel` (on
+//! through the `parallel` feature of polis-stats, polis-export and the facade, all on by
+//! default) they are rayon's; without it they are plain iterators and sequential calls,
+//! so a build without rayon (for example for wasm32 or a single-threaded embedder) needs
+//! no change at any call site.
 //!
 //! ## Guarantees
 //!
@@ -90,6 +91,84 @@ where
     {
         let back = background();
         (foreground(), back)
+    }
+}
+
+/// Maps every item by `f` on the thread pool, longest job first: the items are started in
+/// the order of their `cost` estimates, largest first (ties in item order), each by
+/// whichever thread is free next, and the results come back in item order. Serially it
+/// maps them in item order.
+///
+/// With many jobs of uneven size, handing them out largest first leaves only small ones
+/// for the end, so the threads finish together (Graham's longest-processing-time rule:
+/// at most 4/3 of the best possible wall time with exact costs, and close to it when no
+/// job is large); rayon's splitting of the items in halves may leave a large one for
+/// last, with the other threads idle while it runs. The costs are only estimates: a
+/// wrong one costs time, never a different result.
+///
+/// # Limitations
+///
+/// * It waits for every job, and keeps one claiming loop per pool thread busy until the
+///   jobs run out (jobs that call rayon themselves run on the same pool).
+/// * Jobs are claimed one at a time through one shared counter: meant for jobs far
+///   longer than a counter's increment (cells, not pixels).
+///
+/// # Guarantees
+///
+/// * The results are `f`'s, in item order, whatever the costs, the thread count and the
+///   order the jobs ran in: the costs decide only when each job starts.
+/// * `cost` runs once per item, on the calling thread.
+pub fn map_costliest_first<T, R, C, F>(items: &[T], cost: C, f: F) -> Vec<R>
+where
+    T: Sync,
+    R: Send,
+    C: Fn(&T) -> f64,
+    F: Fn(&T) -> R + Sync,
+{
+    #[cfg(feature = "parallel")]
+    {
+        use std::sync::Mutex;
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let costs: Vec<f64> = items.iter().map(cost).collect();
+        let mut order: Vec<usize> = (0..items.len()).collect();
+        order.sort_by(|&a, &b| {
+            let (ca, cb) = (costs.get(a), costs.get(b));
+            cb.zip(ca)
+                .map_or(std::cmp::Ordering::Equal, |(cb, ca)| cb.total_cmp(ca))
+                .then(a.cmp(&b))
+        });
+        let slots: Vec<Mutex<Option<R>>> = items.iter().map(|_| Mutex::new(None)).collect();
+        let next = AtomicUsize::new(0);
+        // One claiming loop per pool thread: each takes the next job in `order` until
+        // none is left.
+        let work = || {
+            while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                if let (Some(item), Some(slot)) = (items.get(i), slots.get(i)) {
+                    let r = f(item);
+                    if let Ok(mut slot) = slot.lock() {
+                        *slot = Some(r);
+                    }
+                }
+            }
+        };
+        let threads = rayon::current_num_threads().min(items.len()).max(1);
+        rayon::scope(|s| {
+            for _ in 1..threads {
+                s.spawn(|_| work());
+            }
+            work();
+        });
+        // Every slot was filled: a job that panicked has propagated its panic out of the
+        // scope above.
+        slots
+            .into_iter()
+            .filter_map(|m| m.into_inner().ok().flatten())
+            .collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let _ = cost;
+        items.iter().map(f).collect()
     }
 }
 
@@ -218,5 +297,27 @@ mod tests {
         let (front, back) = run_beside(|| (0..100u32).sum::<u32>(), || log.push(1));
         assert_eq!((front, back, log), ((), 4950, vec![1]));
         assert_eq!(install(3, || join(|| 2, || 3)), Ok((2, 3)));
+    }
+
+    /// Whatever the costs (ties, NaN, all equal) and the thread count, the results are
+    /// the items' own, in item order.
+    #[test]
+    fn costliest_first_keeps_item_order() {
+        let v: Vec<u64> = (0..300).collect();
+        let want: Vec<u64> = v.iter().map(|x| x * 3 + 1).collect();
+        let costs: [fn(&u64) -> f64; 4] = [
+            |&x| x as f64,
+            |&x| -(x as f64),
+            |&x| ((x * 7919) % 13) as f64,
+            |&x| if x % 5 == 0 { f64::NAN } else { 1.0 },
+        ];
+        for threads in [1, 2, 5] {
+            for cost in costs {
+                let got = install(threads, || map_costliest_first(&v, cost, |x| x * 3 + 1));
+                assert_eq!(got.as_ref(), Ok(&want));
+            }
+        }
+        let none: Vec<u64> = Vec::new();
+        assert!(map_costliest_first(&none, |_| 1.0, |x| *x).is_empty());
     }
 }

@@ -43,7 +43,9 @@ pub mod stats;
 
 pub use cell::{CellMaps, SecondaryCell};
 pub use error::SecondaryError;
-pub use growth::{CellGrowthReport, CellTraits, SecondaryGrowth, SecondaryRoads, grow_cell};
+pub use growth::{
+    CellGrowthReport, CellTraits, SecondaryGrowth, SecondaryRoads, estimated_work, grow_cell,
+};
 pub use params::{BuildingHint, Deviated, SecondaryParams};
 pub use pattern::CellPattern;
 pub use presets::{CITYGEN_UNIT_M, Neighbourhood, NeighbourhoodPreset};
