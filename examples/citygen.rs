@@ -21,11 +21,13 @@
 //! `--city-only` only generates the whole city, scene included (for timing any preset).
 //!
 //! `PRESET` is a built-in preset in the Citygen mode (`citygen`, `suburbia`, `milan`) or a
-//! configuration file (`….json`); default `citygen`.
+//! configuration file (`….json`); default `citygen`. Flags are parsed by clap (`--help`
+//! lists them; `--bench-growth` alone runs 5 times).
 
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use clap::Parser;
 use polis::citygen::citygen_network;
 use polis::roads::RoadClass;
 use polis::roads::secondary::StreetStats;
@@ -35,28 +37,46 @@ use polis::{CityConfig, CityMaps, Pipeline};
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+/// The Citygen road mode step by step, and the secondary growth's benchmark.
+#[derive(Debug, Parser)]
+#[command(name = "citygen")]
+struct Args {
+    /// A built-in preset in the Citygen mode, or a configuration file (`….json`).
+    #[arg(value_name = "PRESET", default_value = "citygen")]
+    preset: String,
+    /// Also generate the whole city (without the 3-D scene) after the road part.
+    #[arg(long)]
+    city: bool,
+    /// Only generate the whole city, scene included (for timing any preset).
+    #[arg(long, conflicts_with = "city")]
+    city_only: bool,
+    /// The buildings' level of detail (default: the configuration's).
+    #[arg(long, value_name = "N")]
+    lod: Option<usize>,
+    /// Threads of the pool (default: every core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
+    /// The folder the SVG is written to.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    out: std::path::PathBuf,
+    /// Time the secondary growth RUNS times serially and on the pool (see above).
+    #[arg(long, value_name = "RUNS", num_args = 0..=1, default_missing_value = "5",
+          value_parser = clap::value_parser!(u32).range(1..))]
+    bench_growth: Option<u32>,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut preset = "citygen".to_string();
-    let mut city = false;
-    let mut city_only = false;
-    let mut lod = None;
-    let mut bench_growth = 0usize;
-    let mut threads = None;
-    let mut out = std::path::PathBuf::from("out");
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--city" => city = true,
-            "--city-only" => city_only = true,
-            "--bench-growth" => {
-                bench_growth = args.next().and_then(|t| t.parse().ok()).unwrap_or(5)
-            }
-            "--lod" => lod = args.next().and_then(|t| t.parse().ok()),
-            "--threads" => threads = args.next().and_then(|t| t.parse().ok()),
-            "--out" => out = args.next().unwrap_or_default().into(),
-            _ => preset = a,
-        }
-    }
+    let Args {
+        preset,
+        city,
+        city_only,
+        lod,
+        threads,
+        out,
+        bench_growth,
+    } = Args::parse();
+    let threads = threads.map(usize::from);
+    let bench_growth = bench_growth.map_or(0, |r| r as usize);
     let mut config = if preset.ends_with(".json") {
         CityConfig::from_path(&preset)?
     } else {
