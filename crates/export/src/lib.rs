@@ -100,6 +100,7 @@ mod images;
 pub mod map;
 #[cfg(feature = "obj")]
 pub mod obj;
+pub mod shared;
 pub mod sink;
 pub mod surfaces;
 #[cfg(feature = "svg")]
@@ -108,6 +109,7 @@ pub mod svg;
 mod text;
 
 pub use error::ExportError;
+pub use shared::SharedScene;
 
 #[cfg(test)]
 mod testing;

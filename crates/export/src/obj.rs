@@ -54,7 +54,8 @@ use polis_geom::par::{self, prelude::*};
 use polis_geom::scene::{Material, Scene};
 
 use crate::ExportError;
-use crate::images::{png_bytes, sanitize};
+use crate::SharedScene;
+use crate::images::sanitize;
 use crate::sink::FileSink;
 use crate::text::{F32Texts, push_u64};
 
@@ -129,7 +130,22 @@ pub fn write_obj<W: Write, S: FileSink>(
     obj: W,
     sink: &mut S,
 ) -> Result<ObjReport, ExportError> {
-    write_obj_in_batches(scene, options, obj, sink, BATCH_VERTICES)
+    write_obj_in_batches(&SharedScene::new(scene), options, obj, sink, BATCH_VERTICES)
+}
+
+/// [`write_obj`] of `shared`'s scene, with the scene's validation and its images' PNG
+/// files taken from `shared` (computed there once for every writer that shares it: see
+/// [`SharedScene`]). Same bytes as [`write_obj`].
+///
+/// # Errors
+/// As [`write_obj`].
+pub fn write_obj_shared<W: Write, S: FileSink>(
+    shared: &SharedScene<'_>,
+    options: &ObjOptions,
+    obj: W,
+    sink: &mut S,
+) -> Result<ObjReport, ExportError> {
+    write_obj_in_batches(shared, options, obj, sink, BATCH_VERTICES)
 }
 
 /// About how many vertices' text [`write_obj`] formats at a time.
@@ -138,13 +154,14 @@ const BATCH_VERTICES: u64 = 1 << 18;
 /// [`write_obj`] with batches of about `batch_vertices` vertices (the tests vary it: the
 /// bytes must not depend on it).
 pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
-    scene: &Scene,
+    shared: &SharedScene<'_>,
     options: &ObjOptions,
     mut obj: W,
     sink: &mut S,
     batch_vertices: u64,
 ) -> Result<ObjReport, ExportError> {
-    scene.validate()?;
+    shared.survey()?;
+    let scene = shared.scene();
     let stem = &options.stem;
     let plain = |name: &str| {
         !name.is_empty()
@@ -217,32 +234,30 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     let mut bytes = header.len() as u64;
     // One node's text appended to `out`, welded in `g` (its arrays reused), with the
     // thread's weld maps and recent number texts.
-    let node_text = |&(i, _): &(usize, u64),
-                     g: &mut NodeGeometry,
-                     scratch: &mut Scratch,
-                     out: &mut Vec<u8>| {
-        let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
-        g.weld(drawn_meshes(i), &world, &mut scratch.weld);
-        let mirror = DMat3::from_mat4(world).determinant() < 0.0;
-        out.reserve(g.text_estimate());
-        out.extend_from_slice(b"g ");
-        out.extend_from_slice(sanitize(&scene.nodes[i].name, "node").as_bytes());
-        out.push(b'_');
-        push_u64(out, i as u64);
-        out.push(b'\n');
-        g.push_vertices(out, &mut scratch.texts);
-        let mut corner = 0;
-        for m in drawn_meshes(i) {
-            out.extend_from_slice(b"usemtl ");
-            match m.material.and_then(|id| material_names.get(id.index())) {
-                Some(name) => out.extend_from_slice(name.as_bytes()),
-                None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
-            }
+    let node_text =
+        |&(i, _): &(usize, u64), g: &mut NodeGeometry, scratch: &mut Scratch, out: &mut Vec<u8>| {
+            let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
+            g.weld(drawn_meshes(i), &world, &mut scratch.weld);
+            let mirror = DMat3::from_mat4(world).determinant() < 0.0;
+            out.reserve(g.text_estimate());
+            out.extend_from_slice(b"g ");
+            out.extend_from_slice(sanitize(&scene.nodes[i].name, "node").as_bytes());
+            out.push(b'_');
+            push_u64(out, i as u64);
             out.push(b'\n');
-            g.push_faces(out, m, corner, mirror);
-            corner += m.vertex_count();
-        }
-    };
+            g.push_vertices(out, &mut scratch.texts);
+            let mut corner = 0;
+            for m in drawn_meshes(i) {
+                out.extend_from_slice(b"usemtl ");
+                match m.material.and_then(|id| material_names.get(id.index())) {
+                    Some(name) => out.extend_from_slice(name.as_bytes()),
+                    None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
+                }
+                out.push(b'\n');
+                g.push_faces(out, m, corner, mirror);
+                corner += m.vertex_count();
+            }
+        };
     // Batches of about 256 Ki vertices (some tens of MiB of text): the next batch is
     // formatted on the thread pool while this thread writes the last one. A batch is cut
     // into pieces of consecutive nodes (1/32 of its vertices), formatted in parallel,
@@ -355,12 +370,16 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
         .map_err(ExportError::io(mtl_name.clone()))?;
     }
     report.materials = scene.materials.len() + usize::from(uses_default);
-    for (i, name) in texture_files.iter().enumerate() {
-        let (Some(name), Some(img)) = (name, scene.images.get(i)) else {
+    // The used images' files, encoded in parallel (or by a writer sharing `shared`).
+    let used: Vec<usize> = (0..texture_files.len())
+        .filter(|&i| texture_files[i].is_some())
+        .collect();
+    let pngs = shared.pngs(&used)?;
+    for (&i, png) in used.iter().zip(pngs) {
+        let Some(name) = &texture_files[i] else {
             continue;
         };
-        let png = png_bytes(i, img)?;
-        sink.write_file(name, &png)
+        sink.write_file(name, png)
             .map_err(ExportError::io(name.clone()))?;
         report.textures += 1;
     }

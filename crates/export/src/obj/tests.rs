@@ -400,7 +400,14 @@ fn batches_and_threads_do_not_change_the_bytes() {
     let options = ObjOptions::default();
     let write = |batch: u64| {
         let (mut obj, mut files) = (Vec::new(), MemorySink::new());
-        let report = write_obj_in_batches(&scene, &options, &mut obj, &mut files, batch).unwrap();
+        let report = write_obj_in_batches(
+            &crate::SharedScene::new(&scene),
+            &options,
+            &mut obj,
+            &mut files,
+            batch,
+        )
+        .unwrap();
         assert_eq!(report.bytes, obj.len() as u64);
         obj
     };
