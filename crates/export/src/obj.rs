@@ -33,9 +33,15 @@
 //!
 //! Numbers are written exactly as Rust's `Display` writes them (shortest round-trip digits,
 //! plain notation), so output is byte-identical for identical scenes, and `f32` values
-//! read back exactly. The text is formatted node by node on rayon's thread pool, a batch
-//! of about 256 Ki vertices at a time while the previous batch is written, and written in
-//! node order: the bytes do not depend on the number of threads.
+//! read back exactly (a value written recently is copied from a small per-thread table of
+//! texts instead of being formatted again). The text is formatted on rayon's thread pool,
+//! a batch of about 256 Ki vertices at a time while the previous batch is written, each
+//! batch in pieces of consecutive nodes cut by vertex count (each piece into one buffer,
+//! the buffers reused batch after batch), and written in node order: the bytes do not
+//! depend on the number of threads.
+//!
+//! [`write_obj_shared`] takes the scene's validation and texture files from a
+//! [`SharedScene`] that a glb writer of the same scene shares.
 //!
 //! ## Limitations
 //!

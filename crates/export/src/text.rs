@@ -6,7 +6,8 @@
 //! from `zmij` (Schubfach), breaks ties the way `core` does, and lays them out in plain
 //! notation. That it matches `core` for every one of the 2³² `f32` bit patterns is checked
 //! by the ignored test `f32_text_matches_display_for_every_f32` (about five minutes on
-//! two cores); a property test samples it on every run.
+//! two cores); a property test samples it on every run. [`F32Texts`] keeps the texts of
+//! recent values for writers that repeat values often.
 
 /// Appends `x` exactly as `format!("{x}")` would: the shortest decimal that reads back to
 /// the same `f32`, in plain notation (`0.000001`, `123456790`, `-0`), a midpoint between
@@ -194,7 +195,10 @@ impl F32Texts {
             return;
         };
         if slot.len != 0 && slot.bits == bits {
-            out.extend_from_slice(slot.text.get(..usize::from(slot.len)).unwrap_or_default());
+            // The whole slot (a copy of fixed size), then cut back to the text.
+            let end = out.len() + usize::from(slot.len);
+            out.extend_from_slice(&slot.text);
+            out.truncate(end);
             return;
         }
         let start = out.len();

@@ -87,9 +87,10 @@
 //! * The scene is validated ([`Scene::validate`]) before anything is written; an invalid
 //!   scene is never written.
 //! * Streaming: the binary chunk is written straight from the scene's meshes through a
-//!   small buffer, never assembled in memory (batched geometry, PNG encodings and the
-//!   tangents of one geometry at a time are the only copies; the web profile holds its
-//!   compressed streams).
+//!   small buffer, never assembled in memory (the per-parent batches, PNG encodings and
+//!   the tangents of one geometry at a time are the only copies: the tiled layout's
+//!   merged geometries are streamed piece by piece from the scene's meshes; the web
+//!   profile holds its compressed streams).
 //! * Byte-identical output for identical scenes and options.
 //! * The container is exactly what [`gltf::binary::Glb::to_writer`] writes for the same
 //!   chunks (tested byte for byte). It is written here rather than by `Glb::to_writer`

@@ -87,9 +87,10 @@ struct Target {
 
 /// The merged geometries of one root, built in two passes: the walk records every
 /// piece in order and counts each (layer, tile, LOD level, material) geometry's vertices
-/// and indices; [`fill`](Self::fill) then allocates every array once at its final size
-/// and copies the pieces in, each read once (no doubling re-copies, no bounds pass over
-/// the merged arrays). The bytes are those of appending the pieces one by one.
+/// and indices; [`fill`](Self::fill) then hands each geometry its pieces (a
+/// [`Gathered`] geometry: the scene's meshes borrowed, the walk's moved in), which the
+/// writer streams piece by piece. No merged array is made (the web profile makes one per
+/// geometry as it encodes it); the bytes are those of appending the pieces one by one.
 #[derive(Default)]
 struct Merge<'a> {
     groups: BTreeMap<GroupKey, BTreeMap<Option<MaterialId>, usize>>,
@@ -108,7 +109,8 @@ fn moved_box(b: Aabb3, t: DVec3) -> Aabb3 {
 }
 
 /// A merged geometry: the mesh (the scene's own when it is the geometry's only piece,
-/// unmoved) and, when any piece has a feature, the feature id of every vertex.
+/// unmoved), else its pieces; and, when any piece has a feature, the feature id of every
+/// vertex.
 type Merged<'a> = (Shape<'a>, Option<FeatureIds>);
 
 /// The merged geometries of one group: (material, geometry, bounds) per material.
