@@ -234,7 +234,7 @@ pub fn write_glb_shared<W: Write>(
             .pngs(&used.images)?
             .into_iter()
             .map(Cow::Borrowed)
-            .collect(),
+            .collect::<Vec<_>>(),
     };
     let mut layout = match options.profile {
         GlbProfile::Plain => layout::plain(scene, &plan, &pngs)?,

@@ -21,6 +21,7 @@ const UV_AREA_TOLERANCE: f32 = 1e-12;
 const TANGENT_TOLERANCE: f32 = 1e-12;
 
 /// One unit tangent with handedness per vertex of `m` (whose normals are unit length).
+#[cfg_attr(not(feature = "web"), allow(dead_code))]
 pub(crate) fn tangents(m: &Mesh) -> Vec<Vec4> {
     tangents_of(&m.positions, &m.normals, &m.uvs, &m.indices)
 }

@@ -412,7 +412,9 @@ fn batches_and_threads_do_not_change_the_bytes() {
         obj
     };
     let reference = reference_obj(&scene, &options.stem);
-    for batch in [1, 5, 64, BATCH_VERTICES] {
+    // Pieces of one node (1, 5, 64), of several nodes each (1,024: 32 vertices a piece),
+    // the whole scene in one piece.
+    for batch in [1, 5, 64, 1024, BATCH_VERTICES] {
         assert_eq!(write(batch), reference, "batch {batch}");
     }
     for threads in [1, 3] {
