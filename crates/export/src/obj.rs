@@ -330,7 +330,6 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
             ready = Vec::new();
         }
     }
-    drop((ready, spare));
     report.vertices = (counts.positions - 1) as usize;
     report.texcoords = (counts.uvs - 1) as usize;
     report.normals = (counts.normals - 1) as usize;
