@@ -287,13 +287,22 @@ impl City {
         out: W,
         profile: glb::GlbProfile,
     ) -> Result<glb::GlbReport> {
-        let options = glb::GlbOptions {
+        Ok(glb::write_glb(
+            &self.scene,
+            &self.glb_options(profile),
+            out,
+        )?)
+    }
+
+    /// The glb options of [`write_glb_with`](Self::write_glb_with).
+    #[cfg(feature = "gltf")]
+    fn glb_options(&self, profile: glb::GlbProfile) -> glb::GlbOptions {
+        glb::GlbOptions {
             batching: self.config.scene.batching,
             tile_size_m: self.config.scene.tile_size_m,
             profile,
             ..glb::GlbOptions::default()
-        };
-        Ok(glb::write_glb(&self.scene, &options, out)?)
+        }
     }
 
     /// Writes the chosen `formats` into `dir` (created if missing): `city.glb`,
@@ -328,7 +337,10 @@ impl City {
             source,
         })?;
         // The files are written at the same time (the OBJ text is also formatted in
-        // parallel); the first error in the order below is returned.
+        // parallel); the first error in the order below is returned. The glb and OBJ
+        // writers validate the scene and encode its textures once between them.
+        #[cfg(any(feature = "gltf", feature = "obj"))]
+        let shared = polis_export::SharedScene::new(&self.scene);
         #[cfg(any(feature = "svg", feature = "geojson"))]
         let maps = || -> Result<Vec<PathBuf>> {
             if !(formats.svg || formats.geojson) {
@@ -376,7 +388,9 @@ impl City {
                 return Ok(Vec::new());
             }
             let path = write_file(dir.join("city.glb"), |w| {
-                self.write_glb_with(w, options.glb_profile).map(|_| ())
+                let glb_options = self.glb_options(options.glb_profile);
+                glb::write_glb_shared(&shared, &glb_options, w)?;
+                Ok(())
             })?;
             Ok(vec![path])
         };
@@ -396,7 +410,7 @@ impl City {
                     stem: "city".into(),
                     texture_dir: crate::output::TEXTURE_DIR.into(),
                 };
-                obj::write_obj(&self.scene, &options, w, &mut sink)?;
+                obj::write_obj_shared(&shared, &options, w, &mut sink)?;
                 Ok(())
             })?;
             // The MTL first, then the textures by name.

@@ -100,6 +100,8 @@ mod images;
 pub mod map;
 #[cfg(feature = "obj")]
 pub mod obj;
+#[cfg(any(feature = "gltf", feature = "obj"))]
+pub mod shared;
 pub mod sink;
 pub mod surfaces;
 #[cfg(feature = "svg")]
@@ -108,6 +110,8 @@ pub mod svg;
 mod text;
 
 pub use error::ExportError;
+#[cfg(any(feature = "gltf", feature = "obj"))]
+pub use shared::SharedScene;
 
 #[cfg(test)]
 mod testing;

@@ -33,9 +33,15 @@
 //!
 //! Numbers are written exactly as Rust's `Display` writes them (shortest round-trip digits,
 //! plain notation), so output is byte-identical for identical scenes, and `f32` values
-//! read back exactly. The text is formatted node by node on rayon's thread pool, a batch
-//! of about 256 Ki vertices at a time while the previous batch is written, and written in
-//! node order: the bytes do not depend on the number of threads.
+//! read back exactly (a value written recently is copied from a small per-thread table of
+//! texts instead of being formatted again). The text is formatted on rayon's thread pool,
+//! a batch of about 256 Ki vertices at a time while the previous batch is written, each
+//! batch in pieces of consecutive nodes cut by vertex count (each piece into one buffer,
+//! the buffers reused batch after batch), and written in node order: the bytes do not
+//! depend on the number of threads.
+//!
+//! [`write_obj_shared`] takes the scene's validation and texture files from a
+//! [`SharedScene`] that a glb writer of the same scene shares.
 //!
 //! ## Limitations
 //!
@@ -54,9 +60,10 @@ use polis_geom::par::{self, prelude::*};
 use polis_geom::scene::{Material, Scene};
 
 use crate::ExportError;
-use crate::images::{png_bytes, sanitize};
+use crate::SharedScene;
+use crate::images::sanitize;
 use crate::sink::FileSink;
-use crate::text::{push_f32, push_u64};
+use crate::text::{F32Texts, push_u64};
 
 /// Options of [`write_obj`].
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -129,7 +136,22 @@ pub fn write_obj<W: Write, S: FileSink>(
     obj: W,
     sink: &mut S,
 ) -> Result<ObjReport, ExportError> {
-    write_obj_in_batches(scene, options, obj, sink, BATCH_VERTICES)
+    write_obj_in_batches(&SharedScene::new(scene), options, obj, sink, BATCH_VERTICES)
+}
+
+/// [`write_obj`] of `shared`'s scene, with the scene's validation and its images' PNG
+/// files taken from `shared` (computed there once for every writer that shares it: see
+/// [`SharedScene`]). Same bytes as [`write_obj`].
+///
+/// # Errors
+/// As [`write_obj`].
+pub fn write_obj_shared<W: Write, S: FileSink>(
+    shared: &SharedScene<'_>,
+    options: &ObjOptions,
+    obj: W,
+    sink: &mut S,
+) -> Result<ObjReport, ExportError> {
+    write_obj_in_batches(shared, options, obj, sink, BATCH_VERTICES)
 }
 
 /// About how many vertices' text [`write_obj`] formats at a time.
@@ -138,13 +160,14 @@ const BATCH_VERTICES: u64 = 1 << 18;
 /// [`write_obj`] with batches of about `batch_vertices` vertices (the tests vary it: the
 /// bytes must not depend on it).
 pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
-    scene: &Scene,
+    shared: &SharedScene<'_>,
     options: &ObjOptions,
     mut obj: W,
     sink: &mut S,
     batch_vertices: u64,
 ) -> Result<ObjReport, ExportError> {
-    scene.validate()?;
+    shared.survey()?;
+    let scene = shared.scene();
     let stem = &options.stem;
     let plain = |name: &str| {
         !name.is_empty()
@@ -215,57 +238,68 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     .map_err(ExportError::io("obj"))?;
     obj.write_all(&header).map_err(ExportError::io("obj"))?;
     let mut bytes = header.len() as u64;
-    let geometry = |&(i, _): &(usize, u64)| -> NodeGeometry {
-        let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
-        NodeGeometry::new(drawn_meshes(i), &world)
-    };
-    let node_text = |&(i, _): &(usize, u64), g: &NodeGeometry| -> Vec<u8> {
-        let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
-        let mirror = DMat3::from_mat4(world).determinant() < 0.0;
-        let mut out = Vec::with_capacity(g.text_estimate());
-        out.extend_from_slice(b"g ");
-        out.extend_from_slice(sanitize(&scene.nodes[i].name, "node").as_bytes());
-        out.push(b'_');
-        push_u64(&mut out, i as u64);
-        out.push(b'\n');
-        g.push_vertices(&mut out);
-        let mut corner = 0;
-        for m in drawn_meshes(i) {
-            out.extend_from_slice(b"usemtl ");
-            match m.material.and_then(|id| material_names.get(id.index())) {
-                Some(name) => out.extend_from_slice(name.as_bytes()),
-                None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
-            }
+    // One node's text appended to `out`, welded in `g` (its arrays reused), with the
+    // thread's weld maps and recent number texts.
+    let node_text =
+        |&(i, _): &(usize, u64), g: &mut NodeGeometry, scratch: &mut Scratch, out: &mut Vec<u8>| {
+            let world = worlds.get(i).copied().unwrap_or(DMat4::IDENTITY);
+            g.weld(drawn_meshes(i), &world, &mut scratch.weld);
+            let mirror = DMat3::from_mat4(world).determinant() < 0.0;
+            out.reserve(g.text_estimate());
+            out.extend_from_slice(b"g ");
+            out.extend_from_slice(sanitize(&scene.nodes[i].name, "node").as_bytes());
+            out.push(b'_');
+            push_u64(out, i as u64);
             out.push(b'\n');
-            g.push_faces(&mut out, m, corner, mirror);
-            corner += m.vertex_count();
-        }
-        out
-    };
+            g.push_vertices(out, &mut scratch.texts);
+            let mut corner = 0;
+            for m in drawn_meshes(i) {
+                out.extend_from_slice(b"usemtl ");
+                match m.material.and_then(|id| material_names.get(id.index())) {
+                    Some(name) => out.extend_from_slice(name.as_bytes()),
+                    None => out.extend_from_slice(DEFAULT_MATERIAL.as_bytes()),
+                }
+                out.push(b'\n');
+                g.push_faces(out, m, corner, mirror);
+                corner += m.vertex_count();
+            }
+        };
     // Batches of about 256 Ki vertices (some tens of MiB of text): the next batch is
-    // formatted on the thread pool while this thread writes the last one. A batch's nodes
-    // are welded and formatted in parallel (a node's text does not depend on the nodes
-    // before it: its faces index relative to its own values); the streams' running
-    // counts are only for the report.
+    // formatted on the thread pool while this thread writes the last one. A batch is cut
+    // into pieces of consecutive nodes (1/32 of its vertices), formatted in parallel,
+    // each into one buffer (a node's text does not depend on the nodes before it: its
+    // faces index relative to its own values). The buffers of the batch written last are
+    // the next batch's, so the text does not take fresh memory batch after batch. The
+    // pieces are cut by vertex counts, not by threads; the streams' running counts are
+    // only for the report.
     let batches = batch_bounds(&drawn, batch_vertices);
-    let format = |range: &std::ops::Range<usize>, start: Counts| -> (Vec<Vec<u8>>, Counts) {
+    let piece_vertices = (batch_vertices / 32).max(1);
+    let format = |range: &std::ops::Range<usize>,
+                  start: Counts,
+                  mut buffers: Vec<Vec<u8>>|
+     -> (Vec<Vec<u8>>, Counts) {
         let nodes = drawn.get(range.clone()).unwrap_or_default();
-        let made: Vec<(Vec<u8>, Counts)> = nodes
+        let pieces = batch_bounds(nodes, piece_vertices);
+        buffers.resize_with(pieces.len(), Vec::new);
+        let counts: Vec<Counts> = pieces
             .par_iter()
-            .map(|node| {
-                let g = geometry(node);
-                (node_text(node, &g), Counts::of(&g))
+            .zip(buffers.par_iter_mut())
+            .map(|(piece, out)| {
+                out.clear();
+                SCRATCH.with_borrow_mut(|scratch| {
+                    let mut g = std::mem::take(&mut scratch.geometry);
+                    let mut counts = Counts::ZERO;
+                    for node in nodes.get(piece.clone()).unwrap_or_default() {
+                        node_text(node, &mut g, scratch, out);
+                        counts = counts.plus(Counts::of(&g));
+                    }
+                    scratch.geometry = g;
+                    counts
+                })
             })
             .collect();
-        let mut next = start;
-        let texts = made
-            .into_iter()
-            .map(|(text, counts)| {
-                next = next.plus(counts);
-                text
-            })
-            .collect();
-        (texts, next)
+        let next = counts.into_iter().fold(start, Counts::plus);
+        (buffers, next)
     };
     let one = Counts {
         positions: 1,
@@ -274,11 +308,12 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     };
     let (mut ready, mut counts) = batches
         .first()
-        .map(|r| format(r, one))
+        .map(|r| format(r, one, Vec::new()))
         .unwrap_or((Vec::new(), one));
+    let mut spare = Vec::new();
     for k in 0..batches.len() {
         let (written, next) = par::run_beside(
-            || batches.get(k + 1).map(|r| format(r, counts)),
+            || batches.get(k + 1).map(|r| format(r, counts, spare)),
             || {
                 ready.iter().try_for_each(|text| {
                     bytes += text.len() as u64;
@@ -288,9 +323,10 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
         );
         written.map_err(ExportError::io("obj"))?;
         if let Some((texts, after)) = next {
-            ready = texts;
+            spare = std::mem::replace(&mut ready, texts);
             counts = after;
         } else {
+            spare = Vec::new();
             ready = Vec::new();
         }
     }
@@ -339,12 +375,16 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
         .map_err(ExportError::io(mtl_name.clone()))?;
     }
     report.materials = scene.materials.len() + usize::from(uses_default);
-    for (i, name) in texture_files.iter().enumerate() {
-        let (Some(name), Some(img)) = (name, scene.images.get(i)) else {
+    // The used images' files, encoded in parallel (or by a writer sharing `shared`).
+    let used: Vec<usize> = (0..texture_files.len())
+        .filter(|&i| texture_files[i].is_some())
+        .collect();
+    let pngs = shared.pngs(&used)?;
+    for (&i, png) in used.iter().zip(pngs) {
+        let Some(name) = &texture_files[i] else {
             continue;
         };
-        let png = png_bytes(i, img)?;
-        sink.write_file(name, &png)
+        sink.write_file(name, png)
             .map_err(ExportError::io(name.clone()))?;
         report.textures += 1;
     }
@@ -413,6 +453,13 @@ struct Counts {
 }
 
 impl Counts {
+    /// No values.
+    const ZERO: Counts = Counts {
+        positions: 0,
+        uvs: 0,
+        normals: 0,
+    };
+
     /// The sum of two counts.
     fn plus(self, other: Counts) -> Counts {
         Counts {
@@ -462,8 +509,17 @@ impl WeldMaps {
     }
 }
 
+/// What a thread keeps between the nodes it formats: the weld maps, the texts of the
+/// numbers it wrote last, and one node's welded arrays (their memory reused).
+#[derive(Default)]
+struct Scratch {
+    weld: WeldMaps,
+    texts: F32Texts,
+    geometry: NodeGeometry,
+}
+
 thread_local! {
-    static WELD: std::cell::RefCell<WeldMaps> = std::cell::RefCell::default();
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
 }
 
 /// One node's geometry in world coordinates, welded: each distinct position, texture
@@ -472,6 +528,7 @@ thread_local! {
 /// indices into them. OBJ indexes the three streams separately: a flat face's corners
 /// share one normal line, and a vertex shared by faces with different normals or texture
 /// coordinates still has one position line.
+#[derive(Default)]
 struct NodeGeometry {
     positions: Vec<Vec3>,
     uvs: Vec<Vec2>,
@@ -481,17 +538,22 @@ struct NodeGeometry {
 }
 
 impl NodeGeometry {
-    /// Welds the meshes of one node whose world matrix is `world`.
-    fn new<'a>(meshes: impl Iterator<Item = &'a Mesh>, world: &DMat4) -> Self {
+    /// Welds the meshes of one node whose world matrix is `world`, in place of what
+    /// `self` held, with the maps `seen`.
+    fn weld<'a>(
+        &mut self,
+        meshes: impl Iterator<Item = &'a Mesh>,
+        world: &DMat4,
+        seen: &mut WeldMaps,
+    ) {
         let identity = *world == DMat4::IDENTITY;
         let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
-        let mut g = NodeGeometry {
-            positions: Vec::new(),
-            uvs: Vec::new(),
-            normals: Vec::new(),
-            corners: Vec::new(),
-        };
-        WELD.with_borrow_mut(|seen| {
+        let g = self;
+        g.positions.clear();
+        g.uvs.clear();
+        g.normals.clear();
+        g.corners.clear();
+        {
             seen.clear();
             for m in meshes {
                 let n = m.vertex_count();
@@ -525,8 +587,7 @@ impl NodeGeometry {
                     g.corners.push([ip, it, inn]);
                 }
             }
-        });
-        g
+        }
     }
 
     /// About how many bytes of text the node takes (vertex lines about 30 bytes a value,
@@ -536,16 +597,16 @@ impl NodeGeometry {
             + self.corners.len() / 3 * 50
     }
 
-    /// Appends the `v`, `vt` and `vn` lines.
-    fn push_vertices(&self, out: &mut Vec<u8>) {
+    /// Appends the `v`, `vt` and `vn` lines (numbers through `texts`).
+    fn push_vertices(&self, out: &mut Vec<u8>, texts: &mut F32Texts) {
         for p in &self.positions {
-            push_vector(out, b"v ", &p.to_array());
+            push_vector(out, b"v ", &p.to_array(), texts);
         }
         for t in &self.uvs {
-            push_vector(out, b"vt ", &t.to_array());
+            push_vector(out, b"vt ", &t.to_array(), texts);
         }
         for n in &self.normals {
-            push_vector(out, b"vn ", &n.to_array());
+            push_vector(out, b"vn ", &n.to_array(), texts);
         }
     }
 
@@ -598,13 +659,13 @@ fn index_of<T: Copy, const N: usize>(
 }
 
 /// Appends `tag`, the components separated by spaces, and a newline.
-fn push_vector(out: &mut Vec<u8>, tag: &[u8], v: &[f32]) {
+fn push_vector(out: &mut Vec<u8>, tag: &[u8], v: &[f32], texts: &mut F32Texts) {
     out.extend_from_slice(tag);
     for (k, &x) in v.iter().enumerate() {
         if k > 0 {
             out.push(b' ');
         }
-        push_f32(out, x);
+        texts.push(out, x);
     }
     out.push(b'\n');
 }

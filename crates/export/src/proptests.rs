@@ -248,7 +248,7 @@ proptest! {
         let reference = crate::obj::tests::reference_obj(&scene, &ObjOptions::default().stem);
         prop_assert_eq!(&obj, &reference);
         let mut small = Vec::new();
-        crate::obj::write_obj_in_batches(&scene, &ObjOptions::default(), &mut small, &mut MemorySink::new(), 3).unwrap();
+        crate::obj::write_obj_in_batches(&crate::SharedScene::new(&scene), &ObjOptions::default(), &mut small, &mut MemorySink::new(), 3).unwrap();
         prop_assert_eq!(&small, &reference);
         if drawn > 0 {
             let (models, _) = crate::obj::tests::load(&obj, &files);

@@ -6,7 +6,8 @@
 //! from `zmij` (Schubfach), breaks ties the way `core` does, and lays them out in plain
 //! notation. That it matches `core` for every one of the 2³² `f32` bit patterns is checked
 //! by the ignored test `f32_text_matches_display_for_every_f32` (about five minutes on
-//! two cores); a property test samples it on every run.
+//! two cores); a property test samples it on every run. [`F32Texts`] keeps the texts of
+//! recent values for writers that repeat values often.
 
 /// Appends `x` exactly as `format!("{x}")` would: the shortest decimal that reads back to
 /// the same `f32`, in plain notation (`0.000001`, `123456790`, `-0`), a midpoint between
@@ -143,7 +144,78 @@ fn strip_zeros(d: &mut u64, q: &mut i32) {
 
 /// Appends `n` in decimal.
 pub(crate) fn push_u64(out: &mut Vec<u8>, n: u64) {
-    out.extend_from_slice(itoa::Buffer::new().format(n).as_bytes());
+    // One and two digits (an OBJ face's relative indices, mostly) without itoa's buffer.
+    if n < 10 {
+        out.push(b'0' + n as u8);
+    } else if n < 100 {
+        out.extend_from_slice(&[b'0' + (n / 10) as u8, b'0' + (n % 10) as u8]);
+    } else {
+        out.extend_from_slice(itoa::Buffer::new().format(n).as_bytes());
+    }
+}
+
+/// The texts of the `f32` values [`push_f32`] wrote last, by their bits: a
+/// direct-mapped table of [`F32Texts::SLOTS`] slots, each holding one value's text (up to
+/// 15 bytes; longer texts are not kept). A text format repeats values often (a city's
+/// storey heights, a facade's texture coordinates, its normals): in `citygen`'s OBJ
+/// about three of five non-whole values are found here instead of being formatted again.
+pub(crate) struct F32Texts {
+    slots: Vec<F32Slot>,
+}
+
+/// One slot of [`F32Texts`]: the bits of a value and its text (`len` 0: empty).
+#[derive(Clone, Copy, Default)]
+struct F32Slot {
+    bits: u32,
+    len: u8,
+    text: [u8; 15],
+}
+
+impl F32Texts {
+    /// log₂ of the number of slots (4,096 slots of 20 bytes: 80 KiB).
+    const SLOT_BITS: u32 = 12;
+    /// The number of slots.
+    pub(crate) const SLOTS: usize = 1 << Self::SLOT_BITS;
+
+    /// An empty table.
+    pub(crate) fn new() -> Self {
+        F32Texts {
+            slots: vec![F32Slot::default(); Self::SLOTS],
+        }
+    }
+
+    /// Appends `x` exactly as [`push_f32`] does, from the table when `x`'s bits are in
+    /// its slot.
+    pub(crate) fn push(&mut self, out: &mut Vec<u8>, x: f32) {
+        let bits = x.to_bits();
+        // Fibonacci hashing: the top bits of the product spread nearby values.
+        let index = (bits.wrapping_mul(0x9e37_79b1) >> (32 - Self::SLOT_BITS)) as usize;
+        let Some(slot) = self.slots.get_mut(index) else {
+            push_f32(out, x);
+            return;
+        };
+        if slot.len != 0 && slot.bits == bits {
+            // The whole slot (a copy of fixed size), then cut back to the text.
+            let end = out.len() + usize::from(slot.len);
+            out.extend_from_slice(&slot.text);
+            out.truncate(end);
+            return;
+        }
+        let start = out.len();
+        push_f32(out, x);
+        let text = out.get(start..).unwrap_or_default();
+        if let Some(room) = slot.text.get_mut(..text.len()) {
+            room.copy_from_slice(text);
+            slot.bits = bits;
+            slot.len = text.len() as u8;
+        }
+    }
+}
+
+impl Default for F32Texts {
+    fn default() -> Self {
+        F32Texts::new()
+    }
 }
 
 /// The exponent after zmij's `e`: an optional sign and decimal digits.
@@ -276,8 +348,56 @@ mod tests {
         }
     }
 
+    /// The table writes what `push_f32` writes, whether the value is in it or not,
+    /// and keeps no stale text when two values share a slot.
+    #[test]
+    fn f32_texts_match_push_f32() {
+        let mut table = F32Texts::new();
+        let mut values: Vec<f32> = (0..20_000u32)
+            .map(|i| f32::from_bits(i.wrapping_mul(2_654_435_761)))
+            .collect();
+        // Repeats, whole numbers, signed zeros, texts longer than a slot, non-finite values.
+        values.extend([0.0, -0.0, 1.0, -1.0, 0.25, 1e-7, -1.234_567_8e-12, f32::MAX]);
+        values.extend([f32::NAN, f32::INFINITY, f32::MIN_POSITIVE, 3.5, 3.5, -0.0]);
+        let again = values.clone();
+        values.extend(again.iter().rev());
+        let (mut ours, mut plain) = (Vec::new(), Vec::new());
+        for &x in &values {
+            table.push(&mut ours, x);
+            ours.push(b' ');
+            push_f32(&mut plain, x);
+            plain.push(b' ');
+        }
+        assert_eq!(ours, plain);
+    }
+
+    /// Values that share a slot, written in turns: each is written as `push_f32` writes
+    /// it (a slot holds the last one only).
+    #[test]
+    fn f32_texts_keep_values_of_one_slot_apart() {
+        let slot = |x: f32| x.to_bits().wrapping_mul(0x9e37_79b1) >> (32 - F32Texts::SLOT_BITS);
+        let first = 1.234_5_f32;
+        let same: Vec<f32> = (1..u32::MAX)
+            .map(|k| f32::from_bits(first.to_bits().wrapping_add(k)))
+            .filter(|&x| slot(x) == slot(first))
+            .take(5)
+            .chain([first])
+            .collect();
+        assert_eq!(same.len(), 6);
+        let mut table = F32Texts::new();
+        for _ in 0..3 {
+            for &x in same.iter().chain(same.iter().rev()) {
+                let (mut ours, mut plain) = (Vec::new(), Vec::new());
+                table.push(&mut ours, x);
+                push_f32(&mut plain, x);
+                assert_eq!(ours, plain, "bits {:#x}", x.to_bits());
+            }
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(20_000))]
+
         #[test]
         fn any_f32_matches_display(bits in any::<u32>()) {
             let x = f32::from_bits(bits);

@@ -4,10 +4,11 @@
 use std::io::Write;
 
 use gltf::json;
-use polis_geom::glam::Vec3;
+use polis_geom::Mesh;
+use polis_geom::glam::{DVec3, Vec3};
 use polis_geom::scene::{Material, MaterialId, Scene};
 
-use super::plan::{FeatureIds, Geometry, Plan};
+use super::plan::{FeatureIds, Geometry, Plan, Shape, moved};
 use super::tangents;
 use crate::ExportError;
 
@@ -326,19 +327,19 @@ pub(crate) fn plain(
             ..ArrayLayout::new(Slot::Position, n, T::Vec3, C::F32, 12)
         });
         arrays.push(ArrayLayout::new(Slot::Normal, n, T::Vec3, C::F32, 12));
-        if writes_uvs(scene, m.material) {
+        if writes_uvs(scene, m.material()) {
             arrays.push(ArrayLayout::new(Slot::Uv, n, T::Vec2, C::F32, 8));
         }
         let wide = n > U16_VERTEX_LIMIT;
         let (ic, isize) = if wide { (C::U32, 4) } else { (C::U16, 2) };
         arrays.push(ArrayLayout::new(
             Slot::Index,
-            m.indices.len(),
+            m.index_count(),
             T::Scalar,
             ic,
             isize,
         ));
-        if writes_tangents(scene, m.material) {
+        if writes_tangents(scene, m.material()) {
             arrays.push(ArrayLayout::new(Slot::Tangent, n, T::Vec4, C::F32, 16));
         }
         if let Some(ids) = &g.features {
@@ -486,15 +487,44 @@ fn vec3_bytes(p: Vec3) -> [u8; 12] {
     b
 }
 
-/// Streams one array of a geometry.
+/// Streams one array of a geometry: a whole mesh's, or a gathered geometry's piece by
+/// piece (the bytes of its merged mesh).
 fn write_array<W: Write>(
     w: &mut Chunked<'_, W>,
     g: &Geometry<'_>,
     a: &ArrayLayout,
 ) -> std::io::Result<()> {
-    let m = &g.mesh;
+    match (&g.mesh, a.slot) {
+        (_, Slot::Feature) => write_features(w, g, a),
+        (Shape::Whole(m), _) => write_piece(w, m, DVec3::ZERO, 0, a),
+        // A piece's tangents depend on its own triangles only, when every piece has
+        // its normals and texture coordinates (else the merged arrays are made).
+        (Shape::Gathered(gathered), Slot::Tangent) if !gathered.aligned() => {
+            write_piece(w, &gathered.to_mesh(), DVec3::ZERO, 0, a)
+        }
+        (Shape::Gathered(gathered), _) => {
+            let mut base = 0u32;
+            for (m, t) in &gathered.pieces {
+                write_piece(w, m, *t, base, a)?;
+                base += m.positions.len() as u32;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Streams array `a` (not the feature ids) of mesh `m` as a piece of a merged geometry:
+/// its positions moved by `t` ([`moved`]), its indices counted from `base`.
+fn write_piece<W: Write>(
+    w: &mut Chunked<'_, W>,
+    m: &Mesh,
+    t: DVec3,
+    base: u32,
+    a: &ArrayLayout,
+) -> std::io::Result<()> {
     match a.slot {
-        Slot::Position => w.put_all(&m.positions, |p| vec3_bytes(*p))?,
+        Slot::Position if t == DVec3::ZERO => w.put_all(&m.positions, |p| vec3_bytes(*p))?,
+        Slot::Position => w.put_all(&m.positions, |&p| vec3_bytes(moved(p, t)))?,
         Slot::Normal => w.put_all(&m.normals, |n| vec3_bytes(n.normalize_or_zero()))?,
         Slot::Uv => w.put_all(&m.uvs, |t| {
             let mut b = [0u8; 8];
@@ -504,44 +534,148 @@ fn write_array<W: Write>(
         })?,
         Slot::Index => {
             if a.component == json::accessor::ComponentType::U32 {
-                w.put_all(&m.indices, |i| i.to_le_bytes())?;
+                w.put_all(&m.indices, |&i| (base + i).to_le_bytes())?;
             } else {
-                w.put_all(&m.indices, |&i| (i as u16).to_le_bytes())?;
+                w.put_all(&m.indices, |&i| ((base + i) as u16).to_le_bytes())?;
             }
         }
-        Slot::Tangent => w.put_all(&tangents::tangents(m), |t| {
-            let mut b = [0u8; 16];
-            for (k, c) in t.to_array().into_iter().enumerate() {
-                b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-            }
-            b
-        })?,
-        Slot::Feature => {
-            let Some(ids) = &g.features else {
-                return Ok(());
+        Slot::Tangent => {
+            let moved_positions: Vec<Vec3>;
+            let positions = if t == DVec3::ZERO {
+                &m.positions
+            } else {
+                moved_positions = m.positions.iter().map(|&p| moved(p, t)).collect();
+                &moved_positions
             };
-            // Each run is one id repeated: its four bytes laid out once in a block,
-            // and the block written as often as the run needs.
-            const BLOCK: usize = 1024;
-            let mut block = [0u8; 4 * BLOCK];
-            for &(n, f) in ids.runs() {
-                let bytes = if a.component == json::accessor::ComponentType::F32 {
-                    (f as f32).to_le_bytes()
-                } else {
-                    let [lo, hi] = (f as u16).to_le_bytes();
-                    [lo, hi, 0, 0]
-                };
-                let mut left = n as usize;
-                for c in block.chunks_exact_mut(4).take(left.min(BLOCK)) {
-                    c.copy_from_slice(&bytes);
+            let all = tangents::tangents_of(positions, &m.normals, &m.uvs, &m.indices);
+            w.put_all(&all, |t| {
+                let mut b = [0u8; 16];
+                for (k, c) in t.to_array().into_iter().enumerate() {
+                    b[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
                 }
-                while left > 0 {
-                    let k = left.min(BLOCK);
-                    w.put(&block[..4 * k])?;
-                    left -= k;
-                }
-            }
+                b
+            })?
+        }
+        Slot::Feature => {}
+    }
+    Ok(())
+}
+
+/// Streams a geometry's feature ids (array `a`), run by run.
+fn write_features<W: Write>(
+    w: &mut Chunked<'_, W>,
+    g: &Geometry<'_>,
+    a: &ArrayLayout,
+) -> std::io::Result<()> {
+    let Some(ids) = &g.features else {
+        return Ok(());
+    };
+    // Each run is one id repeated: its four bytes laid out once in a block,
+    // and the block written as often as the run needs.
+    const BLOCK: usize = 1024;
+    let mut block = [0u8; 4 * BLOCK];
+    for &(n, f) in ids.runs() {
+        let bytes = if a.component == json::accessor::ComponentType::F32 {
+            (f as f32).to_le_bytes()
+        } else {
+            let [lo, hi] = (f as u16).to_le_bytes();
+            [lo, hi, 0, 0]
+        };
+        let mut left = n as usize;
+        for c in block.chunks_exact_mut(4).take(left.min(BLOCK)) {
+            c.copy_from_slice(&bytes);
+        }
+        while left > 0 {
+            let k = left.min(BLOCK);
+            w.put(&block[..4 * k])?;
+            left -= k;
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::glb::plan::Gathered;
+    use polis_geom::glam::Vec2;
+    use proptest::prelude::*;
+    use std::borrow::Cow;
+
+    /// A mesh of `n` vertices (values from `seed`, −0 among them) and `t` triangles;
+    /// without texture coordinates when `uvs` is false.
+    fn piece(seed: u32, n: usize, t: usize, uvs: bool) -> Mesh {
+        let value = |k: usize| {
+            let v = (seed as usize * 31 + k * 17) % 23;
+            if v == 0 { -0.0 } else { v as f32 * 0.37 - 3.0 }
+        };
+        let mut m = Mesh::new(None);
+        for k in 0..n {
+            m.positions
+                .push(Vec3::new(value(3 * k), value(3 * k + 1), value(3 * k + 2)));
+            m.normals
+                .push(Vec3::new(value(k), 1.0, value(k + 5)).normalize_or(Vec3::Y));
+            if uvs {
+                m.uvs.push(Vec2::new(value(k + 7), value(k + 11)));
+            }
+        }
+        for k in 0..t {
+            m.indices
+                .extend([k % n, (k * 7 + 1) % n, (k * 5 + 2) % n].map(|i| i as u32));
+        }
+        m
+    }
+
+    fn bytes(g: &Geometry<'_>, a: &ArrayLayout) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut w = Chunked::new(&mut out);
+        write_array(&mut w, g, a).unwrap();
+        w.finish().unwrap();
+        out
+    }
+
+    proptest! {
+        /// A gathered geometry streams the bytes of its merged mesh, array by array
+        /// (tangents from the merged mesh too when a piece lacks texture coordinates).
+        #[test]
+        fn gathered_pieces_stream_their_merged_arrays(
+            spec in proptest::collection::vec(
+                (0u32..1000, 1usize..20, 0usize..12, 0usize..3, -1e4f64..1e4),
+                1..6,
+            ),
+            missing_uvs in any::<bool>(),
+        ) {
+            let pieces: Vec<(Cow<'_, Mesh>, DVec3)> = spec
+                .iter()
+                .enumerate()
+                .map(|(i, &(seed, n, t, moved, x))| {
+                    let m = piece(seed, n, t, !(missing_uvs && i == 0));
+                    let t = if moved == 0 { DVec3::ZERO } else { DVec3::new(x, -0.5, x * 0.3) };
+                    (Cow::Owned(m), t)
+                })
+                .collect();
+            let gathered = Gathered {
+                material: None,
+                vertices: pieces.iter().map(|(m, _)| m.positions.len()).sum(),
+                indices: pieces.iter().map(|(m, _)| m.indices.len()).sum(),
+                pieces,
+            };
+            let merged = gathered.to_mesh();
+            let n = merged.vertex_count();
+            let g = Geometry { mesh: Shape::Gathered(gathered), features: None, bounds: None };
+            let whole = Geometry { mesh: Shape::Whole(Cow::Borrowed(&merged)), features: None, bounds: None };
+            use json::accessor::{ComponentType as C, Type as T};
+            let arrays = [
+                ArrayLayout::new(Slot::Position, n, T::Vec3, C::F32, 12),
+                ArrayLayout::new(Slot::Normal, n, T::Vec3, C::F32, 12),
+                ArrayLayout::new(Slot::Uv, n, T::Vec2, C::F32, 8),
+                ArrayLayout::new(Slot::Index, merged.indices.len(), T::Scalar, C::U16, 2),
+                ArrayLayout::new(Slot::Index, merged.indices.len(), T::Scalar, C::U32, 4),
+                ArrayLayout::new(Slot::Tangent, n, T::Vec4, C::F32, 16),
+            ];
+            for a in &arrays {
+                prop_assert_eq!(bytes(&g, a), bytes(&whole, a), "{:?}", a.slot);
+            }
+        }
+    }
 }

@@ -87,9 +87,10 @@
 //! * The scene is validated ([`Scene::validate`]) before anything is written; an invalid
 //!   scene is never written.
 //! * Streaming: the binary chunk is written straight from the scene's meshes through a
-//!   small buffer, never assembled in memory (batched geometry, PNG encodings and the
-//!   tangents of one geometry at a time are the only copies; the web profile holds its
-//!   compressed streams).
+//!   small buffer, never assembled in memory (the per-parent batches, PNG encodings and
+//!   the tangents of one geometry at a time are the only copies: the tiled layout's
+//!   merged geometries are streamed piece by piece from the scene's meshes; the web
+//!   profile holds its compressed streams).
 //! * Byte-identical output for identical scenes and options.
 //! * The container is exactly what [`gltf::binary::Glb::to_writer`] writes for the same
 //!   chunks (tested byte for byte). It is written here rather than by `Glb::to_writer`
@@ -128,9 +129,10 @@ use polis_geom::scene::{Filter, Scene, Transform, Wrap};
 use serde::Serialize;
 
 use crate::ExportError;
-use crate::images::png_bytes;
+use crate::SharedScene;
 use layout::{Chunked, Layout, Slot, pad4, write_view};
 use plan::Plan;
+use std::borrow::Cow;
 
 /// What [`write_glb`] wrote.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -190,21 +192,36 @@ pub struct GlbReport {
 pub fn write_glb<W: Write>(
     scene: &Scene,
     options: &GlbOptions,
+    out: W,
+) -> Result<GlbReport, ExportError> {
+    write_glb_shared(&SharedScene::new(scene), options, out)
+}
+
+/// [`write_glb`] of `shared`'s scene, with the scene's validation and its images' PNG
+/// files taken from `shared` (computed there once for every writer that shares it: see
+/// [`SharedScene`]). Same bytes as [`write_glb`].
+///
+/// # Errors
+/// As [`write_glb`].
+pub fn write_glb_shared<W: Write>(
+    shared: &SharedScene<'_>,
+    options: &GlbOptions,
     mut out: W,
 ) -> Result<GlbReport, ExportError> {
     options.validate()?;
+    let scene = shared.scene();
     let mut plan = match options.batching {
         Batching::PerNode => {
-            scene.validate()?;
+            shared.survey()?;
             plan::per_node(scene)
         }
         Batching::PerParentAndMaterial => {
-            scene.validate()?;
+            shared.survey()?;
             plan::batched(scene)?
         }
         // The validating pass also surveys each mesh (its box, whether it is one
         // tile's cut): the tiled plan reads those instead of the meshes.
-        Batching::Tiled => tiles::tiled(scene, &scene.survey()?, options)?,
+        Batching::Tiled => tiles::tiled(scene, shared.survey()?, options)?,
     };
     if options.gpu_instancing && options.batching == Batching::PerNode {
         instancing::instance(scene, &mut plan)?;
@@ -213,11 +230,11 @@ pub fn write_glb<W: Write>(
     let pngs = match options.profile {
         #[cfg(feature = "web")]
         GlbProfile::Web => web::images(scene, &used, options.web_texture_max_px)?,
-        _ => used
-            .images
-            .iter()
-            .map(|&i| png_bytes(i, &scene.images[i]))
-            .collect::<Result<Vec<_>, _>>()?,
+        _ => shared
+            .pngs(&used.images)?
+            .into_iter()
+            .map(Cow::Borrowed)
+            .collect::<Vec<_>>(),
     };
     let mut layout = match options.profile {
         GlbProfile::Plain => layout::plain(scene, &plan, &pngs)?,

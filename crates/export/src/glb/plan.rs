@@ -5,6 +5,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
 
+use polis_geom::glam::{DVec3, Vec3};
 use polis_geom::scene::{MaterialId, MeshId, Metadata, Node, NodeId, Scene};
 use polis_geom::{Aabb3, Mesh};
 
@@ -54,7 +55,7 @@ impl Plan<'_> {
 /// One geometry: a mesh and, in the tiled layout, the feature index of every vertex.
 #[derive(Debug)]
 pub(crate) struct Geometry<'a> {
-    pub mesh: Cow<'a, Mesh>,
+    pub mesh: Shape<'a>,
     /// `_FEATURE_ID_0` per vertex, as runs.
     pub features: Option<FeatureIds>,
     /// The bounds of `mesh`'s positions when the plan already knows them (the tiled
@@ -65,7 +66,7 @@ pub(crate) struct Geometry<'a> {
 impl<'a> Geometry<'a> {
     fn plain(mesh: Cow<'a, Mesh>) -> Self {
         Geometry {
-            mesh,
+            mesh: Shape::Whole(mesh),
             features: None,
             bounds: None,
         }
@@ -73,7 +74,112 @@ impl<'a> Geometry<'a> {
 
     /// The bounding box of the positions.
     pub fn bbox(&self) -> Aabb3 {
-        self.bounds.unwrap_or_else(|| self.mesh.bbox())
+        self.bounds.unwrap_or_else(|| self.mesh.to_mesh().bbox())
+    }
+}
+
+/// A geometry's vertices and triangles: one mesh, or the pieces of a merged geometry (the
+/// tiled layout) laid end to end. The plain writer streams a merged geometry's arrays
+/// straight from its pieces, so no merged copy of the city is made.
+#[derive(Debug)]
+pub(crate) enum Shape<'a> {
+    /// One mesh, as it is.
+    Whole(Cow<'a, Mesh>),
+    /// Pieces laid end to end.
+    Gathered(Gathered<'a>),
+}
+
+/// The pieces of a merged geometry: what appending them one by one to an empty mesh of
+/// `material` gives ([`to_mesh`](Self::to_mesh)), without the copy.
+#[derive(Debug)]
+pub(crate) struct Gathered<'a> {
+    pub material: Option<MaterialId>,
+    /// Positions over all pieces.
+    pub vertices: usize,
+    /// Indices over all pieces.
+    pub indices: usize,
+    /// Each piece's mesh and the translation of its positions: zero, the positions as
+    /// they are (a −0 kept); else each `p + t` in `f64`, rounded to `f32`. Normals,
+    /// texture coordinates are the piece's; its indices count from the vertices of the
+    /// pieces before it.
+    pub pieces: Vec<(Cow<'a, Mesh>, DVec3)>,
+}
+
+impl Gathered<'_> {
+    /// The merged mesh: the pieces appended in order, moved.
+    pub fn to_mesh(&self) -> Mesh {
+        let mut out = Mesh::new(self.material);
+        out.positions.reserve_exact(self.vertices);
+        out.normals.reserve_exact(self.vertices);
+        out.uvs.reserve_exact(self.vertices);
+        out.indices.reserve_exact(self.indices);
+        for (m, t) in &self.pieces {
+            let base = out.positions.len() as u32;
+            out.positions
+                .extend(m.positions.iter().map(|&p| moved(p, *t)));
+            out.normals.extend_from_slice(&m.normals);
+            out.uvs.extend_from_slice(&m.uvs);
+            out.indices.extend(m.indices.iter().map(|&i| base + i));
+        }
+        out
+    }
+
+    /// Whether each piece has a normal and a texture coordinate per position, so arrays
+    /// computed per vertex from its own triangles (tangents) can be computed piece by
+    /// piece.
+    pub fn aligned(&self) -> bool {
+        self.pieces
+            .iter()
+            .all(|(m, _)| m.normals.len() == m.positions.len() && m.uvs.len() == m.positions.len())
+    }
+}
+
+/// `p` moved by `t` as a merged geometry moves it: unchanged for a zero `t` (a −0 kept),
+/// else `p + t` in `f64`, rounded to `f32`.
+pub(crate) fn moved(p: Vec3, t: DVec3) -> Vec3 {
+    if t == DVec3::ZERO {
+        p
+    } else {
+        (p.as_dvec3() + t).as_vec3()
+    }
+}
+
+impl Shape<'_> {
+    /// The mesh's material.
+    pub fn material(&self) -> Option<MaterialId> {
+        match self {
+            Shape::Whole(m) => m.material,
+            Shape::Gathered(g) => g.material,
+        }
+    }
+
+    /// Vertices.
+    pub fn vertex_count(&self) -> usize {
+        match self {
+            Shape::Whole(m) => m.vertex_count(),
+            Shape::Gathered(g) => g.vertices,
+        }
+    }
+
+    /// Indices (three per triangle).
+    pub fn index_count(&self) -> usize {
+        match self {
+            Shape::Whole(m) => m.indices.len(),
+            Shape::Gathered(g) => g.indices,
+        }
+    }
+
+    /// Triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.index_count() / 3
+    }
+
+    /// The mesh: borrowed when whole, merged from the pieces when gathered.
+    pub fn to_mesh(&self) -> Cow<'_, Mesh> {
+        match self {
+            Shape::Whole(m) => Cow::Borrowed(m),
+            Shape::Gathered(g) => Cow::Owned(g.to_mesh()),
+        }
     }
 }
 
@@ -268,7 +374,10 @@ pub(crate) fn per_node(scene: &Scene) -> Plan<'_> {
                 None => {
                     let mesh = &scene.meshes[id.index()];
                     let same = by_content.entry(content_hash(mesh)).or_default();
-                    let g = match same.iter().find(|&&g| *geometries[g].mesh == *mesh) {
+                    let g = match same
+                        .iter()
+                        .find(|&&g| matches!(&geometries[g].mesh, Shape::Whole(w) if **w == *mesh))
+                    {
                         Some(&g) => g,
                         None => {
                             geometries.push(Geometry::plain(Cow::Borrowed(mesh)));
@@ -289,7 +398,7 @@ pub(crate) fn per_node(scene: &Scene) -> Plan<'_> {
         } else {
             let primitives = gs
                 .iter()
-                .map(|&g| (g, geometries[g].mesh.material))
+                .map(|&g| (g, geometries[g].mesh.material()))
                 .collect();
             meshes.push(PlannedMesh {
                 name: node.name.clone(),

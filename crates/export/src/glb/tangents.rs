@@ -12,7 +12,7 @@
 //! any unit vector orthogonal to the normal is used.
 
 use polis_geom::Mesh;
-use polis_geom::glam::{Vec3, Vec4};
+use polis_geom::glam::{Vec2, Vec3, Vec4};
 
 /// Below this |UV-area · 2|, a triangle's texture mapping is degenerate.
 const UV_AREA_TOLERANCE: f32 = 1e-12;
@@ -21,18 +21,29 @@ const UV_AREA_TOLERANCE: f32 = 1e-12;
 const TANGENT_TOLERANCE: f32 = 1e-12;
 
 /// One unit tangent with handedness per vertex of `m` (whose normals are unit length).
+#[cfg_attr(not(feature = "web"), allow(dead_code))]
 pub(crate) fn tangents(m: &Mesh) -> Vec<Vec4> {
-    let n = m.vertex_count();
+    tangents_of(&m.positions, &m.normals, &m.uvs, &m.indices)
+}
+
+/// [`tangents`] of the mesh with these arrays (three indices per triangle).
+pub(crate) fn tangents_of(
+    positions: &[Vec3],
+    normals: &[Vec3],
+    uvs: &[Vec2],
+    indices: &[u32],
+) -> Vec<Vec4> {
+    let n = positions.len();
     let mut tan = vec![Vec3::ZERO; n];
     let mut bit = vec![Vec3::ZERO; n];
-    for [a, b, c] in m.triangles() {
-        let (a, b, c) = (a as usize, b as usize, c as usize);
+    for tri in indices.chunks_exact(3) {
+        let (a, b, c) = (tri[0] as usize, tri[1] as usize, tri[2] as usize);
         let (Some(&pa), Some(&pb), Some(&pc)) =
-            (m.positions.get(a), m.positions.get(b), m.positions.get(c))
+            (positions.get(a), positions.get(b), positions.get(c))
         else {
             continue;
         };
-        let (Some(&ta), Some(&tb), Some(&tc)) = (m.uvs.get(a), m.uvs.get(b), m.uvs.get(c)) else {
+        let (Some(&ta), Some(&tb), Some(&tc)) = (uvs.get(a), uvs.get(b), uvs.get(c)) else {
             continue;
         };
         let (e1, e2) = (pb - pa, pc - pa);
@@ -55,8 +66,7 @@ pub(crate) fn tangents(m: &Mesh) -> Vec<Vec4> {
     }
     (0..n)
         .map(|i| {
-            let normal = m
-                .normals
+            let normal = normals
                 .get(i)
                 .copied()
                 .unwrap_or(Vec3::Y)

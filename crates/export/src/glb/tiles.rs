@@ -40,7 +40,7 @@ use serde_json::value::RawValue;
 use serde_json::{Map, Value, json};
 
 use super::options::{GlbOptions, GlbProfile};
-use super::plan::{FeatureIds, Geometry, Plan, PlannedMesh, PlannedNode};
+use super::plan::{FeatureIds, Gathered, Geometry, Plan, PlannedMesh, PlannedNode, Shape};
 use crate::ExportError;
 
 /// No feature yet (replaced by the table's length once it is known).
@@ -87,9 +87,10 @@ struct Target {
 
 /// The merged geometries of one root, built in two passes: the walk records every
 /// piece in order and counts each (layer, tile, LOD level, material) geometry's vertices
-/// and indices; [`fill`](Self::fill) then allocates every array once at its final size
-/// and copies the pieces in, each read once (no doubling re-copies, no bounds pass over
-/// the merged arrays). The bytes are those of appending the pieces one by one.
+/// and indices; [`fill`](Self::fill) then hands each geometry its pieces (a
+/// [`Gathered`] geometry: the scene's meshes borrowed, the walk's moved in), which the
+/// writer streams piece by piece. No merged array is made (the web profile makes one per
+/// geometry as it encodes it); the bytes are those of appending the pieces one by one.
 #[derive(Default)]
 struct Merge<'a> {
     groups: BTreeMap<GroupKey, BTreeMap<Option<MaterialId>, usize>>,
@@ -108,8 +109,9 @@ fn moved_box(b: Aabb3, t: DVec3) -> Aabb3 {
 }
 
 /// A merged geometry: the mesh (the scene's own when it is the geometry's only piece,
-/// unmoved) and, when any piece has a feature, the feature id of every vertex.
-type Merged<'a> = (Cow<'a, Mesh>, Option<FeatureIds>);
+/// unmoved), else its pieces; and, when any piece has a feature, the feature id of every
+/// vertex.
+type Merged<'a> = (Shape<'a>, Option<FeatureIds>);
 
 /// The merged geometries of one group: (material, geometry, bounds) per material.
 type GroupGeometries<'a> = Vec<(Option<MaterialId>, Merged<'a>, Aabb3)>;
@@ -162,7 +164,9 @@ impl<'a> Merge<'a> {
     }
 
     /// The merged geometries, per group in key order and per material in order, with
-    /// their bounds; a piece without a feature gets `null_id`.
+    /// their bounds; a piece without a feature gets `null_id`. A geometry of several
+    /// pieces (or one moved piece) is [gathered](Shape::Gathered): the pieces are kept,
+    /// not copied, and the writer streams their arrays.
     fn fill(self, null_id: u32) -> Vec<(GroupKey, GroupGeometries<'a>)> {
         let Merge {
             groups,
@@ -178,61 +182,43 @@ impl<'a> Merge<'a> {
             } else {
                 piece.feature
             };
+            let (mesh, t) = match piece.source {
+                Source::Scene(m, t) => (Cow::Borrowed(m), t),
+                Source::Owned(k) => match owned[k].take() {
+                    Some(m) => (Cow::Owned(m), DVec3::ZERO),
+                    None => continue,
+                },
+            };
             let slot = &mut merged[piece.target];
-            // A geometry of one piece is that piece: a mesh the walk made is moved in, a
-            // scene mesh that is not moved is borrowed (copying it would give the same
-            // arrays: its material is the geometry's, its indices start at 0).
-            if spec.pieces == 1 {
-                let whole = match piece.source {
-                    Source::Owned(k) => owned[k].take().map(Cow::Owned),
-                    Source::Scene(m, t) if t == DVec3::ZERO => Some(Cow::Borrowed(m)),
-                    Source::Scene(..) => None,
-                };
-                if let Some(m) = whole {
-                    let ids = spec.featured.then(|| {
-                        let mut ids = FeatureIds::with_capacity(1);
-                        ids.push(feature, m.positions.len());
-                        ids
-                    });
-                    *slot = Some((m, ids));
-                    continue;
-                }
+            // A geometry of one unmoved piece is that piece (a mesh the walk made moved
+            // in, a scene mesh borrowed): its material is the geometry's, its indices
+            // start at 0.
+            if spec.pieces == 1 && t == DVec3::ZERO {
+                let ids = spec.featured.then(|| {
+                    let mut ids = FeatureIds::with_capacity(1);
+                    ids.push(feature, mesh.positions.len());
+                    ids
+                });
+                *slot = Some((Shape::Whole(mesh), ids));
+                continue;
             }
-            let (out, ids) = slot.get_or_insert_with(|| {
-                let mut m = Mesh::new(spec.material);
-                m.positions.reserve_exact(spec.vertices);
-                m.normals.reserve_exact(spec.vertices);
-                m.uvs.reserve_exact(spec.vertices);
-                m.indices.reserve_exact(spec.indices);
+            let (shape, ids) = slot.get_or_insert_with(|| {
                 (
-                    Cow::Owned(m),
+                    Shape::Gathered(Gathered {
+                        material: spec.material,
+                        vertices: spec.vertices,
+                        indices: spec.indices,
+                        pieces: Vec::with_capacity(spec.pieces),
+                    }),
                     spec.featured
                         .then(|| FeatureIds::with_capacity(spec.pieces)),
                 )
             });
-            let out = out.to_mut();
-            let (m, t) = match piece.source {
-                Source::Scene(m, t) => (m, t),
-                Source::Owned(k) => match &owned[k] {
-                    Some(m) => (m, DVec3::ZERO),
-                    None => continue,
-                },
-            };
-            let base = out.positions.len() as u32;
-            if t == DVec3::ZERO {
-                out.positions.extend_from_slice(&m.positions);
-            } else {
-                out.positions
-                    .extend(m.positions.iter().map(|p| (p.as_dvec3() + t).as_vec3()));
-            }
-            out.normals.extend_from_slice(&m.normals);
-            out.uvs.extend_from_slice(&m.uvs);
-            out.indices.extend(m.indices.iter().map(|&i| base + i));
             if let Some(ids) = ids {
-                ids.push(feature, m.positions.len());
+                ids.push(feature, mesh.positions.len());
             }
-            if let Source::Owned(k) = piece.source {
-                owned[k] = None;
+            if let Shape::Gathered(g) = shape {
+                g.pieces.push((mesh, t));
             }
         }
         groups
@@ -840,14 +826,14 @@ mod tests {
             let mut got = BTreeMap::new();
             for (key, geometries) in merge.fill(null_id) {
                 for (material, (mesh, ids), bounds) in geometries {
-                    prop_assert_eq!(mesh.material, material);
+                    prop_assert_eq!(mesh.material(), material);
                     got.insert((key, material), (mesh, ids, bounds));
                 }
             }
             prop_assert_eq!(got.len(), expect.len());
             for (k, (mesh, ids, bounds, count)) in expect {
                 let (g_mesh, g_ids, g_bounds) = &got[&k];
-                prop_assert_eq!(&**g_mesh, &mesh);
+                prop_assert_eq!(&*g_mesh.to_mesh(), &mesh);
                 prop_assert_eq!(g_bounds, &bounds);
                 match g_ids {
                     Some(g) => {
@@ -856,12 +842,11 @@ mod tests {
                     }
                     None => prop_assert!(ids.iter().all(|&f| f == null_id)),
                 }
-                // A lone piece made by the walk is moved in; anything else was copied
-                // into arrays allocated at their final size.
+                // A lone unmoved piece is the geometry's mesh; several pieces are
+                // gathered, not copied.
                 if count > 1 {
-                    prop_assert_eq!(g_mesh.positions.capacity(), g_mesh.positions.len());
-                    prop_assert_eq!(g_mesh.normals.capacity(), g_mesh.normals.len());
-                    prop_assert_eq!(g_mesh.indices.capacity(), g_mesh.indices.len());
+                    let gathered = matches!(g_mesh, Shape::Gathered(g) if g.pieces.len() == count);
+                    prop_assert!(gathered);
                 }
             }
         }

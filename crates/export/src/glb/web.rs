@@ -178,7 +178,8 @@ fn encode(
     grid: Grid,
     ws: &mut Workspace,
 ) -> Result<(GeometryLayout, Vec<Data>), ExportError> {
-    let m = &g.mesh;
+    // A gathered geometry's merged arrays are made here: the codecs reorder them.
+    let m = &*g.mesh.to_mesh();
     // Triangles in vertex-cache order (Forsyth's method, meshoptimizer's), then vertices
     // in first-use order: what the codecs compress best.
     let cached = optimize_vertex_cache(&m.indices, m.vertex_count(), ws).map_err(codec)?;

@@ -400,12 +400,21 @@ fn batches_and_threads_do_not_change_the_bytes() {
     let options = ObjOptions::default();
     let write = |batch: u64| {
         let (mut obj, mut files) = (Vec::new(), MemorySink::new());
-        let report = write_obj_in_batches(&scene, &options, &mut obj, &mut files, batch).unwrap();
+        let report = write_obj_in_batches(
+            &crate::SharedScene::new(&scene),
+            &options,
+            &mut obj,
+            &mut files,
+            batch,
+        )
+        .unwrap();
         assert_eq!(report.bytes, obj.len() as u64);
         obj
     };
     let reference = reference_obj(&scene, &options.stem);
-    for batch in [1, 5, 64, BATCH_VERTICES] {
+    // Pieces of one node (1, 5, 64), of several nodes each (1,024: 32 vertices a piece),
+    // the whole scene in one piece.
+    for batch in [1, 5, 64, 1024, BATCH_VERTICES] {
         assert_eq!(write(batch), reference, "batch {batch}");
     }
     for threads in [1, 3] {
