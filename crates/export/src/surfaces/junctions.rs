@@ -9,15 +9,15 @@
 //! than a half-turn get a miter (or a bevel beyond [`MITER_LIMIT`]), a straight gap a step
 //! between the two borders, a dead end a cap.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
-use polis_geom::hash::point_key as key;
+use polis_geom::hash::{FxBuild, point_key as key};
 use polis_geom::mesh::triangulate;
 use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 
-use super::{EndCap, MITER_LIMIT, RoadSurfaceOptions, RoadSurfaceReport};
+use super::{EndCap, MITER_LIMIT, RoadSurfaceMemo, RoadSurfaceOptions, RoadSurfaceReport};
 use crate::map::MapRoad;
 
 /// The shortest cut of a ribbon end at a junction, in half-widths: keeps the node strictly
@@ -189,10 +189,21 @@ fn classify(c: DVec2, i: &End, j: &End) -> Gap {
     }
 }
 
-/// Builds the plan: segments, trims, cuts and junction polygons.
-pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
+/// Builds the plan: segments, trims, cuts and junction polygons (each ring's triangles
+/// from `memo` where an earlier run triangulated the same ring).
+pub(crate) fn plan(
+    roads: &[MapRoad],
+    o: &RoadSurfaceOptions,
+    mut memo: Option<&mut RoadSurfaceMemo>,
+) -> Plan {
     let mut p = Plan::default();
-    let mut index: BTreeMap<[u64; 2], usize> = BTreeMap::new();
+    // Room for every point and segment (an upper bound); the maps are looked up only,
+    // never iterated, so their order does not reach the plan.
+    let points: usize = roads.iter().map(|r| r.points.len()).sum();
+    p.nodes.reserve(points);
+    p.edges.reserve(points);
+    let mut index: HashMap<[u64; 2], usize, FxBuild> =
+        HashMap::with_capacity_and_hasher(points, FxBuild::default());
     let mut node = |nodes: &mut Vec<PlanNode>, q: DVec2| -> usize {
         *index.entry(key(q)).or_insert_with(|| {
             nodes.push(PlanNode {
@@ -202,7 +213,8 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
             nodes.len() - 1
         })
     };
-    let mut pair: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut pair: HashMap<(usize, usize), usize, FxBuild> =
+        HashMap::with_capacity_and_hasher(points, FxBuild::default());
     for (r, road) in roads.iter().enumerate() {
         let half = road.width_m / 2.0;
         if half.is_nan() || half <= 0.0 {
@@ -320,28 +332,36 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
             _ => junction(c, es, &gaps[v], &mut p.edges, &mut p.report),
         };
         let Some(ring) = ring else { continue };
-        push_junction(&mut p, v, ring);
+        push_junction(&mut p, v, ring, memo.as_deref_mut());
     }
     for cl in &clusters {
         let ring = cluster_junction(&p.nodes, &ends, &gaps, cl, &mut p.edges, &mut p.report);
         if let Some(ring) = ring {
-            push_junction(&mut p, cl.nodes[0], ring);
+            push_junction(&mut p, cl.nodes[0], ring, memo.as_deref_mut());
         }
     }
     p.report.junctions = p.junctions.len();
     p
 }
 
-/// Triangulates a junction ring and keeps it (or counts it as skipped).
-fn push_junction(p: &mut Plan, v: usize, ring: Vec<DVec2>) {
-    let polygon = PolygonWithHoles::new(Polygon::new(ring.clone()), Vec::new());
-    match triangulate(&polygon) {
-        Ok(triangles) if !triangles.is_empty() => p.junctions.push(Junction {
+/// Triangulates a junction ring (or takes its triangles from `memo`) and keeps it, or
+/// counts it as skipped.
+fn push_junction(p: &mut Plan, v: usize, ring: Vec<DVec2>, memo: Option<&mut RoadSurfaceMemo>) {
+    let triangulated = || {
+        let polygon = PolygonWithHoles::new(Polygon::new(ring.clone()), Vec::new());
+        triangulate(&polygon).ok().filter(|t| !t.is_empty())
+    };
+    let triangles = match memo {
+        Some(m) => m.ring_triangles(&ring, triangulated),
+        None => triangulated(),
+    };
+    match triangles {
+        Some(triangles) => p.junctions.push(Junction {
             node: v,
             ring,
             triangles,
         }),
-        _ => p.report.skipped_junctions += 1,
+        None => p.report.skipped_junctions += 1,
     }
 }
 
