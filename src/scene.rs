@@ -459,16 +459,6 @@ pub(crate) trait GroundReuse: Sync {
     fn water_outlines(&self) -> Option<Vec<PolygonWithHoles>>;
     /// Keeps the water map's outlines made in this run.
     fn keep_water_outlines(&self, outlines: &[PolygonWithHoles]);
-    /// The digest of the ground (the terrain's key: the same ground and water bed of
-    /// digest `bed` as an earlier run's is the same field) and the road surfaces' memo,
-    /// locked for this run's road surfaces.
-    fn road_surfaces(
-        &self,
-        bed: Option<crate::editor::key::Key>,
-    ) -> (
-        crate::editor::key::Key,
-        std::sync::MutexGuard<'_, polis_export::surfaces::RoadSurfaceMemo>,
-    );
 }
 
 /// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
@@ -722,22 +712,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         if roads.is_empty() {
             return Ok(None);
         }
-        let options = RoadSurfaceOptions::default();
-        // In an editor, pieces whose inputs an edit left alone come from the last run:
-        // on the terrain's ground (no roads graded into it), keyed as the terrain is.
-        match inp.terrains.filter(|_| inp.cut_in.is_none()) {
-            Some(memo) => {
-                let (ground, mut surfaces) =
-                    memo.road_surfaces(inp.water.map(crate::water::Water::bed_key));
-                Ok(Some(surfaces.parts(
-                    &roads,
-                    elevation,
-                    Some(ground),
-                    &options,
-                )?))
-            }
-            None => Ok(Some(road_surface_parts(&roads, elevation, &options)?)),
-        }
+        Ok(Some(road_surface_parts(
+            &roads,
+            elevation,
+            &RoadSurfaceOptions::default(),
+        )?))
     };
     // Buildings and plinths reach below the ground as far as the terrain may lie below
     // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut, the

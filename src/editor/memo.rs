@@ -202,9 +202,6 @@ pub(crate) struct Memo {
     terrain: Mutex<Option<(Key, TerrainTiles)>>,
     /// The water map's outlines of the last run, by [`Fingerprints::ground`].
     water: Mutex<Option<(Key, Vec<polis_geom::PolygonWithHoles>)>>,
-    /// The road surfaces' pieces of the last run (ribbons, junction plates, junction
-    /// triangulations), each by the digest of what it reads.
-    road_surfaces: Mutex<polis_export::surfaces::RoadSurfaceMemo>,
     /// Road-graph cells' buildings and skins, whole (see [`WholeCell`]).
     whole: Mutex<Store<WholeCell>>,
     /// The number of the current run.
@@ -619,16 +616,6 @@ impl GroundReuse for Memo {
 
     fn keep_water_outlines(&self, outlines: &[polis_geom::PolygonWithHoles]) {
         *lock(&self.water) = Some((self.fingerprints().ground, outlines.to_vec()));
-    }
-
-    fn road_surfaces(
-        &self,
-        bed: Option<Key>,
-    ) -> (Key, MutexGuard<'_, polis_export::surfaces::RoadSurfaceMemo>) {
-        (
-            terrain_key(self.fingerprints().ground, bed),
-            lock(&self.road_surfaces),
-        )
     }
 }
 

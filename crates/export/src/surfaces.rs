@@ -72,11 +72,10 @@
 //!
 //! The footpath strips around blocks are meshed by [`crate::footpaths`].
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 use polis_geom::field::Field;
 use polis_geom::glam::DVec3;
-use polis_geom::hash::{Digest, FxBuild};
 use polis_geom::mesh::to_world;
 use polis_geom::scene::MaterialId;
 use polis_geom::{DVec2, Mesh};
@@ -206,7 +205,7 @@ pub fn road_surfaces_with_report(
 ) -> Result<(Mesh, RoadSurfaceReport), ExportError> {
     check_options(options)?;
     check_roads(roads)?;
-    let plan = junctions::plan(roads, options, None);
+    let plan = junctions::plan(roads, options);
     let drape = Drape::new(roads, &plan, elevation, options)?;
     // Room for everything below (an upper bound: degenerate pieces are skipped), so the
     // one large mesh never grows by doubling.
@@ -277,182 +276,9 @@ pub fn road_surface_parts(
     elevation: &dyn Field,
     options: &RoadSurfaceOptions,
 ) -> Result<RoadSurfaceParts, ExportError> {
-    parts_with(roads, elevation, options, None)
-}
-
-/// Road-surface pieces kept between runs of [`RoadSurfaceMemo::parts`]: the reusable
-/// worker of [`road_surface_parts`] for a network edited a little at a time (the
-/// editable city), whose surfaces differ from the last run's only near the edit.
-///
-/// Each junction ring's triangulation is kept by the ring's exact bits, and each draped
-/// piece (one ribbon, one junction plate or dead-end cap, with its vertices, normals and
-/// texture coordinates) by a [`Digest`] of everything it reads: the road's width, class
-/// and bridge flag, the segment's position along the road, its cuts and trims, the
-/// heights its junctions give its ends, the options, and the caller's digest of the
-/// elevation field. A piece whose digest a run made before is copied instead of made
-/// again, so the surfaces are bit for bit those [`road_surface_parts`] makes (tested);
-/// the plan of the whole network (nodes, cuts, merged junctions) is still made on every
-/// run. After a run the memo keeps only what that run used: memory stays one network's
-/// worth of pieces.
-#[derive(Debug, Default)]
-pub struct RoadSurfaceMemo {
-    /// Triangles of each junction ring (`None`: it has none), by the ring's digest.
-    rings: HashMap<Digest, Kept<Option<Vec<[u32; 3]>>>, FxBuild>,
-    /// Draped pieces (`None`: a junction with no usable triangle after rounding), by the
-    /// digest of their inputs.
-    pieces: HashMap<Digest, Kept<Option<Mesh>>, FxBuild>,
-    /// The number of the current run.
-    run: u64,
-    /// Pieces and rings reused and made by the last run.
-    last: MemoCounts,
-}
-
-/// What one run of [`RoadSurfaceMemo::parts`] reused and made.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-#[non_exhaustive]
-pub struct MemoCounts {
-    /// Draped pieces (ribbons, junction plates) copied from an earlier run.
-    pub pieces_reused: usize,
-    /// Draped pieces made (and kept).
-    pub pieces_made: usize,
-    /// Junction rings whose triangles came from an earlier run.
-    pub rings_reused: usize,
-    /// Junction rings triangulated.
-    pub rings_made: usize,
-}
-
-/// A kept value and the number of the last run that used it.
-#[derive(Debug)]
-struct Kept<T> {
-    value: T,
-    run: u64,
-}
-
-impl RoadSurfaceMemo {
-    /// An empty memo.
-    #[must_use]
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// [`road_surface_parts`] of `roads` on `elevation`, reusing the pieces of earlier
-    /// runs that read the same bits.
-    ///
-    /// `ground` is the caller's digest of `elevation`: equal digests must mean the same
-    /// field (the same height at every point). With `None` the draped pieces are made
-    /// afresh (and not kept); only junction triangulations are reused.
-    ///
-    /// # Errors
-    /// As [`road_surfaces`]; a failed run keeps what it made before failing.
-    pub fn parts(
-        &mut self,
-        roads: &[MapRoad],
-        elevation: &dyn Field,
-        ground: Option<Digest>,
-        options: &RoadSurfaceOptions,
-    ) -> Result<RoadSurfaceParts, ExportError> {
-        self.run += 1;
-        self.last = MemoCounts::default();
-        let out = parts_with(roads, elevation, options, Some((self, ground)));
-        if out.is_ok() {
-            let run = self.run;
-            self.rings.retain(|_, k| k.run == run);
-            self.pieces.retain(|_, k| k.run == run);
-        }
-        out
-    }
-
-    /// What the last run reused and made.
-    #[must_use]
-    pub fn last_run(&self) -> MemoCounts {
-        self.last
-    }
-
-    /// Draped pieces and junction rings kept.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.pieces.len() + self.rings.len()
-    }
-
-    /// Whether nothing is kept.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The triangles of junction ring `ring` (`triangulate` of it, kept by its bits).
-    pub(crate) fn ring_triangles(
-        &mut self,
-        ring: &[DVec2],
-        triangulate: impl FnOnce() -> Option<Vec<[u32; 3]>>,
-    ) -> Option<Vec<[u32; 3]>> {
-        let key = Digest::new(0x7269_6E67).points(ring);
-        let run = self.run;
-        if let Some(k) = self.rings.get_mut(&key) {
-            k.run = run;
-            self.last.rings_reused += 1;
-            return k.value.clone();
-        }
-        let value = triangulate();
-        self.last.rings_made += 1;
-        self.rings.insert(
-            key,
-            Kept {
-                value: value.clone(),
-                run,
-            },
-        );
-        value
-    }
-
-    /// Appends the piece of digest `key` to `mesh`, made by `make` (into an empty mesh)
-    /// unless an earlier run made it; `make`'s `false` (nothing usable) is kept too.
-    fn piece(
-        &mut self,
-        key: Digest,
-        mesh: &mut Mesh,
-        make: impl FnOnce(&mut Mesh) -> Result<bool, ExportError>,
-    ) -> Result<bool, ExportError> {
-        let run = self.run;
-        if let Some(k) = self.pieces.get_mut(&key) {
-            k.run = run;
-            self.last.pieces_reused += 1;
-            return Ok(match &k.value {
-                Some(piece) => {
-                    mesh.append(piece);
-                    true
-                }
-                None => false,
-            });
-        }
-        let mut piece = Mesh::new(None);
-        let made = make(&mut piece)?;
-        mesh.append(&piece);
-        self.last.pieces_made += 1;
-        self.pieces.insert(
-            key,
-            Kept {
-                value: made.then_some(piece),
-                run,
-            },
-        );
-        Ok(made)
-    }
-}
-
-/// The memo of a run and the caller's digest of the elevation field.
-type MemoOf<'m> = Option<(&'m mut RoadSurfaceMemo, Option<Digest>)>;
-
-/// [`road_surface_parts`], with pieces from and for `memo`.
-fn parts_with(
-    roads: &[MapRoad],
-    elevation: &dyn Field,
-    options: &RoadSurfaceOptions,
-    mut memo: MemoOf<'_>,
-) -> Result<RoadSurfaceParts, ExportError> {
     check_options(options)?;
     check_roads(roads)?;
-    let plan = junctions::plan(roads, options, memo.as_mut().map(|(m, _)| &mut **m));
+    let plan = junctions::plan(roads, options);
     let drape = Drape::new(roads, &plan, elevation, options)?;
     // The ribbon groups by (class rank, class, width), each sized before it is filled.
     let mut index: BTreeMap<(u8, &str, u64), usize> = BTreeMap::new();
@@ -494,37 +320,13 @@ fn parts_with(
     for (group, &quads) in groups.iter_mut().zip(&sizes) {
         group.mesh.reserve(4 * quads, 2 * quads);
     }
-    // Pieces are kept only where the caller vouches for the field.
-    let ground = memo.as_ref().and_then(|(_, g)| *g);
     for (e, g) in ribbons {
-        let mesh = &mut groups[g].mesh;
-        match (
-            &mut memo,
-            ground,
-            ribbon_key(roads, e, &drape, options, ground),
-        ) {
-            (Some((m, _)), Some(_), Some(key)) => {
-                m.piece(key, mesh, |piece| {
-                    add_ribbon(piece, roads, e, &drape, options).map(|()| true)
-                })?;
-            }
-            _ => add_ribbon(mesh, roads, e, &drape, options)?,
-        }
+        add_ribbon(&mut groups[g].mesh, roads, e, &drape, options)?;
     }
     let mut junctions = Mesh::with_capacity(None, ring_vertices(&plan), ring_triangles(&plan));
     let mut report = plan.report.clone();
     for j in &plan.junctions {
-        let added = match (&mut memo, ground) {
-            (Some((m, _)), Some(g)) => {
-                let key = Digest::new(0x6A75_6E63)
-                    .key(g)
-                    .points(&j.ring)
-                    .u64(drape.deck[j.node].map_or(u64::MAX, f64::to_bits))
-                    .f64(drape.node_lift[j.node]);
-                m.piece(key, &mut junctions, |piece| add_junction(piece, j, &drape))?
-            }
-            _ => add_junction(&mut junctions, j, &drape)?,
-        };
+        let added = add_junction(&mut junctions, j, &drape)?;
         if !added {
             report.skipped_junctions += 1;
             report.junctions -= 1;
@@ -542,43 +344,6 @@ fn parts_with(
         junctions,
         report,
     })
-}
-
-/// The digest of everything [`add_ribbon`] reads for edge `e` on the ground of digest
-/// `ground`; `None` (made afresh) without a ground digest or for a bridge that follows a
-/// profile.
-fn ribbon_key(
-    roads: &[MapRoad],
-    e: &junctions::PlanEdge,
-    drape: &Drape<'_>,
-    o: &RoadSurfaceOptions,
-    ground: Option<Digest>,
-) -> Option<Digest> {
-    let road = &roads[e.road];
-    if road.profile.is_some() {
-        return None;
-    }
-    let deck = |v: usize| drape.deck[v].map_or(u64::MAX, f64::to_bits);
-    Some(
-        Digest::new(0x7269_6262)
-            .key(ground?)
-            .f64(o.max_segment_m)
-            .f64(o.lift_m)
-            .f64(o.class_lift_m)
-            .f64(road.width_m)
-            .u64(u64::from(road.class.rank()))
-            .u64(u64::from(road.bridge))
-            .f64(e.s_a)
-            .f64(e.len)
-            .f64(e.trim[0])
-            .f64(e.trim[1])
-            .points(&e.cut_a)
-            .points(&e.cut_b)
-            .u64(deck(e.a))
-            .u64(deck(e.b))
-            .f64(drape.node_lift[e.a])
-            .f64(drape.node_lift[e.b]),
-    )
 }
 
 fn check_options(o: &RoadSurfaceOptions) -> Result<(), ExportError> {

@@ -1,13 +1,10 @@
 //! [`splitmix64`]: the stateless 64-bit mix that derives seeds from seeds and ids;
 //! [`point_key`]: an exact key of a point for sorting, hashing and matching;
-//! [`FxHasher`]: a fast deterministic hasher for such keys;
-//! [`Digest`]: a 128-bit digest of the exact bits of a piece of work's inputs, for memos.
+//! [`FxHasher`]: a fast deterministic hasher for such keys.
 
 use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec2;
-
-use crate::polygon::{Polygon, PolygonWithHoles};
 
 /// An exact key for a point: the bit patterns of its coordinates, with −0 and +0 the same
 /// coordinate (adding +0.0 turns −0.0 into +0.0; every other value keeps its bits). Two
@@ -81,107 +78,9 @@ impl Hasher for FxHasher {
 /// [`FxHasher`] as a hash map's `BuildHasher` (`HashMap<K, V, FxBuild>`).
 pub type FxBuild = BuildHasherDefault<FxHasher>;
 
-/// A running 128-bit digest of exact bits (two independent SplitMix64 lanes), the key
-/// of a memo: equal digests mean equal inputs up to a collision chance of about
-/// n² / 2¹²⁹ for n items. Floats enter by their bits (`-0.0` and `0.0` differ, as do
-/// two NaNs of different payloads), so a memo keyed by it hands back only what the
-/// same bits made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct Digest(u64, u64);
-
-impl Digest {
-    /// A digest started with a salt naming what is hashed.
-    #[must_use]
-    pub fn new(salt: u64) -> Self {
-        Digest(splitmix64(salt ^ 0x6B65_795F_6C61_6E31), splitmix64(!salt))
-    }
-
-    /// Mixes one word in.
-    #[must_use]
-    #[inline]
-    pub fn u64(mut self, v: u64) -> Self {
-        self.0 = splitmix64(self.0 ^ v);
-        self.1 = splitmix64(self.1.rotate_left(23) ^ v ^ 0x9E37_79B9_7F4A_7C15);
-        self
-    }
-
-    /// Mixes the bits of a float in.
-    #[must_use]
-    #[inline]
-    pub fn f64(self, v: f64) -> Self {
-        self.u64(v.to_bits())
-    }
-
-    /// Mixes a point in.
-    #[must_use]
-    #[inline]
-    pub fn point(self, p: DVec2) -> Self {
-        self.f64(p.x).f64(p.y)
-    }
-
-    /// Mixes bytes in (length first).
-    #[must_use]
-    pub fn bytes(mut self, b: &[u8]) -> Self {
-        self = self.u64(b.len() as u64);
-        for chunk in b.chunks(8) {
-            let mut w = [0u8; 8];
-            w[..chunk.len()].copy_from_slice(chunk);
-            self = self.u64(u64::from_le_bytes(w));
-        }
-        self
-    }
-
-    /// Mixes points in (count first).
-    #[must_use]
-    pub fn points(mut self, points: &[DVec2]) -> Self {
-        self = self.u64(points.len() as u64);
-        for &p in points {
-            self = self.point(p);
-        }
-        self
-    }
-
-    /// Mixes a ring in (length first).
-    #[must_use]
-    pub fn ring(self, ring: &Polygon) -> Self {
-        self.points(ring.points())
-    }
-
-    /// Mixes a region in (outer ring, then each hole).
-    #[must_use]
-    pub fn region(mut self, r: &PolygonWithHoles) -> Self {
-        self = self.ring(&r.outer).u64(r.holes.len() as u64);
-        for h in &r.holes {
-            self = self.ring(h);
-        }
-        self
-    }
-
-    /// Mixes another digest in.
-    #[must_use]
-    pub fn key(self, k: Digest) -> Self {
-        self.u64(k.0).u64(k.1)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn digests_separate_order_values_and_salts() {
-        let a = Digest::new(1).u64(2).u64(3);
-        assert_eq!(a, Digest::new(1).u64(2).u64(3));
-        assert_ne!(a, Digest::new(1).u64(3).u64(2));
-        assert_ne!(a, Digest::new(2).u64(2).u64(3));
-        assert_ne!(Digest::new(0).f64(0.0), Digest::new(0).f64(-0.0));
-        assert_ne!(Digest::new(0).bytes(b"ab"), Digest::new(0).bytes(b"ab\0"));
-        let ring = [DVec2::ZERO, DVec2::X, DVec2::Y];
-        assert_eq!(
-            Digest::new(0).ring(&Polygon::new(ring.to_vec())),
-            Digest::new(0).points(&ring)
-        );
-    }
 
     #[test]
     fn point_keys_match_exactly_when_points_are_equal() {

@@ -17,7 +17,7 @@ use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
 use polis_geom::{DVec2, Polygon, PolygonWithHoles};
 
-use super::{EndCap, MITER_LIMIT, RoadSurfaceMemo, RoadSurfaceOptions, RoadSurfaceReport};
+use super::{EndCap, MITER_LIMIT, RoadSurfaceOptions, RoadSurfaceReport};
 use crate::map::MapRoad;
 
 /// The shortest cut of a ribbon end at a junction, in half-widths: keeps the node strictly
@@ -189,13 +189,8 @@ fn classify(c: DVec2, i: &End, j: &End) -> Gap {
     }
 }
 
-/// Builds the plan: segments, trims, cuts and junction polygons (each ring's triangles
-/// from `memo` where an earlier run triangulated the same ring).
-pub(crate) fn plan(
-    roads: &[MapRoad],
-    o: &RoadSurfaceOptions,
-    mut memo: Option<&mut RoadSurfaceMemo>,
-) -> Plan {
+/// Builds the plan: segments, trims, cuts and junction polygons.
+pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
     let mut p = Plan::default();
     // Room for every point and segment (an upper bound); the maps are looked up only,
     // never iterated, so their order does not reach the plan.
@@ -332,36 +327,28 @@ pub(crate) fn plan(
             _ => junction(c, es, &gaps[v], &mut p.edges, &mut p.report),
         };
         let Some(ring) = ring else { continue };
-        push_junction(&mut p, v, ring, memo.as_deref_mut());
+        push_junction(&mut p, v, ring);
     }
     for cl in &clusters {
         let ring = cluster_junction(&p.nodes, &ends, &gaps, cl, &mut p.edges, &mut p.report);
         if let Some(ring) = ring {
-            push_junction(&mut p, cl.nodes[0], ring, memo.as_deref_mut());
+            push_junction(&mut p, cl.nodes[0], ring);
         }
     }
     p.report.junctions = p.junctions.len();
     p
 }
 
-/// Triangulates a junction ring (or takes its triangles from `memo`) and keeps it, or
-/// counts it as skipped.
-fn push_junction(p: &mut Plan, v: usize, ring: Vec<DVec2>, memo: Option<&mut RoadSurfaceMemo>) {
-    let triangulated = || {
-        let polygon = PolygonWithHoles::new(Polygon::new(ring.clone()), Vec::new());
-        triangulate(&polygon).ok().filter(|t| !t.is_empty())
-    };
-    let triangles = match memo {
-        Some(m) => m.ring_triangles(&ring, triangulated),
-        None => triangulated(),
-    };
-    match triangles {
-        Some(triangles) => p.junctions.push(Junction {
+/// Triangulates a junction ring and keeps it (or counts it as skipped).
+fn push_junction(p: &mut Plan, v: usize, ring: Vec<DVec2>) {
+    let polygon = PolygonWithHoles::new(Polygon::new(ring.clone()), Vec::new());
+    match triangulate(&polygon) {
+        Ok(triangles) if !triangles.is_empty() => p.junctions.push(Junction {
             node: v,
             ring,
             triangles,
         }),
-        None => p.report.skipped_junctions += 1,
+        _ => p.report.skipped_junctions += 1,
     }
 }
 
@@ -660,22 +647,26 @@ fn find_clusters(p: &Plan, ends: &[Vec<End>]) -> Vec<Cluster> {
         }
     }
     let roots: Vec<usize> = (0..n).map(|v| root(&mut parent, v)).collect();
+    // Only sets of two nodes or more can merge: no group (and no allocation) for the
+    // others. A set's nodes in ascending order (its root, the least, first).
+    let mut size = vec![0u32; n];
+    for &r in &roots {
+        size[r] += 1;
+    }
     let mut groups: BTreeMap<usize, Cluster> = BTreeMap::new();
     for (v, &r) in roots.iter().enumerate() {
-        if r != v || groups.contains_key(&r) {
-            if let Some(g) = groups.get_mut(&r) {
-                g.nodes.push(v);
-            }
+        if size[r] < 2 {
             continue;
         }
-        groups.insert(
-            r,
-            Cluster {
-                nodes: vec![v],
+        groups
+            .entry(r)
+            .or_insert_with(|| Cluster {
+                nodes: Vec::new(),
                 internal: Vec::new(),
                 seq: Vec::new(),
-            },
-        );
+            })
+            .nodes
+            .push(v);
     }
     for (e, edge) in p.edges.iter().enumerate().filter(|(_, e)| !e.dropped) {
         if roots[edge.a] == roots[edge.b]

@@ -288,7 +288,7 @@ fn crossing_t_and_y_have_the_union_area() {
         RoadClass::Street,
         2.0 * h,
     );
-    let p = plan(&[a.clone(), b.clone()], &o, None);
+    let p = plan(&[a.clone(), b.clone()], &o);
     check_plan(&p, 50.0);
     assert_eq!(p.junctions.len(), 1);
     assert!((area(&p.junctions[0].ring) - 64.0).abs() < 1e-9);
@@ -303,7 +303,7 @@ fn crossing_t_and_y_have_the_union_area() {
     ];
     // The through road has no point at the T: it must be split there to meet (planar
     // input). Split it.
-    let p = plan(&t, &o, None);
+    let p = plan(&t, &o);
     assert_eq!(p.junctions.len(), 0, "no shared point, no junction");
     let t = [
         road(
@@ -313,7 +313,7 @@ fn crossing_t_and_y_have_the_union_area() {
         ),
         road(&[(0.0, 0.0), (0.0, 50.0)], RoadClass::Street, 8.0),
     ];
-    let p = plan(&t, &o, None);
+    let p = plan(&t, &o);
     check_plan(&p, 50.0);
     assert_eq!(p.junctions.len(), 1);
     assert!((total_area(&pieces(&p)) - (800.0 + 46.0 * 8.0)).abs() < 1e-9);
@@ -326,7 +326,7 @@ fn crossing_t_and_y_have_the_union_area() {
         .iter()
         .map(|d| MapRoad::new(vec![DVec2::ZERO, *d], RoadClass::Street, 2.0 * h))
         .collect();
-    let p = plan(&y, &o, None);
+    let p = plan(&y, &o);
     check_plan(&p, 50.0);
     let want = 6.0 * h * 50.0 - 3f64.sqrt() * h * h;
     assert!((total_area(&pieces(&p)) - want).abs() < 1e-9);
@@ -341,7 +341,7 @@ fn every_cut_lies_on_its_junction() {
         road(&[(0.0, 0.0), (-30.0, -2.0)], RoadClass::Street, 8.0),
         road(&[(0.0, 0.0), (3.0, -40.0)], RoadClass::Footpath, 2.0),
     ];
-    let p = plan(&roads, &flat(), None);
+    let p = plan(&roads, &flat());
     check_plan(&p, 40.0);
     let j = &p.junctions[0];
     for e in &p.edges {
@@ -381,7 +381,7 @@ fn bends_wide_meets_narrow_and_near_parallel_roads() {
                     road(&[(-1000.0, 0.0), (0.0, 0.0)], RoadClass::Street, w0),
                     MapRoad::new(vec![DVec2::ZERO, far], RoadClass::Street, w1),
                 ];
-                let p = plan(&roads, &o, None);
+                let p = plan(&roads, &o);
                 assert_eq!(p.report.clamped_segments, 0, "{deg}° {w0}/{w1}");
                 assert_eq!(p.report.approximated_junctions, 0, "{deg}° {w0}/{w1}");
                 check_plan(&p, 10.0);
@@ -396,7 +396,7 @@ fn bends_wide_meets_narrow_and_near_parallel_roads() {
         road(&[(0.0, 0.0), (-70.0, 70.0)], RoadClass::Street, 4.0),
         road(&[(0.0, 0.0), (-70.0, -70.0)], RoadClass::Street, 4.0),
     ];
-    let p = plan(&roads, &o, None);
+    let p = plan(&roads, &o);
     check_plan(&p, 30.0);
     assert_eq!(p.report.approximated_junctions, 0);
     // Near-parallel roads (0.5°) that are long enough: a long thin junction.
@@ -409,7 +409,7 @@ fn bends_wide_meets_narrow_and_near_parallel_roads() {
             6.0,
         ),
     ];
-    let p = plan(&roads, &o, None);
+    let p = plan(&roads, &o);
     assert_eq!(p.report.clamped_segments, 0);
     check_plan(&p, 10.0);
     let trim = p.edges[0].trim[0];
@@ -455,7 +455,7 @@ fn short_segments_overlapping_roads_and_caps() {
             end_cap: cap,
             ..flat()
         };
-        let p = plan(&one, &o, None);
+        let p = plan(&one, &o);
         check_plan(&p, 30.0);
         assert!(
             (total_area(&pieces(&p)) - (120.0 + extra)).abs() < 1e-9,
@@ -481,7 +481,7 @@ fn close_junctions_merge_into_one_polygon() {
         MapRoad::new(vec![a, v(1.0, -70.0)], RoadClass::Street, 8.0),
         MapRoad::new(vec![b, v(3.0, 75.0)], RoadClass::Street, 8.0),
     ];
-    let p = plan(&roads, &o, None);
+    let p = plan(&roads, &o);
     assert_eq!(p.report.merged_junctions, 1, "{:?}", p.report);
     assert_eq!(p.report.approximated_junctions, 0);
     assert_eq!(p.report.clamped_segments, 0);
@@ -513,7 +513,7 @@ fn close_junctions_merge_into_one_polygon() {
         MapRoad::new(vec![v(0.0, 0.0), v(60.0, -5.0)], RoadClass::Street, 7.0),
         MapRoad::new(vec![v(0.0, 0.0), v(-60.0, -5.0)], RoadClass::Street, 7.0),
     ];
-    let p = plan(&roads, &o, None);
+    let p = plan(&roads, &o);
     assert_eq!(p.report.merged_junctions, 1, "{:?}", p.report);
     assert_eq!(p.report.approximated_junctions, 0);
     check_plan(&p, 10.0);
@@ -660,7 +660,7 @@ proptest! {
             })
             .collect();
         let o = RoadSurfaceOptions { end_cap: cap, ..flat() };
-        let p = plan(&roads, &o, None);
+        let p = plan(&roads, &o);
         prop_assert_eq!(p.report.clamped_segments, 0);
         prop_assert_eq!(p.report.approximated_junctions, 0);
         prop_assert_eq!(p.report.skipped_junctions, 0);
@@ -772,119 +772,5 @@ fn parts_split_the_same_surface_into_ribbon_groups_and_junction_plates() {
     for (p, uv) in parts.junctions.positions.iter().zip(&parts.junctions.uvs) {
         // World (x, y, z) = layout (x, h, −y): uv = (x, −y) = (world x, world z).
         assert!((uv.x - p.x).abs() < 1e-3 && (uv.y - p.z).abs() < 1e-3);
-    }
-}
-
-/// The exact bits of a mesh: positions, normals, texture coordinates, indices.
-fn mesh_bits(m: &Mesh) -> Vec<u32> {
-    let mut out: Vec<u32> = Vec::new();
-    out.extend(
-        m.positions
-            .iter()
-            .flat_map(|p| p.to_array().map(f32::to_bits)),
-    );
-    out.extend(
-        m.normals
-            .iter()
-            .flat_map(|p| p.to_array().map(f32::to_bits)),
-    );
-    out.extend(m.uvs.iter().flat_map(|p| p.to_array().map(f32::to_bits)));
-    out.extend(&m.indices);
-    out
-}
-
-/// The exact bits of road surface parts.
-fn parts_bits(p: &RoadSurfaceParts) -> (Vec<(String, u64, Vec<u32>)>, Vec<u32>, RoadSurfaceReport) {
-    (
-        p.ribbons
-            .iter()
-            .map(|g| {
-                (
-                    g.class.as_str().to_string(),
-                    g.width_m.to_bits(),
-                    mesh_bits(&g.mesh),
-                )
-            })
-            .collect(),
-        mesh_bits(&p.junctions),
-        p.report.clone(),
-    )
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
-
-    /// A memo's parts are bit for bit `road_surface_parts` of the same roads, run after
-    /// run while roads are moved, widened and removed (bridges, classes and merged or
-    /// clamped junctions included); a run of the same roads on the same ground reuses
-    /// every piece.
-    #[test]
-    fn memo_parts_equal_fresh_parts_run_after_run(
-        segs in lattice_segments(),
-        widths in prop::collection::vec(prop_oneof![0.5..4.0f64, 4.0..30.0f64], 64),
-        flags in prop::collection::vec((prop::bool::weighted(0.15), 0u8..5), 64),
-        edits in prop::collection::vec((0usize..64, 0u8..3, -3i32..4, -3i32..4), 1..6),
-    ) {
-        let segs = graph_roads(&segs, 10.0);
-        let class = |k: u8| match k {
-            0 => RoadClass::Highway,
-            1 => RoadClass::Major,
-            2 => RoadClass::Street,
-            3 => RoadClass::Footpath,
-            _ => RoadClass::Other("lane".into()),
-        };
-        let mut roads: Vec<MapRoad> = segs
-            .iter()
-            .enumerate()
-            .map(|(i, &(a, b))| MapRoad {
-                bridge: flags[i % 64].0,
-                ..MapRoad::new(vec![a, b], class(flags[i % 64].1), widths[i % 64])
-            })
-            .collect();
-        let ground = FnField::new(|q: DVec2| 0.05 * q.y + (q.x / 17.0).sin());
-        let key = Some(polis_geom::hash::Digest::new(7));
-        let o = RoadSurfaceOptions::default();
-        let mut memo = RoadSurfaceMemo::new();
-        let first = memo.parts(&roads, &ground, key, &o).unwrap();
-        prop_assert_eq!(parts_bits(&first), parts_bits(&road_surface_parts(&roads, &ground, &o).unwrap()));
-        let again = memo.parts(&roads, &ground, key, &o).unwrap();
-        prop_assert_eq!(parts_bits(&again), parts_bits(&first));
-        prop_assert_eq!(memo.last_run().pieces_made, 0);
-        prop_assert_eq!(memo.last_run().rings_made, 0);
-        for (r, kind, dx, dy) in edits {
-            if roads.is_empty() {
-                break;
-            }
-            let r = r % roads.len();
-            match kind {
-                0 => {
-                    // Move an end point (and every road end on it, as a graph edit would).
-                    let at = roads[r].points[0];
-                    let to = at + v(f64::from(dx), f64::from(dy)) * 1.5;
-                    for road in &mut roads {
-                        for p in &mut road.points {
-                            if *p == at {
-                                *p = to;
-                            }
-                        }
-                    }
-                }
-                1 => roads[r].width_m = widths[(r + 7) % 64] * 0.5,
-                _ => {
-                    roads.remove(r);
-                }
-            }
-            let fresh = road_surface_parts(&roads, &ground, &o);
-            let kept = memo.parts(&roads, &ground, key, &o);
-            match (fresh, kept) {
-                (Ok(f), Ok(k)) => prop_assert_eq!(parts_bits(&k), parts_bits(&f)),
-                (f, k) => prop_assert_eq!(f.is_err(), k.is_err()),
-            }
-        }
-        // Without a digest of the ground nothing draped is kept.
-        let mut bare = RoadSurfaceMemo::new();
-        let plain = bare.parts(&roads, &ground, None, &o).unwrap();
-        prop_assert_eq!(parts_bits(&plain), parts_bits(&road_surface_parts(&roads, &ground, &o).unwrap()));
-        prop_assert_eq!(bare.last_run().pieces_made + bare.last_run().pieces_reused, 0);
     }
 }
