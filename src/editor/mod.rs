@@ -84,7 +84,9 @@
 //!   still runs the pipeline: it builds the union graph and its cell decomposition whole
 //!   (their inputs are the whole city), looks up every road-graph cell's lots in the
 //!   memo and copies them out (a cell whose inputs are unchanged then takes its
-//!   buildings and skins whole, in one look-up), meshes the road surfaces again, assembles
+//!   buildings and skins whole, in one look-up), meshes the road surfaces again (a memo
+//!   of their pieces was measured to save nothing: their cost is the plan of the whole
+//!   network and the pass that writes its meshes, not the pieces), assembles
 //!   the scene again (reused leaves, matched to the old ones by position, take their
 //!   meshes, names and metadata from the old scene without copying them; the terrain is
 //!   reused while the water bed under it is unchanged, the water map's outlines while

@@ -20,7 +20,7 @@ use polis_export::footpaths::{FootpathOptions, footpath_meshes};
 use polis_export::geom::field::FnField;
 use polis_export::geom::{DVec2, Polygon, PolygonWithHoles};
 use polis_export::map::{MapRoad, RoadClass};
-use polis_export::surfaces::{RoadSurfaceOptions, road_surfaces_with_report};
+use polis_export::surfaces::{RoadSurfaceOptions, road_surface_parts, road_surfaces_with_report};
 
 fn main() {
     let (mesh, report) =
@@ -131,6 +131,13 @@ fn road_surfaces_15k(b: Bencher<'_, '_>) {
     b.counter(ItemsCount::new(ROADS.len())).bench(|| {
         road_surfaces_with_report(&ROADS, &field, &RoadSurfaceOptions::default(), None).unwrap()
     });
+}
+
+#[divan::bench(sample_count = 10)]
+fn road_surface_parts_15k(b: Bencher<'_, '_>) {
+    let field = terrain();
+    b.counter(ItemsCount::new(ROADS.len()))
+        .bench(|| road_surface_parts(&ROADS, &field, &RoadSurfaceOptions::default()).unwrap());
 }
 
 #[divan::bench(sample_count = 10)]

@@ -72,6 +72,8 @@
 //!
 //! The footpath strips around blocks are meshed by [`crate::footpaths`].
 
+use std::collections::BTreeMap;
+
 use polis_geom::field::Field;
 use polis_geom::glam::DVec3;
 use polis_geom::mesh::to_world;
@@ -211,13 +213,8 @@ pub fn road_surfaces_with_report(
     let pieces: usize = ribbons().map(|e| ribbon_pieces(e, options)).sum();
     let mut mesh = Mesh::with_capacity(
         material,
-        4 * pieces + plan.junctions.iter().map(|j| j.ring.len()).sum::<usize>(),
-        2 * pieces
-            + plan
-                .junctions
-                .iter()
-                .map(|j| j.triangles.len())
-                .sum::<usize>(),
+        4 * pieces + ring_vertices(&plan),
+        2 * pieces + ring_triangles(&plan),
     );
     for e in ribbons() {
         add_ribbon(&mut mesh, roads, e, &drape, options)?;
@@ -230,6 +227,16 @@ pub fn road_surfaces_with_report(
         }
     }
     Ok((mesh, report))
+}
+
+/// Vertices of every junction ring of `plan`.
+fn ring_vertices(plan: &junctions::Plan) -> usize {
+    plan.junctions.iter().map(|j| j.ring.len()).sum()
+}
+
+/// Triangles of every junction of `plan`.
+fn ring_triangles(plan: &junctions::Plan) -> usize {
+    plan.junctions.iter().map(|j| j.triangles.len()).sum()
 }
 
 /// The ribbons of one road class and width (see [`RoadSurfaceParts`]).
@@ -273,35 +280,67 @@ pub fn road_surface_parts(
     check_roads(roads)?;
     let plan = junctions::plan(roads, options);
     let drape = Drape::new(roads, &plan, elevation, options)?;
-    let mut groups: std::collections::BTreeMap<(u8, String, u64), RibbonGroup> =
-        std::collections::BTreeMap::new();
-    for e in plan.edges.iter().filter(|e| !e.dropped && !e.internal) {
-        let road = &roads[e.road];
-        let key = (
-            road.class.rank(),
-            road.class.as_str().to_string(),
-            road.width_m.to_bits(),
-        );
-        let group = groups.entry(key).or_insert_with(|| RibbonGroup {
-            class: road.class.clone(),
-            width_m: road.width_m,
-            mesh: Mesh::new(None),
-        });
-        add_ribbon(&mut group.mesh, roads, e, &drape, options)?;
+    // The ribbon groups by (class rank, class, width), each sized before it is filled.
+    let mut index: BTreeMap<(u8, &str, u64), usize> = BTreeMap::new();
+    let mut groups: Vec<RibbonGroup> = Vec::new();
+    let mut sizes: Vec<usize> = Vec::new();
+    let mut last: Option<(usize, usize)> = None;
+    let ribbons: Vec<(&junctions::PlanEdge, usize)> = plan
+        .edges
+        .iter()
+        .filter(|e| !e.dropped && !e.internal)
+        .map(|e| {
+            // A road's segments are consecutive: its group is looked up once.
+            let g = match last {
+                Some((r, g)) if r == e.road => g,
+                _ => {
+                    let road = &roads[e.road];
+                    let key = (
+                        road.class.rank(),
+                        road.class.as_str(),
+                        road.width_m.to_bits(),
+                    );
+                    let g = *index.entry(key).or_insert_with(|| {
+                        groups.push(RibbonGroup {
+                            class: road.class.clone(),
+                            width_m: road.width_m,
+                            mesh: Mesh::new(None),
+                        });
+                        sizes.push(0);
+                        groups.len() - 1
+                    });
+                    last = Some((e.road, g));
+                    g
+                }
+            };
+            sizes[g] += ribbon_pieces(e, options);
+            (e, g)
+        })
+        .collect();
+    for (group, &quads) in groups.iter_mut().zip(&sizes) {
+        group.mesh.reserve(4 * quads, 2 * quads);
     }
-    let mut junctions = Mesh::new(None);
+    for (e, g) in ribbons {
+        add_ribbon(&mut groups[g].mesh, roads, e, &drape, options)?;
+    }
+    let mut junctions = Mesh::with_capacity(None, ring_vertices(&plan), ring_triangles(&plan));
     let mut report = plan.report.clone();
     for j in &plan.junctions {
-        if !add_junction(&mut junctions, j, &drape)? {
+        let added = add_junction(&mut junctions, j, &drape)?;
+        if !added {
             report.skipped_junctions += 1;
             report.junctions -= 1;
         }
     }
+    let mut ribbons: Vec<RibbonGroup> = Vec::with_capacity(groups.len());
+    let mut groups: Vec<Option<RibbonGroup>> = groups.into_iter().map(Some).collect();
+    for &g in index.values() {
+        if let Some(group) = groups[g].take().filter(|g| g.mesh.triangle_count() > 0) {
+            ribbons.push(group);
+        }
+    }
     Ok(RoadSurfaceParts {
-        ribbons: groups
-            .into_values()
-            .filter(|g| g.mesh.triangle_count() > 0)
-            .collect(),
+        ribbons,
         junctions,
         report,
     })

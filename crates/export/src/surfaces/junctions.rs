@@ -9,9 +9,9 @@
 //! than a half-turn get a miter (or a bevel beyond [`MITER_LIMIT`]), a straight gap a step
 //! between the two borders, a dead end a cap.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
-use polis_geom::hash::point_key as key;
+use polis_geom::hash::{FxBuild, point_key as key};
 use polis_geom::mesh::triangulate;
 use polis_geom::polygon::ring_signed_area;
 use polis_geom::predicates::{AngleStart, Orientation, ccw_cmp, orient2d, orient2d_value};
@@ -192,7 +192,13 @@ fn classify(c: DVec2, i: &End, j: &End) -> Gap {
 /// Builds the plan: segments, trims, cuts and junction polygons.
 pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
     let mut p = Plan::default();
-    let mut index: BTreeMap<[u64; 2], usize> = BTreeMap::new();
+    // Room for every point and segment (an upper bound); the maps are looked up only,
+    // never iterated, so their order does not reach the plan.
+    let points: usize = roads.iter().map(|r| r.points.len()).sum();
+    p.nodes.reserve(points);
+    p.edges.reserve(points);
+    let mut index: HashMap<[u64; 2], usize, FxBuild> =
+        HashMap::with_capacity_and_hasher(points, FxBuild::default());
     let mut node = |nodes: &mut Vec<PlanNode>, q: DVec2| -> usize {
         *index.entry(key(q)).or_insert_with(|| {
             nodes.push(PlanNode {
@@ -202,7 +208,8 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
             nodes.len() - 1
         })
     };
-    let mut pair: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut pair: HashMap<(usize, usize), usize, FxBuild> =
+        HashMap::with_capacity_and_hasher(points, FxBuild::default());
     for (r, road) in roads.iter().enumerate() {
         let half = road.width_m / 2.0;
         if half.is_nan() || half <= 0.0 {
@@ -254,24 +261,24 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
             p.nodes[edge.b].ends.push((e, false));
         }
     }
-    let ends: Vec<Vec<End>> = p
-        .nodes
-        .iter_mut()
-        .map(|n| sorted_ends(n, &p.edges))
-        .collect();
+    // Every node's ends sorted around it, and the gaps between them, in flat arrays.
+    let kept = 2 * p.edges.iter().filter(|e| !e.dropped).count();
+    let mut ends: PerNode<End> = PerNode::with_capacity(p.nodes.len(), kept);
+    for n in &mut p.nodes {
+        sorted_ends(n, &p.edges, &mut ends);
+    }
     // Pass 1: the trim each junction wants.
-    let mut gaps: Vec<Vec<Gap>> = Vec::with_capacity(ends.len());
+    let mut gaps: PerNode<Gap> = PerNode::with_capacity(p.nodes.len(), kept);
     for (v, es) in ends.iter().enumerate() {
         let c = p.nodes[v].pos;
         let k = es.len();
-        let g: Vec<Gap> = if k >= 2 {
-            (0..k)
-                .map(|i| classify(c, &es[i], &es[(i + 1) % k]))
-                .collect()
+        if k >= 2 {
+            gaps.push_node((0..k).map(|i| classify(c, &es[i], &es[(i + 1) % k])));
         } else {
-            Vec::new()
-        };
-        if !is_straight(&g) {
+            gaps.push_node(std::iter::empty());
+        }
+        let g = &gaps[v];
+        if !is_straight(g) {
             for (i, gap) in g.iter().enumerate() {
                 want_gap(&mut p.edges, &es[i], &es[(i + 1) % k], *gap);
             }
@@ -281,7 +288,6 @@ pub(crate) fn plan(roads: &[MapRoad], o: &RoadSurfaceOptions) -> Plan {
                 }
             }
         }
-        gaps.push(g);
     }
     // Pass 1b: junctions joined by a segment shorter than the cuts they want at its ends
     // merge into one polygon around both (a jogged crossing, a fork on a short stem).
@@ -351,27 +357,65 @@ fn is_straight(gaps: &[Gap]) -> bool {
     gaps.len() == 2 && gaps.iter().all(|g| *g == Gap::Straight)
 }
 
-fn sorted_ends(n: &mut PlanNode, edges: &[PlanEdge]) -> Vec<End> {
+/// Appends node `n`'s ends, sorted counter-clockwise, to `ends` (and puts `n.ends` in
+/// that order).
+fn sorted_ends(n: &mut PlanNode, edges: &[PlanEdge], ends: &mut PerNode<End>) {
     let c = n.pos;
-    let mut es: Vec<End> = n
-        .ends
-        .iter()
-        .map(|&(edge, starts)| {
-            let e = &edges[edge];
-            let far = if starts { e.cut_b[0] } else { e.cut_a[0] };
-            End {
-                edge,
-                starts,
-                far,
-                d: (far - c) / e.len,
-                w: e.half,
-            }
-        })
-        .collect();
+    let es = ends.push_node(n.ends.iter().map(|&(edge, starts)| {
+        let e = &edges[edge];
+        let far = if starts { e.cut_b[0] } else { e.cut_a[0] };
+        End {
+            edge,
+            starts,
+            far,
+            d: (far - c) / e.len,
+            w: e.half,
+        }
+    }));
     // Stable: equal directions (overlapping segments) keep the input order.
     es.sort_by(|x, y| ccw_cmp(c, x.far, y.far, AngleStart::East));
-    n.ends = es.iter().map(|e| (e.edge, e.starts)).collect();
-    es
+    for (slot, e) in n.ends.iter_mut().zip(es.iter()) {
+        *slot = (e.edge, e.starts);
+    }
+}
+
+/// Lists of every node in one flat array: node `v`'s are `items[start[v]..start[v + 1]]`
+/// (one allocation for all nodes instead of one per node).
+#[derive(Debug)]
+struct PerNode<T> {
+    items: Vec<T>,
+    start: Vec<usize>,
+}
+
+impl<T> PerNode<T> {
+    fn with_capacity(nodes: usize, items: usize) -> Self {
+        let mut start = Vec::with_capacity(nodes + 1);
+        start.push(0);
+        PerNode {
+            items: Vec::with_capacity(items),
+            start,
+        }
+    }
+
+    /// Adds the next node's list and returns it.
+    fn push_node(&mut self, list: impl IntoIterator<Item = T>) -> &mut [T] {
+        let from = self.items.len();
+        self.items.extend(list);
+        self.start.push(self.items.len());
+        &mut self.items[from..]
+    }
+
+    /// Each node's list, in node order.
+    fn iter(&self) -> impl Iterator<Item = &[T]> {
+        self.start.windows(2).map(|w| &self.items[w[0]..w[1]])
+    }
+}
+
+impl<T> std::ops::Index<usize> for PerNode<T> {
+    type Output = [T];
+    fn index(&self, v: usize) -> &[T] {
+        &self.items[self.start[v]..self.start[v + 1]]
+    }
 }
 
 fn slot(end: &End) -> usize {
@@ -552,7 +596,7 @@ fn join_at(
 
 /// Marks the merged junctions: their nodes, their inner segments, and the cuts their
 /// outside roads want (recomputed from the merged polygon's corners).
-fn apply_clusters(p: &mut Plan, ends: &[Vec<End>], gaps: &[Vec<Gap>], clusters: &[Cluster]) {
+fn apply_clusters(p: &mut Plan, ends: &PerNode<End>, gaps: &PerNode<Gap>, clusters: &[Cluster]) {
     p.rep = (0..p.nodes.len()).collect();
     p.merged = vec![false; p.nodes.len()];
     for e in &mut p.edges {
@@ -628,7 +672,7 @@ fn far_node(edges: &[PlanEdge], end: &End) -> usize {
 /// Merges the ends of every segment whose two cuts overlap (neither end a dead end) and
 /// keeps the groups whose short segments form a tree (a group around a face, or with
 /// another segment inside, stays as it is: its segments are clamped).
-fn find_clusters(p: &Plan, ends: &[Vec<End>]) -> Vec<Cluster> {
+fn find_clusters(p: &Plan, ends: &PerNode<End>) -> Vec<Cluster> {
     let n = p.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
     for e in p.edges.iter().filter(|e| !e.dropped) {
@@ -640,22 +684,26 @@ fn find_clusters(p: &Plan, ends: &[Vec<End>]) -> Vec<Cluster> {
         }
     }
     let roots: Vec<usize> = (0..n).map(|v| root(&mut parent, v)).collect();
+    // Only sets of two nodes or more can merge: no group (and no allocation) for the
+    // others. A set's nodes in ascending order (its root, the least, first).
+    let mut size = vec![0u32; n];
+    for &r in &roots {
+        size[r] += 1;
+    }
     let mut groups: BTreeMap<usize, Cluster> = BTreeMap::new();
     for (v, &r) in roots.iter().enumerate() {
-        if r != v || groups.contains_key(&r) {
-            if let Some(g) = groups.get_mut(&r) {
-                g.nodes.push(v);
-            }
+        if size[r] < 2 {
             continue;
         }
-        groups.insert(
-            r,
-            Cluster {
-                nodes: vec![v],
+        groups
+            .entry(r)
+            .or_insert_with(|| Cluster {
+                nodes: Vec::new(),
                 internal: Vec::new(),
                 seq: Vec::new(),
-            },
-        );
+            })
+            .nodes
+            .push(v);
     }
     for (e, edge) in p.edges.iter().enumerate().filter(|(_, e)| !e.dropped) {
         if roots[edge.a] == roots[edge.b]
@@ -681,7 +729,7 @@ fn find_clusters(p: &Plan, ends: &[Vec<End>]) -> Vec<Cluster> {
 /// node in its order, crossing every inner segment to continue after it at its far node.
 fn walk_outside(
     edges: &[PlanEdge],
-    ends: &[Vec<End>],
+    ends: &PerNode<End>,
     roots: &[usize],
     r: usize,
     nodes: &[usize],
@@ -724,8 +772,8 @@ enum Link {
 
 fn link(
     nodes: &[PlanNode],
-    ends: &[Vec<End>],
-    gaps: &[Vec<Gap>],
+    ends: &PerNode<End>,
+    gaps: &PerNode<Gap>,
     (v, k): (usize, usize),
     (u, l): (usize, usize),
 ) -> Link {
@@ -754,8 +802,8 @@ fn link(
 /// corners; the convex hull if that is not a simple counter-clockwise ring.
 fn cluster_junction(
     nodes: &[PlanNode],
-    ends: &[Vec<End>],
-    gaps: &[Vec<Gap>],
+    ends: &PerNode<End>,
+    gaps: &PerNode<Gap>,
     cl: &Cluster,
     edges: &mut [PlanEdge],
     report: &mut RoadSurfaceReport,
