@@ -437,7 +437,7 @@ pub(crate) struct SceneInputs<'a> {
     pub terrains: Option<&'a dyn GroundReuse>,
 }
 
-/// Terrains (and the water map's outlines) an editor keeps between runs. A terrain is
+/// Terrains (and the water bodies with their shores) an editor keeps between runs. A terrain is
 /// a function of the ground it follows, the map and the terrain options: a memo keyed by
 /// the configuration's digest (which fixes the map, the options and the elevation map)
 /// and the water bed's ([`Water::bed_key`](crate::water::Water)) hands back the terrain
@@ -453,12 +453,13 @@ pub(crate) trait GroundReuse: Sync {
         report: polis_geom::mesh::TerrainReport,
         tiles: &[Mesh],
     );
-    /// The water map's outlines ([`smooth_mask`](crate::smooth_mask)) an earlier run on
-    /// the same maps made, if kept. They read only the configuration's maps, seed and
-    /// size (no map paint reaches the water map).
-    fn water_outlines(&self) -> Option<Vec<PolygonWithHoles>>;
-    /// Keeps the water map's outlines made in this run.
-    fn keep_water_outlines(&self, outlines: &[PolygonWithHoles]);
+    /// The water bodies and their shores ([`WaterBase`](crate::water::WaterBase): the
+    /// water map's outlines, [`smooth_mask`](crate::smooth_mask), on the elevation) an
+    /// earlier run on the same maps made, if kept. They read only the configuration's
+    /// maps, seed and size (no map paint reaches the water map or the elevation).
+    fn water_base(&self) -> Option<std::sync::Arc<crate::water::WaterBase>>;
+    /// Keeps the water bodies and shores made in this run.
+    fn keep_water_base(&self, base: &std::sync::Arc<crate::water::WaterBase>);
 }
 
 /// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
@@ -814,7 +815,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         let size = inp.config.size_m;
         let water: Vec<PolygonWithHoles> = inp
             .water
-            .map(|w| w.bodies.iter().map(|b| b.polygon.clone()).collect())
+            .map(|w| w.bodies().iter().map(|b| b.polygon.clone()).collect())
             .unwrap_or_default();
         let terrain = if scene.terrain {
             let mut parks = if inp.maps.has_parks {
@@ -863,7 +864,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         };
         let water = match inp.water {
             Some(w) if scene.water_surfaces => w
-                .bodies
+                .bodies()
                 .iter()
                 .map(|b| (b.polygon.clone(), b.level))
                 .collect(),

@@ -162,34 +162,26 @@ pub(crate) struct WaterBody {
     pub level: f64,
 }
 
-/// The water bodies of a city and what the bed under them needs: see the
-/// [module docs](self).
-pub(crate) struct Water {
-    pub bodies: Vec<WaterBody>,
+/// The water bodies of a map and their shores: what the water map's outlines, the
+/// elevation and the map's bounds fix, so an editor keeps them between runs on the same
+/// maps ([`GroundReuse::water_base`](crate::scene::GroundReuse::water_base)).
+pub(crate) struct WaterBase {
+    bodies: Vec<WaterBody>,
     shore: Rings,
-    /// Blocks that reach into a body (land inside an outline).
-    blocks: Rings,
-    /// Road corridors off bridges and tunnels: segments and half widths.
-    roads: Vec<(DVec2, DVec2, f64)>,
-    road_index: SegmentIndex<u32>,
-    widest_road: f64,
-    /// A digest of everything the bed reads besides the ground under it
-    /// ([`bed_key`](Self::bed_key)).
-    bed_key: crate::editor::key::Key,
 }
 
-impl Water {
-    /// The bodies of `outlines` on `elevation` (levels) inside the map `bounds`, with the
-    /// roads of `network` and the `blocks` as land. `None` without a body.
-    pub(crate) fn new<'a>(
+impl WaterBase {
+    /// The bodies of `outlines` on `elevation` (levels) inside the map `bounds`.
+    fn new(
         outlines: Vec<PolygonWithHoles>,
         elevation: &dyn Field,
         bounds: Aabb2,
-        network: &polis_roads::RoadNetwork,
-        blocks: impl Iterator<Item = &'a PolygonWithHoles>,
-    ) -> Result<Option<Water>> {
+    ) -> Result<WaterBase> {
         if outlines.is_empty() {
-            return Ok(None);
+            return Ok(WaterBase {
+                bodies: Vec::new(),
+                shore: Rings::new(std::iter::empty())?,
+            });
         }
         let border = 1e-6 * (bounds.max - bounds.min).max_element().max(1.0);
         let on_border = |p: DVec2| {
@@ -226,6 +218,53 @@ impl Water {
                 .enumerate()
                 .flat_map(|(k, b)| b.polygon.rings().map(move |(_, r)| (r.points(), k as u32))),
         )?;
+        Ok(WaterBase { bodies, shore })
+    }
+}
+
+/// The water bodies of a city and what the bed under them needs: see the
+/// [module docs](self).
+pub(crate) struct Water {
+    /// The bodies and their shores (what the water map and the elevation fix).
+    base: std::sync::Arc<WaterBase>,
+    /// Blocks that reach into a body (land inside an outline).
+    blocks: Rings,
+    /// Road corridors off bridges and tunnels within reach of a body (see
+    /// [`Water::on`]): segments and half widths.
+    roads: Vec<(DVec2, DVec2, f64)>,
+    road_index: SegmentIndex<u32>,
+    widest_road: f64,
+    /// A digest of everything the bed reads besides the ground under it
+    /// ([`bed_key`](Self::bed_key)).
+    bed_key: crate::editor::key::Key,
+}
+
+impl Water {
+    /// The bodies of `outlines` on `elevation` (levels) inside the map `bounds`, with the
+    /// roads of `network` and the `blocks` as land. `None` without a body.
+    #[cfg(test)]
+    pub(crate) fn new<'a>(
+        outlines: Vec<PolygonWithHoles>,
+        elevation: &dyn Field,
+        bounds: Aabb2,
+        network: &polis_roads::RoadNetwork,
+        blocks: impl Iterator<Item = &'a PolygonWithHoles>,
+    ) -> Result<Option<Water>> {
+        let base = WaterBase::new(outlines, elevation, bounds)?;
+        Water::on(std::sync::Arc::new(base), network, blocks)
+    }
+
+    /// The bodies of `base` with the roads of `network` and the `blocks` as land. `None`
+    /// without a body.
+    fn on<'a>(
+        base: std::sync::Arc<WaterBase>,
+        network: &polis_roads::RoadNetwork,
+        blocks: impl Iterator<Item = &'a PolygonWithHoles>,
+    ) -> Result<Option<Water>> {
+        if base.bodies.is_empty() {
+            return Ok(None);
+        }
+        let (bodies, shore) = (&base.bodies, &base.shore);
         // Blocks with a corner in a body or an edge near a shore.
         let reaches_in = |b: &PolygonWithHoles| {
             let bbox = b.bbox().expanded(WATER_LAND_MARGIN_M);
@@ -246,50 +285,54 @@ impl Water {
                 .flat_map(|(k, b)| b.rings().map(move |(_, r)| (r.points(), k as u32))),
         )?;
         let mut roads = Vec::new();
-        let mut road_index = SegmentIndex::new(GridOptions { cell_size: CELL_M })?;
         for (e, _, _, road) in network.edges() {
             if road.bridge || road.tunnel {
                 continue;
             }
             let (a, b) = network.segment(e)?;
-            road_index.insert(roads.len() as u32, Shape::Segment(a, b))?;
             roads.push((a, b, 0.5 * road.width.max(0.0)));
         }
         let widest_road = roads.iter().map(|r| r.2).fold(0.0, f64::max);
-        // The bed's digest: the bodies, the blocks that reach into them, and the roads
-        // within reach of one. A depth is read inside a body, within a bank's reach
-        // (`WATER_BANK_M + WATER_BANK_WALL_M`) of its shore, from roads whose corridor
-        // with its margin comes closer than that: no road farther from a body's box
-        // can change it.
+        // A depth is read inside a body, within a bank's reach (`WATER_BANK_M +
+        // WATER_BANK_WALL_M`) of its shore, from roads whose corridor with its margin
+        // comes closer than that: no road farther from a body's box can change it. Only
+        // the roads within that reach are kept (the rest of the city's roads would fill
+        // the index on every edit for nothing).
         let reach = WATER_BANK_M + WATER_BANK_WALL_M + widest_road + WATER_LAND_MARGIN_M;
         let boxes: Vec<Aabb2> = bodies
             .iter()
             .map(|b| b.polygon.bbox().expanded(reach))
             .collect();
-        // The blocks and roads in any order (the bed reads them as sets: whether a
+        roads.retain(|&(a, b, _)| {
+            let seg = Aabb2::new(a.min(b), a.max(b));
+            boxes.iter().any(|x| x.intersects(&seg))
+        });
+        let mut road_index = SegmentIndex::new(GridOptions { cell_size: CELL_M })?;
+        for (k, &(a, b, _)) in roads.iter().enumerate() {
+            road_index.insert(k as u32, Shape::Segment(a, b))?;
+        }
+        // The bed's digest: the bodies, the blocks that reach into them, and the roads
+        // within reach of one (those kept). The blocks and roads in any order (the bed reads them as sets: whether a
         // point lies in a block, the nearest distances), so an edit elsewhere that
         // renumbers them keeps the digest.
         use crate::editor::key::Key;
         let mut bed_key = Key::new(0x7761_7465).u64(bodies.len() as u64);
-        for b in &bodies {
+        for b in bodies {
             bed_key = bed_key.region(&b.polygon).f64(b.level);
         }
         let mut land: Vec<Key> = wet.iter().map(|b| Key::new(1).region(b)).collect();
-        land.extend(roads.iter().filter_map(|&(a, b, half)| {
-            let seg = Aabb2::new(a.min(b), a.max(b));
-            boxes
+        land.extend(
+            roads
                 .iter()
-                .any(|x| x.intersects(&seg))
-                .then(|| Key::new(2).point(a).point(b).f64(half))
-        }));
+                .map(|&(a, b, half)| Key::new(2).point(a).point(b).f64(half)),
+        );
         land.sort_unstable();
         bed_key = bed_key.u64(land.len() as u64);
         for k in land {
             bed_key = bed_key.key(k);
         }
         Ok(Some(Water {
-            bodies,
-            shore,
+            base,
             blocks,
             roads,
             road_index,
@@ -299,8 +342,9 @@ impl Water {
     }
 
     /// The water bodies of a city's water map (none without one), with its roads and
-    /// blocks as land. The map's outlines are taken from `kept` where it holds those of
-    /// the same configuration (the editor's memo), and handed to it when made.
+    /// blocks as land. The bodies and their shores (the map's outlines, their levels and
+    /// their grid) are taken from `kept` where it holds those of the same configuration
+    /// (the editor's memo), and handed to it when made.
     pub(crate) fn of_city(
         config: &crate::CityConfig,
         maps: &crate::CityMaps,
@@ -311,30 +355,35 @@ impl Water {
         if !maps.has_water {
             return Ok(None);
         }
-        let outlines = match kept.and_then(|k| k.water_outlines()) {
-            Some(outlines) => outlines,
+        let base = match kept.and_then(|k| k.water_base()) {
+            Some(base) => base,
             None => {
-                let made = crate::city::smooth_mask(maps.inputs.water.as_ref(), config.size_m)?;
+                let outlines = crate::city::smooth_mask(maps.inputs.water.as_ref(), config.size_m)?;
+                let made = std::sync::Arc::new(WaterBase::new(
+                    outlines,
+                    maps.inputs.elevation.as_ref(),
+                    crate::ground::map_bounds(config),
+                )?);
                 if let Some(k) = kept {
-                    k.keep_water_outlines(&made);
+                    k.keep_water_base(&made);
                 }
                 made
             }
         };
-        Water::new(
-            outlines,
-            maps.inputs.elevation.as_ref(),
-            crate::ground::map_bounds(config),
-            network,
-            blocks.iter().map(|b| &b.polygon),
-        )
+        Water::on(base, network, blocks.iter().map(|b| &b.polygon))
+    }
+
+    /// The water bodies.
+    pub(crate) fn bodies(&self) -> &[WaterBody] {
+        &self.base.bodies
     }
 
     /// The body whose outline holds `p`.
     pub(crate) fn body_at(&self, p: DVec2) -> Option<&WaterBody> {
-        self.shore
+        self.base
+            .shore
             .owner_at(p)
-            .and_then(|k| self.bodies.get(k as usize))
+            .and_then(|k| self.base.bodies.get(k as usize))
     }
 
     /// How far below the ground `e` at `p` the bed lies there (0 outside the bodies).
@@ -348,7 +397,7 @@ impl Water {
         }
         // `bank(d) ≥ excess` from this distance on.
         let reach = (excess / WATER_BANK_SLOPE).min(WATER_BANK_M + WATER_BANK_WALL_M);
-        let mut d = self.shore.distance_within(p, reach);
+        let mut d = self.base.shore.distance_within(p, reach);
         if d > 0.0 && !self.blocks.edges.is_empty() {
             if self.blocks.owner_at(p).is_some() {
                 d = 0.0;
@@ -421,7 +470,7 @@ impl Field for WaterBed<'_> {
                 index.for_each_candidate(&b, |_, s| hit |= s.intersects_box(&b));
                 hit
             };
-            !near(&w.shore.index, 0.0)
+            !near(&w.base.shore.index, 0.0)
                 && !near(&w.blocks.index, m)
                 && !near(&w.road_index, w.widest_road + m)
         });
@@ -446,7 +495,8 @@ impl Field for WaterBed<'_> {
                 let dry = Aabb2::of_finite_points(points).is_some_and(|b| {
                     let b = b.expanded(SHORE_CLEAR_M);
                     let mut hit = false;
-                    w.shore
+                    w.base
+                        .shore
                         .index
                         .for_each_candidate(&b, |_, s| hit |= s.intersects_box(&b));
                     !hit && points.iter().all(|p| p.is_finite())
@@ -519,7 +569,7 @@ mod tests {
         .unwrap()
         .unwrap();
         let level = 10.0 - WATER_FREEBOARD_M;
-        assert_eq!(water.bodies[0].level, level);
+        assert_eq!(water.bodies()[0].level, level);
         let bed = water.bed(&ground);
         // Mid-river: the deepest bed; on land and on the island: the ground.
         assert_eq!(bed.sample(DVec2::new(0.0, 0.0)), 10.0);
@@ -646,7 +696,7 @@ mod tests {
         .unwrap()
         .unwrap();
         let bed = water.bed(&hill);
-        let deepest = water.bodies[0].level - WATER_MAX_DEPTH_M;
+        let deepest = water.bodies()[0].level - WATER_MAX_DEPTH_M;
         let far = WATER_BANK_M + WATER_BANK_WALL_M;
         assert_eq!(bed.sample(DVec2::new(0.0, 0.0)), deepest);
         assert_eq!(bed.sample(DVec2::new(200.0 - far - 1.0, 0.0)), deepest);

@@ -200,8 +200,8 @@ pub(crate) struct Memo {
     dresses: Mutex<Store<Option<Arc<Dress>>>>,
     /// The last terrain made, by [`Fingerprints::ground`] and the water bed's digest.
     terrain: Mutex<Option<(Key, TerrainTiles)>>,
-    /// The water map's outlines of the last run, by [`Fingerprints::ground`].
-    water: Mutex<Option<(Key, Vec<polis_geom::PolygonWithHoles>)>>,
+    /// The water bodies and shores of the last run, by [`Fingerprints::ground`].
+    water: Mutex<Option<(Key, Arc<crate::water::WaterBase>)>>,
     /// Road-graph cells' buildings and skins, whole (see [`WholeCell`]).
     whole: Mutex<Store<WholeCell>>,
     /// The number of the current run.
@@ -606,16 +606,16 @@ impl GroundReuse for Memo {
         *lock(&self.terrain) = Some((key, (report, tiles.to_vec())));
     }
 
-    fn water_outlines(&self) -> Option<Vec<polis_geom::PolygonWithHoles>> {
+    fn water_base(&self) -> Option<Arc<crate::water::WaterBase>> {
         let key = self.fingerprints().ground;
         match &*lock(&self.water) {
-            Some((k, outlines)) if *k == key => Some(outlines.clone()),
+            Some((k, base)) if *k == key => Some(base.clone()),
             _ => None,
         }
     }
 
-    fn keep_water_outlines(&self, outlines: &[polis_geom::PolygonWithHoles]) {
-        *lock(&self.water) = Some((self.fingerprints().ground, outlines.to_vec()));
+    fn keep_water_base(&self, base: &Arc<crate::water::WaterBase>) {
+        *lock(&self.water) = Some((self.fingerprints().ground, base.clone()));
     }
 }
 

@@ -89,8 +89,8 @@
 //!   network and the pass that writes its meshes, not the pieces), assembles
 //!   the scene again (reused leaves, matched to the old ones by position, take their
 //!   meshes, names and metadata from the old scene without copying them; the terrain is
-//!   reused while the water bed under it is unchanged, the water map's outlines while
-//!   the maps are) and the change events compare the lots and blocks of the two cities.
+//!   reused while the water bed under it is unchanged, the water bodies with their
+//!   shores' grid while the maps are) and the change events compare the lots and blocks of the two cities.
 //!   Its cost is therefore still proportional to the city's size, not to the dirty set:
 //!   about 0.5 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
 //!   BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene
