@@ -304,22 +304,20 @@ fn growth_bench(
                 }
                 None => slot.insert(SecondaryGrowth::new(p.clone()).ok()?),
             };
-            worker
-                .grow(cell, &maps, seed)
-                .ok()
-                .map(|r| graph_digest(&r.network))
+            worker.grow(cell, &maps, seed).ok().map(|r| r.network)
         })
     };
-    let digest_of = |grown: &[Option<u64>]| {
-        grown
-            .iter()
-            .flatten()
-            .fold(0u64, |d, &g| polis::geom::hash::splitmix64(d ^ g))
+    // The digest is taken after the clock stops, as the serial runs' cell times leave it
+    // out (the pipeline collects the networks and hashes nothing).
+    let digest_of = |grown: &[Option<polis::roads::RoadNetwork>]| {
+        grown.iter().flatten().fold(0u64, |d, g| {
+            polis::geom::hash::splitmix64(d ^ graph_digest(g))
+        })
     };
     for run in 0..runs {
         let t = Instant::now();
         // Largest first by the pipeline's estimate, as the pipeline schedules them.
-        let grown: Vec<Option<u64>> = pool.install(|| {
+        let grown: Vec<Option<polis::roads::RoadNetwork>> = pool.install(|| {
             polis::geom::par::map_costliest_first(
                 &inputs,
                 |(cell, p)| estimated_work(p, cell.region.area()),
@@ -333,7 +331,7 @@ fn growth_bench(
             digest_of(&grown)
         );
         let t = Instant::now();
-        let grown: Vec<Option<u64>> = pool.install(|| {
+        let grown: Vec<Option<polis::roads::RoadNetwork>> = pool.install(|| {
             use rayon::prelude::*;
             inputs.par_iter().map(grow_one).collect()
         });

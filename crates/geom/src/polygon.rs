@@ -427,7 +427,19 @@ fn vertex_mean(points: &[DVec2]) -> DVec2 {
 /// Exact point location in one ring by the winding-number rule.
 pub fn locate_in_ring(points: &[DVec2], p: DVec2) -> PointLocation {
     let mut winding = 0i64;
-    for (a, b) in ring_edges(points) {
+    // The edges in the order (last, first), (first, second), …: the result does not
+    // depend on their order (any edge holding `p` answers `OnBoundary`, the winding is
+    // a sum), and stepping along the ring needs no `%` per edge.
+    let Some(&last) = points.last() else {
+        return PointLocation::Outside;
+    };
+    let mut prev = last;
+    for &b in points {
+        let a = std::mem::replace(&mut prev, b);
+        // An edge wholly above or below `p` neither holds it nor crosses its ray.
+        if (p.y < a.y && p.y < b.y) || (p.y > a.y && p.y > b.y) {
+            continue;
+        }
         if point_on_segment(p, a, b) {
             return PointLocation::OnBoundary;
         }

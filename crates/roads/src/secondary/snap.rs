@@ -57,14 +57,6 @@ pub enum SnapEvent {
     Blocked,
 }
 
-/// Kelly's `r` and `s` of a node for the current query, with the exact side.
-#[derive(Debug, Clone, Copy, Default)]
-struct NodeScalars {
-    r: f64,
-    s: f64,
-    side: i8,
-}
-
 /// The snap algorithm with its per-query scratch (reused between queries).
 #[derive(Debug, Default, Clone)]
 pub struct Snapper {
@@ -254,13 +246,15 @@ impl Snapper {
             if u == root || v == root || !Aabb2::new(pu, pv).intersects(&segment_box) {
                 continue;
             }
-            let su = compute(pu, a, b);
-            let sv = compute(pv, a, b);
-            if su.side * sv.side >= 0 {
+            // The exact sides first: most roads here lie on one side of the line ab, and
+            // their `r` and `s` (two divisions each) are not needed.
+            if side(pu, a, b) * side(pv, a, b) >= 0 {
                 continue; // same side of the line ab, or touching it (a node event)
             }
-            let (wu, wv) = (su.s.abs(), sv.s.abs());
-            let r = (su.r * wv + sv.r * wu) / (wu + wv);
+            let (ru, su) = along(pu, a, d, len2);
+            let (rv, sv) = along(pv, a, d, len2);
+            let (wu, wv) = (su.abs(), sv.abs());
+            let r = (ru * wv + rv * wu) / (wu + wv);
             let bound = cross.map_or(limit, |(cr, _, _)| cr);
             if !(r > 0.0 && r <= bound) {
                 continue;
@@ -419,17 +413,14 @@ pub(crate) fn root_ends(g: &RoadNetwork, root: NodeId, out: &mut Vec<(NodeId, DV
     }
 }
 
-/// Kelly's `r` and `s` of `p` against `a–b`, with the exact side of `p`.
+/// The exact side of `p` against the directed line `a → b`: 1 left, −1 right, 0 on it.
 #[inline]
-fn compute(p: DVec2, a: DVec2, b: DVec2) -> NodeScalars {
-    let ab = b - a;
-    let (r, s) = along(p, a, ab, ab.length_squared());
-    let side = match orient2d(a, b, p) {
+fn side(p: DVec2, a: DVec2, b: DVec2) -> i8 {
+    match orient2d(a, b, p) {
         Orientation::CounterClockwise => 1,
         Orientation::Clockwise => -1,
         Orientation::Collinear => 0,
-    };
-    NodeScalars { r, s, side }
+    }
 }
 
 /// Kelly's `r` and `s` of `p` against the segment from `a` along `ab` (`len2 = |ab|²`).
