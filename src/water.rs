@@ -312,9 +312,9 @@ impl Water {
             road_index.insert(k as u32, Shape::Segment(a, b))?;
         }
         // The bed's digest: the bodies, the blocks that reach into them, and the roads
-        // within reach of one (those kept). The blocks and roads in any order (the bed reads them as sets: whether a
-        // point lies in a block, the nearest distances), so an edit elsewhere that
-        // renumbers them keeps the digest.
+        // within reach of one (those kept). The blocks and roads in any order (the bed
+        // reads them as sets: whether a point lies in a block, the nearest distances),
+        // so an edit elsewhere that renumbers them keeps the digest.
         use crate::editor::key::Key;
         let mut bed_key = Key::new(0x7761_7465).u64(bodies.len() as u64);
         for b in bodies {

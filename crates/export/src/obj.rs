@@ -376,14 +376,13 @@ pub(crate) fn write_obj_in_batches<W: Write, S: FileSink>(
     }
     report.materials = scene.materials.len() + usize::from(uses_default);
     // The used images' files, encoded in parallel (or by a writer sharing `shared`).
-    let used: Vec<usize> = (0..texture_files.len())
-        .filter(|&i| texture_files[i].is_some())
-        .collect();
+    let (used, names): (Vec<usize>, Vec<&String>) = texture_files
+        .iter()
+        .enumerate()
+        .filter_map(|(i, name)| Some((i, name.as_ref()?)))
+        .unzip();
     let pngs = shared.pngs(&used)?;
-    for (&i, png) in used.iter().zip(pngs) {
-        let Some(name) = &texture_files[i] else {
-            continue;
-        };
+    for (name, png) in names.into_iter().zip(pngs) {
         sink.write_file(name, png)
             .map_err(ExportError::io(name.clone()))?;
         report.textures += 1;
@@ -548,44 +547,41 @@ impl NodeGeometry {
     ) {
         let identity = *world == DMat4::IDENTITY;
         let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
-        let g = self;
-        g.positions.clear();
-        g.uvs.clear();
-        g.normals.clear();
-        g.corners.clear();
-        {
-            seen.clear();
-            for m in meshes {
-                let n = m.vertex_count();
-                g.corners.reserve(n);
-                let with_uvs = m.uvs.len() == n;
-                let with_normals = m.normals.len() == n;
-                for k in 0..n {
-                    let p = if identity {
-                        m.positions[k]
+        self.positions.clear();
+        self.uvs.clear();
+        self.normals.clear();
+        self.corners.clear();
+        seen.clear();
+        for m in meshes {
+            let n = m.vertex_count();
+            self.corners.reserve(n);
+            let with_uvs = m.uvs.len() == n;
+            let with_normals = m.normals.len() == n;
+            for k in 0..n {
+                let p = if identity {
+                    m.positions[k]
+                } else {
+                    world.transform_point3(m.positions[k].as_dvec3()).as_vec3()
+                };
+                let ip = index_of(&mut seen.positions, &mut self.positions, p, p.to_array());
+                let it = if with_uvs {
+                    let t = Vec2::new(m.uvs[k].x, 1.0 - m.uvs[k].y);
+                    index_of(&mut seen.uvs, &mut self.uvs, t, t.to_array())
+                } else {
+                    ABSENT
+                };
+                let inn = if with_normals {
+                    let v = m.normals[k];
+                    let v = if identity {
+                        v.normalize_or_zero()
                     } else {
-                        world.transform_point3(m.positions[k].as_dvec3()).as_vec3()
+                        (normal_matrix * v.as_dvec3()).normalize_or_zero().as_vec3()
                     };
-                    let ip = index_of(&mut seen.positions, &mut g.positions, p, p.to_array());
-                    let it = if with_uvs {
-                        let t = Vec2::new(m.uvs[k].x, 1.0 - m.uvs[k].y);
-                        index_of(&mut seen.uvs, &mut g.uvs, t, t.to_array())
-                    } else {
-                        ABSENT
-                    };
-                    let inn = if with_normals {
-                        let v = m.normals[k];
-                        let v = if identity {
-                            v.normalize_or_zero()
-                        } else {
-                            (normal_matrix * v.as_dvec3()).normalize_or_zero().as_vec3()
-                        };
-                        index_of(&mut seen.normals, &mut g.normals, v, v.to_array())
-                    } else {
-                        ABSENT
-                    };
-                    g.corners.push([ip, it, inn]);
-                }
+                    index_of(&mut seen.normals, &mut self.normals, v, v.to_array())
+                } else {
+                    ABSENT
+                };
+                self.corners.push([ip, it, inn]);
             }
         }
     }

@@ -184,13 +184,17 @@ impl F32Texts {
         }
     }
 
+    /// The slot of a value's bits: Fibonacci hashing, the top bits of the product, so
+    /// nearby values spread.
+    fn slot_of(bits: u32) -> usize {
+        (bits.wrapping_mul(0x9e37_79b1) >> (32 - Self::SLOT_BITS)) as usize
+    }
+
     /// Appends `x` exactly as [`push_f32`] does, from the table when `x`'s bits are in
     /// its slot.
     pub(crate) fn push(&mut self, out: &mut Vec<u8>, x: f32) {
         let bits = x.to_bits();
-        // Fibonacci hashing: the top bits of the product spread nearby values.
-        let index = (bits.wrapping_mul(0x9e37_79b1) >> (32 - Self::SLOT_BITS)) as usize;
-        let Some(slot) = self.slots.get_mut(index) else {
+        let Some(slot) = self.slots.get_mut(Self::slot_of(bits)) else {
             push_f32(out, x);
             return;
         };
@@ -375,7 +379,7 @@ mod tests {
     /// it (a slot holds the last one only).
     #[test]
     fn f32_texts_keep_values_of_one_slot_apart() {
-        let slot = |x: f32| x.to_bits().wrapping_mul(0x9e37_79b1) >> (32 - F32Texts::SLOT_BITS);
+        let slot = |x: f32| F32Texts::slot_of(x.to_bits());
         let first = 1.234_5_f32;
         let same: Vec<f32> = (1..u32::MAX)
             .map(|k| f32::from_bits(first.to_bits().wrapping_add(k)))
