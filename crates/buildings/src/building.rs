@@ -3,7 +3,7 @@
 use polis_geom::mesh::to_world;
 use polis_geom::polygon::{locate_in_ring, ring_signed_area};
 use polis_geom::{
-    DVec2, DVec3, Mesh, PointLocation, Polygon, SegmentIntersection, segment_intersection,
+    Aabb2, DVec2, DVec3, Mesh, PointLocation, Polygon, SegmentIntersection, segment_intersection,
 };
 use polis_lsystem::ParamString;
 
@@ -425,16 +425,8 @@ impl Output<'_> {
                 // The template fills the shape's box, which may overhang a non-rectangular
                 // footprint: it must still lie inside the lot.
                 let (x, y) = (cx.frame_x, cx.frame_x.perp());
-                let (mut u0, mut u1, mut v0, mut v1) = (
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                );
-                for q in ring {
-                    (u0, u1) = (u0.min(q.dot(x)), u1.max(q.dot(x)));
-                    (v0, v1) = (v0.min(q.dot(y)), v1.max(q.dot(y)));
-                }
+                let b = Aabb2::in_frame(ring.iter().copied(), x, y);
+                let (u0, u1, v0, v1) = (b.min.x, b.max.x, b.min.y, b.max.y);
                 let corners = [
                     x * u0 + y * v0,
                     x * u1 + y * v0,
@@ -572,18 +564,8 @@ fn bounding_quad(pts: &[DVec3]) -> Option<FacadeFace> {
         t.normalize()
     };
     let v = nrm.cross(t);
-    let (mut u0, mut u1, mut v0, mut v1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in pts {
-        u0 = u0.min(p.dot(t));
-        u1 = u1.max(p.dot(t));
-        v0 = v0.min(p.dot(v));
-        v1 = v1.max(p.dot(v));
-    }
+    let b = Aabb2::from_points(pts.iter().map(|p| DVec2::new(p.dot(t), p.dot(v))));
+    let (u0, u1, v0, v1) = (b.min.x, b.max.x, b.min.y, b.max.y);
     let off = nrm * pts[0].dot(nrm);
     Some(FacadeFace {
         origin: off + t * u0 + v * v0,

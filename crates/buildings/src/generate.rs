@@ -1,6 +1,6 @@
 //! The building generator: footprint → height → grammar derivation → shapes, per LOD.
 
-use polis_geom::{DVec2, Field, Polygon};
+use polis_geom::{Aabb2, DVec2, Field, Polygon};
 use polis_lots::Lot;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -426,20 +426,8 @@ fn extents(ring: &[DVec2]) -> (f64, f64, DVec2) {
         [a, b, ..] => (*b - *a).normalize_or(DVec2::X),
         _ => DVec2::X,
     };
-    let y = x.perp();
-    let (mut u0, mut u1, mut v0, mut v1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in ring {
-        u0 = u0.min(p.dot(x));
-        u1 = u1.max(p.dot(x));
-        v0 = v0.min(p.dot(y));
-        v1 = v1.max(p.dot(y));
-    }
-    (u1 - u0, v1 - v0, x)
+    let b = Aabb2::in_frame(ring.iter().copied(), x, x.perp());
+    (b.max.x - b.min.x, b.max.y - b.min.y, x)
 }
 
 /// How zones choose building types.

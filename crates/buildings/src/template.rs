@@ -2,7 +2,7 @@
 //! volume by the `Template(i)` module.
 
 use polis_geom::mesh::to_world;
-use polis_geom::{DVec2, DVec3, Mesh};
+use polis_geom::{Aabb2, DVec2, DVec3, Mesh};
 
 use crate::BuildingsError;
 use crate::solid::add_face;
@@ -112,18 +112,8 @@ impl Template {
         h: f64,
     ) -> Result<Mesh, BuildingsError> {
         let y = x.perp();
-        let (mut u0, mut u1, mut v0, mut v1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for p in ring {
-            u0 = u0.min(p.dot(x));
-            u1 = u1.max(p.dot(x));
-            v0 = v0.min(p.dot(y));
-            v1 = v1.max(p.dot(y));
-        }
+        let b = Aabb2::in_frame(ring.iter().copied(), x, y);
+        let (u0, u1, v0, v1) = (b.min.x, b.max.x, b.min.y, b.max.y);
         let size = self.max - self.min;
         let map = |p: DVec3| {
             let su = (p.x - self.min.x) / size.x;

@@ -45,6 +45,13 @@ impl Aabb2 {
         b
     }
 
+    /// The smallest box containing the coordinates of all `points` along the axes `x`
+    /// and `y` (`(p · x, p · y)`; empty for no points): an oriented bounding box in
+    /// the frame those axes span, e.g. a footprint's box along its first edge.
+    pub fn in_frame(points: impl IntoIterator<Item = DVec2>, x: DVec2, y: DVec2) -> Self {
+        Self::from_points(points.into_iter().map(|p| DVec2::new(p.dot(x), p.dot(y))))
+    }
+
     /// The smallest box containing all `points`, `None` when there are none or one is
     /// not finite (a NaN coordinate would otherwise vanish in `min`/`max`).
     pub fn of_finite_points(points: &[DVec2]) -> Option<Self> {

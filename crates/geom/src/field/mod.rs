@@ -176,59 +176,31 @@ pub fn central_difference<F: Field + ?Sized>(field: &F, p: DVec2, h: f64) -> DVe
     )
 }
 
-impl<F: Field + ?Sized> Field for &F {
-    fn sample(&self, p: DVec2) -> f64 {
-        (**self).sample(p)
-    }
-    fn gradient(&self, p: DVec2) -> DVec2 {
-        (**self).gradient(p)
-    }
-    fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
-        (**self).sample_with_gradient(p)
-    }
-    fn constant_value(&self) -> Option<f64> {
-        (**self).constant_value()
-    }
-    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
-        (**self).sample_many(points, out)
-    }
+/// `Field` for pointers to a field: every method forwards to the pointee, so a
+/// pointer's overrides (a constant's value, batched sampling) are the field's own.
+macro_rules! forward_field {
+    ($($pointer:ty),*) => {$(
+        impl<F: Field + ?Sized> Field for $pointer {
+            fn sample(&self, p: DVec2) -> f64 {
+                (**self).sample(p)
+            }
+            fn gradient(&self, p: DVec2) -> DVec2 {
+                (**self).gradient(p)
+            }
+            fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
+                (**self).sample_with_gradient(p)
+            }
+            fn constant_value(&self) -> Option<f64> {
+                (**self).constant_value()
+            }
+            fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
+                (**self).sample_many(points, out)
+            }
+        }
+    )*};
 }
 
-impl<F: Field + ?Sized> Field for Box<F> {
-    fn sample(&self, p: DVec2) -> f64 {
-        (**self).sample(p)
-    }
-    fn gradient(&self, p: DVec2) -> DVec2 {
-        (**self).gradient(p)
-    }
-    fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
-        (**self).sample_with_gradient(p)
-    }
-    fn constant_value(&self) -> Option<f64> {
-        (**self).constant_value()
-    }
-    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
-        (**self).sample_many(points, out)
-    }
-}
-
-impl<F: Field + ?Sized> Field for Arc<F> {
-    fn sample(&self, p: DVec2) -> f64 {
-        (**self).sample(p)
-    }
-    fn gradient(&self, p: DVec2) -> DVec2 {
-        (**self).gradient(p)
-    }
-    fn sample_with_gradient(&self, p: DVec2) -> (f64, DVec2) {
-        (**self).sample_with_gradient(p)
-    }
-    fn constant_value(&self) -> Option<f64> {
-        (**self).constant_value()
-    }
-    fn sample_many(&self, points: &[DVec2], out: &mut [f64]) {
-        (**self).sample_many(points, out)
-    }
-}
+forward_field!(&F, Box<F>, Arc<F>);
 
 /// The same value everywhere; the gradient is zero. The point is ignored, even when NaN.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
