@@ -243,8 +243,13 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         }
         let mut out = Insertion::default();
         let a = self.realize(ap, &mut make_node, &mut out)?;
-        // Re-anchor q: realising p may have split the edge q snaps to.
-        let b = self.anchor(q, snap);
+        // Re-anchor q: realising p may have split the edge q snaps to. (A node anchor
+        // realises to itself and changes nothing: q's anchor stands.)
+        let b = if matches!(ap, Anchor::Node(_)) {
+            aq
+        } else {
+            self.anchor(q, snap)
+        };
         let b = self.realize(b, &mut make_node, &mut out)?;
         if a == b {
             return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
