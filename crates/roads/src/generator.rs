@@ -11,7 +11,7 @@
 use std::sync::Arc;
 
 use polis_geom::graph::{Insertion, SnapOptions};
-use polis_geom::par;
+use polis_geom::par::prelude::*;
 use polis_geom::spatial::GridOptions;
 use polis_geom::{Aabb2, DVec2, GeomError};
 use polis_lsystem::{Derivation, DeriveOptions, Environment, TurtleState, TypedRules};
@@ -47,10 +47,6 @@ const MIN_SPECULATIVE: usize = 16;
 /// its snap distance ([`INSERT_SNAP_M`]): a speculative answer whose reads come nearer is
 /// evaluated again.
 const CHANGED_MARGIN_M: f64 = 1.0;
-
-/// Cells per side of the lookup grid of a pass's changed boxes (over the map's bounds;
-/// a speed knob only).
-const CHANGED_GRID: usize = 64;
 
 /// What speculative evaluation did in a run ([`RoadGenerator::speculation`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -134,122 +130,10 @@ struct Ahead {
     next: usize,
     /// Boxes around what this pass's insertions changed.
     changed: Vec<Aabb2>,
-    /// `changed` filed by cell of a [`CHANGED_GRID`]² grid over the map.
-    grid: ChangedGrid,
     stats: SpeculationStats,
 }
 
-/// A coarse grid over the map holding indices of changed boxes, so an answer is checked
-/// only against the boxes filed in the cells its reads cover. Boxes reaching past the
-/// map are filed in the border cells (clamping keeps overlapping boxes in a common cell).
-#[derive(Default)]
-struct ChangedGrid {
-    origin: DVec2,
-    /// Cells per metre.
-    scale: DVec2,
-    cells: Vec<Vec<u32>>,
-    /// Cells holding something (to empty them at the next pass).
-    used: Vec<usize>,
-}
-
-impl ChangedGrid {
-    fn new(bounds: &Aabb2) -> Self {
-        let size = bounds.size();
-        let n = CHANGED_GRID as f64;
-        let scale = DVec2::new(n / size.x, n / size.y);
-        let ok = scale.is_finite() && scale.min_element() > 0.0 && bounds.min.is_finite();
-        ChangedGrid {
-            origin: bounds.min,
-            scale: if ok { scale } else { DVec2::ZERO },
-            cells: vec![Vec::new(); CHANGED_GRID * CHANGED_GRID],
-            used: Vec::new(),
-        }
-    }
-
-    /// The cell index ranges `b` covers (clamped to the grid; NaN lands in cell 0, and
-    /// a box with a NaN corner is never filed or looked up by cell).
-    fn range(&self, b: &Aabb2) -> Option<([usize; 2], [usize; 2])> {
-        if !(b.min.is_finite() && b.max.is_finite()) {
-            return None;
-        }
-        let top = (CHANGED_GRID - 1) as f64;
-        // Float-to-int casts saturate; clamping first keeps the index in the grid.
-        let cell = |v: f64, o: f64, s: f64| ((v - o) * s).clamp(0.0, top) as usize;
-        let x = [
-            cell(b.min.x, self.origin.x, self.scale.x),
-            cell(b.max.x, self.origin.x, self.scale.x),
-        ];
-        let y = [
-            cell(b.min.y, self.origin.y, self.scale.y),
-            cell(b.max.y, self.origin.y, self.scale.y),
-        ];
-        Some((x, y))
-    }
-
-    fn clear(&mut self) {
-        for &c in &self.used {
-            if let Some(v) = self.cells.get_mut(c) {
-                v.clear();
-            }
-        }
-        self.used.clear();
-    }
-}
-
 impl Ahead {
-    /// Empties the pass's answers and changed boxes.
-    fn clear(&mut self) {
-        self.gathered = false;
-        self.answers.clear();
-        self.next = 0;
-        self.changed.clear();
-        self.grid.clear();
-    }
-
-    /// Notes a box around what an insertion changed. Returns `false` if the box cannot
-    /// be filed (not finite): speculation must then stop for the pass.
-    fn add_changed(&mut self, b: Aabb2) -> bool {
-        let (Some(([x0, x1], [y0, y1])), Ok(k)) =
-            (self.grid.range(&b), u32::try_from(self.changed.len()))
-        else {
-            return false;
-        };
-        self.changed.push(b);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let c = y * CHANGED_GRID + x;
-                if let Some(v) = self.grid.cells.get_mut(c) {
-                    if v.is_empty() {
-                        self.grid.used.push(c);
-                    }
-                    v.push(k);
-                }
-            }
-        }
-        true
-    }
-
-    /// Whether a box noted by [`add_changed`](Self::add_changed) meets `reads`.
-    fn changed_near(&self, reads: &Aabb2) -> bool {
-        if reads.is_empty() {
-            return false;
-        }
-        let Some(([x0, x1], [y0, y1])) = self.grid.range(reads) else {
-            return true;
-        };
-        (y0..=y1).any(|y| {
-            (x0..=x1).any(|x| {
-                self.grid.cells.get(y * CHANGED_GRID + x).is_some_and(|v| {
-                    v.iter().any(|&k| {
-                        self.changed
-                            .get(k as usize)
-                            .is_none_or(|c| c.intersects(reads))
-                    })
-                })
-            })
-        })
-    }
-
     /// The answer evaluated ahead for module `i`, if there is one and nothing inserted
     /// since came near what it read.
     fn take(&mut self, i: usize) -> Option<(RoadAttr, Evaluation)> {
@@ -261,7 +145,7 @@ impl Ahead {
             return None;
         }
         self.next += 1;
-        if self.changed_near(&ev.reads) {
+        if self.changed.iter().any(|c| c.intersects(&ev.reads)) {
             self.stats.redone += 1;
             return None;
         }
@@ -299,20 +183,14 @@ fn evaluate_ahead(
     if pending.len() < MIN_SPECULATIVE {
         return Vec::new();
     }
-    let answer = |&(j, road): &(usize, RoadAttr)| {
-        let mut road = road;
-        let ev = spec.evaluate(&mut road, graph);
-        (j, road, ev)
-    };
-    // The calling thread answers the first half while one pool thread answers the
-    // second (a single helper: the pass is too short to be worth waking more).
-    let (front, back) = pending.split_at(pending.len() / 2);
-    let (mut out, rest) = par::run_beside(
-        || back.iter().map(answer).collect::<Vec<_>>(),
-        || front.iter().map(answer).collect::<Vec<_>>(),
-    );
-    out.extend(rest);
-    out
+    pending
+        .par_iter()
+        .map(|&(j, road)| {
+            let mut road = road;
+            let ev = spec.evaluate(&mut road, graph);
+            (j, road, ev)
+        })
+        .collect()
 }
 
 /// A box around everything `ins` (the insertion of `p–q`) changed in `graph`: the
@@ -339,7 +217,11 @@ fn changed_box(graph: &RoadNetwork, ins: &Insertion, p: DVec2, q: DVec2) -> Aabb
 impl Environment<Vec<RoadModule>> for RoadEnv<'_> {
     fn begin_pass(&mut self, step: usize) {
         self.step = u32::try_from(step).unwrap_or(u32::MAX);
-        self.ahead.clear();
+        let a = &mut self.ahead;
+        a.gathered = false;
+        a.answers.clear();
+        a.next = 0;
+        a.changed.clear();
     }
 
     fn communicate(&mut self, s: &mut Vec<RoadModule>, i: usize, _turtle: &TurtleState) {
@@ -406,10 +288,7 @@ impl RoadEnv<'_> {
                 self.segments += 1;
                 if self.ahead.gathered && !self.ahead.answers.is_empty() {
                     let changed = changed_box(self.graph, &ins, road.start, road.end);
-                    if !self.ahead.add_changed(changed) {
-                        // Unfiled: no answer of this pass can be trusted any more.
-                        self.ahead.answers.clear();
-                    }
+                    self.ahead.changed.push(changed);
                 }
                 if let Some(p) = ins.nodes.last().and_then(|&n| self.graph.position(n).ok()) {
                     road.end = p;
@@ -562,7 +441,6 @@ impl RoadGenerator {
             error: None,
             ahead: Ahead {
                 enabled: self.speculate,
-                grid: ChangedGrid::new(&self.params.bounds()),
                 ..Ahead::default()
             },
         };
