@@ -1,12 +1,5 @@
 //! The generator: runs the road L-system ([`crate::modules`]) with an environment that
 //! answers `?I` through [`LocalConstraints`] and grows the planar [`RoadNetwork`].
-//!
-//! With the feature `parallel`, a pass's proposals are first answered all at once on the
-//! thread pool against the network as the pass found it (speculative evaluation,
-//! [`RoadGenerator::with_speculation`]); the serial walk then uses an answer only where no
-//! segment it inserted earlier in the pass changed the network inside the box the answer
-//! read, and evaluates the proposal again otherwise. The network and the report are
-//! those of serial evaluation, bit for bit (`tests/speculation.rs`).
 
 use std::sync::Arc;
 
