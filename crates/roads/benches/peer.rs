@@ -5,15 +5,13 @@
 //! figures.
 //!
 //! Run: `cargo bench -p polis-roads --bench peer` (`-- once` grows one network and exits:
-//! for profilers and fresh-process timings; `-- serial` turns speculative evaluation off,
-//! `RoadGenerator::with_speculation`). The process's CPU time (all threads) is printed
-//! beside the thread's: with speculative evaluation the thread pool does part of the work.
+//! for profilers and fresh-process timings).
 
 #![allow(clippy::unwrap_used)]
 
 use std::time::Instant;
 
-use polis_roads::RoadGenerator;
+use polis_roads::generate;
 
 #[path = "common/peer.rs"]
 mod peer;
@@ -27,28 +25,6 @@ fn cpu_s() -> f64 {
         .map_or(f64::NAN, |ns| ns * 1e-9)
 }
 
-/// CPU time of the whole process (all threads) in seconds (`/proc/self/stat`, clock
-/// ticks of 10 ms: only meaningful over many runs).
-fn process_cpu_s() -> f64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    // Fields after the command name (which is in parentheses): utime and stime are the
-    // 12th and 13th of them.
-    let rest = s.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<f64> = rest
-        .split_whitespace()
-        .skip(11)
-        .take(2)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    if f.len() == 2 {
-        (f[0] + f[1]) / 100.0
-    } else {
-        f64::NAN
-    }
-}
-
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
@@ -57,25 +33,16 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let (params, inputs) = peer_params(PEER_SEGMENTS);
     let once = std::env::args().any(|a| a == "once");
-    let serial = std::env::args().any(|a| a == "serial");
-    let process0 = process_cpu_s();
     let (mut walls, mut cpus) = (Vec::new(), Vec::new());
     let mut last = None;
-    let mut speculation = Default::default();
     for _ in 0..if once { 1 } else { 11 } {
         drop(last.take());
         let (w0, c0) = (Instant::now(), cpu_s());
-        let mut generator = RoadGenerator::new(&params, &inputs)
-            .unwrap()
-            .with_speculation(!serial);
-        let g = generator.run().unwrap();
+        let g = generate(&params, &inputs).unwrap();
         cpus.push(cpu_s() - c0);
-        speculation = generator.speculation();
         walls.push(w0.elapsed().as_secs_f64());
         last = Some(g);
     }
-    let runs = walls.len() as f64;
-    let process = process_cpu_s() - process0;
     let g = last.unwrap();
     let seg = g.report.segments as f64;
     println!(
@@ -97,12 +64,6 @@ fn main() {
             peer_ms * 1e-3 / cpu,
         );
     };
-    println!("speculative evaluation (last run): {speculation:?}");
-    println!(
-        "process CPU per run (all threads, mean of {runs} runs incl. set-up): {:.1} ms; thread CPU mean {:.1} ms",
-        process / runs * 1e3,
-        cpus.iter().sum::<f64>() / runs * 1e3
-    );
     row("cold", walls[0], cpus[0], PEER_COLD_MS);
     if !once {
         row(

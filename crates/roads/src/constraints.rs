@@ -1,7 +1,7 @@
 //! Local constraints (§3.3, §3.3.1): legality (prune, bridge, rotate, tunnel) and
 //! self-sensitivity (crossings, snapping to junctions and roads, minimum angles).
 
-use polis_geom::{Aabb2, DVec2, NodeId};
+use polis_geom::{DVec2, NodeId};
 use serde::{Deserialize, Serialize};
 
 use crate::inputs::RoadInputs;
@@ -44,73 +44,6 @@ pub trait LocalConstraints: Send {
     /// Counters of what the constraints did (for reports). Default: none.
     fn stats(&self) -> ConstraintStats {
         ConstraintStats::default()
-    }
-
-    /// These constraints as a pure function of the proposal and the network, which the
-    /// generator may call on several threads ahead of time (speculative evaluation,
-    /// checked against the segments inserted in between). `None` (the default): every
-    /// proposal goes through [`adjust`](Self::adjust), one at a time.
-    fn speculative(&self) -> Option<&dyn SpeculativeConstraints> {
-        None
-    }
-
-    /// Adds the counters of an evaluation made through
-    /// [`speculative`](Self::speculative) whose answer the generator used. Default:
-    /// nothing.
-    fn absorb(&mut self, _stats: &ConstraintStats) {}
-}
-
-/// One answer of [`SpeculativeConstraints::evaluate`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Evaluation {
-    /// What [`LocalConstraints::adjust`] would return.
-    pub state: QueryState,
-    /// The counters [`LocalConstraints::adjust`] would add.
-    pub stats: ConstraintStats,
-    /// Where the answer looked: it depends on no junction outside this box and no road
-    /// that misses it, so a change to the network that leaves alone every junction in it
-    /// and every road meeting it (with the roads at those junctions) leaves the answer
-    /// unchanged. Empty when the answer does not depend on the network.
-    pub reads: Aabb2,
-}
-
-/// Local constraints that can answer a proposal without changing themselves, on any
-/// thread ([`LocalConstraints::speculative`]).
-pub trait SpeculativeConstraints: Sync {
-    /// Does what [`LocalConstraints::adjust`] does to `road` against `network`, bit for
-    /// bit, and returns the state, the counters and the box read instead of counting.
-    fn evaluate(&self, road: &mut RoadAttr, network: &RoadNetwork) -> Evaluation;
-}
-
-impl ConstraintStats {
-    /// Adds every counter of `other`.
-    pub fn add(&mut self, other: &ConstraintStats) {
-        let ConstraintStats {
-            proposals,
-            pruned,
-            rotated,
-            bridges,
-            tunnels,
-            crossings,
-            junction_snaps,
-            road_snaps,
-            failed_illegal,
-            failed_angle,
-            failed_short,
-            failed_tunnel,
-        } = *other;
-        self.proposals += proposals;
-        self.pruned += pruned;
-        self.rotated += rotated;
-        self.bridges += bridges;
-        self.tunnels += tunnels;
-        self.crossings += crossings;
-        self.junction_snaps += junction_snaps;
-        self.road_snaps += road_snaps;
-        self.failed_illegal += failed_illegal;
-        self.failed_angle += failed_angle;
-        self.failed_short += failed_short;
-        self.failed_tunnel += failed_tunnel;
     }
 }
 
@@ -174,8 +107,7 @@ impl DefaultConstraints {
     /// Step 1 of §3.3: make the segment legal (prune, bridge, rotate, tunnel). Returns
     /// the new end and angle and what the segment crosses, or `None`.
     fn make_legal(
-        &self,
-        st: &mut ConstraintStats,
+        &mut self,
         a: DVec2,
         angle: f64,
         len: f64,
@@ -201,7 +133,7 @@ impl DefaultConstraints {
         let pruned = lo * len;
         if pruned >= (1.0 - p.max_prune_factor) * len && pruned >= p.min_segment_length_m.max(1e-3)
         {
-            st.pruned += 1;
+            self.stats.pruned += 1;
             return Some((a + (b - a) * lo, angle, Span::Ground));
         }
         let under_water = p.tunnel_under_water;
@@ -214,13 +146,13 @@ impl DefaultConstraints {
                 self.legality
                     .bridge_landing(a, dir(angle), v.t * len, p.max_bridge_length_m)
         {
-            st.bridges += 1;
+            self.stats.bridges += 1;
             return Some((landing, angle, Span::Bridge));
         }
         // Rotate within the maximal angle, nearest first, left before right (roads follow
         // coastlines and park edges, not the edge of the map).
         if v.what == Illegal::Outside {
-            st.failed_illegal += 1;
+            self.stats.failed_illegal += 1;
             return None;
         }
         let step = p.rotate_step_deg.to_radians();
@@ -231,7 +163,7 @@ impl DefaultConstraints {
                 let ang = angle + s * k * step;
                 let e = a + dir(ang) * len;
                 if self.legality.segment_ok(a, e) {
-                    st.rotated += 1;
+                    self.stats.rotated += 1;
                     return Some((e, ang, Span::Ground));
                 }
             }
@@ -251,10 +183,10 @@ impl DefaultConstraints {
                 under_water,
             )
         {
-            st.tunnels += 1;
+            self.stats.tunnels += 1;
             return Some((far, angle, Span::Tunnel));
         }
-        st.failed_illegal += 1;
+        self.stats.failed_illegal += 1;
         None
     }
 
@@ -293,7 +225,6 @@ impl DefaultConstraints {
     /// `Err` for one below it or one on a tunnel edge.
     fn snap_event(
         &self,
-        reads: &mut Aabb2,
         net: &RoadNetwork,
         start_node: Option<NodeId>,
         a: DVec2,
@@ -310,7 +241,6 @@ impl DefaultConstraints {
                 RoadClass::Street => None,
             },
         };
-        *reads = reads.union(&snap_reach(&q));
         let Some(ev) = snap(net, &q) else {
             return Ok(None);
         };
@@ -337,7 +267,6 @@ impl DefaultConstraints {
     /// `b` (the start junction excluded), or `None`.
     fn first_crossing(
         &self,
-        reads: &mut Aabb2,
         net: &RoadNetwork,
         start_node: Option<NodeId>,
         a: DVec2,
@@ -350,7 +279,6 @@ impl DefaultConstraints {
             start_node,
             only: None,
         };
-        *reads = reads.union(&snap_reach(&q));
         match snap(net, &q) {
             Some(SnapEvent::Cross { point, .. } | SnapEvent::Junction { point, .. })
                 if point.distance(b) > SAME_POINT_M =>
@@ -361,38 +289,47 @@ impl DefaultConstraints {
         }
     }
 
-    /// [`LocalConstraints::adjust`] without changing `self`: counts into `st` and grows
-    /// `reads` to hold every part of `net` the answer depends on (see
-    /// [`SpeculativeConstraints::evaluate`]).
-    fn adjust_in(
-        &self,
-        road: &mut RoadAttr,
-        net: &RoadNetwork,
-        st: &mut ConstraintStats,
-        reads: &mut Aabb2,
-    ) -> QueryState {
-        st.proposals += 1;
+    fn count_snap(&mut self, ev: &SnapEvent) {
+        match ev {
+            SnapEvent::Junction { .. } => self.stats.junction_snaps += 1,
+            SnapEvent::Cross { .. } => self.stats.crossings += 1,
+            SnapEvent::Road { .. } => self.stats.road_snaps += 1,
+        }
+    }
+}
+
+impl LocalConstraints for DefaultConstraints {
+    /// §3.3's two steps. Step 1 makes the proposal legal (prune, bridge, rotate), step 2
+    /// applies the self-sensitive rules (snap to a crossing, junction or road, minimum
+    /// angles), and a snapped road is checked for legality again.
+    ///
+    /// When the proposal as given, snapped, is already a legal road, the result of the two
+    /// steps is that road, and it is taken straight away: one legality walk instead of
+    /// two. (If the proposal itself was illegal, step 1 would have pruned or rotated it
+    /// first; taking the legal snapped road instead connects to the network where the
+    /// two-step order would stop short of it.)
+    fn adjust(&mut self, road: &mut RoadAttr, net: &RoadNetwork) -> QueryState {
+        self.stats.proposals += 1;
         let a = road.start;
         if !(a.is_finite()
             && road.angle.is_finite()
             && road.length.is_finite()
             && road.length > 0.0)
         {
-            st.failed_illegal += 1;
+            self.stats.failed_illegal += 1;
             return QueryState::Failed;
         }
         let min_len = self.params.min_segment_length_m.max(1e-3);
-        *reads = reads.union(&Aabb2::new(a, a).expanded(SAME_POINT_M));
         let start_node = net.nearest_node(a, SAME_POINT_M).map(|(n, _)| n);
         let proposed = a + dir(road.angle) * road.length;
         // The proposal as given, snapped: taken when that road is legal.
-        let first = self.snap_event(reads, net, start_node, a, proposed, road.class);
+        let first = self.snap_event(net, start_node, a, proposed, road.class);
         if let Ok(Some(ev)) = first {
             let end = ev.point();
             let len = a.distance(end);
             let start_ok = start_node.is_none_or(|s| self.angle_ok_at(net, s, proposed));
             if start_ok && len >= min_len && self.legality.segment_ok(a, end) {
-                count_snap(st, &ev);
+                self.count_snap(&ev);
                 road.end = end;
                 road.angle = angle_of(end - a);
                 road.length = len;
@@ -404,8 +341,7 @@ impl DefaultConstraints {
             }
         }
         // Step 1: legality.
-        let Some((mut end, angle, span)) =
-            self.make_legal(st, a, road.angle, road.length, road.class)
+        let Some((mut end, angle, span)) = self.make_legal(a, road.angle, road.length, road.class)
         else {
             return QueryState::Failed;
         };
@@ -413,28 +349,28 @@ impl DefaultConstraints {
         if let Some(s) = start_node
             && !self.angle_ok_at(net, s, end)
         {
-            st.failed_angle += 1;
+            self.stats.failed_angle += 1;
             return QueryState::Failed;
         }
         // Step 2: self-sensitivity (the snap of the unchanged proposal is known already).
         let event = if end == proposed {
             first
         } else {
-            self.snap_event(reads, net, start_node, a, end, road.class)
+            self.snap_event(net, start_node, a, end, road.class)
         };
         let mut snapped = false;
         let mut crossed = false;
         match event {
             Err(Refusal::Angle) => {
-                st.failed_angle += 1;
+                self.stats.failed_angle += 1;
                 return QueryState::Failed;
             }
             Err(Refusal::Tunnel) => {
-                st.failed_tunnel += 1;
+                self.stats.failed_tunnel += 1;
                 return QueryState::Failed;
             }
             Ok(Some(ev)) => {
-                count_snap(st, &ev);
+                self.count_snap(&ev);
                 end = ev.point();
                 snapped = true;
                 crossed = matches!(ev, SnapEvent::Cross { .. });
@@ -443,7 +379,7 @@ impl DefaultConstraints {
         }
         let len = a.distance(end);
         if len.is_nan() || len < min_len {
-            st.failed_short += 1;
+            self.stats.failed_short += 1;
             return QueryState::Failed;
         }
         let max_bridge = self.params.max_bridge_length_m;
@@ -464,17 +400,17 @@ impl DefaultConstraints {
                 self.legality.segment_ok(a, end)
             };
             if !legal {
-                st.failed_illegal += 1;
+                self.stats.failed_illegal += 1;
                 return QueryState::Failed;
             }
         }
         // Highways snap to highways only, but a tunnel passes under no road at all: it
         // ends at the first road it would cross (a junction on legal ground there, its
         // far portal), or is refused.
-        if tunnel && let Some(c) = self.first_crossing(reads, net, start_node, a, end) {
+        if tunnel && let Some(c) = self.first_crossing(net, start_node, a, end) {
             let under_water = self.params.tunnel_under_water;
             if !(a.distance(c) >= min_len && tunnelable(&self.legality, a, c, under_water)) {
-                st.failed_tunnel += 1;
+                self.stats.failed_tunnel += 1;
                 return QueryState::Failed;
             }
             (end, snapped, crossed) = (c, true, true);
@@ -489,65 +425,9 @@ impl DefaultConstraints {
         road.crossed = crossed;
         QueryState::Succeed
     }
-}
-
-/// Counts a snap event.
-fn count_snap(st: &mut ConstraintStats, ev: &SnapEvent) {
-    match ev {
-        SnapEvent::Junction { .. } => st.junction_snaps += 1,
-        SnapEvent::Cross { .. } => st.crossings += 1,
-        SnapEvent::Road { .. } => st.road_snaps += 1,
-    }
-}
-
-/// The box a snap query reads: every junction and road its answer depends on meets it
-/// ([`snap`] looks at junctions in the segment's box grown by the radius, roads meeting
-/// the segment, and roads within the radius of its end).
-fn snap_reach(q: &SnapQuery) -> Aabb2 {
-    Aabb2::new(q.a, q.b).expanded(q.radius.max(0.0))
-}
-
-impl LocalConstraints for DefaultConstraints {
-    /// §3.3's two steps. Step 1 makes the proposal legal (prune, bridge, rotate), step 2
-    /// applies the self-sensitive rules (snap to a crossing, junction or road, minimum
-    /// angles), and a snapped road is checked for legality again.
-    ///
-    /// When the proposal as given, snapped, is already a legal road, the result of the two
-    /// steps is that road, and it is taken straight away: one legality walk instead of
-    /// two. (If the proposal itself was illegal, step 1 would have pruned or rotated it
-    /// first; taking the legal snapped road instead connects to the network where the
-    /// two-step order would stop short of it.)
-    fn adjust(&mut self, road: &mut RoadAttr, net: &RoadNetwork) -> QueryState {
-        let mut st = self.stats;
-        let mut reads = Aabb2::EMPTY;
-        let state = self.adjust_in(road, net, &mut st, &mut reads);
-        self.stats = st;
-        state
-    }
-
-    fn speculative(&self) -> Option<&dyn SpeculativeConstraints> {
-        Some(self)
-    }
-
-    fn absorb(&mut self, stats: &ConstraintStats) {
-        self.stats.add(stats);
-    }
 
     fn stats(&self) -> ConstraintStats {
         self.stats
-    }
-}
-
-impl SpeculativeConstraints for DefaultConstraints {
-    fn evaluate(&self, road: &mut RoadAttr, network: &RoadNetwork) -> Evaluation {
-        let mut stats = ConstraintStats::default();
-        let mut reads = Aabb2::EMPTY;
-        let state = self.adjust_in(road, network, &mut stats, &mut reads);
-        Evaluation {
-            state,
-            stats,
-            reads,
-        }
     }
 }
 

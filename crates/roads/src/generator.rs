@@ -3,21 +3,18 @@
 
 use std::sync::Arc;
 
-use polis_geom::graph::{Insertion, SnapOptions};
-use polis_geom::par::prelude::*;
+use polis_geom::GeomError;
+use polis_geom::graph::SnapOptions;
 use polis_geom::spatial::GridOptions;
-use polis_geom::{Aabb2, DVec2, GeomError};
 use polis_lsystem::{Derivation, DeriveOptions, Environment, TurtleState, TypedRules};
 use serde::{Deserialize, Serialize};
 
-use crate::constraints::{
-    ConstraintStats, DefaultConstraints, Evaluation, LocalConstraints, SpeculativeConstraints,
-};
+use crate::constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 use crate::error::{Result, RoadError};
 use crate::feedback::PopulationFeedback;
 use crate::goals::{DefaultGoals, GlobalGoals};
 use crate::inputs::RoadInputs;
-use crate::modules::{QueryState, RoadAttr, RoadModule, road_rules};
+use crate::modules::{QueryState, RoadModule, road_rules};
 use crate::network::{Junction, Road, RoadClass, RoadNetwork};
 use crate::params::RoadParams;
 use crate::smooth::smooth_highways;
@@ -31,29 +28,6 @@ pub const INSERT_SNAP_M: f64 = 1e-3;
 /// and 128 m (fewer instructions than the 64 m default, ~10 % less time, less memory).
 /// A speed knob only: answers do not depend on it.
 pub const INDEX_CELL_M: f64 = 128.0;
-
-/// Fewest proposals in a pass for which speculative evaluation is worth waking a second
-/// thread (a speed knob only: the network is the same either way).
-const MIN_SPECULATIVE: usize = 16;
-
-/// Margin (metres) around what a planar insertion changed, far above its rounding and
-/// its snap distance ([`INSERT_SNAP_M`]): a speculative answer whose reads come nearer is
-/// evaluated again.
-const CHANGED_MARGIN_M: f64 = 1.0;
-
-/// What speculative evaluation did in a run ([`RoadGenerator::speculation`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct SpeculationStats {
-    /// Passes whose proposals were evaluated ahead on the thread pool.
-    pub passes: usize,
-    /// Proposals evaluated ahead.
-    pub evaluated: usize,
-    /// Answers used as they were: nothing inserted earlier in the pass came near them.
-    pub used: usize,
-    /// Answers dropped and evaluated again, one at a time, because an insertion earlier
-    /// in the pass changed the network where they looked.
-    pub redone: usize,
-}
 
 /// Why the growth stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -103,147 +77,29 @@ struct RoadEnv<'a> {
     step: u32,
     segments: usize,
     error: Option<RoadError>,
-    ahead: Ahead,
-}
-
-/// Speculative evaluation of one pass: every proposal of the pass is answered on the
-/// thread pool against the network as it stood when the pass began; the serial walk
-/// then takes an answer only when no segment inserted earlier in the pass changed the
-/// network inside the box the answer read, and evaluates it again otherwise. Either way
-/// the answer is the one serial evaluation gives, so the network is the same.
-#[derive(Default)]
-struct Ahead {
-    /// Whether speculative evaluation is on.
-    enabled: bool,
-    /// Whether this pass's proposals were gathered.
-    gathered: bool,
-    /// Answers of this pass in string order: (module index, adjusted road, evaluation).
-    answers: Vec<(usize, RoadAttr, Evaluation)>,
-    /// First answer not yet used or passed.
-    next: usize,
-    /// Boxes around what this pass's insertions changed.
-    changed: Vec<Aabb2>,
-    stats: SpeculationStats,
-}
-
-impl Ahead {
-    /// The answer evaluated ahead for module `i`, if there is one and nothing inserted
-    /// since came near what it read.
-    fn take(&mut self, i: usize) -> Option<(RoadAttr, Evaluation)> {
-        while self.answers.get(self.next).is_some_and(|(j, ..)| *j < i) {
-            self.next += 1;
-        }
-        let &(j, road, ev) = self.answers.get(self.next)?;
-        if j != i {
-            return None;
-        }
-        self.next += 1;
-        if self.changed.iter().any(|c| c.intersects(&ev.reads)) {
-            self.stats.redone += 1;
-            return None;
-        }
-        self.stats.used += 1;
-        Some((road, ev))
-    }
-}
-
-/// Whether module `i` of `s` is a query the environment answers: unassigned, and not
-/// deleted by p7 (its road stopped by the global goals).
-fn answerable(s: &[RoadModule], i: usize) -> Option<RoadAttr> {
-    let Some(RoadModule::I { road, state }) = s.get(i).copied() else {
-        return None;
-    };
-    if state != QueryState::Unassigned {
-        return None;
-    }
-    if i > 0 && matches!(s.get(i - 1), Some(RoadModule::R { del, .. }) if *del < 0) {
-        return None;
-    }
-    Some(road)
-}
-
-/// Evaluates every answerable query of `s` from module `from` on against `graph`, on the
-/// thread pool, in string order.
-fn evaluate_ahead(
-    spec: &dyn SpeculativeConstraints,
-    graph: &RoadNetwork,
-    s: &[RoadModule],
-    from: usize,
-) -> Vec<(usize, RoadAttr, Evaluation)> {
-    let pending: Vec<(usize, RoadAttr)> = (from..s.len())
-        .filter_map(|j| answerable(s, j).map(|r| (j, r)))
-        .collect();
-    if pending.len() < MIN_SPECULATIVE {
-        return Vec::new();
-    }
-    pending
-        .par_iter()
-        .map(|&(j, road)| {
-            let mut road = road;
-            let ev = spec.evaluate(&mut road, graph);
-            (j, road, ev)
-        })
-        .collect()
-}
-
-/// A box around everything `ins` (the insertion of `p–q`) changed in `graph`: the
-/// segment as given, its route, the edges it created and the edges it split (both
-/// pieces of each: together they cover the edge as it was), grown by
-/// [`CHANGED_MARGIN_M`].
-fn changed_box(graph: &RoadNetwork, ins: &Insertion, p: DVec2, q: DVec2) -> Aabb2 {
-    let mut b = Aabb2::new(p, q);
-    for &n in &ins.nodes {
-        if let Ok(x) = graph.position(n) {
-            b.extend(x);
-        }
-    }
-    let split = ins.split.iter().flat_map(|&(e, piece)| [e, piece]);
-    for e in ins.created.iter().chain(&ins.path).copied().chain(split) {
-        if let Ok((u, v)) = graph.segment(e) {
-            b.extend(u);
-            b.extend(v);
-        }
-    }
-    b.expanded(CHANGED_MARGIN_M)
 }
 
 impl Environment<Vec<RoadModule>> for RoadEnv<'_> {
     fn begin_pass(&mut self, step: usize) {
         self.step = u32::try_from(step).unwrap_or(u32::MAX);
-        let a = &mut self.ahead;
-        a.gathered = false;
-        a.answers.clear();
-        a.next = 0;
-        a.changed.clear();
     }
 
     fn communicate(&mut self, s: &mut Vec<RoadModule>, i: usize, _turtle: &TurtleState) {
-        // p7 deletes a query whose road was stopped by the global goals: never answer it.
-        let Some(mut road) = answerable(s, i) else {
+        let Some(RoadModule::I { road, state }) = s.get(i).copied() else {
             return;
         };
-        if self.ahead.enabled && !self.ahead.gathered {
-            self.ahead.gathered = true;
-            if let Some(spec) = self.constraints.speculative() {
-                self.ahead.answers = evaluate_ahead(spec, self.graph, s, i);
-                if !self.ahead.answers.is_empty() {
-                    self.ahead.stats.passes += 1;
-                    self.ahead.stats.evaluated += self.ahead.answers.len();
-                }
-            }
+        if state != QueryState::Unassigned {
+            return;
         }
+        // p7 deletes a query whose road was stopped by the global goals: never answer it.
+        if i > 0 && matches!(s.get(i - 1), Some(RoadModule::R { del, .. }) if *del < 0) {
+            return;
+        }
+        let mut road = road;
         let new_state = if self.segments >= self.params.max_segments || self.error.is_some() {
             QueryState::Failed
         } else {
-            let state = match self.ahead.take(i) {
-                Some((adjusted, ev)) => {
-                    self.constraints.absorb(&ev.stats);
-                    road = adjusted;
-                    ev.state
-                }
-                None => self.constraints.adjust(&mut road, self.graph),
-            };
-            match state {
+            match self.constraints.adjust(&mut road, self.graph) {
                 QueryState::Succeed => self.insert(&mut road),
                 _ => QueryState::Failed,
             }
@@ -258,7 +114,7 @@ impl Environment<Vec<RoadModule>> for RoadEnv<'_> {
 }
 
 impl RoadEnv<'_> {
-    fn insert(&mut self, road: &mut RoadAttr) -> QueryState {
+    fn insert(&mut self, road: &mut crate::modules::RoadAttr) -> QueryState {
         let payload = Road {
             class: road.class,
             width: match road.class {
@@ -279,10 +135,6 @@ impl RoadEnv<'_> {
         {
             Ok(ins) => {
                 self.segments += 1;
-                if self.ahead.gathered && !self.ahead.answers.is_empty() {
-                    let changed = changed_box(self.graph, &ins, road.start, road.end);
-                    self.ahead.changed.push(changed);
-                }
                 if let Some(p) = ins.nodes.last().and_then(|&n| self.graph.position(n).ok()) {
                     road.end = p;
                 }
@@ -314,8 +166,6 @@ pub struct RoadGenerator {
     constraints: Box<dyn LocalConstraints>,
     inputs: RoadInputs,
     feedback: Option<Arc<PopulationFeedback>>,
-    speculate: bool,
-    speculation: SpeculationStats,
 }
 
 impl std::fmt::Debug for RoadGenerator {
@@ -346,27 +196,7 @@ impl RoadGenerator {
             constraints: Box::new(DefaultConstraints::new(params, &fed)),
             inputs: fed,
             feedback,
-            speculate: polis_geom::par::PARALLEL,
-            speculation: SpeculationStats::default(),
         })
-    }
-
-    /// Turns speculative evaluation on or off (default: on when polis runs in parallel,
-    /// [`polis_geom::par::PARALLEL`]). While a pass applies the local constraints to its
-    /// proposals one at a time, inserting each accepted segment, speculative evaluation
-    /// first answers all of them at once on the thread pool against the network as it
-    /// stood, then takes an answer only where no segment inserted earlier in the pass
-    /// changed the network near what the answer read. It needs constraints that can be
-    /// evaluated that way ([`LocalConstraints::speculative`]). The network is the same
-    /// either way; only the time differs.
-    pub fn with_speculation(mut self, on: bool) -> Self {
-        self.speculate = on;
-        self
-    }
-
-    /// What speculative evaluation did in the last [`run`](Self::run).
-    pub fn speculation(&self) -> SpeculationStats {
-        self.speculation
     }
 
     /// Replaces the global goals.
@@ -432,10 +262,6 @@ impl RoadGenerator {
             step: 0,
             segments: 0,
             error: None,
-            ahead: Ahead {
-                enabled: self.speculate,
-                ..Ahead::default()
-            },
         };
         loop {
             if env.segments >= self.params.max_segments {
@@ -459,7 +285,6 @@ impl RoadGenerator {
         report.steps = derivation.steps_done();
         report.segments = env.segments;
         report.constraints = env.constraints.stats();
-        self.speculation = env.ahead.stats;
         if self.params.smooth_highways {
             report.smoothed_corners = smooth_highways(&mut graph, &self.params, &self.inputs)?;
         }

@@ -102,14 +102,11 @@ pub mod snap;
 pub mod street_rules;
 pub mod tunnels;
 
-pub use constraints::{
-    ConstraintStats, DefaultConstraints, Evaluation, LocalConstraints, SpeculativeConstraints,
-};
+pub use constraints::{ConstraintStats, DefaultConstraints, LocalConstraints};
 pub use error::{Result, RoadError, RoadsError};
 pub use feedback::PopulationFeedback;
 pub use generator::{
-    Generated, GrowthReport, RoadGenerator, SpeculationStats, StopReason, generate,
-    generate_default,
+    Generated, GrowthReport, RoadGenerator, StopReason, generate, generate_default,
 };
 pub use goals::{DefaultGoals, GlobalGoals};
 pub use grading::{Earthworks, GradeParams, GradedGround, grade_roads};
