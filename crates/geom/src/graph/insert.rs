@@ -177,6 +177,62 @@ impl Event {
     }
 }
 
+/// The walk's stack of targets ([`PlanarGraph::connect`]): almost always one or two
+/// nodes, kept inline up to [`Targets::INLINE`] (no allocation), in a `Vec` beyond.
+struct Targets {
+    inline: [NodeId; Targets::INLINE],
+    len: usize,
+    spill: Vec<NodeId>,
+}
+
+impl Targets {
+    const INLINE: usize = 4;
+
+    fn new(first: NodeId) -> Self {
+        Targets {
+            inline: [first; Targets::INLINE],
+            len: 1,
+            spill: Vec::new(),
+        }
+    }
+
+    fn as_slice(&self) -> &[NodeId] {
+        if self.spill.is_empty() {
+            self.inline.get(..self.len).unwrap_or(&[])
+        } else {
+            &self.spill
+        }
+    }
+
+    fn last(&self) -> Option<NodeId> {
+        self.as_slice().last().copied()
+    }
+
+    fn push(&mut self, n: NodeId) {
+        if self.spill.is_empty() {
+            if let Some(slot) = self.inline.get_mut(self.len) {
+                *slot = n;
+                self.len += 1;
+                return;
+            }
+            self.spill.extend_from_slice(&self.inline);
+        }
+        self.spill.push(n);
+    }
+
+    fn pop(&mut self) {
+        if self.spill.is_empty() {
+            self.len = self.len.saturating_sub(1);
+        } else {
+            self.spill.pop();
+            if self.spill.is_empty() {
+                // Emptied from a spill: the inline part is stale, the stack is empty.
+                self.len = 0;
+            }
+        }
+    }
+}
+
 impl<N, E: Clone> PlanarGraph<N, E> {
     /// Inserts the segment `p–q` keeping the graph planar; new nodes get `N::default()`.
     /// See [`insert_segment_with`](Self::insert_segment_with).
@@ -243,18 +299,27 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         }
         let mut out = Insertion::default();
         let a = self.realize(ap, &mut make_node, &mut out)?;
-        // Re-anchor q: realising p may have split the edge q snaps to.
-        let b = self.anchor(q, snap);
+        // Re-anchor q: realising p may have split the edge q snaps to. (A node anchor
+        // realises to itself and changes nothing: q's anchor stands.)
+        let b = if matches!(ap, Anchor::Node(_)) {
+            aq
+        } else {
+            self.anchor(q, snap)
+        };
         let b = self.realize(b, &mut make_node, &mut out)?;
         if a == b {
             return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
         }
         self.connect(a, b, (p, q), &payload, snap, &mut make_node, &mut out, 0)?;
-        let mut touched = out.created.clone();
-        for &(e, piece) in &out.split {
-            touched.extend([e, piece].into_iter().filter(|&x| self.contains_edge(x)));
-        }
-        self.check_local(&touched)?;
+        // The created edges, then both pieces of each split that still exist (no list
+        // built: one allocation less per segment).
+        let split = out.split.iter().flat_map(|&(e, piece)| [e, piece]);
+        let touched = out
+            .created
+            .iter()
+            .copied()
+            .chain(split.filter(|&x| self.contains_edge(x)));
+        self.check_local(touched)?;
         Ok(out)
     }
 
@@ -290,7 +355,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let pieces_ok = out
             .split
             .iter()
-            .all(|&(e, piece)| self.check_local(&[e, piece]).is_ok());
+            .all(|&(e, piece)| self.check_local([e, piece]).is_ok());
         self.planar_by_construction = planar && keeps_planarity(&result) && pieces_ok;
         Ok((result?, out.split.first().copied()))
     }
@@ -407,10 +472,10 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     ) -> Result<(), GeomError> {
         out.nodes.push(from);
         let mut cur = from;
-        let mut targets = vec![to];
+        let mut targets = Targets::new(to);
         let limit = 64 + 8 * (self.node_count() + self.edge_count());
         let mut steps = 0usize;
-        while let Some(&target) = targets.last() {
+        while let Some(target) = targets.last() {
             steps += 1;
             if steps > limit {
                 return Err(GeomError::GraphCorrupt(format!(
@@ -421,7 +486,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 targets.pop();
                 continue;
             }
-            match self.next_event(cur, target, line, snap, &out.nodes, &targets)? {
+            match self.next_event(cur, target, line, snap, &out.nodes, targets.as_slice())? {
                 None => {
                     let e = match self.find_edge(cur, target) {
                         Some(e) => e,
@@ -775,8 +840,8 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     }
 
     /// Checks that the given edges meet other edges only at common end nodes.
-    fn check_local(&self, edges: &[EdgeId]) -> Result<(), GeomError> {
-        for &e in edges {
+    fn check_local(&self, edges: impl IntoIterator<Item = EdgeId>) -> Result<(), GeomError> {
+        for e in edges {
             let (a, b) = self.endpoints(e)?;
             let (pa, pb) = (self.position(a)?, self.position(b)?);
             if let Some(hit) = self.meets_elsewhere((a, pa), (b, pb), Some(e)) {
