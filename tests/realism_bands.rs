@@ -31,7 +31,7 @@
 //! Citygen units and neighbourhood parameters retuned on seeds 1–5; `citygen_us` kept
 //! one circuity miss, seed 1's until session 13's highway rays, seed 2's since, until
 //! session 20 bowed its streets between their junctions, `SecondaryParams::bow`: seeds
-//! 1–40 all in the circuity band). `citygen` itself is Kelly's test city
+//! 1–200 all in the circuity band). `citygen` itself is Kelly's test city
 //! (issue 18: 16 km², ≥ 15,000 roads, ≥ 57,000 buildings, the workload of issue 25's
 //! timings), whose street density no real city's band admits; it is not tested here.
 //!
@@ -140,8 +140,9 @@ fn suburbia_is_in_charlottes_band() {
 /// is 26 m (Manhattan's 5-unit segments are 130 m, so junctions come about 100 m apart),
 /// its highways lean to a grid (New York weight 0.7), and Industrial and Suburbia
 /// meander more (Kelly §6.3). Its streets bow between their junctions (`bow`: grids
-/// 0.14, Suburbia and Industrial 0.08 of the street, ± 50 %); straight, they left seed 2
-/// at circuity 1.020 against 1.045 ± 0.02 (its grid cells carry more of the length).
+/// 0.10, Suburbia 0.16 and Industrial 0.12 of the street, ± 50 %); straight, they left
+/// seed 2 at circuity 1.020 against 1.045 ± 0.02 (its grid cells carry more of the
+/// length).
 #[test]
 fn citygen_us_is_in_the_us_canada_band() {
     check("citygen_us");
