@@ -560,3 +560,29 @@ fn bowed_streets_keep_the_junctions_of_the_straight_growth() {
     let ratio = bowed_len / plain_len;
     assert!((1.012..1.03).contains(&ratio), "{ratio}");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Any cell, preset and bow up to the largest allowed: the bowed cell keeps every
+    /// invariant of the straight growth (planar, inside the cell, connected to the
+    /// boundary).
+    #[test]
+    fn bowed_streets_keep_the_cell_invariants(
+        n in 3usize..12,
+        radius in 250.0f64..700.0,
+        jitter in proptest::collection::vec(0.0f64..1.0, 12),
+        preset in 0usize..5,
+        bow in 0.0f64..0.5,
+        deviance in 0.0f64..1.0,
+        seed in 0u64..1000,
+    ) {
+        let cell = SecondaryCell::new(seed, star(n, radius, 0.3, jitter, 0.0));
+        let mut params = Neighbourhood::ALL[preset].params().unwrap();
+        params.bow = Deviated::new(bow, deviance);
+        match grow_cell(&params, &cell, &CellMaps::none(), seed) {
+            Ok(roads) => check_cell(&cell, &roads),
+            Err(e) => prop_assert!(e.is_skip(), "{e}"),
+        }
+    }
+}
