@@ -51,6 +51,9 @@ pub enum CellParam {
     StartSides(u32),
     /// [`SecondaryParams::min_angle_deg`]: degrees in [0, 90].
     MinAngle(f64),
+    /// [`SecondaryParams::bow`]: a fraction of the street in [0, 0.5] (streets bowed
+    /// between their ends; 0 keeps them straight).
+    Bow(Deviated),
 }
 
 impl CellParam {
@@ -69,6 +72,7 @@ impl CellParam {
             CellParam::BuildingHint(h) => p.building_hint = h,
             CellParam::StartSides(s) => p.start_sides = s,
             CellParam::MinAngle(a) => p.min_angle_deg = a,
+            CellParam::Bow(b) => p.bow = b,
         }
     }
 

@@ -9,6 +9,7 @@ use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
+use super::bend;
 use super::cell::{CellMaps, SecondaryCell};
 use super::error::SecondaryError;
 use super::grid::GridRoad;
@@ -173,6 +174,9 @@ pub const INSERT_TOLERANCE: f64 = 1e-3;
 /// More rounds over the start sides when none could start a first segment (see
 /// [`SecondaryGrowth::grow`]).
 pub const START_RETRIES: u32 = 8;
+
+/// Mixed into the seed of the bows' generator ([`SecondaryParams::bow`]).
+const BOW_STREAM: u64 = 0x626f_775f_7374_7265;
 
 /// A placed segment's end, for the queue.
 struct Placed {
@@ -461,6 +465,14 @@ impl SecondaryGrowth {
                     queue.push_back((placed.node, new_dir));
                 }
             }
+        }
+        // Streets bowed between their ends (ours; off at a bow of 0), from a generator
+        // of their own so that the growth above draws as it does without them.
+        if p.bow.value > 0.0 {
+            let mut bow_rng =
+                Pcg64Mcg::seed_from_u64(splitmix64(seed ^ splitmix64(cell.id) ^ BOW_STREAM));
+            bend::bow_streets(&mut run.g, &p, maps, &mut bow_rng)?;
+            run.g.release_spatial_index();
         }
         let report = run.report;
         self.joins.0 += run.joins.0;

@@ -10,6 +10,7 @@
 //! | [`presets`] | Manhattan, Suburbia, Industrial (Fig. 76), Raster, Organic (Fig. 44) as JSON |
 //! | [`cell`] | the input: [`SecondaryCell`] (region, filaments, stable id) and [`CellMaps`] |
 //! | [`growth`] | the growth of Fig. 42: [`SecondaryGrowth`], [`grow_cell`] |
+//! | [`bend`] | streets bowed between their ends ([`SecondaryParams::bow`], ours) |
 //! | [`snap`] | the snap algorithm of §4.3.3 (extended box, three ordered tests, `r`/`s` reuse) |
 //! | [`pattern`] | [`CellPattern`]: where other per-cell road generators plug in |
 //! | [`stats`] | junction statistics ([`StreetStats`]) |
@@ -30,6 +31,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bend;
 pub mod cell;
 pub mod error;
 mod grid;

@@ -146,6 +146,14 @@ pub struct SecondaryParams {
     /// a sharper angle, at its root or where it joins, is dropped. Above 72° no junction
     /// can get a fifth arm. Must be in `[0, 90]`. Default: 0 (no test, Kelly).
     pub min_angle_deg: f64,
+    /// How far each street bows from the straight line between its ends, as a fraction
+    /// of that distance (the sagitta of a half-sine bend; ours, not Kelly's: his growth
+    /// places straight segments), drawn per street with its deviance, to a random side.
+    /// Bows street edges after the growth, where they stay clear of the other roads and
+    /// the maps (see [`bend`](super::bend)); lengthens a street by about `2 bow²` to
+    /// `π² bow² / 4` (0.1: 2–2.5 %). Value in `[0, 0.5]`. Default: 0 (straight streets,
+    /// Kelly).
+    pub bow: Deviated,
     /// Lot width, metres (*Lot Size* and *Lot Deviance*), for the lot stage. Must be > 0.
     /// Default: 14 ± 40 %.
     pub lot_size_m: Deviated,
@@ -173,6 +181,7 @@ impl Default for SecondaryParams {
             road_width_m: Deviated::exact(9.0),
             connectivity: Deviated::exact(1.0),
             min_angle_deg: 0.0,
+            bow: Deviated::exact(0.0),
             lot_size_m: Deviated::new(14.0, 0.4),
             building_height_m: Deviated::new(34.0, 0.7),
             building_hint: BuildingHint::MidRise,
@@ -224,6 +233,16 @@ impl SecondaryParams {
             return Err(SecondaryError::InvalidParameter {
                 name: "min_angle_deg",
                 reason: format!("{}; give an angle in [0, 90] degrees", self.min_angle_deg),
+            });
+        }
+        self.bow.check("bow", 0.0, true)?;
+        if self.bow.value > 0.5 {
+            return Err(SecondaryError::InvalidParameter {
+                name: "bow",
+                reason: format!(
+                    "{}; give a fraction of the street in [0, 0.5]",
+                    self.bow.value
+                ),
             });
         }
         self.lot_size_m.check("lot_size_m", 0.0, false)?;
@@ -279,6 +298,9 @@ mod tests {
         assert_eq!(bad(|p| p.start_sides = 0), "start_sides");
         assert_eq!(bad(|p| p.min_angle_deg = 91.0), "min_angle_deg");
         assert_eq!(bad(|p| p.min_angle_deg = -1.0), "min_angle_deg");
+        assert_eq!(bad(|p| p.bow.value = 0.6), "bow");
+        assert_eq!(bad(|p| p.bow.value = -0.1), "bow");
+        assert_eq!(bad(|p| p.bow.deviance = 1.5), "bow");
     }
 
     #[test]
