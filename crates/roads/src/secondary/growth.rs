@@ -166,6 +166,20 @@ struct Buffers {
     root_ends: Vec<(NodeId, DVec2)>,
 }
 
+impl Buffers {
+    /// Notes the road from the node read (at `a`) to node `n` at `p` in `root_ends` and,
+    /// unless it has no length, in `root_roads`.
+    #[inline]
+    fn add_root_road(&mut self, a: DVec2, n: NodeId, p: DVec2) {
+        self.root_ends.push((n, p));
+        let ap = p - a;
+        let len = ap.length();
+        if len > 0.0 {
+            self.root_roads.push((ap / len, len));
+        }
+    }
+}
+
 /// Planar insertion's snap distance, relative to the segment size: ends and nodes closer
 /// than this are merged, so no road shorter than it is ever made (1 mm per metre of
 /// segment size, at least 1 mm).
@@ -684,6 +698,7 @@ impl Run<'_> {
     /// Whether every proposal from `source` in a direction deviated from `turned` (as
     /// [`deviate`](Self::deviate) draws it) folds onto a road at `source` by test 0,
     /// whatever its length and snap size draws (see [`FoldBound`]).
+    #[inline]
     fn folds_for_sure(
         &mut self,
         source: NodeId,
@@ -722,14 +737,32 @@ impl Run<'_> {
         for &e in self.g.edges_at(source)? {
             let n = self.g.other_end(e, source)?;
             let p = self.g.position(n)?;
-            self.buffers.root_ends.push((n, p));
-            let ap = p - a;
-            let len = ap.length();
-            if len > 0.0 {
-                self.buffers.root_roads.push((ap / len, len));
-            }
+            self.buffers.add_root_road(a, n, p);
         }
         self.root = (Some(source), roads);
+        Ok(())
+    }
+
+    /// The road from `source` (at `a`) to `end` was just added, with no other change at
+    /// `source` (a free end, a joined node, or a split of a road not at `source`: events
+    /// on the root's own roads are refused): if the buffers held `source`'s roads as
+    /// they were at `before` (the graph's edge bound and count), the new road joins
+    /// them, as [`read_root_again`](Self::read_root_again) would read it (the order of
+    /// the roads does not matter to their readers), instead of reading them all again.
+    #[inline]
+    fn root_gained(
+        &mut self,
+        source: NodeId,
+        a: DVec2,
+        before: (usize, usize),
+        end: NodeId,
+    ) -> Result<(), SecondaryError> {
+        if self.root != (Some(source), before) {
+            return Ok(());
+        }
+        let p = self.g.position(end)?;
+        self.buffers.add_root_road(a, end, p);
+        self.root = (Some(source), (self.g.edge_bound(), self.g.edge_count()));
         Ok(())
     }
 
@@ -849,14 +882,19 @@ impl Run<'_> {
         // A free end met nothing within the snap size and a node target passed the exact
         // check, so the road goes in as it is; a road target splits the road through
         // planar insertion, which anchors the end onto it.
+        let before = (self.g.edge_bound(), self.g.edge_count());
         let end = match target {
             Target::Free(q) => {
                 let n = self.g.add_node(q, Junction { step })?;
                 self.g.add_edge(source, n, road)?;
+                self.root_gained(source, a, before, n)?;
                 n
             }
             Target::Node(n) => match self.g.add_edge(source, n, road) {
-                Ok(_) => n,
+                Ok(_) => {
+                    self.root_gained(source, a, before, n)?;
+                    n
+                }
                 Err(
                     polis_geom::GeomError::DuplicateEdge { .. }
                     | polis_geom::GeomError::ZeroLengthEdge { .. },
@@ -882,6 +920,7 @@ impl Run<'_> {
                         let (m, _) = self.g.split_edge(edge, point, Junction { step })?;
                         self.snapper.touched(&self.g, edge);
                         self.g.add_edge(source, m, road)?;
+                        self.root_gained(source, a, before, m)?;
                         m
                     }
                     Join::ZeroLength => {

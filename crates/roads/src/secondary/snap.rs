@@ -213,16 +213,24 @@ impl Snapper {
         let mut best: Option<(f64, NodeId)> = None;
         let mut best_r = 1.0 + radius / len;
         let mut node = |n: NodeId, p: DVec2| {
-            if !ext.contains(p) || !self.first_sight(n) {
+            if !ext.contains(p) {
                 return;
             }
-            let (r, s) = along(p, a, d, len2);
+            // `r` (as `along` computes it) is positive only for a positive `ap·ab`: the
+            // nodes behind the root need no division and no mark.
+            let ap = p - a;
+            let dot = ap.dot(d);
+            let ahead = dot > 0.0;
+            if !ahead || !self.first_sight(n) {
+                return;
+            }
+            let r = dot / len2;
             let better = r < best_r || (r == best_r && best.is_some_and(|(_, m)| n < m));
             if !(r > 0.0 && better) {
                 return;
             }
             let hit = if r <= 1.0 {
-                s.abs() * len <= radius
+                (d.perp_dot(ap) / len2).abs() * len <= radius
             } else {
                 p.distance_squared(b) <= radius * radius
             };
