@@ -94,7 +94,7 @@
 //!   reused while the water bed under it is unchanged, the water bodies with their
 //!   shores' grid while the maps are) and the change events compare the lots and blocks of the two cities.
 //!   Its cost is therefore still proportional to the city's size, not to the dirty set:
-//!   about 0.5 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
+//!   about 0.4 s of CPU per node move on that preset (session 20), far from Kelly's 60 ms per cell;
 //!   BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene
 //!   is not spliced and the terrain not reused (the ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it
