@@ -111,6 +111,10 @@ fn subtree(
     while let Some(n) = stack.pop() {
         let node = nodes.get(n)?;
         n_count += 1;
+        // More visits than nodes: not a tree (a cycle); not indexed.
+        if n_count > nodes.len() {
+            return None;
+        }
         n_max = n_max.max(n);
         for c in &node.children {
             if c.index() <= top {
