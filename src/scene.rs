@@ -432,7 +432,7 @@ pub(crate) struct SceneInputs<'a> {
     pub tile_sets: &'a [TileSet],
     /// Green spaces of the lot stage (parks on the ground).
     pub green_spaces: &'a [PolygonWithHoles],
-    /// Leaves of an earlier scene of the same city to reuse (the editor's splice).
+    /// Cells of an earlier scene of the same city to reuse whole (the editor's splice).
     pub reuse: Option<&'a dyn SceneReuse>,
     /// Terrains of earlier runs to reuse (the editor's memo); only where `ground` does
     /// not depend on the road graph (no roads graded into it).
@@ -499,7 +499,8 @@ pub(crate) fn node_id(name: &str, kind: &str) -> Option<u64> {
     name.strip_prefix(kind)?.strip_prefix(' ')?.parse().ok()
 }
 
-/// A reused leaf: its node's name, translation and metadata, and its meshes.
+/// A building leaf made outside a scene (the editor's in-place patch): its node's name,
+/// translation and metadata, and its meshes.
 pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
 /// How far buildings and plinths reach below the ground: the terrain's one-sided
