@@ -2,7 +2,9 @@
 //! their facade skins, and the shared facade textures as materials.
 //!
 //! The node tree is `city → roads | water`, `city → cell <id> → block <id> | building
-//! <id>`; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
+//! <id>`; each cell's subtree is one run of nodes (the cell, its blocks, then each
+//! building followed by its `lod 0` box) and one run of meshes, which an editor moves
+//! whole when the cell is unchanged; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
 //! `buildings`); building nodes carry `id` (text, exact) and `id_number`, `kind`,
 //! `type`, `height`, `floors`, `lot`, `lot_id`, `cell` and `style` (when dressed), block
 //! nodes `id` and `cell`. The glb writer's default
@@ -17,7 +19,7 @@ use polis_export::surfaces::{RoadSurfaceOptions, road_surface_parts};
 use polis_facades::TileSet;
 
 use polis_geom::par::{self, prelude::*};
-use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, Node, NodeId, Texture};
+use polis_geom::scene::{Image, ImageData, MeshId, MetaValue, Metadata, NodeId, Texture};
 use polis_geom::{
     DVec2, DVec3, Facing, Field, Material, MaterialId, Mesh, PolygonWithHoles, Scene, Transform,
     to_world,
@@ -430,7 +432,7 @@ pub(crate) struct SceneInputs<'a> {
     pub tile_sets: &'a [TileSet],
     /// Green spaces of the lot stage (parks on the ground).
     pub green_spaces: &'a [PolygonWithHoles],
-    /// Leaves of an earlier scene of the same city to reuse (the editor's splice).
+    /// Cells of an earlier scene of the same city to reuse whole (the editor's splice).
     pub reuse: Option<&'a dyn SceneReuse>,
     /// Terrains of earlier runs to reuse (the editor's memo); only where `ground` does
     /// not depend on the road graph (no roads graded into it).
@@ -462,27 +464,23 @@ pub(crate) trait GroundReuse: Sync {
     fn keep_water_base(&self, base: &std::sync::Arc<crate::water::WaterBase>);
 }
 
-/// Parts of an earlier scene an editor hands back to [`assemble`] instead of making them
-/// again. Each method returns what `assemble` would make for the item, or `None` to have
-/// it made; an implementation must only return parts whose inputs (the item, the
-/// ground, the palette, the configuration) are those of the earlier scene.
+/// Cells of an earlier scene an editor hands back to [`assemble`] whole instead of
+/// making their leaves again. An implementation must only hand back a cell whose
+/// inputs (its blocks, buildings, skins and their order; the ground, the palette, the
+/// configuration) are those of the earlier scene, and only a subtree `assemble` made.
 pub(crate) trait SceneReuse: Sync {
-    /// Called once with the buildings of the scene to make, in order, before any of
-    /// their leaves is asked for; `index` below is a position in this list.
-    fn prepare(&self, buildings: &[std::sync::Arc<Building>]);
-    /// The leaf of building `b`, at `index` (with skin `dress`, in cell `cell`).
-    fn building(
-        &self,
-        index: usize,
-        b: &std::sync::Arc<Building>,
-        dress: Option<&std::sync::Arc<Dress>>,
-        cell: Option<u64>,
-    ) -> Option<Reused>;
-    /// The coarse level-of-detail box of building `b`, at `index` (`Some(None)`: it had
-    /// none).
-    fn coarse(&self, index: usize, b: &std::sync::Arc<Building>) -> Option<Option<Mesh>>;
-    /// The leaf of block `b`.
-    fn block(&self, b: &std::sync::Arc<Block>) -> Option<Reused>;
+    /// Whether the subtree of cell `cell` in the earlier scene was made of exactly
+    /// `items` (the same blocks, buildings and skins, in order), so that
+    /// [`take_cell`](Self::take_cell) can hand it back: its numbers of nodes and meshes
+    /// if so.
+    fn whole_cell(&self, cell: u64, items: &CellItems<'_>) -> Option<(usize, usize)>;
+    /// Appends the subtree of cell `cell` of the earlier scene (its nodes and meshes,
+    /// renumbered) to `scene` as the last child of `parent`; `false` (nothing appended)
+    /// if it cannot.
+    ///
+    /// # Errors
+    /// `parent` is not a node of `scene`.
+    fn take_cell(&self, cell: u64, scene: &mut Scene, parent: NodeId) -> Result<bool>;
 }
 
 /// The scene node name of building `id`; [`node_id`] reads it back.
@@ -501,7 +499,8 @@ pub(crate) fn node_id(name: &str, kind: &str) -> Option<u64> {
     name.strip_prefix(kind)?.strip_prefix(' ')?.parse().ok()
 }
 
-/// A reused leaf: its node's name, translation and metadata, and its meshes.
+/// A building leaf made outside a scene (the editor's in-place patch): its node's name,
+/// translation and metadata, and its meshes.
 pub(crate) type Reused = (String, DVec3, Metadata, Vec<Mesh>);
 
 /// How far buildings and plinths reach below the ground: the terrain's one-sided
@@ -725,87 +724,144 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     // diagonal's rise on the bank).
     let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
-    if let Some(r) = inp.reuse {
-        r.prepare(inp.buildings);
+    // Cells in id order: the parent of their blocks and buildings. Each cell's subtree
+    // (its node; its blocks; its buildings, each followed by its coarse box) is one run
+    // of nodes and one run of meshes, so an editor can take it whole (`SceneReuse`).
+    let cell_ids: Vec<u64> = {
+        let mut ids: Vec<u64> = inp
+            .blocks
+            .iter()
+            .map(|b| b.cell_id)
+            .chain(inp.building_cells.iter().copied())
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    };
+    let cell_index = |c: u64| cell_ids.binary_search(&c).ok();
+    // Per cell (by index in `cell_ids`): its blocks and buildings, by index, in order.
+    let mut cell_blocks: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+    let mut cell_buildings: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+    for (i, b) in inp.blocks.iter().enumerate() {
+        if let Some(list) = cell_index(b.cell_id).and_then(|k| cell_blocks.get_mut(k)) {
+            list.push(i);
+        }
     }
-    // Each building's node (name, placement, metadata) and meshes.
-    let buildings_job = || -> Vec<Leaf> {
-        inp.buildings
+    for (i, &c) in inp
+        .building_cells
+        .iter()
+        .enumerate()
+        .take(inp.buildings.len())
+    {
+        if let Some(list) = cell_index(c).and_then(|k| cell_buildings.get_mut(k)) {
+            list.push(i);
+        }
+    }
+    // The cells an earlier scene hands back whole (with their numbers of nodes and
+    // meshes): their leaves are not made.
+    let whole: Vec<Option<(usize, usize)>> = match inp.reuse {
+        Some(r) => cell_ids
             .par_iter()
-            .enumerate()
-            .map(|(i, b)| {
-                let reused = inp.reuse.and_then(|r| {
-                    r.building(
-                        i,
-                        b,
-                        inp.dresses.get(i).and_then(Option::as_ref),
-                        inp.building_cells.get(i).copied(),
-                    )
-                });
-                if let Some((name, translation, metadata, meshes)) = reused {
-                    let node = LeafNode {
-                        name,
-                        translation,
-                        metadata,
-                    };
-                    return Ok((node, meshes));
-                }
-                let leaf = LeafContext {
-                    config: inp.config,
-                    ground: elevation,
-                    palette: &pal,
-                    tile_sets: inp.tile_sets,
-                    foot,
-                };
-                let dress = inp.dresses.get(i).and_then(Option::as_deref);
-                building_leaf(&leaf, b, dress, inp.building_cells.get(i).copied())
+            .zip(cell_blocks.par_iter().zip(cell_buildings.par_iter()))
+            .map(|(&c, (blocks, buildings))| {
+                r.whole_cell(
+                    c,
+                    &CellItems {
+                        blocks: blocks.iter().filter_map(|&i| inp.blocks.get(i)).collect(),
+                        buildings: buildings
+                            .iter()
+                            .filter_map(|&i| {
+                                let b = inp.buildings.get(i)?;
+                                Some((b, inp.dresses.get(i).and_then(Option::as_ref)))
+                            })
+                            .collect(),
+                    },
+                )
             })
+            .collect(),
+        None => vec![None; cell_ids.len()],
+    };
+    let fine = inp.config.effective_lod();
+    let coarse = inp.config.scene.coarse_lod && fine > 0;
+    // Building `i`'s node (name, placement, metadata) and meshes, and its coarse box
+    // when the scene has coarse levels (`None` also where the footprint cannot be
+    // extruded).
+    let make_building = |i: usize| -> Result<(LeafNode, Vec<Mesh>, Option<Mesh>)> {
+        let Some(b) = inp.buildings.get(i) else {
+            return Ok(Default::default());
+        };
+        let leaf = LeafContext {
+            config: inp.config,
+            ground: elevation,
+            palette: &pal,
+            tile_sets: inp.tile_sets,
+            foot,
+        };
+        let dress = inp.dresses.get(i).and_then(Option::as_deref);
+        let (node, meshes) = building_leaf(&leaf, b, dress, inp.building_cells.get(i).copied())?;
+        let boxed = if coarse {
+            coarse_box(inp.config, elevation, &pal, b, foot)
+        } else {
+            None
+        };
+        Ok((node, meshes, boxed))
+    };
+    // Block `i`'s node and kerb-high plinth (none without a kerb).
+    let kerb = inp.config.scene.kerb_height_m;
+    let make_block = |i: usize| -> Result<Option<(LeafNode, Vec<Mesh>)>> {
+        let Some(block) = inp.blocks.get(i).filter(|_| kerb > 0.0) else {
+            return Ok(None);
+        };
+        let base = ground(elevation, block.polygon.outer.points());
+        let plinth = if inp.config.maps.elevation.is_some() {
+            // On an elevation map the plinth follows the ground: its top a kerb
+            // above it, its bottom a foot below it, at every vertex.
+            let mut m = Mesh::new(Some(pal.pavement));
+            let height = |p: DVec2| {
+                let g = elevation.sample(p);
+                if g.is_finite() { g } else { base }
+            };
+            m.add_draped_slab(&block.polygon, &PLINTH_REFINE, height, -plinth_foot, kerb)?;
+            m
+        } else {
+            polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
+        };
+        let node = LeafNode {
+            name: block_node_name(block.id()),
+            translation: DVec3::ZERO,
+            metadata: Metadata::from([
+                ("layer", MetaValue::from_static("blocks")),
+                ("id", MetaValue::from(block.id().to_string().as_str())),
+                ("cell", MetaValue::from(block.cell_id as f64)),
+            ]),
+        };
+        Ok(Some((node, vec![plinth])))
+    };
+    // The leaves of the cells not handed back whole, made in parallel: by index, `None`
+    // for the others.
+    let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
+        let mut made = vec![false; len];
+        for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
+            for &i in list {
+                if let Some(m) = made.get_mut(i) {
+                    *m = true;
+                }
+            }
+        }
+        made
+    };
+    let buildings_job = || -> Vec<Option<BuildingMade>> {
+        let made = todo(&cell_buildings, inp.buildings.len());
+        made.par_iter()
+            .enumerate()
+            .map(|(i, &m)| m.then(|| make_building(i)))
             .collect()
     };
-    // Each block's node and kerb-high plinth.
-    let kerb = inp.config.scene.kerb_height_m;
-    let blocks_job = || -> Vec<Leaf> {
-        if kerb <= 0.0 {
-            return Vec::new();
-        }
-        inp.blocks
-            .par_iter()
-            .map(|block| {
-                if let Some((name, translation, metadata, meshes)) =
-                    inp.reuse.and_then(|r| r.block(block))
-                {
-                    let node = LeafNode {
-                        name,
-                        translation,
-                        metadata,
-                    };
-                    return Ok((node, meshes));
-                }
-                let base = ground(elevation, block.polygon.outer.points());
-                let plinth = if inp.config.maps.elevation.is_some() {
-                    // On an elevation map the plinth follows the ground: its top a kerb
-                    // above it, its bottom a foot below it, at every vertex.
-                    let mut m = Mesh::new(Some(pal.pavement));
-                    let height = |p: DVec2| {
-                        let g = elevation.sample(p);
-                        if g.is_finite() { g } else { base }
-                    };
-                    m.add_draped_slab(&block.polygon, &PLINTH_REFINE, height, -plinth_foot, kerb)?;
-                    m
-                } else {
-                    polis_geom::mesh::prism(&block.polygon, base, base + kerb, Some(pal.pavement))?
-                };
-                let node = LeafNode {
-                    name: block_node_name(block.id()),
-                    translation: DVec3::ZERO,
-                    metadata: Metadata::from([
-                        ("layer", MetaValue::from_static("blocks")),
-                        ("id", MetaValue::from(block.id().to_string().as_str())),
-                        ("cell", MetaValue::from(block.cell_id as f64)),
-                    ]),
-                };
-                Ok((node, vec![plinth]))
-            })
+    let blocks_job = || -> Vec<Option<BlockMade>> {
+        let made = todo(&cell_blocks, inp.blocks.len());
+        made.par_iter()
+            .enumerate()
+            .map(|(i, &m)| m.then(|| make_block(i)))
             .collect()
     };
     // Water bodies (flat surfaces at their level, `crate::water`) and the ground
@@ -928,74 +984,111 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         scene.attach_mesh(node, mesh)?;
     }
 
-    // Cells in id order: the parent of their blocks and buildings.
-    let mut cell_ids: Vec<u64> = inp
-        .blocks
-        .iter()
-        .map(|b| b.cell_id)
-        .chain(inp.building_cells.iter().copied())
-        .collect();
-    cell_ids.sort_unstable();
-    cell_ids.dedup();
-    let mut cell_nodes = Vec::with_capacity(cell_ids.len());
-    for &c in &cell_ids {
-        let node = scene.add_node(root, format!("cell {c}"))?;
-        scene.set_metadata(node, "cell", c as f64)?;
-        cell_nodes.push(node);
-    }
-    let cell_node = |c: u64| {
-        cell_ids
-            .binary_search(&c)
-            .ok()
-            .and_then(|i| cell_nodes.get(i).copied())
-    };
-
-    // Blocks, then buildings, under their cells (every leaf's cell has a node; the root
-    // would adopt one that had not).
+    // Each cell's subtree: taken whole from the earlier scene, or its node and leaves
+    // (blocks, then buildings with their coarse boxes under them).
     let mut blocks = blocks;
     let mut buildings = buildings;
-    let parents: Vec<NodeId> = inp
-        .blocks
-        .iter()
-        .map(|b| b.cell_id)
-        .chain(inp.building_cells.iter().copied())
-        .map(|c| cell_node(c).unwrap_or(root))
-        .collect();
-    let (block_parents, building_parents) = parents.split_at(blocks.len().min(parents.len()));
-    insert_leaves(&mut scene, &mut blocks, block_parents)?;
-    let first_building = scene.nodes.len();
-    insert_leaves(&mut scene, &mut buildings, building_parents)?;
-    let building_count = scene.nodes.len() - first_building;
-
-    // Coarse level of detail: each building's footprint extruded to its height, a child
-    // `lod 0` of the building node, whose own meshes become the finest level.
-    let fine = inp.config.effective_lod();
-    if inp.config.scene.coarse_lod && fine > 0 {
-        let boxes: Vec<Option<Mesh>> = inp
-            .buildings
-            .par_iter()
-            .take(building_count)
-            .enumerate()
-            .map(|(i, b)| {
-                if let Some(made) = inp.reuse.and_then(|r| r.coarse(i, b)) {
-                    return made;
-                }
-                coarse_box(inp.config, elevation, &pal, b, foot)
-            })
-            .collect();
-        for (k, made) in boxes.into_iter().enumerate() {
-            // A footprint that cannot be extruded keeps its one level, drawn at every
-            // distance.
-            let Some(mesh) = made else { continue };
-            let node = NodeId((first_building + k) as u32);
-            scene.set_metadata(node, "lod", fine as f64)?;
-            let child = scene.add_node(node, "lod 0")?;
-            scene.set_metadata(child, "lod", 0.0)?;
-            let mesh = scene.add_mesh(mesh);
-            scene.attach_mesh(child, mesh)?;
+    // Room for every cell's nodes and meshes, made once.
+    let (mut more_nodes, mut more_meshes) = (0, 0);
+    for (k, w) in whole.iter().enumerate() {
+        if let Some((nodes, meshes)) = w {
+            more_nodes += nodes;
+            more_meshes += meshes;
+            continue;
+        }
+        more_nodes += 1;
+        for i in cell_blocks.get(k).into_iter().flatten() {
+            if let Some(Some(Ok(Some((_, meshes))))) = blocks.get(*i) {
+                more_nodes += 1;
+                more_meshes += meshes.len();
+            }
+        }
+        for i in cell_buildings.get(k).into_iter().flatten() {
+            if let Some(Some(Ok((_, meshes, boxed)))) = buildings.get(*i) {
+                let boxed = usize::from(boxed.is_some());
+                more_nodes += 1 + boxed;
+                more_meshes += meshes.len() + boxed;
+            }
+        }
+    }
+    scene.nodes.reserve(more_nodes);
+    scene.meshes.reserve(more_meshes);
+    for (k, &c) in cell_ids.iter().enumerate() {
+        if whole.get(k).copied().flatten().is_some()
+            && let Some(r) = inp.reuse
+            && r.take_cell(c, &mut scene, root)?
+        {
+            continue;
+        }
+        let node = scene.add_node(root, format!("cell {c}"))?;
+        scene.set_metadata(node, "cell", c as f64)?;
+        for &i in cell_blocks.get(k).map(Vec::as_slice).unwrap_or_default() {
+            let made = match blocks.get_mut(i).and_then(Option::take) {
+                Some(made) => made,
+                None => make_block(i),
+            }?;
+            if let Some((leaf, meshes)) = made {
+                push_leaf(&mut scene, node, leaf, meshes)?;
+            }
+        }
+        for &i in cell_buildings.get(k).map(Vec::as_slice).unwrap_or_default() {
+            let (leaf, meshes, boxed) = match buildings.get_mut(i).and_then(Option::take) {
+                Some(made) => made,
+                None => make_building(i),
+            }?;
+            let leaf = push_leaf(&mut scene, node, leaf, meshes)?;
+            // Coarse level of detail: the footprint extruded to the building's height,
+            // a child `lod 0` of the building node, whose own meshes become the finest
+            // level. A footprint that cannot be extruded keeps its one level, drawn at
+            // every distance.
+            if let Some(mesh) = boxed {
+                scene.set_metadata(leaf, "lod", fine as f64)?;
+                let child = scene.add_node(leaf, "lod 0")?;
+                scene.set_metadata(child, "lod", 0.0)?;
+                let mesh = scene.add_mesh(mesh);
+                scene.attach_mesh(child, mesh)?;
+            }
         }
     }
     Ok(scene)
+}
+
+/// A building's leaf as made: its node's parts, its meshes and its coarse box.
+type BuildingMade = Result<(LeafNode, Vec<Mesh>, Option<Mesh>)>;
+
+/// A block's leaf as made (`None`: no plinth, no leaf).
+type BlockMade = Result<Option<(LeafNode, Vec<Mesh>)>>;
+
+/// The blocks and buildings (with skins) of one cell of a scene, in the order
+/// [`assemble`] puts their leaves under the cell's node.
+pub(crate) struct CellItems<'a> {
+    /// The cell's blocks.
+    pub blocks: Vec<&'a std::sync::Arc<Block>>,
+    /// The cell's buildings, each with its skin.
+    pub buildings: Vec<(
+        &'a std::sync::Arc<Building>,
+        Option<&'a std::sync::Arc<Dress>>,
+    )>,
+}
+
+/// Adds `leaf` with `meshes` as the last child of `parent`; returns its node.
+fn push_leaf(
+    scene: &mut Scene,
+    parent: NodeId,
+    leaf: LeafNode,
+    meshes: Vec<Mesh>,
+) -> Result<NodeId> {
+    let node = scene.add_node(parent, leaf.name)?;
+    let first = scene.meshes.len();
+    let ids = (first..first + meshes.len())
+        .map(|i| MeshId(i as u32))
+        .collect();
+    scene.meshes.extend(meshes);
+    let n = scene.node_mut(node)?;
+    n.transform = Transform::from_translation(leaf.translation);
+    n.metadata = leaf.metadata;
+    n.meshes = ids;
+    Ok(node)
 }
 
 /// What a leaf node of the scene (a block, a building) is made of before it joins the
@@ -1006,75 +1099,6 @@ struct LeafNode {
     /// Placement relative to the cell node.
     translation: DVec3,
     metadata: Metadata,
-}
-
-/// A leaf made in parallel: its node's parts and its meshes.
-type Leaf = Result<(LeafNode, Vec<Mesh>)>;
-
-/// Appends `made` (in order) as children of `parents`: node ids, mesh ids and the
-/// parents' child lists are assigned serially, which is cheap; the nodes and meshes are
-/// moved into the scene's arrays in parallel, so their fresh pages are touched on every
-/// core. The first error in order is returned, as a serial insertion would.
-fn insert_leaves(scene: &mut Scene, made: &mut [Leaf], parents: &[NodeId]) -> Result<()> {
-    if let Some(bad) = made.iter_mut().find(|m| m.is_err()) {
-        return std::mem::replace(bad, Ok(Default::default())).map(|_| ());
-    }
-    let count = made.len().min(parents.len());
-    let made = made.get_mut(..count).unwrap_or_default();
-    let node_base = scene.nodes.len();
-    let mesh_base = scene.meshes.len();
-    let mut first_mesh = Vec::with_capacity(count);
-    let mut next_mesh = mesh_base;
-    for (k, (m, &parent)) in made.iter().zip(parents).enumerate() {
-        first_mesh.push(next_mesh);
-        next_mesh += m.as_ref().map_or(0, |(_, meshes)| meshes.len());
-        scene
-            .node_mut(parent)?
-            .children
-            .push(NodeId((node_base + k) as u32));
-    }
-    scene.nodes.par_extend(
-        made.par_iter_mut()
-            .zip(first_mesh.par_iter())
-            .map(|(m, &first)| {
-                let (leaf, len) = m
-                    .as_mut()
-                    .map(|(leaf, meshes)| (std::mem::take(leaf), meshes.len()))
-                    .unwrap_or_default();
-                Node {
-                    name: leaf.name,
-                    transform: Transform::from_translation(leaf.translation),
-                    meshes: (first..first + len).map(|i| MeshId(i as u32)).collect(),
-                    children: Vec::new(),
-                    metadata: leaf.metadata,
-                }
-            }),
-    );
-    // Fresh slots (filled on every core), then each leaf's meshes moved into its own.
-    scene.meshes.par_extend(
-        (mesh_base..next_mesh)
-            .into_par_iter()
-            .map(|_| Mesh::default()),
-    );
-    let mut rest = scene.meshes.get_mut(mesh_base..).unwrap_or_default();
-    let mut slots = Vec::with_capacity(count);
-    for m in made.iter() {
-        let len = m.as_ref().map_or(0, |(_, meshes)| meshes.len());
-        let Some((slot, tail)) = std::mem::take(&mut rest).split_at_mut_checked(len) else {
-            break;
-        };
-        slots.push(slot);
-        rest = tail;
-    }
-    made.par_iter_mut().zip(slots).for_each(|(m, slot)| {
-        if let Ok((_, meshes)) = m {
-            for (to, mesh) in slot.iter_mut().zip(meshes.drain(..)) {
-                *to = mesh;
-            }
-            *meshes = Vec::new();
-        }
-    });
-    Ok(())
 }
 
 /// The name of a building kind's map class: the `kind` of a building in the glb, the

@@ -50,9 +50,10 @@
 //! but for the lot overrides, the facade settings and the level of detail, so an edit of
 //! lots, buildings or styles keeps the union graph and its cells whole (keyed by a digest
 //! of what they read). And the 3-D scene is spliced (see `splice.rs`): it is assembled
-//! again, but every block and building equal to the one before the edit (same item,
-//! same skin and cell; same scene-wide settings and ground) takes its node and meshes
-//! from the scene before the edit instead of being meshed again.
+//! again, but every road-graph cell whose blocks, buildings and skins are those before
+//! the edit (same scene-wide settings and ground) takes its whole subtree from the scene
+//! before the edit, one run of nodes and one of meshes moved and renumbered, instead of
+//! being meshed again; a cell with any change has all its leaves made again.
 //!
 //! # Stable identity
 //!
@@ -87,12 +88,13 @@
 //!   buildings and skins whole, in one look-up), meshes the road surfaces again (a memo
 //!   of their pieces was measured to save nothing: their cost is the plan of the whole
 //!   network and the pass that writes its meshes, not the pieces), assembles
-//!   the scene again (reused leaves, matched to the old ones by position, take their
-//!   meshes, names and metadata from the old scene without copying them; the terrain is
+//!   the scene again (a cell left alone moves its subtree's runs of nodes and meshes
+//!   out of the old scene, without a look-up per leaf, but every node and mesh of the
+//!   city is still moved into the new scene's arrays; the terrain is
 //!   reused while the water bed under it is unchanged, the water bodies with their
 //!   shores' grid while the maps are) and the change events compare the lots and blocks of the two cities.
 //!   Its cost is therefore still proportional to the city's size, not to the dirty set:
-//!   about 0.5 s of CPU per edit on that preset, far from Kelly's 60 ms per cell;
+//!   about 0.4 s of CPU per node move on that preset (session 20), far from Kelly's 60 ms per cell;
 //!   BENCHMARKS.md gives the profile. With roads graded into an elevation map the scene
 //!   is not spliced and the terrain not reused (the ground depends on every road).
 //! * Painting parks or water-like values does not re-check existing primary roads; it
