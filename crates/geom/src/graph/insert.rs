@@ -310,14 +310,16 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         if a == b {
             return Err(GeomError::ZeroLengthEdge { a: pp, b: pq });
         }
-        self.connect(a, b, (p, q), &payload, snap, &mut make_node, &mut out, 0)?;
+        let checked = self.connect(a, b, (p, q), &payload, snap, &mut make_node, &mut out, 0)?;
         // The created edges, then both pieces of each split that still exist (no list
-        // built: one allocation less per segment).
+        // built: one allocation less per segment). The walk's last edge is left out when
+        // the walk already found it clean (see `connect`): nothing has changed since.
         let split = out.split.iter().flat_map(|&(e, piece)| [e, piece]);
         let touched = out
             .created
             .iter()
             .copied()
+            .filter(|&e| Some(e) != checked)
             .chain(split.filter(|&x| self.contains_edge(x)));
         self.check_local(touched)?;
         Ok(out)
@@ -458,6 +460,11 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     /// Joins node `from` to node `to` by the walk described in the module docs; `line` is
     /// the segment as the caller gave it, which every node of the route stays within the
     /// snap distance of.
+    ///
+    /// Returns the edge the walk created last if it was its last step and the query that
+    /// found its leg free already showed it meets no edge away from its ends: exactly
+    /// what [`check_local`](Self::check_local) would find for it, since the graph has not
+    /// changed since but for the edge itself.
     #[allow(clippy::too_many_arguments)]
     fn connect(
         &mut self,
@@ -469,8 +476,9 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         make_node: &mut impl FnMut(DVec2) -> N,
         out: &mut Insertion,
         depth: usize,
-    ) -> Result<(), GeomError> {
+    ) -> Result<Option<EdgeId>, GeomError> {
         out.nodes.push(from);
+        let mut checked = None;
         let mut cur = from;
         let mut targets = Targets::new(to);
         let limit = 64 + 8 * (self.node_count() + self.edge_count());
@@ -486,13 +494,19 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 targets.pop();
                 continue;
             }
-            match self.next_event(cur, target, line, snap, &out.nodes, targets.as_slice())? {
+            checked = None;
+            let (event, clean) =
+                self.next_event(cur, target, line, snap, &out.nodes, targets.as_slice())?;
+            match event {
                 None => {
                     let e = match self.find_edge(cur, target) {
                         Some(e) => e,
                         None => {
                             let e = self.add_edge(cur, target, payload.clone())?;
                             out.created.push(e);
+                            if clean {
+                                checked = Some(e);
+                            }
                             e
                         }
                     };
@@ -528,7 +542,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 }
             }
         }
-        Ok(())
+        Ok(checked)
     }
 
     /// The first event on the straight line from `cur` to `target`, if any. Nodes already
@@ -541,6 +555,10 @@ impl<N, E: Clone> PlanarGraph<N, E> {
     /// collinear nodes used to be pulled from node to node along the row. And a node
     /// merely within the snap distance (not within rounding) is a detour taken only where
     /// the straight detour meets no edge ([`sees`](Self::sees)).
+    ///
+    /// Also returns whether the leg `cur–target` meets every edge only at `cur` or
+    /// `target` by an edge ending there ([`meets_elsewhere`](Self::meets_elsewhere)
+    /// finds nothing): the same query, read the same way.
     fn next_event(
         &self,
         cur: NodeId,
@@ -549,7 +567,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         snap: f64,
         visited: &[NodeId],
         pending: &[NodeId],
-    ) -> Result<Option<Event>, GeomError> {
+    ) -> Result<(Option<Event>, bool), GeomError> {
         let fresh =
             |n: NodeId| n != cur && n != target && !visited.contains(&n) && !pending.contains(&n);
         let (pc, pt) = (self.position(cur)?, self.position(target)?);
@@ -597,6 +615,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         // Edges meeting the segment (in no particular order either; a corrupt graph is
         // reported whichever offending edge comes first).
         let mut failure: Option<GeomError> = None;
+        let mut clean = true;
         let mut visit = |hit: SegmentHit<EdgeId>| -> Result<(), GeomError> {
             match hit.kind {
                 SegmentIntersection::Crossing { point, .. } => {
@@ -642,15 +661,17 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 if failure.is_none()
                     && let Shape::Segment(s0, s1) = *s
                     && let Some(hit) = classify_hit(key, pc, pt, s0, s1)
-                    && let Err(e) = visit(hit)
                 {
-                    failure = Some(e);
+                    clean = clean && self.meets_at_ends(&hit, (cur, pc), (target, pt));
+                    if let Err(e) = visit(hit) {
+                        failure = Some(e);
+                    }
                 }
             });
         if let Some(e) = failure {
             return Err(e);
         }
-        Ok(best.map(|(_, ev)| ev))
+        Ok((best.map(|(_, ev)| ev), clean))
     }
 
     /// Bends every edge passing within rounding distance of the new node `m` (but not
@@ -880,19 +901,28 @@ impl<N, E: Clone> PlanarGraph<N, E> {
                 let Some(hit) = classify_hit(key, pa, pb, s0, s1) else {
                     return;
                 };
-                let ok = match hit.kind {
-                    SegmentIntersection::Touching { point, .. } => {
-                        self.endpoints(key).is_ok_and(|(c, d)| {
-                            (point == pa && (c == a || d == a))
-                                || (point == pb && (c == b || d == b))
-                        })
-                    }
-                    _ => false,
-                };
-                if !ok {
+                if !self.meets_at_ends(&hit, (a, pa), (b, pb)) {
                     bad = Some(hit);
                 }
             });
         bad
+    }
+
+    /// Whether `hit` (of an edge with the segment between nodes `a` and `b`) is a touch
+    /// at `a` or `b` by an edge ending there: the only allowed way to meet.
+    fn meets_at_ends(
+        &self,
+        hit: &SegmentHit<EdgeId>,
+        (a, pa): (NodeId, DVec2),
+        (b, pb): (NodeId, DVec2),
+    ) -> bool {
+        match hit.kind {
+            SegmentIntersection::Touching { point, .. } => {
+                self.endpoints(hit.key).is_ok_and(|(c, d)| {
+                    (point == pa && (c == a || d == a)) || (point == pb && (c == b || d == b))
+                })
+            }
+            _ => false,
+        }
     }
 }
