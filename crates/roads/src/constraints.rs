@@ -45,6 +45,14 @@ pub trait LocalConstraints: Send {
     fn stats(&self) -> ConstraintStats {
         ConstraintStats::default()
     }
+
+    /// The junction at `road.start` found by the last [`adjust`](Self::adjust), if it
+    /// looked for one: a hint for the planar insertion, which checks it and searches
+    /// itself when it does not hold (so a wrong answer costs time, never a different
+    /// network). Default: none.
+    fn start_node(&self) -> Option<NodeId> {
+        None
+    }
 }
 
 /// What [`DefaultConstraints`] did.
@@ -84,6 +92,8 @@ pub struct DefaultConstraints {
     params: RoadParams,
     legality: Legality,
     stats: ConstraintStats,
+    /// The start junction found by the last `adjust`.
+    start_node: Option<NodeId>,
 }
 
 /// Distance (metres) under which a point counts as the start junction.
@@ -96,6 +106,7 @@ impl DefaultConstraints {
             params: params.clone(),
             legality: Legality::new(inputs, params),
             stats: ConstraintStats::default(),
+            start_node: None,
         }
     }
 
@@ -310,6 +321,7 @@ impl LocalConstraints for DefaultConstraints {
     /// two-step order would stop short of it.)
     fn adjust(&mut self, road: &mut RoadAttr, net: &RoadNetwork) -> QueryState {
         self.stats.proposals += 1;
+        self.start_node = None;
         let a = road.start;
         if !(a.is_finite()
             && road.angle.is_finite()
@@ -321,6 +333,7 @@ impl LocalConstraints for DefaultConstraints {
         }
         let min_len = self.params.min_segment_length_m.max(1e-3);
         let start_node = net.nearest_node(a, SAME_POINT_M).map(|(n, _)| n);
+        self.start_node = start_node;
         let proposed = a + dir(road.angle) * road.length;
         // The proposal as given, snapped: taken when that road is legal.
         let first = self.snap_event(net, start_node, a, proposed, road.class);
@@ -428,6 +441,10 @@ impl LocalConstraints for DefaultConstraints {
 
     fn stats(&self) -> ConstraintStats {
         self.stats
+    }
+
+    fn start_node(&self) -> Option<NodeId> {
+        self.start_node
     }
 }
 

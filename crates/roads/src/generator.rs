@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use polis_geom::GeomError;
-use polis_geom::graph::SnapOptions;
+use polis_geom::graph::{InsertHints, SnapOptions};
 use polis_geom::spatial::GridOptions;
 use polis_lsystem::{Derivation, DeriveOptions, Environment, TurtleState, TypedRules};
 use serde::{Deserialize, Serialize};
@@ -129,10 +129,16 @@ impl RoadEnv<'_> {
         let opts = SnapOptions {
             snap_distance: INSERT_SNAP_M,
         };
+        // The constraints found the start junction already: the insertion checks it
+        // instead of searching again.
+        let hints = InsertHints {
+            start: self.constraints.start_node(),
+        };
         match self
             .graph
-            .insert_segment_with(road.start, road.end, payload, &opts, |_| Junction { step })
-        {
+            .insert_segment_hinted(road.start, road.end, payload, &opts, &hints, |_| Junction {
+                step,
+            }) {
             Ok(ins) => {
                 self.segments += 1;
                 if let Some(p) = ins.nodes.last().and_then(|&n| self.graph.position(n).ok()) {

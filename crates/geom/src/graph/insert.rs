@@ -142,6 +142,19 @@ pub struct Insertion {
     pub split: Vec<(EdgeId, EdgeId)>,
 }
 
+/// Answers a caller may already know about a segment it inserts
+/// ([`PlanarGraph::insert_segment_hinted`]). Each is checked exactly before it is used
+/// and ignored when it does not hold, so hints change the cost of an insertion, never its
+/// result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct InsertHints {
+    /// The node the segment starts at: taken as the first end's anchor, without a search,
+    /// when the node sits exactly at the first end and the graph is planar by construction
+    /// ([`PlanarGraph::is_planar_by_construction`]: its planar insertions never put two
+    /// nodes at one position, so the node is the nearest one there).
+    pub start: Option<NodeId>,
+}
+
 /// Where a point lands after snapping.
 #[derive(Debug, Clone, Copy)]
 enum Anchor {
@@ -269,8 +282,26 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         options: &SnapOptions,
         make_node: impl FnMut(DVec2) -> N,
     ) -> Result<Insertion, GeomError> {
+        self.insert_segment_hinted(p, q, payload, options, &InsertHints::default(), make_node)
+    }
+
+    /// [`insert_segment_with`](Self::insert_segment_with) given what the caller knows
+    /// about the segment ([`InsertHints`]): the same result, with less searching where
+    /// the hints hold.
+    ///
+    /// # Errors
+    /// As [`insert_segment_with`](Self::insert_segment_with).
+    pub fn insert_segment_hinted(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: E,
+        options: &SnapOptions,
+        hints: &InsertHints,
+        make_node: impl FnMut(DVec2) -> N,
+    ) -> Result<Insertion, GeomError> {
         let planar = self.planar_by_construction;
-        let result = self.insert_segment_unmarked(p, q, payload, options, make_node);
+        let result = self.insert_segment_unmarked(p, q, payload, options, hints, make_node);
         self.planar_by_construction = planar && keeps_planarity(&result);
         result
     }
@@ -283,6 +314,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         q: DVec2,
         payload: E,
         options: &SnapOptions,
+        hints: &InsertHints,
         mut make_node: impl FnMut(DVec2) -> N,
     ) -> Result<Insertion, GeomError> {
         validate_point(0, p)?;
@@ -291,7 +323,15 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let snap = options.snap_distance;
         let scale = p.abs().max(q.abs()).max_element().max(1.0);
         let snap = snap.max(ROUNDING_TOLERANCE * scale);
-        let (ap, aq) = (self.anchor(p, snap), self.anchor(q, snap));
+        // A node exactly at p is the nearest node to p (the only one there, in a graph
+        // planar by construction): `anchor` would find it first.
+        let ap = match hints.start {
+            Some(n) if self.planar_by_construction && self.position(n).is_ok_and(|x| x == p) => {
+                Anchor::Node(n)
+            }
+            _ => self.anchor(p, snap),
+        };
+        let aq = self.anchor(q, snap);
         let (pp, pq) = (self.anchor_position(ap)?, self.anchor_position(aq)?);
         let same_node = matches!((ap, aq), (Anchor::Node(x), Anchor::Node(y)) if x == y);
         if same_node || pp == pq || pp.distance(pq) <= snap || q.distance(pp) <= snap {

@@ -590,3 +590,59 @@ fn planar_insert_open_fuzz_finding_10() {
     let hex = "000000cb0600ffffffff4500d50000233f0000000000370000233f00000000d30000000031000000f7ff0000000000000000000000000034060013000036000000000000006b6b6b6b6b6b6b6bffffff006b6b6b83000034140400";
     replay(hex);
 }
+
+/// Inserts `segs` into two graphs, one plainly and one with hints (the node at the first
+/// end when there is one, else `wrong`), and asserts the same results and graphs.
+fn hinted_matches_plain(
+    segs: &[(DVec2, DVec2)],
+    opts: &SnapOptions,
+    wrong: u32,
+) -> Result<(), TestCaseError> {
+    let (mut plain, mut hinted) = (G::new(), G::new());
+    for &(p, q) in segs {
+        let start = hinted
+            .nearest_node(p, 0.0)
+            .map(|(n, _)| n)
+            .or(Some(NodeId(wrong)));
+        let hints = InsertHints { start };
+        let a = plain.insert_segment(p, q, 0, opts);
+        let b = hinted.insert_segment_hinted(p, q, 0, opts, &hints, |_| ());
+        prop_assert_eq!(a, b);
+        prop_assert_eq!(
+            plain.is_planar_by_construction(),
+            hinted.is_planar_by_construction()
+        );
+    }
+    let nodes = |g: &G| g.nodes().map(|(n, p, _)| (n, p)).collect::<Vec<_>>();
+    let edges = |g: &G| {
+        g.edges()
+            .map(|(e, a, b, &w)| (e, a, b, w))
+            .collect::<Vec<_>>()
+    };
+    prop_assert_eq!(nodes(&plain), nodes(&hinted));
+    prop_assert_eq!(edges(&plain), edges(&hinted));
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(100))]
+
+    /// Hints change the cost of an insertion, never its result: chains that start at
+    /// existing nodes (right hints) and free segments (wrong or dead hints).
+    #[test]
+    fn hints_never_change_the_result(
+        segs in prop::collection::vec(int_segment(), 1..16),
+        chain in prop::collection::vec((-2i32..=2, -2i32..=2), 0..10),
+        wrong in 0u32..40,
+    ) {
+        let mut all = segs.clone();
+        let mut at = segs.last().map_or(v(0., 0.), |s| s.1);
+        for (dx, dy) in chain {
+            let next = at + v(f64::from(dx), f64::from(dy));
+            all.push((at, next));
+            at = next;
+        }
+        hinted_matches_plain(&all, &EXACT, wrong)?;
+        hinted_matches_plain(&all, &SnapOptions { snap_distance: 0.3 }, wrong)?;
+    }
+}

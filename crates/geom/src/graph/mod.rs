@@ -93,7 +93,7 @@ use crate::error::{GeomError, validate_point};
 use crate::predicates::{AngleStart, ccw_cmp};
 use crate::spatial::{GridOptions, SegmentHit, SegmentIndex, SegmentNear, SpatialIndex};
 
-pub use insert::{Insertion, ROUNDING_TOLERANCE, SnapOptions};
+pub use insert::{InsertHints, Insertion, ROUNDING_TOLERANCE, SnapOptions};
 
 /// The id of a node of a [`PlanarGraph`]. Stable: never reused after removal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
