@@ -31,7 +31,9 @@
 //! target instead). A bend moves an edge by up to
 //! that distance, so its two legs are inserted by this same walk (splitting any edge the
 //! move takes them across); all edges passing within rounding of the node are bent together.
-//! Every created or split edge is checked against the edge index before the call returns.
+//! Every created or split edge is checked against the edge index before the call returns
+//! (the walk's last edge by the very query that found its leg free, when nothing changed
+//! after it).
 //!
 //! # Guarantees
 //! * After every successful call the graph is planar in the sense of
@@ -53,7 +55,8 @@
 //! * On [`GeomError::GraphCorrupt`] (a graph that was not planar before the call) the
 //!   graph may be left partly modified.
 //! * Cost per segment: a handful of index queries plus one per crossing; nodes within the
-//!   snap distance of a long segment are found through its bounding box.
+//!   snap distance of a long segment are found through its bounding box. A caller that
+//!   knows the start node passes it in [`InsertHints`] to save the first end's search.
 
 use glam::DVec2;
 
