@@ -967,3 +967,23 @@ fn edits_on_a_coast_keep_the_terrain_generate_makes() {
     ed.undo().unwrap();
     assert_same_as_generate(&ed);
 }
+
+/// A cell's building height changes its buildings: every change event equals a full
+/// comparison of the two cities.
+#[test]
+fn events_of_a_height_edit_equal_a_full_comparison() {
+    let mut ed = CityEditor::new(small()).unwrap();
+    let (buildings, items_before) = (building_texts(ed.city()), items(ed.city()));
+    let cells = ed.cells();
+    let cell = cells[cells.len() / 2].id;
+    let ev = ed
+        .apply(Edit::SetCellParam {
+            cell,
+            param: CellParam::BuildingHeight(Deviated::new(14.0, 0.1)),
+        })
+        .unwrap();
+    assert!(!ev.buildings.changed.is_empty(), "{:?}", ev.buildings);
+    check_building_events(&buildings, ed.city(), &ev);
+    check_lot_and_block_events(&items_before, ed.city(), &ev);
+    assert_same_as_generate(&ed);
+}
