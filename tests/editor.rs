@@ -139,6 +139,116 @@ fn check_building_events(before: &BTreeMap<u64, String>, after: &City, ev: &Chan
     assert_eq!(ev.buildings.removed, removed, "removed buildings");
 }
 
+/// Lots with their cells, by id, as comparable text.
+fn lot_texts(city: &City) -> BTreeMap<u64, String> {
+    city.lots
+        .iter()
+        .map(|l| (l.id, format!("{:?} {}", l.lot, l.cell)))
+        .collect()
+}
+
+/// Blocks by id, as comparable text.
+fn block_texts(city: &City) -> BTreeMap<u64, String> {
+    city.blocks
+        .iter()
+        .map(|b| (b.id(), format!("{b:?}")))
+        .collect()
+}
+
+/// Changed, added and removed keys from `before` to `after`, each ascending.
+fn full_delta(before: &BTreeMap<u64, String>, after: &BTreeMap<u64, String>) -> [Vec<u64>; 3] {
+    [
+        before
+            .iter()
+            .filter(|(k, v)| after.get(*k).is_some_and(|w| w != *v))
+            .map(|(k, _)| *k)
+            .collect(),
+        after
+            .keys()
+            .filter(|k| !before.contains_key(*k))
+            .copied()
+            .collect(),
+        before
+            .keys()
+            .filter(|k| !after.contains_key(*k))
+            .copied()
+            .collect(),
+    ]
+}
+
+/// What the lot and block events of an edit are checked against: the city's lots and
+/// blocks by id as text, each block's id and cell, and its road-graph cells.
+struct Items {
+    lots: BTreeMap<u64, String>,
+    blocks: BTreeMap<u64, String>,
+    block_cells: Vec<(u64, u64)>,
+    cells: BTreeSet<u64>,
+}
+
+fn items(c: &City) -> Items {
+    Items {
+        lots: lot_texts(c),
+        blocks: block_texts(c),
+        block_cells: c.blocks.iter().map(|b| (b.id(), b.cell_id)).collect(),
+        cells: c
+            .lots
+            .iter()
+            .map(|l| l.cell)
+            .chain(c.blocks.iter().map(|b| b.cell_id))
+            .collect(),
+    }
+}
+
+/// The lot and block events (the lots changed, added and removed; the `block <id>`
+/// scene nodes; the road-graph cells changed) equal those of comparing every lot and
+/// block of the two cities (the editor leaves out the cells whose items pair off
+/// unchanged).
+fn check_lot_and_block_events(before: &Items, after: &City, ev: &ChangeEvents) {
+    let after = items(after);
+    let lots = full_delta(&before.lots, &after.lots);
+    assert_eq!(
+        [&ev.lots.changed, &ev.lots.added, &ev.lots.removed],
+        [&lots[0], &lots[1], &lots[2]],
+        "lot events"
+    );
+    let blocks = full_delta(&before.blocks, &after.blocks);
+    let named = |names: &[String]| -> Vec<u64> {
+        let mut ids: Vec<u64> = names
+            .iter()
+            .filter_map(|n| n.strip_prefix("block ")?.parse().ok())
+            .collect();
+        ids.sort_unstable();
+        ids
+    };
+    let s = &ev.scene_nodes;
+    assert_eq!(
+        [named(&s.changed), named(&s.added), named(&s.removed)],
+        blocks,
+        "block events"
+    );
+    // A road-graph cell in both cities changed when a lot or block of it did.
+    let ids: BTreeSet<u64> = blocks.iter().flatten().copied().collect();
+    let touched: BTreeSet<u64> = lots
+        .iter()
+        .flatten()
+        .map(|l| l >> 24)
+        .chain(
+            before
+                .block_cells
+                .iter()
+                .chain(&after.block_cells)
+                .filter(|(b, _)| ids.contains(b))
+                .map(|(_, c)| *c),
+        )
+        .filter(|c| before.cells.contains(c) && after.cells.contains(c))
+        .collect();
+    assert_eq!(
+        ev.blocks.changed,
+        touched.into_iter().collect::<Vec<u64>>(),
+        "cell events"
+    );
+}
+
 /// A random edit, resolved against the editor's current state.
 #[derive(Debug, Clone)]
 enum Op {
@@ -253,6 +363,7 @@ proptest! {
                 .map(|c| (c, [cell_content(ed.city(), c, false), cell_content(ed.city(), c, true)]))
                 .collect();
             let before_buildings = building_texts(ed.city());
+            let before_items = items(ed.city());
             let result = match op {
                 Op::Undo => ed.undo(),
                 Op::Redo => ed.redo(),
@@ -270,6 +381,7 @@ proptest! {
             let painted = before_city_cfg.citygen.paint != ed.config().citygen.paint;
             check_outside_dirty_set(&before, ed.city(), &ev, &overridden, painted);
             check_building_events(&before_buildings, ed.city(), &ev);
+            check_lot_and_block_events(&before_items, ed.city(), &ev);
             if let Some(Edit::SetCellPattern { cell, .. } | Edit::SetCellParam { cell, .. } | Edit::SetCellSeed { cell, .. }) = ed.edits().last().filter(|_| !matches!(op, Op::Undo | Op::Redo)) {
                 prop_assert!(ev.dirty_cells.iter().all(|c| c == cell), "{:?} regrew {:?}", op, ev.dirty_cells);
                 prop_assert!(ev.cells.added.is_empty() && ev.cells.removed.is_empty());
@@ -853,5 +965,25 @@ fn edits_on_a_coast_keep_the_terrain_generate_makes() {
     assert_same_as_generate(&ed);
     ed.undo().unwrap();
     ed.undo().unwrap();
+    assert_same_as_generate(&ed);
+}
+
+/// A cell's building height changes its buildings: every change event equals a full
+/// comparison of the two cities.
+#[test]
+fn events_of_a_height_edit_equal_a_full_comparison() {
+    let mut ed = CityEditor::new(small()).unwrap();
+    let (buildings, items_before) = (building_texts(ed.city()), items(ed.city()));
+    let cells = ed.cells();
+    let cell = cells[cells.len() / 2].id;
+    let ev = ed
+        .apply(Edit::SetCellParam {
+            cell,
+            param: CellParam::BuildingHeight(Deviated::new(14.0, 0.1)),
+        })
+        .unwrap();
+    assert!(!ev.buildings.changed.is_empty(), "{:?}", ev.buildings);
+    check_building_events(&buildings, ed.city(), &ev);
+    check_lot_and_block_events(&items_before, ed.city(), &ev);
     assert_same_as_generate(&ed);
 }

@@ -1,18 +1,23 @@
 //! What changed between two states of an edited city, by stable id: the
 //! [`ChangeEvents`] a host applies to its meshes.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashSet};
+use std::ops::Range;
 use std::sync::Arc;
 
 use polis_geom::DVec2;
 use polis_geom::par;
 
 use super::edit::{ChangeEvents, Delta, Regenerated};
+use super::key::{IdBits, IdMap};
 use super::memo::Redone;
 use super::splice::OldScene;
 use crate::City;
 use crate::CityConfig;
 use crate::citygen::{District, LotOverride};
+
+/// A set of ids (parts).
+type IdSet = HashSet<u64, IdBits>;
 
 /// Pairs sorted by key, of equal keys the last kept (as collecting them into a
 /// `BTreeMap` would): the maps the deltas compare, as sorted vectors (one sort instead of
@@ -78,13 +83,18 @@ fn delta_by<K: Ord + Clone, V, W>(
 
 /// The road-graph cells (those with blocks or lots) of a city.
 fn cells_of(city: &City) -> BTreeSet<u64> {
-    let mut cells: BTreeSet<u64> = city.blocks.iter().map(|b| b.cell_id).collect();
+    let mut cells = BTreeSet::new();
+    // Blocks and lots come cell by cell: one insertion per run.
     let mut last = None;
-    for l in &city.lots {
-        // Lots come cell by cell.
-        if last != Some(l.cell) {
-            cells.insert(l.cell);
-            last = Some(l.cell);
+    for c in city
+        .blocks
+        .iter()
+        .map(|b| b.cell_id)
+        .chain(city.lots.iter().map(|l| l.cell))
+    {
+        if last != Some(c) {
+            cells.insert(c);
+            last = Some(c);
         }
     }
     cells
@@ -150,19 +160,94 @@ fn differ(a: &Dressed<'_>, b: &Dressed<'_>) -> bool {
     !(same_skin && (Arc::ptr_eq(a.0, b.0) || a.0 == b.0))
 }
 
-/// A city's buildings with their index and skin, by id ([`by_key`]).
-fn buildings_of(c: &City) -> Vec<(u64, (usize, Dressed<'_>))> {
+/// Building `i` of a city with its skin.
+fn dressed(c: &City, i: usize) -> Dressed<'_> {
+    (&c.buildings[i], c.dresses.get(i).and_then(Option::as_ref))
+}
+
+/// The buildings of a city at `indices`, with their index and skin, by id ([`by_key`]).
+fn buildings_of<'a>(c: &'a City, indices: &[usize]) -> Vec<(u64, (usize, Dressed<'a>))> {
     by_key(
-        c.buildings
+        indices
             .iter()
-            .enumerate()
-            .map(|(i, b)| (b.id, (i, (b, c.dresses.get(i).and_then(Option::as_ref)))))
+            .filter_map(|&i| {
+                let b = c.buildings.get(i)?;
+                Some((b.id, (i, (b, c.dresses.get(i).and_then(Option::as_ref)))))
+            })
             .collect(),
     )
 }
 
+/// The part of an item with id `id`: its road-graph cell (a lot's id, and its
+/// building's, is its cell's id shifted left by 24 bits and its index in the cell).
+fn part(id: u64) -> u64 {
+    id >> 24
+}
+
+/// The indices of the items a delta must compare, given the ids of the old and the new
+/// items in order: all but those of the parts ([`part`] of their ids) whose items are
+/// the same on both sides, pair by pair in order (`same(i, j)`: old item `i` and new
+/// item `j`, of equal ids, would not be reported changed). Leaving such a part out is
+/// exact: every occurrence of an id lies in its part, and a part that pairs off
+/// unchanged adds nothing to a delta (of equal ids the same pair is kept on both
+/// sides). Items come cell by cell, so a part is one run of consecutive items; where a
+/// part is not (on either side) nothing is left out. The indices left are ascending.
+/// The cost is one pass over the ids (and `same`, a pointer comparison where the edit
+/// shared the items) and a sort of the items left, not of every item.
+fn to_compare(
+    old: &[u64],
+    new: &[u64],
+    same: impl Fn(usize, usize) -> bool,
+) -> (Vec<usize>, Vec<usize>) {
+    let everything = || ((0..old.len()).collect(), (0..new.len()).collect());
+    let (Some(was), Some(is)) = (runs(old), runs(new)) else {
+        return everything();
+    };
+    let is_by_part: IdMap<Range<usize>> = is.iter().map(|(p, r)| (*p, r.clone())).collect();
+    let mut left_out = IdSet::with_capacity_and_hasher(was.len(), IdBits);
+    for (p, r) in &was {
+        if let Some(s) = is_by_part.get(p)
+            && s.len() == r.len()
+            && r.clone()
+                .zip(s.clone())
+                .all(|(i, j)| old.get(i) == new.get(j) && same(i, j))
+        {
+            left_out.insert(*p);
+        }
+    }
+    // The runs are in item order.
+    let keep = |runs: &[(u64, Range<usize>)]| -> Vec<usize> {
+        runs.iter()
+            .filter(|(p, _)| !left_out.contains(p))
+            .flat_map(|(_, r)| r.clone())
+            .collect()
+    };
+    (keep(&was), keep(&is))
+}
+
+/// The runs of consecutive ids of one part ([`part`]), in order, if each part's ids are
+/// one run.
+fn runs(ids: &[u64]) -> Option<Vec<(u64, Range<usize>)>> {
+    let mut out: Vec<(u64, Range<usize>)> = Vec::new();
+    let mut start = 0;
+    for (i, w) in ids.windows(2).enumerate() {
+        if part(w[0]) != part(w[1]) {
+            out.push((part(w[0]), start..i + 1));
+            start = i + 1;
+        }
+    }
+    if let Some(&last) = ids.last() {
+        out.push((part(last), start..ids.len()));
+    }
+    let mut seen = IdSet::with_capacity_and_hasher(out.len(), IdBits);
+    out.iter().all(|(p, _)| seen.insert(*p)).then_some(out)
+}
+
 /// The change events from `old` to `new`. `spliced` is the scene splice of the edit, if
-/// any: the buildings and blocks it found equal and reused are not compared again.
+/// any: the buildings and blocks it found equal and reused are not compared again. The
+/// lots and buildings of a cell whose items pair off unchanged are not sorted or
+/// compared by id at all ([`to_compare`]); the events are those of comparing every
+/// item.
 pub(super) fn changes(
     old: &City,
     new: &City,
@@ -187,22 +272,31 @@ pub(super) fn changes(
     let spliced = spliced.filter(|s| std::ptr::eq(s.city(), old));
     let same_building = |i: usize| spliced.is_some_and(|s| s.same_building_at(i));
     let same_block = |i: usize| spliced.is_some_and(|s| s.same_block_at(i));
-    // The three comparisons are independent: two threads take them. The buildings by
-    // id are kept to find their cells below.
+    // The three comparisons are independent: two threads take them. The lots and
+    // buildings of a cell the edit left alone pair off unchanged and are left out before
+    // sorting ([`to_compare`]); the buildings by id are kept to find their cells below.
     let ((lots, (buildings, old_of, new_of)), block_nodes) = par::join(
         || {
             par::join(
                 || {
                     // A lot of a cell the edit left alone is the old city's, shared:
                     // found equal by its pointer.
+                    let ids = |c: &City| c.lots.iter().map(|l| l.id).collect::<Vec<u64>>();
+                    let (o, n) = to_compare(&ids(old), &ids(new), |i, j| {
+                        old.lots[i].same_as(&new.lots[j])
+                    });
                     delta_by(
-                        &by_key(old.lots.iter().map(|l| (l.id, l)).collect()),
-                        &by_key(new.lots.iter().map(|l| (l.id, l)).collect()),
+                        &by_key(o.iter().map(|&i| (old.lots[i].id, &old.lots[i])).collect()),
+                        &by_key(n.iter().map(|&j| (new.lots[j].id, &new.lots[j])).collect()),
                         |v, w| !v.same_as(w),
                     )
                 },
                 || {
-                    let (old_of, new_of) = (buildings_of(old), buildings_of(new));
+                    let ids = |c: &City| c.buildings.iter().map(|b| b.id).collect::<Vec<u64>>();
+                    let (o, n) = to_compare(&ids(old), &ids(new), |i, j| {
+                        same_building(i) || !differ(&dressed(old, i), &dressed(new, j))
+                    });
+                    let (old_of, new_of) = (buildings_of(old, &o), buildings_of(new, &n));
                     let d = delta_by(&old_of, &new_of, |(i, v), (_, w)| {
                         !same_building(*i) && differ(v, w)
                     });
