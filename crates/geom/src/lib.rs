@@ -50,6 +50,7 @@ pub mod error;
 pub mod field;
 pub mod graph;
 pub mod hash;
+mod inline_vec;
 pub mod lines;
 pub mod measure;
 pub mod mesh;

@@ -62,6 +62,7 @@ use glam::DVec2;
 
 use super::{EdgeId, NodeId, PlanarGraph};
 use crate::error::{GeomError, validate_point};
+use crate::inline_vec::InlineVec;
 use crate::predicates::{SegmentIntersection, closest_point_on_segment, point_on_segment};
 use crate::spatial::{SegmentHit, Shape, SpatialIndex, classify_hit};
 
@@ -194,60 +195,8 @@ impl Event {
 }
 
 /// The walk's stack of targets ([`PlanarGraph::connect`]): almost always one or two
-/// nodes, kept inline up to [`Targets::INLINE`] (no allocation), in a `Vec` beyond.
-struct Targets {
-    inline: [NodeId; Targets::INLINE],
-    len: usize,
-    spill: Vec<NodeId>,
-}
-
-impl Targets {
-    const INLINE: usize = 4;
-
-    fn new(first: NodeId) -> Self {
-        Targets {
-            inline: [first; Targets::INLINE],
-            len: 1,
-            spill: Vec::new(),
-        }
-    }
-
-    fn as_slice(&self) -> &[NodeId] {
-        if self.spill.is_empty() {
-            self.inline.get(..self.len).unwrap_or(&[])
-        } else {
-            &self.spill
-        }
-    }
-
-    fn last(&self) -> Option<NodeId> {
-        self.as_slice().last().copied()
-    }
-
-    fn push(&mut self, n: NodeId) {
-        if self.spill.is_empty() {
-            if let Some(slot) = self.inline.get_mut(self.len) {
-                *slot = n;
-                self.len += 1;
-                return;
-            }
-            self.spill.extend_from_slice(&self.inline);
-        }
-        self.spill.push(n);
-    }
-
-    fn pop(&mut self) {
-        if self.spill.is_empty() {
-            self.len = self.len.saturating_sub(1);
-        } else {
-            self.spill.pop();
-            if self.spill.is_empty() {
-                // Emptied from a spill: the inline part is stale, the stack is empty.
-                self.len = 0;
-            }
-        }
-    }
-}
+/// nodes, kept inline (no allocation).
+type Targets = InlineVec<NodeId, 4>;
 
 impl<N, E: Clone> PlanarGraph<N, E> {
     /// Inserts the segment `p–q` keeping the graph planar; new nodes get `N::default()`.
@@ -524,6 +473,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let mut checked = None;
         let mut cur = from;
         let mut targets = Targets::new(to);
+        targets.push(to);
         let limit = 64 + 8 * (self.node_count() + self.edge_count());
         let mut steps = 0usize;
         while let Some(target) = targets.last() {

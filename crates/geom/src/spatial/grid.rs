@@ -7,6 +7,7 @@ use glam::DVec2;
 use super::{GridOptions, IndexKey, Shape, SpatialIndex};
 use crate::bbox::Aabb2;
 use crate::error::GeomError;
+use crate::inline_vec::InlineVec;
 
 pub(crate) use crate::hash::FxBuild;
 
@@ -146,44 +147,7 @@ impl Geo {
 }
 
 /// Column runs of a query walk, kept on the stack for the usual short walks.
-struct Runs {
-    inline: [(i64, i64, i64); 16],
-    len: usize,
-    more: Vec<(i64, i64, i64)>,
-}
-
-impl Runs {
-    fn new() -> Self {
-        Runs {
-            inline: [(0, 0, 0); 16],
-            len: 0,
-            more: Vec::new(),
-        }
-    }
-
-    fn push(&mut self, run: (i64, i64, i64)) {
-        if self.more.is_empty()
-            && let Some(slot) = self.inline.get_mut(self.len)
-        {
-            *slot = run;
-            self.len += 1;
-        } else {
-            if self.more.is_empty() {
-                self.more
-                    .extend_from_slice(self.inline.get(..self.len).unwrap_or(&[]));
-            }
-            self.more.push(run);
-        }
-    }
-
-    fn as_slice(&self) -> &[(i64, i64, i64)] {
-        if self.more.is_empty() {
-            self.inline.get(..self.len).unwrap_or(&[])
-        } else {
-            &self.more
-        }
-    }
-}
+type Runs = InlineVec<(i64, i64, i64), 16>;
 
 #[inline]
 fn chunk_of(c: Cell) -> (Cell, usize) {
@@ -497,7 +461,7 @@ impl<K: IndexKey> SpatialIndex<K> for GridIndex<K> {
             return;
         };
         let geo = self.geo();
-        let mut runs = Runs::new();
+        let mut runs = Runs::new((0, 0, 0));
         let mut cells = 0u64;
         geo.segment_runs(a, b, Some(range), &mut |i, j0, j1| {
             if j0 <= j1 {

@@ -90,7 +90,7 @@ pub(super) fn bow_streets<R: Rng + ?Sized>(
                 break;
             }
             bow_points(a, b, sagitta, &mut points);
-            if fits(g, e, (u, v), &points, maps)? {
+            if fits(g, e, (u, v), (a, b), &points, maps)? {
                 replace(g, e, &points)?;
                 bowed += 1;
                 break;
@@ -118,16 +118,16 @@ fn bow_points(a: DVec2, b: DVec2, sagitta: f64, out: &mut Vec<DVec2>) {
     out.push(b);
 }
 
-/// Whether the chain `pts` can replace street `e` between `ends` (see the module docs).
+/// Whether the chain `pts` can replace street `e` between `ends` (at `at`; see the
+/// module docs).
 fn fits(
     g: &RoadNetwork,
     e: EdgeId,
-    ends: (NodeId, NodeId),
+    (u, v): (NodeId, NodeId),
+    (a, b): (DVec2, DVec2),
     pts: &[DVec2],
     maps: &CellMaps<'_>,
 ) -> Result<bool, SecondaryError> {
-    let (u, v) = ends;
-    let (a, b) = (g.position(u)?, g.position(v)?);
     let clearance = g.edge_payload(e)?.width.max(0.0);
     let (Some(&first), Some(&last)) = (pts.get(1), pts.get(pts.len().saturating_sub(2))) else {
         return Ok(false);
