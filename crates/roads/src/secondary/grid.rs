@@ -254,6 +254,15 @@ impl SnapGrid {
     /// pattern a processor can predict, and a wrong guess costs more than the few
     /// instructions of deciding all three every time.
     pub(crate) fn gather(&mut self, b: &Aabb2, out: &mut Vec<GridRoad>) {
+        // No node has the raw id `u32::MAX` (the graph refuses it), so no road is left out.
+        self.gather_apart(b, u32::MAX, out);
+    }
+
+    /// [`gather`](Self::gather) without the roads at node `apart` (raw id): the snap
+    /// search tests the roads at its root apart from the others (see
+    /// [`Snapper::snap`](super::snap::Snapper::snap)). Whether a road ends at `apart` is
+    /// one more flag of the same decision, so the walk stays without branches.
+    pub(crate) fn gather_apart(&mut self, b: &Aabb2, apart: u32, out: &mut Vec<GridRoad>) {
         if self.nx == 0 || b.is_empty() {
             return;
         }
@@ -280,13 +289,24 @@ impl SnapGrid {
                         & ((lo.x <= p.x) | (lo.x <= q.x))
                         & ((p.y <= hi.y) | (q.y <= hi.y))
                         & ((lo.y <= p.y) | (lo.y <= q.y));
-                    let keep = fresh & slot.alive & meets;
+                    let other = (road.u.raw() != apart) & (road.v.raw() != apart);
+                    let keep = fresh & slot.alive & meets & other;
                     out.push(road);
                     let len = out.len() - usize::from(!keep);
                     out.truncate(len);
                 }
             }
         }
+    }
+
+    /// Road `e` as the grid lists it now (`None` for a dead or unknown id; the grid is
+    /// current after [`sync`](Self::sync) and the changes reported since).
+    #[inline]
+    pub(crate) fn road(&self, e: EdgeId) -> Option<GridRoad> {
+        self.slots
+            .get(e.index())
+            .filter(|s| s.alive && e.index() < self.entered)
+            .map(|s| s.road)
     }
 
     /// The next query's stamp (every slot's stamp is reset when the counter wraps).

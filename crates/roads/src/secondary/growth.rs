@@ -1059,7 +1059,7 @@ impl Run<'_> {
     fn clear(&self, source: NodeId, a: DVec2, t: DVec2, target: &Target) -> bool {
         use polis_geom::predicates::{SegmentIntersection as X, segment_intersection};
         let reach = polis_geom::Aabb2::new(a, t);
-        for road in self.snapper.candidates() {
+        for road in self.snapper.candidates(&self.g) {
             let (key, u, v, pu, pv) = (road.edge, road.u, road.v, road.pu, road.pv);
             // Segments whose boxes do not meet are disjoint (the intersection's own first
             // test, here without the call).

@@ -31,7 +31,13 @@
 //! directions of a suburban node are such folds; answering them without the grid
 //! search roughly halves the growth's time. It differs from the full search only when a
 //! non-adjacent node or road lies in the snap area nearer to the root than the fold,
-//! which the full search would have joined instead. Growth answers test 0 before the
+//! which the full search would have joined instead. A proposal that passes test 0 has
+//! none of the root's neighbours in its snap area by test 1's own arithmetic (and the
+//! root itself has `r = 0`), and test 2 cannot cross a road at the root; so the grid
+//! walk leaves the root's roads out of the candidates of tests 1 and 2 (without a
+//! branch), and only test 3 and [`candidates`](Snapper::candidates) read them, from the
+//! grid's table. About a third of the roads a search met were the root's, and whether
+//! a road was one followed no pattern a processor could predict. Growth answers test 0 before the
 //! proposal's draws where the fold holds for every draw the proposal could make (its
 //! `FoldBound`), stepping the generator past them, so the roads are the same.
 
@@ -64,6 +70,9 @@ pub struct Snapper {
     seen: Vec<u32>,
     query: u32,
     roads: Vec<GridRoad>,
+    /// The root of the last query, when it searched the grid (its roads are not in
+    /// `roads`).
+    root: Option<NodeId>,
     /// Scratch of [`snap`](Self::snap): the root's roads' far ends.
     root_ends: Vec<(NodeId, DVec2)>,
     /// Exact segment-intersection tests run (the rest were excluded by `r`/`s`).
@@ -112,9 +121,18 @@ impl Snapper {
     }
 
     /// The roads the last query gathered (those whose boxes meet its extended box), with
-    /// their ends; empty after a query answered by test 0.
-    pub(crate) fn candidates(&self) -> &[GridRoad] {
-        &self.roads
+    /// their ends, each once, in no particular order: the roads of tests 1 and 2, then
+    /// the roads at its root (`g` is the graph it searched, unchanged since); none after
+    /// a query answered by test 0.
+    pub(crate) fn candidates<'s>(
+        &'s self,
+        g: &'s RoadNetwork,
+    ) -> impl Iterator<Item = GridRoad> + 's {
+        let at_root = self
+            .root
+            .into_iter()
+            .flat_map(move |root| roads_at(&self.grid, g, root));
+        self.roads.iter().copied().chain(at_root)
     }
 
     /// Counts a proposal that growth found folding onto a road at its root (test 0)
@@ -122,6 +140,7 @@ impl Snapper {
     pub(crate) fn count_fold(&mut self) {
         self.folded += 1;
         self.roads.clear();
+        self.root = None;
     }
 
     /// Appends to `out` every road of `g` whose box meets `b`, with its ends, as the
@@ -187,8 +206,7 @@ impl Snapper {
         let len = len2.sqrt();
         let radius = radius.max(0.0);
         if folds_onto_root(ends, a, b, radius) {
-            self.folded += 1;
-            self.roads.clear();
+            self.count_fold();
             return SnapEvent::Blocked;
         }
         self.begin(g.node_bound());
@@ -196,18 +214,25 @@ impl Snapper {
         // Extended bounding box exclusion: the roads whose boxes meet the extended box.
         // Every node of a cell graph ends a road, and a node in the extended box ends a
         // road whose box meets it, so the ends of these roads are test 1's candidates too.
+        // The roads at the root (all of them meet the box, which holds `a`) are left out:
+        // after test 0 none of their ends is a node event of test 1 (the root has
+        // `r = 0`; a far end in the snap area would have folded by the same arithmetic),
+        // and test 2 cannot cross them. Test 3 and `candidates` read them apart.
         let mut roads = std::mem::take(&mut self.roads);
         roads.clear();
         self.grid.sync(g);
-        self.grid.gather(&ext, &mut roads);
+        self.grid.gather_apart(&ext, root.raw(), &mut roads);
+        self.root = Some(root);
         debug_assert!(
-            roads.iter().all(|r| GridRoad::of(g, r.edge)
-                .is_some_and(|c| (c.u, c.v, c.pu, c.pv) == (r.u, r.v, r.pu, r.pv))),
+            roads.iter().all(|r| r.u != root
+                && r.v != root
+                && GridRoad::of(g, r.edge)
+                    .is_some_and(|c| (c.u, c.v, c.pu, c.pv) == (r.u, r.v, r.pu, r.pv))),
             "the snap grid is out of date: a split or removed road was not reported"
         );
         // The grid reports each road once, in an order fixed by the growth so far; every
         // choice below breaks ties by id, so the order does not matter.
-        self.box_hits += roads.len() as u64;
+        self.box_hits += (roads.len() + ends.len()) as u64;
         // Test 1: node proximity, over the ends of these roads in the extended box (each
         // node once; only `r` and `s` are needed here).
         let mut best: Option<(f64, NodeId)> = None;
@@ -250,8 +275,8 @@ impl Snapper {
         let segment_box = Aabb2::new(a, b);
         let mut cross: Option<(f64, usize, DVec2)> = None;
         for (i, road) in roads.iter().enumerate() {
-            let (u, v, pu, pv) = (road.u, road.v, road.pu, road.pv);
-            if u == root || v == root || !Aabb2::new(pu, pv).intersects(&segment_box) {
+            let (pu, pv) = (road.pu, road.pv);
+            if !Aabb2::new(pu, pv).intersects(&segment_box) {
                 continue;
             }
             // The exact sides first: most roads here lie on one side of the line ab, and
@@ -326,25 +351,25 @@ impl Snapper {
             return ev;
         }
         // Test 3: proximity of b to a road. Every road within the snap size of `b` meets
-        // the extended box, so the roads gathered for tests 1 and 2 are the candidates.
+        // the extended box, so the roads gathered for tests 1 and 2 and the roads at the
+        // root are the candidates.
         let around = Aabb2::new(b, b).expanded(radius);
         let r2 = radius * radius;
-        let mut near: Option<(f64, usize, DVec2)> = None;
-        for (i, road) in roads.iter().enumerate() {
+        let mut near: Option<(f64, GridRoad, DVec2)> = None;
+        for road in roads.iter().copied().chain(roads_at(&self.grid, g, root)) {
             let (u, v) = (road.pu, road.pv);
             if !Aabb2::new(u, v).intersects(&around) {
                 continue;
             }
             let c = closest_point(b, u, v);
             let dist = c.distance_squared(b);
-            let better = near.is_none_or(|(bd, bi, _)| {
-                dist < bd || (dist == bd && roads.get(bi).is_none_or(|o| road.edge < o.edge))
-            });
+            let better =
+                near.is_none_or(|(bd, o, _)| dist < bd || (dist == bd && road.edge < o.edge));
             if dist <= r2 && better {
-                near = Some((dist, i, c));
+                near = Some((dist, road, c));
             }
         }
-        let event = match near.and_then(|(_, i, c)| Some((*roads.get(i)?, c))) {
+        let event = match near.map(|(_, road, c)| (road, c)) {
             None => SnapEvent::None,
             Some((road, _)) if road.u == root || road.v == root => SnapEvent::Blocked,
             Some((road, c)) => {
@@ -362,6 +387,18 @@ impl Snapper {
         self.roads = roads;
         event
     }
+}
+
+/// The roads at `root`, as the grid lists them (the grid current for `g`).
+fn roads_at<'s>(
+    grid: &'s SnapGrid,
+    g: &'s RoadNetwork,
+    root: NodeId,
+) -> impl Iterator<Item = GridRoad> + 's {
+    g.edges_at(root)
+        .into_iter()
+        .flatten()
+        .filter_map(|&e| grid.road(e))
 }
 
 /// The point of segment `u–v` closest to `p`: the arithmetic of
