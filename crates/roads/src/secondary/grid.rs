@@ -254,19 +254,24 @@ impl SnapGrid {
     /// pattern a processor can predict, and a wrong guess costs more than the few
     /// instructions of deciding all three every time.
     pub(crate) fn gather(&mut self, b: &Aabb2, out: &mut Vec<GridRoad>) {
-        // No node has the raw id `u32::MAX` (the graph refuses it), so no road is left out.
-        self.gather_apart(b, u32::MAX, out);
+        self.gather_apart(b, &[], out);
     }
 
-    /// [`gather`](Self::gather) without the roads at node `apart` (raw id): the snap
-    /// search tests the roads at its root apart from the others (see
-    /// [`Snapper::snap`](super::snap::Snapper::snap)). Whether a road ends at `apart` is
-    /// one more flag of the same decision, so the walk stays without branches.
-    pub(crate) fn gather_apart(&mut self, b: &Aabb2, apart: u32, out: &mut Vec<GridRoad>) {
+    /// [`gather`](Self::gather) without the roads `apart` (the snap search tests the
+    /// roads at its root apart from the others, see
+    /// [`Snapper::snap`](super::snap::Snapper::snap)): they are stamped with the query
+    /// before the walk, so the walk takes them for roads it has reported already, at no
+    /// cost an entry.
+    pub(crate) fn gather_apart(&mut self, b: &Aabb2, apart: &[EdgeId], out: &mut Vec<GridRoad>) {
         if self.nx == 0 || b.is_empty() {
             return;
         }
         let query = self.next_query();
+        for e in apart {
+            if let Some(slot) = self.slots.get_mut(e.index()) {
+                slot.stamp = query;
+            }
+        }
         let (c0, c1) = (self.col(b.min.x), self.col(b.max.x));
         let (r0, r1) = (self.row(b.min.y), self.row(b.max.y));
         let (lo, hi) = (b.min, b.max);
@@ -289,8 +294,7 @@ impl SnapGrid {
                         & ((lo.x <= p.x) | (lo.x <= q.x))
                         & ((p.y <= hi.y) | (q.y <= hi.y))
                         & ((lo.y <= p.y) | (lo.y <= q.y));
-                    let other = (road.u.raw() != apart) & (road.v.raw() != apart);
-                    let keep = fresh & slot.alive & meets & other;
+                    let keep = fresh & slot.alive & meets;
                     out.push(road);
                     let len = out.len() - usize::from(!keep);
                     out.truncate(len);
