@@ -31,16 +31,17 @@
 //! directions of a suburban node are such folds; answering them without the grid
 //! search roughly halves the growth's time. It differs from the full search only when a
 //! non-adjacent node or road lies in the snap area nearer to the root than the fold,
-//! which the full search would have joined instead. A proposal that passes test 0 has
-//! none of the root's neighbours in its snap area by test 1's own arithmetic (and the
-//! root itself has `r = 0`), and test 2 cannot cross a road at the root; so the grid
-//! walk leaves the root's roads out of the candidates of tests 1 and 2 (it stamps them as
-//! reported before it starts), and only test 3 and [`candidates`](Snapper::candidates)
-//! read them, from the grid's table. About 30 % of the road ends test 1 met were those
-//! of the root's roads, and whether a road was one followed no pattern a processor could
-//! predict. Growth answers test 0 before the
+//! which the full search would have joined instead. Growth answers test 0 before the
 //! proposal's draws where the fold holds for every draw the proposal could make (its
 //! `FoldBound`), stepping the generator past them, so the roads are the same.
+//!
+//! A proposal that passes test 0 has none of the root's neighbours in its snap area by
+//! test 1's own arithmetic (and the root itself has `r = 0`), and test 2 cannot cross a
+//! road at the root; so the grid walk leaves the root's roads out of the candidates of
+//! tests 1 and 2 (it stamps them as reported before it starts), and only test 3 and
+//! [`candidates`](Snapper::candidates) read them, from the grid's table. About 30 % of
+//! the road ends test 1 met were those of the root's roads, and whether a road was one
+//! followed no pattern a processor could predict.
 
 use polis_geom::predicates::{Orientation, lerp_stable, orient2d};
 use polis_geom::{Aabb2, DVec2, EdgeId, NodeId};
