@@ -758,63 +758,6 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     // diagonal's rise on the bank).
     let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
-    // Cells in id order: the parent of their blocks and buildings. Each cell's subtree
-    // (its node; its blocks; its buildings, each followed by its coarse box) is one run
-    // of nodes and one run of meshes, so an editor can take it whole (`SceneReuse`).
-    let cell_ids: Vec<u64> = {
-        let mut ids: Vec<u64> = inp
-            .blocks
-            .iter()
-            .map(|b| b.cell_id)
-            .chain(inp.building_cells.iter().copied())
-            .collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids
-    };
-    let cell_index = |c: u64| cell_ids.binary_search(&c).ok();
-    // Per cell (by index in `cell_ids`): its blocks and buildings, by index, in order.
-    let mut cell_blocks: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
-    let mut cell_buildings: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
-    for (i, b) in inp.blocks.iter().enumerate() {
-        if let Some(list) = cell_index(b.cell_id).and_then(|k| cell_blocks.get_mut(k)) {
-            list.push(i);
-        }
-    }
-    for (i, &c) in inp
-        .building_cells
-        .iter()
-        .enumerate()
-        .take(inp.buildings.len())
-    {
-        if let Some(list) = cell_index(c).and_then(|k| cell_buildings.get_mut(k)) {
-            list.push(i);
-        }
-    }
-    // The cells an earlier scene hands back whole (with their numbers of nodes and
-    // meshes): their leaves are not made.
-    let whole: Vec<Option<(usize, usize)>> = match inp.reuse {
-        Some(r) => cell_ids
-            .par_iter()
-            .zip(cell_blocks.par_iter().zip(cell_buildings.par_iter()))
-            .map(|(&c, (blocks, buildings))| {
-                r.whole_cell(
-                    c,
-                    &CellItems {
-                        blocks: blocks.iter().filter_map(|&i| inp.blocks.get(i)).collect(),
-                        buildings: buildings
-                            .iter()
-                            .filter_map(|&i| {
-                                let b = inp.buildings.get(i)?;
-                                Some((b, inp.dresses.get(i).and_then(Option::as_ref)))
-                            })
-                            .collect(),
-                    },
-                )
-            })
-            .collect(),
-        None => vec![None; cell_ids.len()],
-    };
     let fine = inp.config.effective_lod();
     let coarse = inp.config.scene.coarse_lod && fine > 0;
     // Building `i`'s node (name, placement, metadata) and meshes, and its coarse box
@@ -870,33 +813,6 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             ]),
         };
         Ok(Some((node, vec![plinth])))
-    };
-    // The leaves of the cells not handed back whole, made in parallel: by index, `None`
-    // for the others.
-    let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
-        let mut made = vec![false; len];
-        for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
-            for &i in list {
-                if let Some(m) = made.get_mut(i) {
-                    *m = true;
-                }
-            }
-        }
-        made
-    };
-    let buildings_job = || -> Vec<Option<BuildingMade>> {
-        let made = todo(&cell_buildings, inp.buildings.len());
-        made.par_iter()
-            .enumerate()
-            .map(|(i, &m)| m.then(|| make_building(i)))
-            .collect()
-    };
-    let blocks_job = || -> Vec<Option<BlockMade>> {
-        let made = todo(&cell_blocks, inp.blocks.len());
-        made.par_iter()
-            .enumerate()
-            .map(|(i, &m)| m.then(|| make_block(i)))
-            .collect()
     };
     // Water bodies (flat surfaces at their level, `crate::water`) and the ground
     // (terrain textured by land use, which paints the water bed).
@@ -962,12 +878,97 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         };
         Ok((water, terrain))
     };
-    // The cells' subtrees go into the scene while the road layer (bridges, road
+    // The cells' subtrees (which cells an earlier scene hands back, the other cells'
+    // leaves, the terrain) go into the scene while the road layer (bridges, road
     // surfaces, portal frames: one serial pass over the network, `RoadLayer`) is made
     // beside them; the layers then follow the cells in the node array but come first
     // among the root's children, so the tree (and every walk of it) is as if they had
     // been added first.
     let cells_job = |scene: &mut Scene| -> Result<(WaterLevels, Option<Ground>)> {
+        // Cells in id order: the parent of their blocks and buildings. Each cell's subtree
+        // (its node; its blocks; its buildings, each followed by its coarse box) is one run
+        // of nodes and one run of meshes, so an editor can take it whole (`SceneReuse`).
+        let cell_ids: Vec<u64> = {
+            let mut ids: Vec<u64> = inp
+                .blocks
+                .iter()
+                .map(|b| b.cell_id)
+                .chain(inp.building_cells.iter().copied())
+                .collect();
+            ids.sort_unstable();
+            ids.dedup();
+            ids
+        };
+        let cell_index = |c: u64| cell_ids.binary_search(&c).ok();
+        // Per cell (by index in `cell_ids`): its blocks and buildings, by index, in order.
+        let mut cell_blocks: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+        let mut cell_buildings: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+        for (i, b) in inp.blocks.iter().enumerate() {
+            if let Some(list) = cell_index(b.cell_id).and_then(|k| cell_blocks.get_mut(k)) {
+                list.push(i);
+            }
+        }
+        for (i, &c) in inp
+            .building_cells
+            .iter()
+            .enumerate()
+            .take(inp.buildings.len())
+        {
+            if let Some(list) = cell_index(c).and_then(|k| cell_buildings.get_mut(k)) {
+                list.push(i);
+            }
+        }
+        // The cells an earlier scene hands back whole (with their numbers of nodes and
+        // meshes): their leaves are not made.
+        let whole: Vec<Option<(usize, usize)>> = match inp.reuse {
+            Some(r) => cell_ids
+                .par_iter()
+                .zip(cell_blocks.par_iter().zip(cell_buildings.par_iter()))
+                .map(|(&c, (blocks, buildings))| {
+                    r.whole_cell(
+                        c,
+                        &CellItems {
+                            blocks: blocks.iter().filter_map(|&i| inp.blocks.get(i)).collect(),
+                            buildings: buildings
+                                .iter()
+                                .filter_map(|&i| {
+                                    let b = inp.buildings.get(i)?;
+                                    Some((b, inp.dresses.get(i).and_then(Option::as_ref)))
+                                })
+                                .collect(),
+                        },
+                    )
+                })
+                .collect(),
+            None => vec![None; cell_ids.len()],
+        };
+        // The leaves of the cells not handed back whole, made in parallel: by index, `None`
+        // for the others.
+        let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
+            let mut made = vec![false; len];
+            for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
+                for &i in list {
+                    if let Some(m) = made.get_mut(i) {
+                        *m = true;
+                    }
+                }
+            }
+            made
+        };
+        let buildings_job = || -> Vec<Option<BuildingMade>> {
+            let made = todo(&cell_buildings, inp.buildings.len());
+            made.par_iter()
+                .enumerate()
+                .map(|(i, &m)| m.then(|| make_building(i)))
+                .collect()
+        };
+        let blocks_job = || -> Vec<Option<BlockMade>> {
+            let made = todo(&cell_blocks, inp.blocks.len());
+            made.par_iter()
+                .enumerate()
+                .map(|(i, &m)| m.then(|| make_block(i)))
+                .collect()
+        };
         // Each cell's subtree: taken whole from the earlier scene, or its node and leaves
         // (blocks, then buildings with their coarse boxes under them).
         let (water_and_ground, (mut blocks, mut buildings)) =
