@@ -4,7 +4,10 @@
 //! The node tree is `city → roads | water`, `city → cell <id> → block <id> | building
 //! <id>`; each cell's subtree is one run of nodes (the cell, its blocks, then each
 //! building followed by its `lod 0` box) and one run of meshes, which an editor moves
-//! whole when the cell is unchanged; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
+//! whole when the cell is unchanged. The cells come first in the node array (they are
+//! moved and made while the road layer, [`RoadLayer`], is made beside them) and the
+//! layers (ground, roads, bridges, portals, water) after them, but first among the
+//! root's children, so every walk of the tree meets the layers first; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
 //! `buildings`); building nodes carry `id` (text, exact) and `id_number`, `kind`,
 //! `type`, `height`, `floors`, `lot`, `lot_id`, `cell` and `style` (when dressed), block
 //! nodes `id` and `cell`. The glb writer's default
