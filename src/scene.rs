@@ -4,7 +4,10 @@
 //! The node tree is `city → roads | water`, `city → cell <id> → block <id> | building
 //! <id>`; each cell's subtree is one run of nodes (the cell, its blocks, then each
 //! building followed by its `lod 0` box) and one run of meshes, which an editor moves
-//! whole when the cell is unchanged; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
+//! whole when the cell is unchanged. The cells come first in the node array (they are
+//! moved and made while the road layer, [`RoadLayer`], is made beside them) and the
+//! layers (ground, roads, bridges, portals, water) after them, but first among the
+//! root's children, so every walk of the tree meets the layers first; every node that draws carries its `layer` (`roads`, `water`, `blocks`,
 //! `buildings`); building nodes carry `id` (text, exact) and `id_number`, `kind`,
 //! `type`, `height`, `floors`, `lot`, `lot_id`, `cell` and `style` (when dressed), block
 //! nodes `id` and `cell`. The glb writer's default
@@ -666,37 +669,61 @@ fn coarse_box(
     polis_geom::mesh::prism(&local.into(), -seat.plinth, b.height, Some(wall)).ok()
 }
 
-/// Builds the scene.
-pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
-    let mut scene = Scene::new();
-    let pal = palette(&mut scene, inp.tile_sets)?;
-    let elevation = inp.ground;
-    let root = scene.add_root(inp.config.name.clone());
-    scene.set_metadata(root, "seed", inp.config.seed as f64)?;
+/// The road layer of the scene: the bridges (closed decks on piers), the road surfaces
+/// (which follow the bridges' profiles) and the tunnels' portal frames. It reads only
+/// the network, the ground (with the water bed) and the water, so [`assemble`] makes it
+/// beside the cells' subtrees (their leaves made and the reused ones moved in) and adds
+/// it to the scene after them.
+pub(crate) struct RoadLayer {
+    bridges: crate::ground::Bridges,
+    surfaces: Option<polis_export::surfaces::RoadSurfaceParts>,
+    portals: Option<Mesh>,
+}
 
-    // Bridges (closed decks on piers) first: the road surfaces follow their profiles.
-    let bridges = crate::ground::bridges(
-        inp.network,
-        elevation,
-        inp.water,
-        &inp.config.scene.road_grading,
-    )?;
-    // The road surfaces (one serial pass over the network) are built while the
-    // buildings' meshes are made in parallel.
-    let road_mesh = || -> Result<Option<polis_export::surfaces::RoadSurfaceParts>> {
-        if !(inp.config.scene.road_surfaces && inp.network.edge_count() > 0) {
+impl RoadLayer {
+    /// The road layer of `network` on `ground` (the elevation, graded roads and water
+    /// bed in it) with the water bodies `water`.
+    ///
+    /// # Errors
+    /// A bridge, road surface or portal frame that cannot be made.
+    pub(crate) fn new(
+        config: &CityConfig,
+        network: &RoadNetwork,
+        ground: &dyn Field,
+        water: Option<&crate::water::Water>,
+    ) -> Result<Self> {
+        // Bridges first: the road surfaces follow their profiles.
+        let bridges = crate::ground::bridges(network, ground, water, &config.scene.road_grading)?;
+        let surfaces = Self::surfaces(config, network, ground, &bridges)?;
+        let portals = polis_roads::portal_mesh(network, ground)?;
+        Ok(RoadLayer {
+            bridges,
+            surfaces,
+            portals,
+        })
+    }
+
+    /// The road surfaces (one serial pass over the network); `None` where there are
+    /// none.
+    fn surfaces(
+        config: &CityConfig,
+        network: &RoadNetwork,
+        ground: &dyn Field,
+        bridges: &crate::ground::Bridges,
+    ) -> Result<Option<polis_export::surfaces::RoadSurfaceParts>> {
+        if !(config.scene.road_surfaces && network.edge_count() > 0) {
             return Ok(None);
         }
         // No surface between a tunnel's portals (polis_roads::tunnels), but the open
         // cut from each portal's junction to its frame.
-        let mut roads = map_roads(inp.network)?;
+        let mut roads = map_roads(network)?;
         for r in roads.iter_mut().filter(|r| r.bridge) {
             if let Ok(k) = bridges.profiles.binary_search_by_key(&r.id, |p| p.0) {
                 r.profile = Some(bridges.profiles[k].1.clone());
             }
         }
         let mut cuts = Vec::new();
-        for p in polis_roads::portals(inp.network)? {
+        for p in polis_roads::portals(network)? {
             if p.setback > 0.0
                 && let Some(tunnel) = roads.iter().find(|r| r.id == u64::from(p.edge.raw()))
             {
@@ -714,73 +741,26 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         }
         Ok(Some(road_surface_parts(
             &roads,
-            elevation,
+            ground,
             &RoadSurfaceOptions::default(),
         )?))
-    };
+    }
+}
+
+/// Builds the scene.
+pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
+    let mut scene = Scene::new();
+    let pal = palette(&mut scene, inp.tile_sets)?;
+    let elevation = inp.ground;
+    let root = scene.add_root(inp.config.name.clone());
+    scene.set_metadata(root, "seed", inp.config.seed as f64)?;
+
     // Buildings and plinths reach below the ground as far as the terrain may lie below
     // it: its one-sided allowance (2 e) and, on graded ground, the corridor cut, the
     // slack under it and the lowering of smallest leaves that miss the bound at the foot of a bank (their
     // diagonal's rise on the bank).
     let foot = foot_of(inp.config, inp.cut_in.is_some());
     let plinth_foot = PLINTH_FOOT_M.max(foot);
-    // Cells in id order: the parent of their blocks and buildings. Each cell's subtree
-    // (its node; its blocks; its buildings, each followed by its coarse box) is one run
-    // of nodes and one run of meshes, so an editor can take it whole (`SceneReuse`).
-    let cell_ids: Vec<u64> = {
-        let mut ids: Vec<u64> = inp
-            .blocks
-            .iter()
-            .map(|b| b.cell_id)
-            .chain(inp.building_cells.iter().copied())
-            .collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids
-    };
-    let cell_index = |c: u64| cell_ids.binary_search(&c).ok();
-    // Per cell (by index in `cell_ids`): its blocks and buildings, by index, in order.
-    let mut cell_blocks: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
-    let mut cell_buildings: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
-    for (i, b) in inp.blocks.iter().enumerate() {
-        if let Some(list) = cell_index(b.cell_id).and_then(|k| cell_blocks.get_mut(k)) {
-            list.push(i);
-        }
-    }
-    for (i, &c) in inp
-        .building_cells
-        .iter()
-        .enumerate()
-        .take(inp.buildings.len())
-    {
-        if let Some(list) = cell_index(c).and_then(|k| cell_buildings.get_mut(k)) {
-            list.push(i);
-        }
-    }
-    // The cells an earlier scene hands back whole (with their numbers of nodes and
-    // meshes): their leaves are not made.
-    let whole: Vec<Option<(usize, usize)>> = match inp.reuse {
-        Some(r) => cell_ids
-            .par_iter()
-            .zip(cell_blocks.par_iter().zip(cell_buildings.par_iter()))
-            .map(|(&c, (blocks, buildings))| {
-                r.whole_cell(
-                    c,
-                    &CellItems {
-                        blocks: blocks.iter().filter_map(|&i| inp.blocks.get(i)).collect(),
-                        buildings: buildings
-                            .iter()
-                            .filter_map(|&i| {
-                                let b = inp.buildings.get(i)?;
-                                Some((b, inp.dresses.get(i).and_then(Option::as_ref)))
-                            })
-                            .collect(),
-                    },
-                )
-            })
-            .collect(),
-        None => vec![None; cell_ids.len()],
-    };
     let fine = inp.config.effective_lod();
     let coarse = inp.config.scene.coarse_lod && fine > 0;
     // Building `i`'s node (name, placement, metadata) and meshes, and its coarse box
@@ -836,33 +816,6 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             ]),
         };
         Ok(Some((node, vec![plinth])))
-    };
-    // The leaves of the cells not handed back whole, made in parallel: by index, `None`
-    // for the others.
-    let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
-        let mut made = vec![false; len];
-        for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
-            for &i in list {
-                if let Some(m) = made.get_mut(i) {
-                    *m = true;
-                }
-            }
-        }
-        made
-    };
-    let buildings_job = || -> Vec<Option<BuildingMade>> {
-        let made = todo(&cell_buildings, inp.buildings.len());
-        made.par_iter()
-            .enumerate()
-            .map(|(i, &m)| m.then(|| make_building(i)))
-            .collect()
-    };
-    let blocks_job = || -> Vec<Option<BlockMade>> {
-        let made = todo(&cell_blocks, inp.blocks.len());
-        made.par_iter()
-            .enumerate()
-            .map(|(i, &m)| m.then(|| make_block(i)))
-            .collect()
     };
     // Water bodies (flat surfaces at their level, `crate::water`) and the ground
     // (terrain textured by land use, which paints the water bed).
@@ -928,15 +881,184 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         };
         Ok((water, terrain))
     };
-    let ((road, water_and_ground), (blocks, buildings)) = par::join(
-        || par::join(road_mesh, water_and_ground),
-        || par::join(blocks_job, buildings_job),
+    // The cells' subtrees (which cells an earlier scene hands back, the other cells'
+    // leaves, the terrain) go into the scene while the road layer (bridges, road
+    // surfaces, portal frames: one serial pass over the network, `RoadLayer`) is made
+    // beside them; the layers then follow the cells in the node array but come first
+    // among the root's children, so the tree (and every walk of it) is as if they had
+    // been added first.
+    let cells_job = |scene: &mut Scene| -> Result<(WaterLevels, Option<Ground>)> {
+        // Cells in id order: the parent of their blocks and buildings. Each cell's subtree
+        // (its node; its blocks; its buildings, each followed by its coarse box) is one run
+        // of nodes and one run of meshes, so an editor can take it whole (`SceneReuse`).
+        let cell_ids: Vec<u64> = {
+            let mut ids: Vec<u64> = inp
+                .blocks
+                .iter()
+                .map(|b| b.cell_id)
+                .chain(inp.building_cells.iter().copied())
+                .collect();
+            ids.sort_unstable();
+            ids.dedup();
+            ids
+        };
+        let cell_index = |c: u64| cell_ids.binary_search(&c).ok();
+        // Per cell (by index in `cell_ids`): its blocks and buildings, by index, in order.
+        let mut cell_blocks: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+        let mut cell_buildings: Vec<Vec<usize>> = vec![Vec::new(); cell_ids.len()];
+        for (i, b) in inp.blocks.iter().enumerate() {
+            if let Some(list) = cell_index(b.cell_id).and_then(|k| cell_blocks.get_mut(k)) {
+                list.push(i);
+            }
+        }
+        for (i, &c) in inp
+            .building_cells
+            .iter()
+            .enumerate()
+            .take(inp.buildings.len())
+        {
+            if let Some(list) = cell_index(c).and_then(|k| cell_buildings.get_mut(k)) {
+                list.push(i);
+            }
+        }
+        // The cells an earlier scene hands back whole (with their numbers of nodes and
+        // meshes): their leaves are not made.
+        let whole: Vec<Option<(usize, usize)>> = match inp.reuse {
+            Some(r) => cell_ids
+                .par_iter()
+                .zip(cell_blocks.par_iter().zip(cell_buildings.par_iter()))
+                .map(|(&c, (blocks, buildings))| {
+                    r.whole_cell(
+                        c,
+                        &CellItems {
+                            blocks: blocks.iter().filter_map(|&i| inp.blocks.get(i)).collect(),
+                            buildings: buildings
+                                .iter()
+                                .filter_map(|&i| {
+                                    let b = inp.buildings.get(i)?;
+                                    Some((b, inp.dresses.get(i).and_then(Option::as_ref)))
+                                })
+                                .collect(),
+                        },
+                    )
+                })
+                .collect(),
+            None => vec![None; cell_ids.len()],
+        };
+        // The leaves of the cells not handed back whole, made in parallel: by index, `None`
+        // for the others.
+        let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
+            let mut made = vec![false; len];
+            for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
+                for &i in list {
+                    if let Some(m) = made.get_mut(i) {
+                        *m = true;
+                    }
+                }
+            }
+            made
+        };
+        let buildings_job = || -> Vec<Option<BuildingMade>> {
+            let made = todo(&cell_buildings, inp.buildings.len());
+            made.par_iter()
+                .enumerate()
+                .map(|(i, &m)| m.then(|| make_building(i)))
+                .collect()
+        };
+        let blocks_job = || -> Vec<Option<BlockMade>> {
+            let made = todo(&cell_blocks, inp.blocks.len());
+            made.par_iter()
+                .enumerate()
+                .map(|(i, &m)| m.then(|| make_block(i)))
+                .collect()
+        };
+        // Each cell's subtree: taken whole from the earlier scene, or its node and leaves
+        // (blocks, then buildings with their coarse boxes under them).
+        let (water_and_ground, (mut blocks, mut buildings)) =
+            par::join(water_and_ground, || par::join(blocks_job, buildings_job));
+        let water_and_ground = water_and_ground?;
+        // Room for every cell's nodes and meshes, made once.
+        let (mut more_nodes, mut more_meshes) = (0, 0);
+        for (k, w) in whole.iter().enumerate() {
+            if let Some((nodes, meshes)) = w {
+                more_nodes += nodes;
+                more_meshes += meshes;
+                continue;
+            }
+            more_nodes += 1;
+            for i in cell_blocks.get(k).into_iter().flatten() {
+                if let Some(Some(Ok(Some((_, meshes))))) = blocks.get(*i) {
+                    more_nodes += 1;
+                    more_meshes += meshes.len();
+                }
+            }
+            for i in cell_buildings.get(k).into_iter().flatten() {
+                if let Some(Some(Ok((_, meshes, boxed)))) = buildings.get(*i) {
+                    let boxed = usize::from(boxed.is_some());
+                    more_nodes += 1 + boxed;
+                    more_meshes += meshes.len() + boxed;
+                }
+            }
+        }
+        // With room for the layers added after the cells: the terrain's tiles, the roads,
+        // bridges, portals and water (a few nodes and meshes each).
+        let tiles = water_and_ground.1.as_ref().map_or(0, |g| g.tiles.len());
+        scene.nodes.reserve(more_nodes + tiles + LAYER_ROOM);
+        scene.meshes.reserve(more_meshes + tiles + LAYER_ROOM);
+        for (k, &c) in cell_ids.iter().enumerate() {
+            if whole.get(k).copied().flatten().is_some()
+                && let Some(r) = inp.reuse
+                && r.take_cell(c, scene, root)?
+            {
+                continue;
+            }
+            let node = scene.add_node(root, format!("cell {c}"))?;
+            scene.set_metadata(node, "cell", c as f64)?;
+            for &i in cell_blocks.get(k).map(Vec::as_slice).unwrap_or_default() {
+                let made = match blocks.get_mut(i).and_then(Option::take) {
+                    Some(made) => made,
+                    None => make_block(i),
+                }?;
+                if let Some((leaf, meshes)) = made {
+                    push_leaf(scene, node, leaf, meshes)?;
+                }
+            }
+            for &i in cell_buildings.get(k).map(Vec::as_slice).unwrap_or_default() {
+                let (leaf, meshes, boxed) = match buildings.get_mut(i).and_then(Option::take) {
+                    Some(made) => made,
+                    None => make_building(i),
+                }?;
+                let leaf = push_leaf(scene, node, leaf, meshes)?;
+                // Coarse level of detail: the footprint extruded to the building's height,
+                // a child `lod 0` of the building node, whose own meshes become the finest
+                // level. A footprint that cannot be extruded keeps its one level, drawn at
+                // every distance.
+                if let Some(mesh) = boxed {
+                    scene.set_metadata(leaf, "lod", fine as f64)?;
+                    let child = scene.add_node(leaf, "lod 0")?;
+                    scene.set_metadata(child, "lod", 0.0)?;
+                    let mesh = scene.add_mesh(mesh);
+                    scene.attach_mesh(child, mesh)?;
+                }
+            }
+        }
+        Ok(water_and_ground)
+    };
+    let (road_layer, made) = par::join(
+        || RoadLayer::new(inp.config, inp.network, elevation, inp.water),
+        || cells_job(&mut scene),
     );
-    let (water, terrain) = water_and_ground?;
+    let RoadLayer {
+        bridges,
+        surfaces,
+        portals,
+    } = road_layer?;
+    let (water, terrain) = made?;
+    let cells = scene.node(root)?.children.len();
     if let Some(terrain) = terrain {
         add_ground(&mut scene, root, terrain)?;
     }
-    if let Some(parts) = road? {
+    if let Some(parts) = surfaces {
         // Ribbons by class with their markings, junction plates apart (Kelly §5.4).
         let node = scene.add_node(root, "roads")?;
         scene.set_metadata(node, "layer", MetaValue::from_static("roads"))?;
@@ -962,7 +1084,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         }
     }
     // Tunnels: a concrete frame at each portal (the road surface stops there).
-    if let Some(mut mesh) = polis_roads::portal_mesh(inp.network, elevation)? {
+    if let Some(mut mesh) = portals {
         let concrete = Material::new("tunnel portal", [0.55, 0.54, 0.52, 1.0]);
         mesh.material = Some(scene.add_material(concrete));
         let node = scene.add_node(root, "tunnel portals")?;
@@ -984,74 +1106,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         scene.attach_mesh(node, mesh)?;
     }
 
-    // Each cell's subtree: taken whole from the earlier scene, or its node and leaves
-    // (blocks, then buildings with their coarse boxes under them).
-    let mut blocks = blocks;
-    let mut buildings = buildings;
-    // Room for every cell's nodes and meshes, made once.
-    let (mut more_nodes, mut more_meshes) = (0, 0);
-    for (k, w) in whole.iter().enumerate() {
-        if let Some((nodes, meshes)) = w {
-            more_nodes += nodes;
-            more_meshes += meshes;
-            continue;
-        }
-        more_nodes += 1;
-        for i in cell_blocks.get(k).into_iter().flatten() {
-            if let Some(Some(Ok(Some((_, meshes))))) = blocks.get(*i) {
-                more_nodes += 1;
-                more_meshes += meshes.len();
-            }
-        }
-        for i in cell_buildings.get(k).into_iter().flatten() {
-            if let Some(Some(Ok((_, meshes, boxed)))) = buildings.get(*i) {
-                let boxed = usize::from(boxed.is_some());
-                more_nodes += 1 + boxed;
-                more_meshes += meshes.len() + boxed;
-            }
-        }
-    }
-    scene.nodes.reserve(more_nodes);
-    scene.meshes.reserve(more_meshes);
-    for (k, &c) in cell_ids.iter().enumerate() {
-        if whole.get(k).copied().flatten().is_some()
-            && let Some(r) = inp.reuse
-            && r.take_cell(c, &mut scene, root)?
-        {
-            continue;
-        }
-        let node = scene.add_node(root, format!("cell {c}"))?;
-        scene.set_metadata(node, "cell", c as f64)?;
-        for &i in cell_blocks.get(k).map(Vec::as_slice).unwrap_or_default() {
-            let made = match blocks.get_mut(i).and_then(Option::take) {
-                Some(made) => made,
-                None => make_block(i),
-            }?;
-            if let Some((leaf, meshes)) = made {
-                push_leaf(&mut scene, node, leaf, meshes)?;
-            }
-        }
-        for &i in cell_buildings.get(k).map(Vec::as_slice).unwrap_or_default() {
-            let (leaf, meshes, boxed) = match buildings.get_mut(i).and_then(Option::take) {
-                Some(made) => made,
-                None => make_building(i),
-            }?;
-            let leaf = push_leaf(&mut scene, node, leaf, meshes)?;
-            // Coarse level of detail: the footprint extruded to the building's height,
-            // a child `lod 0` of the building node, whose own meshes become the finest
-            // level. A footprint that cannot be extruded keeps its one level, drawn at
-            // every distance.
-            if let Some(mesh) = boxed {
-                scene.set_metadata(leaf, "lod", fine as f64)?;
-                let child = scene.add_node(leaf, "lod 0")?;
-                scene.set_metadata(child, "lod", 0.0)?;
-                let mesh = scene.add_mesh(mesh);
-                scene.attach_mesh(child, mesh)?;
-            }
-        }
-    }
+    // The layers before the cells among the root's children.
+    scene.node_mut(root)?.children.rotate_left(cells);
     Ok(scene)
 }
+
+/// Room for the nodes (and meshes) of the layers added after the cells besides the
+/// terrain's tiles: the roads (a mesh per class and marking), bridges, portals, water.
+const LAYER_ROOM: usize = 64;
 
 /// A building's leaf as made: its node's parts, its meshes and its coarse box.
 type BuildingMade = Result<(LeafNode, Vec<Mesh>, Option<Mesh>)>;

@@ -87,7 +87,8 @@
 //!   memo and copies them out (a cell whose inputs are unchanged then takes its
 //!   buildings and skins whole, in one look-up), meshes the road surfaces again (a memo
 //!   of their pieces was measured to save nothing: their cost is the plan of the whole
-//!   network and the pass that writes its meshes, not the pieces), assembles
+//!   network and the pass that writes its meshes, not the pieces; they are made beside the
+//!   scene's cells, off the critical path where the cells take longer), assembles
 //!   the scene again (a cell left alone moves its subtree's runs of nodes and meshes
 //!   out of the old scene, without a look-up per leaf, but every node and mesh of the
 //!   city is still moved into the new scene's arrays; the terrain is
