@@ -151,6 +151,12 @@ impl Metadata {
     ) -> Option<MetaValue> {
         let key = key.into();
         let value = value.into();
+        // Entries written in key order (a node's metadata usually is) are appended
+        // without a search or a shift.
+        if self.entries.last().is_none_or(|(last, _)| **last < *key) {
+            self.entries.push((key, value));
+            return None;
+        }
         match self.find(&key) {
             Ok(i) => self
                 .entries

@@ -38,6 +38,7 @@ use glam::DVec2;
 
 use super::Field;
 use crate::lines::innermost_ring_containing;
+use crate::par::prelude::*;
 use crate::polygon::ring_signed_area;
 use crate::{Aabb2, GeomError, Polygon, PolygonWithHoles};
 
@@ -137,12 +138,21 @@ impl Grid {
         let (w, h) = (xs.len(), ys.len());
         let below = threshold - 1.0;
         let mut values = vec![below; w * h];
-        for j in 1..h - 1 {
-            for i in 1..w - 1 {
-                let v = field.sample(DVec2::new(xs[i], ys[j]));
-                values[j * w + i] = if v.is_finite() { v } else { below };
+        // The inner rows on the thread pool, one row a job (a few hundred samples of a
+        // noise field each): every value is its point's sample, whatever the order.
+        let mut rows: Vec<(usize, &mut [f64])> = values
+            .chunks_mut(w)
+            .enumerate()
+            .skip(1)
+            .take(h.saturating_sub(2))
+            .collect();
+        rows.par_iter_mut().for_each(|(j, row)| {
+            let y = ys[*j];
+            for (i, out) in row.iter_mut().enumerate().take(w - 1).skip(1) {
+                let v = field.sample(DVec2::new(xs[i], y));
+                *out = if v.is_finite() { v } else { below };
             }
-        }
+        });
         Grid {
             w,
             h,
