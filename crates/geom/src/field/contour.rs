@@ -4,8 +4,10 @@
 //! polygons with holes:
 //!
 //! 1. **Sampling.** The field is sampled on a regular grid of `cell_m` squares over the
-//!    box (at most [`MAX_CONTOUR_CELLS`] per side). Outside the box counts as below the
-//!    threshold, so a region that reaches the border is closed along it.
+//!    box (at most [`MAX_CONTOUR_CELLS`] per side), row by row on the thread pool with
+//!    the feature `parallel` (each value is its own point's sample, so the grid does not
+//!    depend on the thread count). Outside the box counts as below the threshold, so a
+//!    region that reaches the border is closed along it.
 //! 2. **Marching squares.** In each cell the outline crosses every edge whose ends lie on
 //!    both sides of the threshold, at the linearly interpolated point (computed once per
 //!    edge, so neighbouring cells share it bit for bit). Segments are directed with the
