@@ -50,6 +50,7 @@ pub use edits::{
 };
 pub use kelly::{InlinePrimary, PATH_TOLERANCE_M};
 pub use traits::{LotPlan, block_ids, district_at, hint_kind, lot_params_of, lot_plan};
+pub(crate) use traits::{district_boxes, lot_plan_in};
 pub use zones::{MIN_ZONE_SAMPLES, ZoneLevel, ZoneMap, ZoneRule, Zoning};
 
 /// How the city's roads are made.

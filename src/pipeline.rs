@@ -641,8 +641,13 @@ impl Pipeline {
         // Buildings, lot by lot in parallel, but for the cells whose buildings and skins
         // the memo of whole cells holds for their inputs.
         let lod = cx.config.effective_lod();
-        let lot_ids: std::collections::BTreeSet<u64> = out.lots.iter().map(|l| l.id).collect();
         let overrides = &cx.config.citygen.lots;
+        // The lots' ids are read only to match overrides (none: no set to build).
+        let lot_ids: std::collections::BTreeSet<u64> = if overrides.is_empty() {
+            std::collections::BTreeSet::new()
+        } else {
+            out.lots.iter().map(|l| l.id).collect()
+        };
         let gone: Vec<bool> = match cell_memo {
             Some(_) => overrides
                 .iter()
@@ -671,6 +676,8 @@ impl Pipeline {
         // Per lot to build: the id its building was drawn under (none for a lot left
         // empty) and the building with its pinned style.
         type Built = (Option<u64>, Result<Option<(Arc<Building>, Option<String>)>>);
+        // Each district's box once, not once per lot looked up in it.
+        let district_boxes = crate::citygen::district_boxes(districts);
         let built: Vec<Built> = todo
             .par_iter()
             .map(|&i| {
@@ -678,7 +685,9 @@ impl Pipeline {
                     return (None, Ok(None));
                 };
                 // Zoning, the cell's traits, the height map and the lot's overrides.
-                let Some(plan) = crate::citygen::lot_plan(cx, districts, l, &lot_ids) else {
+                let Some(plan) =
+                    crate::citygen::lot_plan_in(cx, districts, &district_boxes, l, &lot_ids)
+                else {
                     ticker.tick();
                     return (None, Ok(None));
                 };

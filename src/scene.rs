@@ -621,26 +621,27 @@ fn building_leaf(
         .and_then(|d| cx.tile_sets.get(d.style))
         .map_or("", |t| t.style.as_str());
     // Room for every entry (up to `style` and `cell`), the ids' text moved in: one
-    // allocation for the entries and one per id.
+    // allocation for the entries and one per id. Written in key order, so each entry is
+    // appended (no search, no shift).
     let mut metadata = Metadata::with_capacity(11);
+    if let Some(cell) = cell {
+        metadata.insert("cell", MetaValue::from(cell as f64));
+    }
     metadata.extend([
-        ("layer", MetaValue::from_static("buildings")),
+        ("floors", MetaValue::from(f64::from(b.floors))),
+        ("height", MetaValue::from(b.height)),
         // The id as text (exact in JavaScript above 2^53) and as a number.
         ("id", MetaValue::from(b.id.to_string())),
         ("id_number", MetaValue::from(b.id as f64)),
         ("kind", MetaValue::from_static(kind_class(b.kind))),
-        ("type", MetaValue::from_static(b.kind.name())),
-        ("height", MetaValue::from(b.height)),
-        ("floors", MetaValue::from(f64::from(b.floors))),
+        ("layer", MetaValue::from_static("buildings")),
         ("lot", MetaValue::from(b.lot_id as f64)),
         ("lot_id", MetaValue::from(b.lot_id.to_string())),
     ]);
     if !style.is_empty() {
         metadata.insert("style", MetaValue::from(style));
     }
-    if let Some(cell) = cell {
-        metadata.insert("cell", MetaValue::from(cell as f64));
-    }
+    metadata.insert("type", MetaValue::from_static(b.kind.name()));
     let node = LeafNode {
         name: building_node_name(b.id),
         translation: to_world(b.origin, base),
@@ -809,10 +810,11 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         let node = LeafNode {
             name: block_node_name(block.id()),
             translation: DVec3::ZERO,
+            // In key order: each entry appended.
             metadata: Metadata::from([
-                ("layer", MetaValue::from_static("blocks")),
-                ("id", MetaValue::from(block.id().to_string().as_str())),
                 ("cell", MetaValue::from(block.cell_id as f64)),
+                ("id", MetaValue::from(block.id().to_string().as_str())),
+                ("layer", MetaValue::from_static("blocks")),
             ]),
         };
         Ok(Some((node, vec![plinth])))

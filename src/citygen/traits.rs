@@ -8,7 +8,7 @@ use std::collections::BTreeSet;
 use polis_buildings::BuildingKind;
 use polis_cells::{Cell, CellDecomposition};
 use polis_geom::hash::splitmix64;
-use polis_geom::{DVec2, Field};
+use polis_geom::{Aabb2, DVec2, Field};
 use polis_roads::secondary::BuildingHint;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
@@ -50,6 +50,30 @@ pub fn district_at(districts: &[District], p: DVec2) -> Option<&District> {
     districts
         .iter()
         .find(|d| d.region.outer.bbox().contains(p) && d.region.contains(p))
+}
+
+/// The bounding box of each district's outer ring, in order: for
+/// [`district_in_boxes`], when many points are looked up in the same districts.
+pub(crate) fn district_boxes(districts: &[District]) -> Vec<Aabb2> {
+    districts.iter().map(|d| d.region.outer.bbox()).collect()
+}
+
+/// [`district_at`] with the districts' boxes made once ([`district_boxes`]): the same
+/// district (the first in order whose box and region hold `p`). Without a box for every
+/// district (`boxes` not made from `districts`), [`district_at`].
+pub(crate) fn district_in_boxes<'d>(
+    districts: &'d [District],
+    boxes: &[Aabb2],
+    p: DVec2,
+) -> Option<&'d District> {
+    if boxes.len() != districts.len() {
+        return district_at(districts, p);
+    }
+    districts
+        .iter()
+        .zip(boxes)
+        .find(|(d, b)| b.contains(p) && d.region.contains(p))
+        .map(|(d, _)| d)
 }
 
 /// A point inside the road-graph cell: its ring's centroid if inside, else the centroid
@@ -130,11 +154,23 @@ pub fn lot_plan(
     l: &CityLot,
     lot_ids: &BTreeSet<u64>,
 ) -> Option<LotPlan> {
+    lot_plan_in(cx, districts, &[], l, lot_ids)
+}
+
+/// [`lot_plan`] with the districts' boxes made once ([`district_boxes`]; none: made as
+/// needed), for the lots of a whole city. The same plan.
+pub(crate) fn lot_plan_in(
+    cx: &StageContext<'_>,
+    districts: &[District],
+    boxes: &[Aabb2],
+    l: &CityLot,
+    lot_ids: &BTreeSet<u64>,
+) -> Option<LotPlan> {
     let config = cx.config;
     let maps = cx.maps;
     let c = l.lot.polygon.centroid();
     let (mut kind, mut max_height_m) = config.zoning.zone(maps.inputs.population.sample(c));
-    if let Some(d) = district_at(districts, c).filter(|d| d.traits_apply) {
+    if let Some(d) = district_in_boxes(districts, boxes, c).filter(|d| d.traits_apply) {
         kind = hint_kind(d.traits.building_hint);
         let mut rng = Pcg64Mcg::seed_from_u64(cx.seed(Stage::Buildings, l.id) ^ 0x4845_4947);
         let h = d.traits.building_height_m.sample(&mut rng);

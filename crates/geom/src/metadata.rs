@@ -4,7 +4,9 @@
 //! A city has one node per building and each carries a handful of entries, so the map is
 //! a sorted vector rather than a tree, and keys and text values written as `&'static str`
 //! literals ([`MetaValue::from_static`], [`Metadata::insert`] with a literal key) are
-//! borrowed, not copied: a building's four entries cost one allocation.
+//! borrowed, not copied: a building's four entries cost one allocation. Entries inserted
+//! in key order are appended without a search (writers that know their keys insert them
+//! so).
 //!
 //! ```
 //! use polis_geom::metadata::{MetaValue, Metadata};
@@ -151,6 +153,12 @@ impl Metadata {
     ) -> Option<MetaValue> {
         let key = key.into();
         let value = value.into();
+        // Entries written in key order (a node's metadata usually is) are appended
+        // without a search or a shift.
+        if self.entries.last().is_none_or(|(last, _)| **last < *key) {
+            self.entries.push((key, value));
+            return None;
+        }
         match self.find(&key) {
             Ok(i) => self
                 .entries

@@ -4,8 +4,10 @@
 //! polygons with holes:
 //!
 //! 1. **Sampling.** The field is sampled on a regular grid of `cell_m` squares over the
-//!    box (at most [`MAX_CONTOUR_CELLS`] per side). Outside the box counts as below the
-//!    threshold, so a region that reaches the border is closed along it.
+//!    box (at most [`MAX_CONTOUR_CELLS`] per side), row by row on the thread pool with
+//!    the feature `parallel` (each value is its own point's sample, so the grid does not
+//!    depend on the thread count). Outside the box counts as below the threshold, so a
+//!    region that reaches the border is closed along it.
 //! 2. **Marching squares.** In each cell the outline crosses every edge whose ends lie on
 //!    both sides of the threshold, at the linearly interpolated point (computed once per
 //!    edge, so neighbouring cells share it bit for bit). Segments are directed with the
@@ -38,6 +40,7 @@ use glam::DVec2;
 
 use super::Field;
 use crate::lines::innermost_ring_containing;
+use crate::par::prelude::*;
 use crate::polygon::ring_signed_area;
 use crate::{Aabb2, GeomError, Polygon, PolygonWithHoles};
 
@@ -137,12 +140,21 @@ impl Grid {
         let (w, h) = (xs.len(), ys.len());
         let below = threshold - 1.0;
         let mut values = vec![below; w * h];
-        for j in 1..h - 1 {
-            for i in 1..w - 1 {
-                let v = field.sample(DVec2::new(xs[i], ys[j]));
-                values[j * w + i] = if v.is_finite() { v } else { below };
+        // The inner rows on the thread pool, one row a job (a few hundred samples of a
+        // noise field each): every value is its point's sample, whatever the order.
+        let mut rows: Vec<(usize, &mut [f64])> = values
+            .chunks_mut(w)
+            .enumerate()
+            .skip(1)
+            .take(h.saturating_sub(2))
+            .collect();
+        rows.par_iter_mut().for_each(|(j, row)| {
+            let y = ys[*j];
+            for (i, out) in row.iter_mut().enumerate().take(w - 1).skip(1) {
+                let v = field.sample(DVec2::new(xs[i], y));
+                *out = if v.is_finite() { v } else { below };
             }
-        }
+        });
         Grid {
             w,
             h,
