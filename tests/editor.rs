@@ -987,3 +987,53 @@ fn events_of_a_height_edit_equal_a_full_comparison() {
     check_lot_and_block_events(&items_before, ed.city(), &ev);
     assert_same_as_generate(&ed);
 }
+
+/// Global facade style and level-of-detail edits run the pipeline and keep every lot
+/// and building id (roads and lots are kept), so every cell's items pair off by id,
+/// while buildings' skins or meshes change: every change event equals a full comparison
+/// of the two cities (a cell is left out of the comparison only where its items are
+/// also unchanged, not merely of the same ids).
+#[test]
+fn events_of_edits_that_keep_ids_but_change_buildings_equal_a_full_comparison() {
+    use polis::buildings::BuildingKind;
+    let mut ed = CityEditor::new(small()).unwrap();
+    let count = |k: BuildingKind| ed.city().buildings.iter().filter(|b| b.kind == k).count();
+    let kind = BuildingKind::ALL
+        .into_iter()
+        .max_by_key(|&k| count(k))
+        .expect("kinds");
+    let current = ed.config().facades.style_of.get(kind).to_string();
+    let style = polis::facades::builtin::builtin_styles()
+        .into_iter()
+        .map(|s| s.name)
+        .find(|n| *n != current)
+        .expect("a second built-in style");
+    let edits = [
+        Edit::SetFacadeStyle { kind, style },
+        Edit::SetLod { lod: Some(0) },
+    ];
+    for edit in edits {
+        let ids = |c: &City| -> [Vec<u64>; 2] {
+            [
+                c.lots.iter().map(|l| l.id).collect(),
+                c.buildings.iter().map(|b| b.id).collect(),
+            ]
+        };
+        let (buildings, items_before) = (building_texts(ed.city()), items(ed.city()));
+        let ids_before = ids(ed.city());
+        let ev = ed.apply(edit.clone()).unwrap();
+        assert_eq!(
+            ids(ed.city()),
+            ids_before,
+            "{edit:?} keeps the ids in order"
+        );
+        assert!(
+            !ev.buildings.changed.is_empty(),
+            "{edit:?}: {:?}",
+            ev.buildings
+        );
+        check_building_events(&buildings, ed.city(), &ev);
+        check_lot_and_block_events(&items_before, ed.city(), &ev);
+        assert_same_as_generate(&ed);
+    }
+}
