@@ -61,7 +61,7 @@
 //!   exactly at its ends and their edges, which stay that far from it; see
 //!   `insert_uncontested`) is added after two box queries, without the walk, with the
 //!   walk's result (ids included; property-tested against the walk alone). Most streets
-//!   inserted into a city's union graph are (88 % on the `citygen` preset).
+//!   inserted into a city's union graph are (at least 88 % on the `citygen` preset).
 
 use glam::DVec2;
 
