@@ -57,6 +57,11 @@
 //! * Cost per segment: a handful of index queries plus one per crossing; nodes within the
 //!   snap distance of a long segment are found through its bounding box. A caller that
 //!   knows the start node passes it in [`InsertHints`] to save the first end's search.
+//!   An *uncontested* segment (nothing within twice the snap distance of it but nodes
+//!   exactly at its ends and their edges, which stay that far from it; see
+//!   `insert_uncontested`) is added after two box queries, without the walk, with the
+//!   walk's result (ids included; property-tested against the walk alone). Most streets
+//!   inserted into a city's union graph are (at least 88 % on the `citygen` preset).
 
 use glam::DVec2;
 
@@ -252,14 +257,34 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         hints: &InsertHints,
         make_node: impl FnMut(DVec2) -> N,
     ) -> Result<Insertion, GeomError> {
+        self.insert_segment_marked(p, q, payload, options, hints, true, make_node)
+    }
+
+    /// [`insert_segment_unmarked`](Self::insert_segment_unmarked) with the bookkeeping of
+    /// [`is_planar_by_construction`](Self::is_planar_by_construction). The tests call it
+    /// without the fast path (`fast: false`, the walk alone) to show that the fast path
+    /// changes nothing.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn insert_segment_marked(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: E,
+        options: &SnapOptions,
+        hints: &InsertHints,
+        fast: bool,
+        make_node: impl FnMut(DVec2) -> N,
+    ) -> Result<Insertion, GeomError> {
         let planar = self.planar_by_construction;
-        let result = self.insert_segment_unmarked(p, q, payload, options, hints, make_node);
+        let result = self.insert_segment_unmarked(p, q, payload, options, hints, fast, make_node);
         self.planar_by_construction = planar && keeps_planarity(&result);
         result
     }
 
     /// [`insert_segment_with`](Self::insert_segment_with) without the bookkeeping of
-    /// [`is_planar_by_construction`](Self::is_planar_by_construction).
+    /// [`is_planar_by_construction`](Self::is_planar_by_construction); `fast` tries
+    /// [`insert_uncontested`](Self::insert_uncontested) first.
+    #[allow(clippy::too_many_arguments)]
     fn insert_segment_unmarked(
         &mut self,
         p: DVec2,
@@ -267,6 +292,7 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         payload: E,
         options: &SnapOptions,
         hints: &InsertHints,
+        fast: bool,
         mut make_node: impl FnMut(DVec2) -> N,
     ) -> Result<Insertion, GeomError> {
         validate_point(0, p)?;
@@ -277,6 +303,9 @@ impl<N, E: Clone> PlanarGraph<N, E> {
         let snap = snap.max(ROUNDING_TOLERANCE * scale);
         // A node exactly at p is the nearest node to p (the only one there, in a graph
         // planar by construction): `anchor` would find it first.
+        if fast && let Some(out) = self.insert_uncontested(p, q, &payload, snap, &mut make_node)? {
+            return Ok(out);
+        }
         let ap = match hints.start {
             Some(n) if self.planar_by_construction && self.position(n).is_ok_and(|x| x == p) => {
                 Anchor::Node(n)
@@ -315,6 +344,114 @@ impl<N, E: Clone> PlanarGraph<N, E> {
             .chain(split.filter(|&x| self.contains_edge(x)));
         self.check_local(touched)?;
         Ok(out)
+    }
+
+    /// The insertion of `p–q` when nothing contests it, found with two box queries
+    /// instead of the walk's dozen; `None` (graph untouched) when that cannot be shown.
+    ///
+    /// Uncontested means: every node within `2 · snap` of the segment sits exactly at `p`
+    /// or `q`; every edge within that distance ends at such a node, and then its far end
+    /// and the segment's other end are each farther than `2 · snap` from the other
+    /// segment (so it neither overlaps the segment nor lies near its other end); the ends
+    /// are more than `2 · snap` apart and not already joined. The walk (`anchor`,
+    /// `realize`, `connect`) then anchors each end to the node exactly there or to a new
+    /// node (nothing else is within `snap` of it, not even within rounding), finds no
+    /// event on the way (no node or edge within `snap` of the line but those ending at
+    /// its ends, which meet it only there) and adds one edge: exactly what this does, in
+    /// the same order (new node at `p`, new node at `q`, the edge), so ids, positions
+    /// and payloads are the walk's. The factor 2 keeps the floating-point distances here
+    /// (a few ulps off) far from the walk's exact and rounded decisions at `snap`.
+    pub(crate) fn insert_uncontested(
+        &mut self,
+        p: DVec2,
+        q: DVec2,
+        payload: &E,
+        snap: f64,
+        make_node: &mut impl FnMut(DVec2) -> N,
+    ) -> Result<Option<Insertion>, GeomError> {
+        let r = 2.0 * snap;
+        if p.distance(q) <= r {
+            return Ok(None);
+        }
+        let bx = crate::Aabb2::new(p, q).expanded(r);
+        let near =
+            |x: DVec2, a: DVec2, b: DVec2| crate::predicates::distance_to_segment(x, a, b) <= r;
+        // The nodes at the ends, if any; any other node near the segment contests it.
+        let (mut at_p, mut at_q) = (None, None);
+        let mut contested = false;
+        self.node_index().for_each_candidate(&bx, |n, shape| {
+            let Shape::Point(x) = *shape else { return };
+            if contested {
+                return;
+            }
+            if x == p && at_p.is_none() {
+                at_p = Some(n);
+            } else if x == q && at_q.is_none() {
+                at_q = Some(n);
+            } else if near(x, p, q) {
+                contested = true;
+            }
+        });
+        if contested {
+            return Ok(None);
+        }
+        let ends = |e: EdgeId| self.endpoints(e).ok();
+        self.edge_index().for_each_candidate(&bx, |e, shape| {
+            let Shape::Segment(s0, s1) = *shape else {
+                return;
+            };
+            if contested {
+                return;
+            }
+            let Some((a, b)) = ends(e) else {
+                contested = true;
+                return;
+            };
+            let at = |x: Option<NodeId>| x.is_some_and(|x| x == a || x == b);
+            contested = match (at(at_p), at(at_q)) {
+                // Already joined: the walk would reuse the edge.
+                (true, true) => true,
+                // An edge at `p`: its far end away from the segment, `q` away from it.
+                (true, false) => {
+                    let far = if s0 == p { s1 } else { s0 };
+                    near(far, p, q) || near(q, s0, s1)
+                }
+                (false, true) => {
+                    let far = if s0 == q { s1 } else { s0 };
+                    near(far, p, q) || near(p, s0, s1)
+                }
+                // Any other edge: away from the segment (disjoint, and every end of
+                // either farther than `r` from the other, which for two disjoint
+                // segments is their distance).
+                (false, false) => {
+                    !matches!(
+                        crate::predicates::segment_intersection(p, q, s0, s1),
+                        SegmentIntersection::Disjoint
+                    ) || near(s0, p, q)
+                        || near(s1, p, q)
+                        || near(p, s0, s1)
+                        || near(q, s0, s1)
+                }
+            };
+        });
+        if contested {
+            return Ok(None);
+        }
+        let a = match at_p {
+            Some(n) => n,
+            None => self.add_node(p, make_node(p))?,
+        };
+        let b = match at_q {
+            Some(n) => n,
+            None => self.add_node(q, make_node(q))?,
+        };
+        let e = self.add_edge(a, b, payload.clone())?;
+        Ok(Some(Insertion {
+            nodes: vec![a, b],
+            path: vec![e],
+            created: vec![e],
+            split: Vec::new(),
+        }))
     }
 
     /// The node at `p` after snapping (to a node, else onto an edge, splitting it, else a

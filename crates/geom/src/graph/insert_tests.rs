@@ -613,14 +613,20 @@ fn hinted_matches_plain(
             hinted.is_planar_by_construction()
         );
     }
+    same_graphs(&plain, &hinted)
+}
+
+/// Whether `a` and `b` have the same nodes (ids, positions) and edges (ids, ends,
+/// payloads).
+fn same_graphs(a: &G, b: &G) -> Result<(), TestCaseError> {
     let nodes = |g: &G| g.nodes().map(|(n, p, _)| (n, p)).collect::<Vec<_>>();
     let edges = |g: &G| {
         g.edges()
             .map(|(e, a, b, &w)| (e, a, b, w))
             .collect::<Vec<_>>()
     };
-    prop_assert_eq!(nodes(&plain), nodes(&hinted));
-    prop_assert_eq!(edges(&plain), edges(&hinted));
+    prop_assert_eq!(nodes(a), nodes(b));
+    prop_assert_eq!(edges(a), edges(b));
     Ok(())
 }
 
@@ -644,5 +650,86 @@ proptest! {
         }
         hinted_matches_plain(&all, &EXACT, wrong)?;
         hinted_matches_plain(&all, &SnapOptions { snap_distance: 0.3 }, wrong)?;
+    }
+}
+
+/// Inserts `segs` into two graphs, one by `insert_segment` (which takes the uncontested
+/// fast path where it can) and one by the walk alone, and checks that every answer and
+/// the final graphs (ids, positions, ends, payloads, planarity flag) are the same.
+/// Returns how many insertions the fast path took.
+fn fast_path_matches_walk(
+    segs: &[(DVec2, DVec2)],
+    opts: &SnapOptions,
+) -> Result<usize, TestCaseError> {
+    let (mut fast, mut walked) = (G::new(), G::new());
+    let mut taken = 0;
+    for (i, &(p, q)) in segs.iter().enumerate() {
+        let w = i as u32;
+        let snap = opts
+            .snap_distance
+            .max(ROUNDING_TOLERANCE * p.abs().max(q.abs()).max_element().max(1.0));
+        if p.is_finite() && q.is_finite() {
+            let mut probe = walked.clone();
+            taken += usize::from(matches!(
+                probe.insert_uncontested(p, q, &w, snap, &mut |_| ()),
+                Ok(Some(_))
+            ));
+        }
+        let a = fast.insert_segment(p, q, w, opts);
+        let hints = InsertHints::default();
+        let b = walked.insert_segment_marked(p, q, w, opts, &hints, false, |_| ());
+        prop_assert_eq!(a, b);
+        prop_assert_eq!(
+            fast.is_planar_by_construction(),
+            walked.is_planar_by_construction()
+        );
+    }
+    same_graphs(&fast, &walked)?;
+    Ok(taken)
+}
+
+/// Chains of short steps from random starts (shared ends, T-junctions, near misses at
+/// every scale from the snap distance up), as a street network grows.
+fn chains(coord: f64, step: f64) -> impl Strategy<Value = Vec<(DVec2, DVec2)>> {
+    let start = (-coord..coord, -coord..coord).prop_map(|(x, y)| v(x, y));
+    let walk = prop::collection::vec((-step..step, -step..step), 1..12);
+    prop::collection::vec((start, walk), 1..6).prop_map(|runs| {
+        let mut segs = Vec::new();
+        for (mut at, steps) in runs {
+            for (dx, dy) in steps {
+                let next = at + v(dx, dy);
+                segs.push((at, next));
+                at = next;
+            }
+        }
+        segs
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The uncontested fast path changes the cost of an insertion, never its result:
+    /// integer grids full of overlaps and shared ends, random floats, and chains whose
+    /// steps come within the snap distance of earlier ones.
+    #[test]
+    fn fast_path_never_changes_the_result(
+        ints in prop::collection::vec(int_segment(), 1..20),
+        floats in prop::collection::vec(float_segment(), 1..20),
+        walks in chains(30.0, 8.0),
+        tight in chains(0.2, 0.05),
+    ) {
+        for snap in [0.0, 0.01, 0.3] {
+            let opts = SnapOptions { snap_distance: snap };
+            fast_path_matches_walk(&ints, &opts)?;
+            fast_path_matches_walk(&floats, &opts)?;
+            let taken = fast_path_matches_walk(&walks, &opts)?;
+            // A chain's first step into the empty graph is uncontested, at least.
+            prop_assert!(snap > 0.01 || taken > 0);
+            fast_path_matches_walk(&tight, &opts)?;
+            let mut both = walks.clone();
+            both.extend(tight.iter().map(|&(p, q)| (p * 40.0, q * 40.0)));
+            fast_path_matches_walk(&both, &opts)?;
+        }
     }
 }
