@@ -767,7 +767,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     // Building `i`'s node (name, placement, metadata) and meshes, and its coarse box
     // when the scene has coarse levels (`None` also where the footprint cannot be
     // extruded).
-    let make_building = |i: usize| -> Result<(LeafNode, Vec<Mesh>, Option<Mesh>)> {
+    let make_building = |i: usize| -> BuildingMade {
         let Some(b) = inp.buildings.get(i) else {
             return Ok(Default::default());
         };
@@ -789,7 +789,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
     };
     // Block `i`'s node and kerb-high plinth (none without a kerb).
     let kerb = inp.config.scene.kerb_height_m;
-    let make_block = |i: usize| -> Result<Option<(LeafNode, Vec<Mesh>)>> {
+    let make_block = |i: usize| -> BlockMade {
         let Some(block) = inp.blocks.get(i).filter(|_| kerb > 0.0) else {
             return Ok(None);
         };
@@ -949,7 +949,7 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
         };
         // The leaves of the cells not handed back whole, made in parallel: by index, `None`
         // for the others.
-        let todo = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
+        let made_where = |lists: &[Vec<usize>], len: usize| -> Vec<bool> {
             let mut made = vec![false; len];
             for (list, _) in lists.iter().zip(&whole).filter(|(_, w)| w.is_none()) {
                 for &i in list {
@@ -960,20 +960,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
             }
             made
         };
-        let buildings_job = || -> Vec<Option<BuildingMade>> {
-            let made = todo(&cell_buildings, inp.buildings.len());
-            made.par_iter()
-                .enumerate()
-                .map(|(i, &m)| m.then(|| make_building(i)))
-                .collect()
+        let buildings_job = || {
+            made_in_parallel(
+                &made_where(&cell_buildings, inp.buildings.len()),
+                make_building,
+            )
         };
-        let blocks_job = || -> Vec<Option<BlockMade>> {
-            let made = todo(&cell_blocks, inp.blocks.len());
-            made.par_iter()
-                .enumerate()
-                .map(|(i, &m)| m.then(|| make_block(i)))
-                .collect()
-        };
+        let blocks_job =
+            || made_in_parallel(&made_where(&cell_blocks, inp.blocks.len()), make_block);
         // Each cell's subtree: taken whole from the earlier scene, or its node and leaves
         // (blocks, then buildings with their coarse boxes under them).
         let (water_and_ground, (mut blocks, mut buildings)) =
@@ -1116,6 +1110,14 @@ pub(crate) fn assemble(inp: &SceneInputs<'_>) -> Result<Scene> {
 /// Room for the nodes (and meshes) of the layers added after the cells besides the
 /// terrain's tiles: the roads (a mesh per class and marking), bridges, portals, water.
 const LAYER_ROOM: usize = 64;
+
+/// `make(i)` for every `i` where `made[i]`, in parallel; `None` for the others.
+fn made_in_parallel<T: Send>(made: &[bool], make: impl Fn(usize) -> T + Sync) -> Vec<Option<T>> {
+    made.par_iter()
+        .enumerate()
+        .map(|(i, &m)| m.then(|| make(i)))
+        .collect()
+}
 
 /// A building's leaf as made: its node's parts, its meshes and its coarse box.
 type BuildingMade = Result<(LeafNode, Vec<Mesh>, Option<Mesh>)>;
